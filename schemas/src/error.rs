@@ -1,0 +1,140 @@
+//! The one error type of the crate.
+//!
+//! Every variant names the file (`file`: a path, or the label given to
+//! [`crate::read_recording_bytes`]) and, where relevant, the topic, message index and field, so a
+//! message printed by `sim` or `analyze` says exactly which recording and which channel went wrong.
+//! Malformed input is always an `Err`, never a panic.
+
+/// Errors from writing or reading a recording.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// An operating-system I/O error (create, write, fsync, rename, read).
+    #[error("{file}: {op}: {source}")]
+    Io {
+        file: String,
+        op: &'static str,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// The path handed to [`crate::RecordingWriter::create`] has no file name.
+    #[error("{file}: not a file path")]
+    NotAFilePath { file: String },
+
+    /// The `mcap` library refused to write.
+    #[error("{file}: writing MCAP: {source}")]
+    McapWrite {
+        file: String,
+        #[source]
+        source: mcap::McapError,
+    },
+
+    /// One topic may carry only one message type.
+    #[error("{file}: topic {topic} was first written with {first}, now with {now}")]
+    TopicTypeMismatch {
+        file: String,
+        topic: String,
+        first: String,
+        now: String,
+    },
+
+    /// A message could not be encoded (cannot happen for the crate's own types).
+    #[error("{file}: topic {topic}: encoding a {schema} message failed: {detail}")]
+    Encode {
+        file: String,
+        topic: String,
+        schema: String,
+        detail: String,
+    },
+
+    /// Metadata given by the caller contradicts what the writer stores itself.
+    #[error("{file}: metadata {record}.{key}: {detail}")]
+    BadMetadata {
+        file: String,
+        record: String,
+        key: String,
+        detail: String,
+    },
+
+    /// The bytes do not start with the MCAP magic (empty file, wrong format).
+    #[error("{file}: not an MCAP file ({len} bytes, no MCAP magic at the start)")]
+    NotMcap { file: String, len: usize },
+
+    /// The `mcap` library could not parse the file (truncation, bad CRC, bad record).
+    #[error("{file}: unreadable MCAP: {source}")]
+    McapRead {
+        file: String,
+        #[source]
+        source: mcap::McapError,
+    },
+
+    /// Records parsed but the file ends before its footer.
+    #[error("{file}: truncated MCAP: the file ends before its footer")]
+    Truncated { file: String },
+
+    /// Records are individually valid but inconsistent with each other.
+    #[error("{file}: malformed MCAP: {detail}")]
+    Malformed { file: String, detail: String },
+
+    /// The schema of a channel cannot be used to decode it (bad descriptor set, bad .msg text).
+    #[error("{file}: topic {topic}: schema {schema} ({encoding}) unusable: {detail}")]
+    BadSchema {
+        file: String,
+        topic: String,
+        schema: String,
+        encoding: String,
+        detail: String,
+    },
+
+    /// One message does not decode with its channel's schema.
+    #[error(
+        "{file}: topic {topic}: message #{index} (log_time {log_time_ns} ns, {encoding}): {detail}"
+    )]
+    Decode {
+        file: String,
+        topic: String,
+        index: usize,
+        log_time_ns: u64,
+        encoding: String,
+        detail: String,
+    },
+
+    /// [`crate::Recording::series`] was asked for a topic the file does not have.
+    #[error("{file}: no topic {topic} (topics: {available:?})")]
+    UnknownTopic {
+        file: String,
+        topic: String,
+        available: Vec<String>,
+    },
+
+    /// The topic exists but its encoding is not one the generic reader decodes.
+    #[error("{file}: topic {topic} was not decoded: {reason}")]
+    UndecodedTopic {
+        file: String,
+        topic: String,
+        reason: String,
+    },
+
+    /// A message of the topic lacks the requested field.
+    #[error(
+        "{file}: topic {topic}: message #{index} (log_time {log_time_ns} ns) has no field {field}"
+    )]
+    MissingField {
+        file: String,
+        topic: String,
+        field: String,
+        index: usize,
+        log_time_ns: u64,
+    },
+
+    /// The field exists but is neither a number nor a list of numbers.
+    #[error("{file}: topic {topic}: field {field} of message #{index} is not numeric: {found}")]
+    NotNumeric {
+        file: String,
+        topic: String,
+        field: String,
+        index: usize,
+        found: String,
+    },
+}

@@ -1,0 +1,339 @@
+//! Message types of a recording and the [`Message`] trait the writer takes.
+//!
+//! Our own signals are protobuf produced by `#[derive(foxglove::Encode)]`: the schema is a
+//! `FileDescriptorSet` generated from the struct (schema name `<lowercased struct>.<Struct>`,
+//! field numbers in declaration order, so **do not reorder fields** without bumping
+//! [`crate::FORMAT_VERSION`]). Every message starts with `time` (simulated s), and every array
+//! is indexed by actuated joint (0-based, URDF order of the revolute joints) or by constraint.
+//!
+//! Transforms and the hand point cloud use Foxglove's well-known protobuf schemas
+//! (<https://docs.foxglove.dev/docs/visualization/message-schemas/>), built here by
+//! [`frame_transform`] and [`hand_points`]. The two ROS 2 messages, [`RosString`] and
+//! [`JointState`], are hand-encoded as CDR in [`crate::cdr`].
+
+use foxglove::messages::{
+    packed_element_field::NumericType, FrameTransform, PackedElementField, PointCloud, Pose,
+    Quaternion, Timestamp, Vector3,
+};
+
+/// Anything that can be written to a channel.
+pub trait Message {
+    /// MCAP schema name, e.g. `motorstate.MotorState` or `sensor_msgs/msg/JointState`.
+    fn schema_name() -> String;
+    /// MCAP schema encoding (`protobuf`, `ros2msg`).
+    fn schema_encoding() -> &'static str;
+    /// Schema bytes: a serialized `FileDescriptorSet`, or `.msg` text.
+    fn schema_data() -> Vec<u8>;
+    /// MCAP message encoding (`protobuf`, `cdr`).
+    fn message_encoding() -> &'static str;
+    /// Appends the encoded message to `buf` (does not clear it).
+    fn encode_into(&self, buf: &mut Vec<u8>);
+    /// Like [`Message::encode_into`] but reports an encoder failure instead of dropping it.
+    /// The writer calls this one; the default forwards to `encode_into`.
+    fn try_encode_into(&self, buf: &mut Vec<u8>) -> Result<(), String> {
+        self.encode_into(buf);
+        Ok(())
+    }
+}
+
+/// Electrical and mechanical state of every motor (topic [`crate::topics::MOTORS`]).
+/// Arrays have one entry per actuated joint.
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+pub struct MotorState {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Armature current i, A.
+    pub current: Vec<f64>,
+    /// Terminal voltage v, V.
+    pub voltage: Vec<f64>,
+    /// Back-EMF k_e·ω, V.
+    pub back_emf: Vec<f64>,
+    /// Electric power drawn, i·v, W.
+    pub electric_power: Vec<f64>,
+    /// Torque delivered to the link (after gearing and friction), N·m.
+    pub torque: Vec<f64>,
+}
+
+/// State of every constraint (topic [`crate::topics::CONSTRAINTS`]), one entry per constraint.
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+pub struct ConstraintState {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Normal (constraint) force, N.
+    pub normal_force: Vec<f64>,
+    /// Constraint value C(q), m.
+    pub position: Vec<f64>,
+    /// Constraint rate dC/dt, m/s.
+    pub velocity: Vec<f64>,
+}
+
+/// A 3-vector (m unless stated otherwise).
+#[derive(Debug, Clone, Copy, PartialEq, Default, foxglove::Encode)]
+pub struct Vec3 {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
+
+/// Hand position, world frame, m (topic [`crate::topics::HAND`]).
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+pub struct HandState {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Where the hand is.
+    pub actual: Vec3,
+    /// Where the trajectory wants it.
+    pub desired: Vec3,
+    /// `actual - desired`.
+    pub error: Vec3,
+    /// `|error|`, m.
+    pub error_norm: f64,
+}
+
+/// Energy bookkeeping, J, cumulative from t = 0 (topic [`crate::topics::ENERGY`]).
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+pub struct EnergyState {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Work done by each motor on its link, ∫ τ·ω dt (one per actuated joint).
+    pub link_work: Vec<f64>,
+    /// Electric energy drawn by each motor, ∫ i·v dt (one per actuated joint).
+    pub electric_energy: Vec<f64>,
+    /// Sum of `link_work`.
+    pub link_work_total: f64,
+    /// Sum of `electric_energy`.
+    pub electric_energy_total: f64,
+    /// Kinetic energy of the links (absolute, not cumulative).
+    pub kinetic: f64,
+    /// Gravitational potential energy (absolute).
+    pub potential: f64,
+    /// Magnetic energy ½ L i² of the windings (absolute).
+    pub magnetic: f64,
+    /// Cumulative resistive (R i²) loss.
+    pub resistive_loss: f64,
+    /// Cumulative friction loss.
+    pub friction_loss: f64,
+    /// Energy balance residual: input − stored − dissipated (should stay ≈ 0).
+    pub balance_residual: f64,
+}
+
+/// `std_msgs/msg/String` (ROS 2, CDR). Carries the URDF on [`crate::topics::ROBOT_DESCRIPTION`].
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct RosString {
+    pub data: String,
+}
+
+/// `sensor_msgs/msg/JointState` (ROS 2, CDR), for [`crate::topics::JOINT_STATES`].
+/// The header stamp is `stamp_ns` (ns since t = 0, normally equal to the log time).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointState {
+    /// Header stamp, ns (split into `sec`/`nanosec` on the wire; saturates at i32::MAX s).
+    pub stamp_ns: u64,
+    /// Header frame id (may be empty).
+    pub frame_id: String,
+    /// Joint names (URDF joint names).
+    pub name: Vec<String>,
+    /// rad.
+    pub position: Vec<f64>,
+    /// rad/s.
+    pub velocity: Vec<f64>,
+    /// N·m.
+    pub effort: Vec<f64>,
+}
+
+/// Encodes a protobuf [`foxglove::Encode`] message into a growable buffer.
+fn encode_protobuf<T: foxglove::Encode>(msg: &T, buf: &mut Vec<u8>) -> Result<(), String> {
+    if let Some(n) = msg.encoded_len() {
+        buf.reserve(n);
+    }
+    msg.encode(buf).map_err(|e| e.to_string())
+}
+
+fn protobuf_schema<T: foxglove::Encode>() -> Option<foxglove::Schema> {
+    T::get_schema()
+}
+
+/// Implements [`Message`] for protobuf types that implement [`foxglove::Encode`].
+macro_rules! protobuf_message {
+    ($($t:ty),* $(,)?) => {$(
+        impl Message for $t {
+            fn schema_name() -> String {
+                protobuf_schema::<$t>().map(|s| s.name).unwrap_or_default()
+            }
+            fn schema_encoding() -> &'static str {
+                "protobuf"
+            }
+            fn schema_data() -> Vec<u8> {
+                protobuf_schema::<$t>().map(|s| s.data.into_owned()).unwrap_or_default()
+            }
+            fn message_encoding() -> &'static str {
+                "protobuf"
+            }
+            fn encode_into(&self, buf: &mut Vec<u8>) {
+                // a Vec grows on demand, so the encoder has no failure mode here;
+                // the writer uses try_encode_into, which does report one
+                let _ = encode_protobuf(self, buf);
+            }
+            fn try_encode_into(&self, buf: &mut Vec<u8>) -> Result<(), String> {
+                encode_protobuf(self, buf)
+            }
+        }
+    )*};
+}
+
+protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState);
+
+// every Foxglove well-known schema, so `sim` can record any of them without touching this crate
+use foxglove::messages as fm;
+protobuf_message!(
+    fm::ArrowPrimitive,
+    fm::CameraCalibration,
+    fm::CircleAnnotation,
+    fm::Color,
+    fm::CompressedImage,
+    fm::CompressedPointCloud,
+    fm::CompressedVideo,
+    fm::CubePrimitive,
+    fm::CylinderPrimitive,
+    fm::FrameTransform,
+    fm::FrameTransforms,
+    fm::GeoJson,
+    fm::Grid,
+    fm::ImageAnnotations,
+    fm::JointState,
+    fm::JointStates,
+    fm::KeyValuePair,
+    fm::LaserScan,
+    fm::LinePrimitive,
+    fm::LocationFix,
+    fm::LocationFixes,
+    fm::Log,
+    fm::ModelPrimitive,
+    fm::Odometry,
+    fm::PackedElementField,
+    fm::Point2,
+    fm::Point3,
+    fm::Point3InFrame,
+    fm::PointCloud,
+    fm::PointsAnnotation,
+    fm::Pose,
+    fm::PoseInFrame,
+    fm::PosesInFrame,
+    fm::Quaternion,
+    fm::RawImage,
+    fm::SceneEntity,
+    fm::SceneEntityDeletion,
+    fm::SceneUpdate,
+    fm::SpherePrimitive,
+    fm::TextAnnotation,
+    fm::TextPrimitive,
+    fm::TriangleListPrimitive,
+    fm::Vector2,
+    fm::Vector3,
+    fm::VoxelGrid,
+);
+
+/// A Foxglove timestamp for `t_ns` nanoseconds since t = 0 (saturates past u32::MAX s).
+pub fn timestamp(t_ns: u64) -> Timestamp {
+    let sec = t_ns / 1_000_000_000;
+    let nsec = (t_ns % 1_000_000_000) as u32;
+    match u32::try_from(sec) {
+        Ok(sec) => Timestamp::new(sec, nsec),
+        Err(_) => Timestamp::MAX,
+    }
+}
+
+/// One `parent -> child` transform at `t_ns`: `translation` in m (parent frame), rotation as a
+/// unit quaternion `[x, y, z, w]` (child orientation in the parent frame).
+pub fn frame_transform(
+    t_ns: u64,
+    parent: &str,
+    child: &str,
+    translation: [f64; 3],
+    rotation_xyzw: [f64; 4],
+) -> FrameTransform {
+    let [x, y, z] = translation;
+    let [qx, qy, qz, qw] = rotation_xyzw;
+    FrameTransform {
+        timestamp: Some(timestamp(t_ns)),
+        parent_frame_id: parent.to_string(),
+        child_frame_id: child.to_string(),
+        translation: Some(Vector3 { x, y, z }),
+        rotation: Some(Quaternion {
+            x: qx,
+            y: qy,
+            z: qz,
+            w: qw,
+        }),
+    }
+}
+
+/// Bytes per point of [`hand_points`]: x, y, z as little-endian float64.
+pub const HAND_POINT_STRIDE: u32 = 24;
+
+/// A point cloud of `points` (m, in `frame_id`) with float64 fields `x`, `y`, `z`, stride 24 B,
+/// identity pose. Used for the actual and desired hand on [`crate::topics::HAND_POINTS`].
+pub fn hand_points(t_ns: u64, frame_id: &str, points: &[[f64; 3]]) -> PointCloud {
+    let mut data = Vec::with_capacity(points.len() * HAND_POINT_STRIDE as usize);
+    for p in points {
+        for c in p {
+            data.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let field = |name: &str, offset: u32| PackedElementField {
+        name: name.to_string(),
+        offset,
+        r#type: NumericType::Float64 as i32,
+    };
+    PointCloud {
+        timestamp: Some(timestamp(t_ns)),
+        frame_id: frame_id.to_string(),
+        pose: Some(Pose {
+            position: Some(Vector3 {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+            }),
+            orientation: Some(Quaternion {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+                w: 1.0,
+            }),
+        }),
+        point_stride: HAND_POINT_STRIDE,
+        fields: vec![field("x", 0), field("y", 8), field("z", 16)],
+        data: data.into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn derived_schema_names_follow_the_derive_convention() {
+        assert_eq!(MotorState::schema_name(), "motorstate.MotorState");
+        assert_eq!(HandState::schema_name(), "handstate.HandState");
+        assert_eq!(
+            fm::FrameTransforms::schema_name(),
+            "foxglove.FrameTransforms"
+        );
+        assert!(!EnergyState::schema_data().is_empty());
+    }
+
+    #[test]
+    fn timestamp_splits_and_saturates() {
+        let t = timestamp(3_000_000_007);
+        assert_eq!((t.sec(), t.nsec()), (3, 7));
+        assert_eq!(timestamp(u64::MAX), Timestamp::MAX);
+    }
+
+    #[test]
+    fn hand_points_packs_little_endian_f64() {
+        let pc = hand_points(5, "world", &[[1.0, 2.0, 3.0], [4.0, 5.0, -6.5]]);
+        assert_eq!(pc.data.len(), 48);
+        assert_eq!(&pc.data[40..48], &(-6.5f64).to_le_bytes());
+        assert_eq!(pc.fields[2].offset, 16);
+    }
+}

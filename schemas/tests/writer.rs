@@ -1,0 +1,131 @@
+//! The writer's guarantees: byte-identical output for identical input, no file at `path`
+//! unless `finish` succeeded, no leftover temporary file, misuse reported with the file named.
+
+mod common;
+
+use std::collections::BTreeMap;
+
+use common::{content, write_all};
+use schemas::{read_recording, topics, EnergyState, HandState, MotorState, RecordingWriter};
+
+#[test]
+fn identical_runs_give_identical_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = content(3000); // > 1 MiB uncompressed: several zstd chunks
+    let a = write_all(&dir.path().join("a.mcap"), &c);
+    let b = write_all(&dir.path().join("b.mcap"), &c);
+    let (a, b) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
+    let summary = mcap::Summary::read(&a).unwrap().unwrap();
+    assert!(
+        summary.chunk_indexes.len() >= 2,
+        "{} chunks",
+        summary.chunk_indexes.len()
+    );
+    assert!(summary
+        .chunk_indexes
+        .iter()
+        .all(|c| c.compression == "zstd"));
+    assert!(a == b, "recordings differ");
+    // and the header names our library, not the mcap crate version
+    assert!(a.windows(19).any(|w| w == b"elbow-sim schemas 1"));
+}
+
+#[test]
+fn dropped_writer_leaves_nothing_and_finish_leaves_only_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.mcap");
+    let listing = || {
+        let mut v: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+
+    // dropped mid-run: the temp file existed while writing, afterwards nothing remains
+    {
+        let mut w = RecordingWriter::create(&path).unwrap();
+        w.write(topics::MOTORS, 0, &MotorState::default()).unwrap();
+        assert_eq!(listing(), [".run.mcap.partial"]);
+        assert!(!path.exists());
+    }
+    assert!(listing().is_empty(), "{:?}", listing());
+
+    // panicking mid-run: same
+    let p2 = path.clone();
+    let result = std::panic::catch_unwind(move || {
+        let mut w = RecordingWriter::create(&p2).unwrap();
+        w.write(topics::HAND, 5, &HandState::default()).unwrap();
+        panic!("simulated failure");
+    });
+    assert!(result.is_err());
+    assert!(listing().is_empty(), "{:?}", listing());
+
+    // a stale temp file from a killed run is overwritten, and finish leaves only `path`
+    std::fs::write(
+        dir.path().join(".run.mcap.partial"),
+        b"garbage from a killed run",
+    )
+    .unwrap();
+    let mut w = RecordingWriter::create(&path).unwrap();
+    w.write(topics::MOTORS, 0, &MotorState::default()).unwrap();
+    assert_eq!(w.finish().unwrap(), path);
+    assert_eq!(listing(), ["run.mcap"]);
+    assert_eq!(read_recording(&path).unwrap().messages["/motors"].len(), 1);
+
+    // an abandoned second run never touches the finished recording
+    let before = std::fs::read(&path).unwrap();
+    {
+        let mut w = RecordingWriter::create(&path).unwrap();
+        w.write(
+            topics::MOTORS,
+            0,
+            &MotorState {
+                time: 1.0,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+    }
+    assert_eq!(std::fs::read(&path).unwrap(), before);
+    assert_eq!(listing(), ["run.mcap"]);
+}
+
+#[test]
+fn writer_rejects_misuse_with_errors_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("m.mcap");
+    let mut w = RecordingWriter::create(&path).unwrap();
+    w.write(topics::MOTORS, 0, &MotorState::default()).unwrap();
+    let e = w
+        .write(topics::MOTORS, 1, &HandState::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("m.mcap") && e.contains("/motors") && e.contains("HandState"),
+        "{e}"
+    );
+    let mut bad = BTreeMap::new();
+    bad.insert("format_version".to_string(), "99".to_string());
+    let e = w.write_metadata("recording", &bad).unwrap_err().to_string();
+    assert!(e.contains("format_version") && e.contains("99"), "{e}");
+    drop(w);
+    let e = RecordingWriter::create(&dir.path().join("no_such_dir/x.mcap"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("no_such_dir"), "{e}");
+}
+
+#[test]
+fn format_version_is_written_even_without_a_recording_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("v.mcap");
+    let mut w = RecordingWriter::create(&path).unwrap();
+    w.write(topics::ENERGY, 0, &EnergyState::default()).unwrap();
+    w.finish().unwrap();
+    let r = read_recording(&path).unwrap();
+    assert_eq!(r.metadata_value("recording", "format_version"), Some("1"));
+    assert_eq!(r.metadata.len(), 1);
+}

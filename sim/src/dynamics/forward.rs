@@ -1,0 +1,239 @@
+//! Constrained forward dynamics of the motor–arm system, the paper's eq 21:
+//!
+//! ```text
+//! [ M + J_m   −J_c^T  0 ] [ q̈  ]   [ K_m i − h − G − (D + D_m) q̇ ]
+//! [ J_c        0      0 ] [ f_n ] = [ −J̇_c q̇                     ]
+//! [ 0          0      L ] [ i̇  ]   [ v − R i − K_m q̇            ]
+//! ```
+//!
+//! Two equivalent solutions are offered ([`ConstraintSolver`]):
+//! - `Schur` (default): Cholesky of `M_J = M + J_m`, then the Schur complement
+//!   `A = J_c M_J^{-1} J_c^T` (nc x nc, Cholesky), `f_n = A^{-1}(−J̇_c q̇ − J_c M_J^{-1} b)`,
+//!   `q̈ = M_J^{-1}(b + J_c^T f_n)` (Featherstone, RBDA §8.1, eq 8.9–8.10).
+//! - `Kkt`: LU of the whole (nv + nc) block system, as the paper does.
+//!
+//! The electrical rows are diagonal and solved directly. The mass matrix comes from the
+//! composite-rigid-body algorithm or from the paper's Walker–Orin method ([`MassMatrixMethod`]).
+
+use nalgebra::{Cholesky, DMatrix, DVector, LU};
+
+use super::constraints::{constraint_jacobian, PointOnPlane};
+use super::crba::crba;
+use super::data::Data;
+use super::kinematics::{forward_kinematics, forward_velocities};
+use super::model::Model;
+use super::motor::Drives;
+use super::rnea::bias_forces;
+use super::walker_orin;
+use crate::error::DynamicsError;
+
+/// How the joint-space inertia is computed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MassMatrixMethod {
+    /// Composite-rigid-body algorithm (RBDA §6.2).
+    #[default]
+    Crba,
+    /// n calls of RNEA, the paper's eqs 22–26 (Walker and Orin 1982, method 1).
+    WalkerOrin,
+}
+
+/// How the constrained system is solved.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ConstraintSolver {
+    /// Cholesky of M_J and of the nc x nc Schur complement.
+    #[default]
+    Schur,
+    /// LU of the full (nv + nc) block system of eq 21.
+    Kkt,
+}
+
+/// Scratch and outputs of [`forward_dynamics`], sized once for (nv, nc).
+#[derive(Clone, Debug)]
+pub struct ForwardData {
+    /// `M + J_m`, then its Cholesky factor (nv x nv).
+    pub m_j: DMatrix<f64>,
+    /// Generalised force `b = K_m i − h − G − (D + D_m) q̇` (nv), N m.
+    pub b: DVector<f64>,
+    /// Joint accelerations (nv), rad/s^2.
+    pub qdd: DVector<f64>,
+    /// Constraint Jacobian `J_c` (nc x nv).
+    pub jac: DMatrix<f64>,
+    /// `J̇_c q̇` (nc), m/s^2.
+    pub jdqd: DVector<f64>,
+    /// `M_J^{-1} J_c^T` (nv x nc).
+    pub y: DMatrix<f64>,
+    /// Schur complement `J_c M_J^{-1} J_c^T` (nc x nc).
+    pub a: DMatrix<f64>,
+    /// Normal forces `f_n` (nc), N.
+    pub f_n: DVector<f64>,
+    /// Block matrix of eq 21 without the electrical rows ((nv + nc)^2), for `Kkt`.
+    pub kkt: DMatrix<f64>,
+    pub kkt_rhs: DVector<f64>,
+    /// Current rates (nv), A/s.
+    pub di: DVector<f64>,
+    /// Torque delivered to each link by its motor, eq 12 (nv), N m.
+    pub tau_motor: DVector<f64>,
+}
+
+impl ForwardData {
+    pub fn new(nv: usize, nc: usize) -> Self {
+        Self {
+            m_j: DMatrix::zeros(nv, nv),
+            b: DVector::zeros(nv),
+            qdd: DVector::zeros(nv),
+            jac: DMatrix::zeros(nc, nv),
+            jdqd: DVector::zeros(nc),
+            y: DMatrix::zeros(nv, nc),
+            a: DMatrix::zeros(nc, nc),
+            f_n: DVector::zeros(nc),
+            kkt: DMatrix::zeros(nv + nc, nv + nc),
+            kkt_rhs: DVector::zeros(nv + nc),
+            di: DVector::zeros(nv),
+            tau_motor: DVector::zeros(nv),
+        }
+    }
+}
+
+/// The pieces of a system that [`forward_dynamics`] reads.
+#[derive(Clone, Copy, Debug)]
+pub struct Plant<'a> {
+    pub model: &'a Model,
+    pub drives: &'a Drives,
+    pub contacts: &'a [PointOnPlane],
+    pub mass_matrix: MassMatrixMethod,
+    pub solver: ConstraintSolver,
+}
+
+/// Solve eq 21 at time `t` (used only in error messages) for the state `q` (rad), `qd`
+/// (rad/s), `current` (A) and the motor voltages `voltage` (V), all of length nv.
+/// Outputs in `fd`: `qdd`, `f_n`, `di`, `tau_motor`; `data` holds the kinematics at `q`.
+pub fn forward_dynamics(
+    plant: &Plant,
+    data: &mut Data,
+    fd: &mut ForwardData,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    current: &[f64],
+    voltage: &[f64],
+) -> Result<(), DynamicsError> {
+    let (model, drives) = (plant.model, plant.drives);
+    let nv = model.nv;
+    let nc = plant.contacts.len();
+
+    // bias forces h + G, and b = K_m i − h − G − (D + D_m) q̇
+    bias_forces(model, data, q, qd);
+    for j in 0..nv {
+        fd.b[j] = drives.km[j] * current[j] - data.tau[j] - (drives.d[j] + drives.dm[j]) * qd[j];
+    }
+    // M_J = M + J_m
+    match plant.mass_matrix {
+        MassMatrixMethod::Crba => crba(model, data, q),
+        MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
+    };
+    fd.m_j.copy_from(&data.m);
+    for j in 0..nv {
+        fd.m_j[(j, j)] += drives.jm[j];
+    }
+    // constraint rows
+    if nc > 0 {
+        forward_kinematics(model, data, q);
+        forward_velocities(model, data, qd);
+        constraint_jacobian(model, data, plant.contacts, &mut fd.jac, &mut fd.jdqd);
+    }
+    match plant.solver {
+        ConstraintSolver::Schur => solve_schur(plant, fd, t)?,
+        ConstraintSolver::Kkt => solve_kkt(plant, fd, t)?,
+    }
+    // electrical rows and the motor torque of eq 12
+    for j in 0..nv {
+        fd.di[j] = drives.current_rate(j, voltage[j], current[j], qd[j]);
+        fd.tau_motor[j] = drives.link_torque(j, current[j], qd[j], fd.qdd[j]);
+    }
+    if let Some(j) = fd.qdd.iter().position(|x| !x.is_finite()) {
+        return Err(DynamicsError::NonFinite { t, what: format!("the acceleration of {}", model.bodies[j].joint) });
+    }
+    Ok(())
+}
+
+fn contact_names(plant: &Plant) -> String {
+    plant.contacts.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", ")
+}
+
+fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), DynamicsError> {
+    let nv = plant.model.nv;
+    let nc = plant.contacts.len();
+    // factor M_J in place: the storage moves into the factor and back, no allocation
+    let m_j = std::mem::replace(&mut fd.m_j, DMatrix::zeros(0, 0));
+    let Some(chol) = Cholesky::new(m_j) else {
+        fd.m_j = DMatrix::zeros(nv, nv);
+        return Err(DynamicsError::SingularMassMatrix { t });
+    };
+    fd.qdd.copy_from(&fd.b);
+    chol.solve_mut(&mut fd.qdd);
+    if nc > 0 {
+        fd.y.tr_copy_from(&fd.jac);
+        chol.solve_mut(&mut fd.y);
+        fd.a.gemm(1.0, &fd.jac, &fd.y, 0.0);
+        // f_n = A^{-1} (−J̇q̇ − J q̈_free)
+        fd.f_n.copy_from(&fd.jdqd);
+        fd.f_n.gemv(-1.0, &fd.jac, &fd.qdd, -1.0);
+        let a = std::mem::replace(&mut fd.a, DMatrix::zeros(0, 0));
+        let Some(chol_a) = Cholesky::new(a) else {
+            fd.a = DMatrix::zeros(nc, nc);
+            fd.m_j = chol.unpack_dirty();
+            return Err(DynamicsError::SingularConstraints { t, constraints: contact_names(plant) });
+        };
+        chol_a.solve_mut(&mut fd.f_n);
+        // the Cholesky of a numerically singular A can succeed with a tiny pivot
+        let min_pivot = chol_a.l_dirty().diagonal().iter().fold(f64::INFINITY, |m, x| m.min(x.abs()));
+        let max_pivot = chol_a.l_dirty().diagonal().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        fd.a = chol_a.unpack_dirty();
+        if !(min_pivot > 1e-7 * max_pivot) {
+            fd.m_j = chol.unpack_dirty();
+            return Err(DynamicsError::SingularConstraints { t, constraints: contact_names(plant) });
+        }
+        fd.qdd.gemv(1.0, &fd.y, &fd.f_n, 1.0);
+    }
+    fd.m_j = chol.unpack_dirty();
+    Ok(())
+}
+
+fn solve_kkt(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), DynamicsError> {
+    let nv = plant.model.nv;
+    let nc = plant.contacts.len();
+    let n = nv + nc;
+    fd.kkt.fill(0.0);
+    fd.kkt.view_mut((0, 0), (nv, nv)).copy_from(&fd.m_j);
+    for k in 0..nc {
+        for j in 0..nv {
+            fd.kkt[(j, nv + k)] = -fd.jac[(k, j)];
+            fd.kkt[(nv + k, j)] = fd.jac[(k, j)];
+        }
+    }
+    fd.kkt_rhs.rows_mut(0, nv).copy_from(&fd.b);
+    for k in 0..nc {
+        fd.kkt_rhs[nv + k] = -fd.jdqd[k];
+    }
+    // LU with partial pivoting (its permutation is the one allocation of this baseline path)
+    let kkt = std::mem::replace(&mut fd.kkt, DMatrix::zeros(0, 0));
+    let lu = LU::new(kkt);
+    let ok = lu.solve_mut(&mut fd.kkt_rhs);
+    let u_diag_min = lu.u().diagonal().iter().fold(f64::INFINITY, |m, x| m.min(x.abs()));
+    fd.kkt = lu.l_unpack();
+    fd.kkt.resize_mut(n, n, 0.0);
+    if !ok || !(u_diag_min > 1e-12) {
+        return Err(if nc > 0 {
+            DynamicsError::SingularConstraints { t, constraints: contact_names(plant) }
+        } else {
+            DynamicsError::SingularMassMatrix { t }
+        });
+    }
+    fd.qdd.copy_from(&fd.kkt_rhs.rows(0, nv));
+    for k in 0..nc {
+        fd.f_n[k] = fd.kkt_rhs[nv + k];
+    }
+    Ok(())
+}

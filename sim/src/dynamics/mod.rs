@@ -1,0 +1,20 @@
+//! Rigid-body dynamics of motor-driven arms: the read-only [`Model`], the scratch [`Data`],
+//! and one algorithm per file.
+
+pub mod constraints;
+pub mod crba;
+pub mod data;
+pub mod energy;
+pub mod forward;
+pub mod kinematics;
+pub mod model;
+pub mod motor;
+pub mod rnea;
+pub mod samples;
+pub mod spatial;
+pub mod walker_orin;
+
+pub use data::Data;
+pub use model::Model;
+#[cfg(test)]
+mod tests;

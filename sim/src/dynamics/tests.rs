@@ -1,0 +1,256 @@
+//! Cross-algorithm identities on random chains and trees (the pinocchio way): each one is a
+//! property that only holds when both algorithms are right.
+
+use nalgebra::{DMatrix, DVector, Unit, Vector3};
+
+use super::constraints::{constraint_jacobian, PointOnPlane};
+use super::crba::crba;
+use super::data::Data;
+use super::energy::{link_kinetic_energy, potential_energy};
+use super::forward::{forward_dynamics, ConstraintSolver, ForwardData, MassMatrixMethod, Plant};
+use super::kinematics::{forward_kinematics, forward_velocities, BodyPoint};
+use super::model::Model;
+use super::motor::{Drives, MotorParams};
+use super::rnea::{bias_forces, rnea};
+use super::samples::{random_branching_tree, random_chain, SplitMix64};
+use super::walker_orin;
+
+fn models() -> Vec<Model> {
+    let mut v = Vec::new();
+    for (k, n) in [1usize, 2, 3, 7, 10, 16].iter().enumerate() {
+        v.push(random_chain(*n, 100 + k as u64));
+        v.push(random_branching_tree(*n, 200 + k as u64));
+    }
+    v
+}
+
+fn rel_diff(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    (a - b).amax() / a.amax().max(1.0)
+}
+
+/// Walker–Orin (n RNEA calls, eq 26) equals CRBA to 1e-12 (relative to max |M|, >= 1).
+#[test]
+fn walker_orin_mass_matrix_equals_crba() {
+    for model in models() {
+        let mut rng = SplitMix64(7 + model.nv as u64);
+        let mut data = Data::new(&model);
+        for _ in 0..5 {
+            let q = rng.vector(model.nv, -3.0, 3.0);
+            let m_crba = crba(&model, &mut data, &q).clone();
+            let m_wo = walker_orin::mass_matrix(&model, &mut data, &q).clone();
+            let d = rel_diff(&m_crba, &m_wo);
+            assert!(d <= 1e-12, "{}: |M_crba - M_wo| = {d:e}", model.name);
+        }
+    }
+}
+
+/// M is symmetric (exactly, both triangles written from one value) and positive definite.
+#[test]
+fn mass_matrix_is_symmetric_positive_definite() {
+    for model in models() {
+        let mut rng = SplitMix64(11);
+        let mut data = Data::new(&model);
+        for _ in 0..5 {
+            let q = rng.vector(model.nv, -3.0, 3.0);
+            let m = crba(&model, &mut data, &q).clone();
+            assert_eq!(m, m.transpose(), "{}", model.name);
+            let eig = m.clone().symmetric_eigenvalues();
+            assert!(eig.min() > 0.0, "{}: min eigenvalue {}", model.name, eig.min());
+            // WO is symmetric up to rounding
+            let m_wo = walker_orin::mass_matrix(&model, &mut data, &q).clone();
+            assert!(rel_diff(&m_wo, &m_wo.transpose()) < 1e-13);
+        }
+    }
+}
+
+/// M q̈ + h(q, q̇) + G(q) = RNEA(q, q̇, q̈), to 1e-11 relative.
+#[test]
+fn crba_plus_bias_equals_rnea() {
+    for model in models() {
+        let mut rng = SplitMix64(13);
+        let mut data = Data::new(&model);
+        for _ in 0..5 {
+            let q = rng.vector(model.nv, -3.0, 3.0);
+            let qd = rng.vector(model.nv, -2.0, 2.0);
+            let qdd = rng.vector(model.nv, -5.0, 5.0);
+            let tau = rnea(&model, &mut data, &q, &qd, &qdd, &model.gravity).clone();
+            let bias = bias_forces(&model, &mut data, &q, &qd).clone();
+            let m = crba(&model, &mut data, &q).clone();
+            let lhs = &m * DVector::from_column_slice(&qdd) + bias;
+            let err = (&lhs - &tau).amax() / tau.amax().max(1.0);
+            assert!(err < 1e-11, "{}: {err:e}", model.name);
+        }
+    }
+}
+
+/// ½ q̇ᵀ M q̇ equals the sum of the bodies' kinetic energies, to 1e-12 relative.
+#[test]
+fn kinetic_energy_matches_mass_matrix() {
+    for model in models() {
+        let mut rng = SplitMix64(17);
+        let mut data = Data::new(&model);
+        let q = rng.vector(model.nv, -3.0, 3.0);
+        let qd = DVector::from_vec(rng.vector(model.nv, -2.0, 2.0));
+        let m = crba(&model, &mut data, &q).clone();
+        bias_forces(&model, &mut data, &q, qd.as_slice());
+        let t_bodies = link_kinetic_energy(&model, &data);
+        let t_m = 0.5 * qd.dot(&(&m * &qd));
+        assert!((t_bodies - t_m).abs() < 1e-12 * t_m.max(1.0), "{}", model.name);
+    }
+}
+
+/// G(q) = ∂V/∂q: gravity torques equal the gradient of the potential energy (central
+/// differences, h = 1e-6, tolerance 1e-7 relative).
+#[test]
+fn gravity_torque_is_gradient_of_potential() {
+    for model in models() {
+        let mut rng = SplitMix64(19);
+        let mut data = Data::new(&model);
+        let q = rng.vector(model.nv, -3.0, 3.0);
+        let g = bias_forces(&model, &mut data, &q, &vec![0.0; model.nv]).clone();
+        for j in 0..model.nv {
+            let h = 1e-6;
+            let mut qp = q.clone();
+            qp[j] += h;
+            forward_kinematics(&model, &mut data, &qp);
+            let vp = potential_energy(&model, &data);
+            qp[j] -= 2.0 * h;
+            forward_kinematics(&model, &mut data, &qp);
+            let vm = potential_energy(&model, &data);
+            let fd = (vp - vm) / (2.0 * h);
+            assert!((fd - g[j]).abs() < 1e-7 * g.amax().max(1.0), "{} dof {j}: {fd} vs {}", model.name, g[j]);
+        }
+    }
+}
+
+fn random_point(model: &Model, rng: &mut SplitMix64) -> BodyPoint {
+    let body = Some((rng.next_u64() % model.nv as u64) as usize);
+    BodyPoint { body, p_body: Vector3::new(rng.range(-0.2, 0.2), rng.range(-0.2, 0.2), rng.range(0.0, 0.4)) }
+}
+
+/// The point Jacobian against central differences of the position (h = 1e-6, tol 1e-8), and
+/// J̇q̇ against the central difference of (J q̇) along the motion q(s) = q + s q̇ (tol 1e-6).
+#[test]
+fn point_jacobian_and_bias_match_finite_differences() {
+    for model in models() {
+        let mut rng = SplitMix64(23);
+        let mut data = Data::new(&model);
+        let nv = model.nv;
+        for _ in 0..3 {
+            let point = random_point(&model, &mut rng);
+            let q = rng.vector(nv, -3.0, 3.0);
+            let qd = DVector::from_vec(rng.vector(nv, -2.0, 2.0));
+            let mut jac = DMatrix::zeros(3, nv);
+            forward_kinematics(&model, &mut data, &q);
+            point.jacobian(&model, &data, &mut jac);
+            let h = 1e-6;
+            for j in 0..nv {
+                let mut qp = q.clone();
+                qp[j] += h;
+                forward_kinematics(&model, &mut data, &qp);
+                let pp = point.position(&data);
+                qp[j] -= 2.0 * h;
+                forward_kinematics(&model, &mut data, &qp);
+                let pm = point.position(&data);
+                let col = (pp - pm) / (2.0 * h);
+                assert!((col - jac.column(j)).amax() < 1e-8, "{} col {j}", model.name);
+            }
+            // velocity = J q̇
+            forward_kinematics(&model, &mut data, &q);
+            forward_velocities(&model, &mut data, qd.as_slice());
+            let v = point.velocity(&data);
+            assert!((v - &jac * &qd).amax() < 1e-12 * (1.0 + v.amax()));
+            let bias = point.bias_acceleration(&data);
+            // d/ds [J(q + s q̇) q̇] at s = 0 is J̇ q̇
+            let jqd_at = |s: f64, data: &mut Data| {
+                let qs: Vec<f64> = q.iter().zip(qd.iter()).map(|(a, b)| a + s * b).collect();
+                forward_kinematics(&model, data, &qs);
+                let mut js = DMatrix::zeros(3, nv);
+                point.jacobian(&model, data, &mut js);
+                js * &qd
+            };
+            let fd = (jqd_at(h, &mut data) - jqd_at(-h, &mut data)) / (2.0 * h);
+            assert!((&fd - bias).amax() < 1e-6 * (1.0 + bias.amax()), "{}: {fd} vs {bias}", model.name);
+        }
+    }
+}
+
+fn paper_like_drives(nv: usize) -> Drives {
+    let m = MotorParams {
+        torque_constant: 0.203, resistance: 1.1, inductance: 0.0017, rotor_inertia: 0.000164,
+        gear_ratio: 3.0, gear_damping: 0.01,
+    };
+    Drives::new(&vec![m; nv], &vec![0.5; nv])
+}
+
+/// With contacts, the solved accelerations satisfy J q̈ + J̇ q̇ = 0 (to 1e-9 relative), the
+/// Schur and the full block (eq 21) solutions agree (1e-9), and CRBA and Walker–Orin agree.
+#[test]
+fn constrained_accelerations_satisfy_the_constraints() {
+    for n in [4usize, 7, 10] {
+        let model = random_chain(n, 300 + n as u64);
+        let drives = paper_like_drives(n);
+        let mut rng = SplitMix64(29);
+        let contacts: Vec<PointOnPlane> = (0..2)
+            .map(|k| PointOnPlane {
+                name: format!("c{k}"),
+                point: BodyPoint { body: Some(n / 2 + k * (n / 2 - 1)), p_body: Vector3::new(0.0, 0.0, 0.1) },
+                normal_world: Unit::new_normalize(rng.unit_vector()),
+                offset: 0.0,
+            })
+            .collect();
+        let q = rng.vector(n, -2.0, 2.0);
+        let qd = rng.vector(n, -1.0, 1.0);
+        let cur = rng.vector(n, -3.0, 3.0);
+        let volt = rng.vector(n, -10.0, 10.0);
+        let mut data = Data::new(&model);
+        let mut results = Vec::new();
+        for (mm, solver) in [
+            (MassMatrixMethod::Crba, ConstraintSolver::Schur),
+            (MassMatrixMethod::Crba, ConstraintSolver::Kkt),
+            (MassMatrixMethod::WalkerOrin, ConstraintSolver::Kkt),
+        ] {
+            let plant = Plant { model: &model, drives: &drives, contacts: &contacts, mass_matrix: mm, solver };
+            let mut fd = ForwardData::new(n, contacts.len());
+            forward_dynamics(&plant, &mut data, &mut fd, 0.0, &q, &qd, &cur, &volt).expect("solvable");
+            // residual of eq 15
+            let mut jac = DMatrix::zeros(2, n);
+            let mut jdqd = DVector::zeros(2);
+            forward_kinematics(&model, &mut data, &q);
+            forward_velocities(&model, &mut data, &qd);
+            constraint_jacobian(&model, &data, &contacts, &mut jac, &mut jdqd);
+            let res = &jac * &fd.qdd + &jdqd;
+            assert!(res.amax() < 1e-9 * (1.0 + fd.qdd.amax()), "n={n} {mm:?} {solver:?}: residual {res}");
+            results.push((fd.qdd.clone(), fd.f_n.clone()));
+        }
+        for r in &results[1..] {
+            assert!((&r.0 - &results[0].0).amax() < 1e-9 * (1.0 + results[0].0.amax()));
+            assert!((&r.1 - &results[0].1).amax() < 1e-9 * (1.0 + results[0].1.amax()));
+        }
+    }
+}
+
+/// The same point twice makes J_c rank deficient: reported as singular, not NaN.
+#[test]
+fn redundant_contacts_are_reported_not_nan() {
+    let n = 5;
+    let model = random_chain(n, 5);
+    let drives = paper_like_drives(n);
+    let c = PointOnPlane {
+        name: "p".into(),
+        point: BodyPoint { body: Some(3), p_body: Vector3::zeros() },
+        normal_world: Vector3::z_axis(),
+        offset: 0.0,
+    };
+    let contacts = vec![c.clone(), PointOnPlane { name: "p-again".into(), ..c }];
+    let plant = Plant {
+        model: &model, drives: &drives, contacts: &contacts, mass_matrix: MassMatrixMethod::Crba,
+        solver: ConstraintSolver::Schur,
+    };
+    let mut data = Data::new(&model);
+    let mut fd = ForwardData::new(n, 2);
+    let z = vec![0.1; n];
+    let err = forward_dynamics(&plant, &mut data, &mut fd, 1.25, &z, &z, &z, &z).unwrap_err();
+    assert!(err.to_string().contains("t = 1.25"), "{err}");
+    assert!(err.to_string().contains("singular"), "{err}");
+}

@@ -1,0 +1,514 @@
+//! Classical 4th-order Runge–Kutta method with a fixed step and cubic Hermite dense output.
+//!
+//! Tableau: Kutta (1901), HNW I §II.1 ("the" Runge–Kutta method):
+//! `c = (0, 1/2, 1/2, 1)`, `b = (1/6, 1/3, 1/3, 1/6)`, `a21 = a32 = 1/2`, `a43 = 1`.
+//!
+//! Step times lie on the grid `t0 + k h`, each computed by multiplication (no accumulated
+//! round-off). A step that would pass `t_stop` is shortened to land on `t_stop` exactly; the
+//! following step then returns to the grid.
+//!
+//! Dense output is the cubic Hermite interpolant through `(y, f)` at both ends of the step
+//! (HNW I §II.6); `f` at the end of a step is the first stage of the next one, so the
+//! interpolant costs no extra evaluation: 4 evaluations per step, plus 1 in `init`.
+//! Its error is O(h^4), matching the method's global error.
+
+use super::{first_non_finite, IntegrateError, OdeSystem, Stats, Stepper};
+
+/// Fixed-step classical Runge–Kutta method (4 stages, order 4).
+#[derive(Clone, Debug)]
+pub struct Rk4 {
+    /// State dimension.
+    dim: usize,
+    /// Grid spacing (the nominal step), > 0.
+    h: f64,
+    /// Grid origin, set by `init`.
+    t0: f64,
+    /// Index `k` of the last grid point `t0 + k h` reached.
+    k_grid: u64,
+    /// Current time and state `y(t)`, with `f = f(t, y)`.
+    t: f64,
+    y: Vec<f64>,
+    f: Vec<f64>,
+    /// Start of the last accepted step and its `y`, `f` (the Hermite data at the left end).
+    t_prev: f64,
+    y_prev: Vec<f64>,
+    f_prev: Vec<f64>,
+    /// Stage derivatives k2..k4 and the stage argument (scratch).
+    k2: Vec<f64>,
+    k3: Vec<f64>,
+    k4: Vec<f64>,
+    y_stage: Vec<f64>,
+    stats: Stats,
+    initialized: bool,
+}
+
+impl Rk4 {
+    /// A stepper for systems of dimension `dim` with fixed step `h` (> 0, finite).
+    ///
+    /// All buffers are allocated here; `init`, `step` and `interpolate` never allocate.
+    ///
+    /// # Panics
+    /// If `h` is not finite and positive (validate user input before constructing).
+    pub fn new(dim: usize, h: f64) -> Self {
+        assert!(
+            h.is_finite() && h > 0.0,
+            "Rk4::new: step h must be finite and > 0, got {h}"
+        );
+        let z = || vec![0.0; dim];
+        Self {
+            dim,
+            h,
+            t0: 0.0,
+            k_grid: 0,
+            t: 0.0,
+            y: z(),
+            f: z(),
+            t_prev: 0.0,
+            y_prev: z(),
+            f_prev: z(),
+            k2: z(),
+            k3: z(),
+            k4: z(),
+            y_stage: z(),
+            stats: Stats::default(),
+            initialized: false,
+        }
+    }
+
+    /// The fixed (grid) step.
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
+    /// Start of the last accepted step (equals `t()` before the first step).
+    pub fn t_prev(&self) -> f64 {
+        self.t_prev
+    }
+
+    /// Current time (same as [`Stepper::t`], without naming the system type).
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Current state (same as [`Stepper::y`]).
+    pub fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    /// Cubic Hermite interpolation on `[t_prev, t]`. Outside that interval it extrapolates the
+    /// same cubic (accuracy degrades quickly).
+    pub fn interpolate(&self, t_query: f64, out: &mut [f64]) {
+        assert_eq!(out.len(), self.dim, "Rk4::interpolate: out length vs dim");
+        let h = self.t - self.t_prev;
+        if t_query == self.t || h == 0.0 {
+            out.copy_from_slice(&self.y);
+            return;
+        }
+        if t_query == self.t_prev {
+            out.copy_from_slice(&self.y_prev);
+            return;
+        }
+        // Hermite basis in theta = (t_query - t_prev) / h
+        let th = (t_query - self.t_prev) / h;
+        let th2 = th * th;
+        let th3 = th2 * th;
+        let h00 = 2.0 * th3 - 3.0 * th2 + 1.0;
+        let h10 = th3 - 2.0 * th2 + th;
+        let h01 = -2.0 * th3 + 3.0 * th2;
+        let h11 = th3 - th2;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = h00 * self.y_prev[i]
+                + h01 * self.y[i]
+                + h * (h10 * self.f_prev[i] + h11 * self.f[i]);
+        }
+    }
+
+    /// Work counters since `init` (same as [`Stepper::stats`]).
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// Evaluates `sys.rhs(t, y_stage)` into `out`, counting it and checking it is finite.
+    fn eval<S: OdeSystem>(
+        stats: &mut Stats,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), IntegrateError<S::Error>> {
+        stats.rhs_evals += 1;
+        sys.rhs(t, y, out).map_err(IntegrateError::Rhs)?;
+        match first_non_finite(out) {
+            Some(index) => Err(IntegrateError::NonFiniteState { t, index }),
+            None => Ok(()),
+        }
+    }
+}
+
+impl<S: OdeSystem> Stepper<S> for Rk4 {
+    fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        assert_eq!(sys.dim(), self.dim, "Rk4::init: system dim vs stepper dim");
+        assert_eq!(y0.len(), self.dim, "Rk4::init: y0 length vs dim");
+        self.initialized = false;
+        self.stats = Stats::default();
+        if let Some(index) = first_non_finite(y0) {
+            return Err(IntegrateError::NonFiniteState { t: t0, index });
+        }
+        self.t0 = t0;
+        self.k_grid = 0;
+        self.t = t0;
+        self.t_prev = t0;
+        self.y.copy_from_slice(y0);
+        self.y_prev.copy_from_slice(y0);
+        Self::eval(&mut self.stats, sys, t0, y0, &mut self.f)?;
+        self.f_prev.copy_from_slice(&self.f);
+        self.initialized = true;
+        Ok(())
+    }
+
+    fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {
+        assert!(
+            self.initialized,
+            "Rk4::step called before a successful init"
+        );
+        // nothing to do at or past the stop time (forward integration only)
+        if t_stop.is_nan() || t_stop <= self.t {
+            return Ok(self.t);
+        }
+
+        // next grid point; land on t_stop instead when the grid point reaches it, or misses it
+        // by no more than rounding (no sliver steps)
+        let t_grid = self.t0 + (self.k_grid + 1) as f64 * self.h;
+        let snap = 1e-9 * self.h + 4.0 * f64::EPSILON * t_stop.abs();
+        let (t_new, on_grid) = if t_grid >= t_stop - snap {
+            (t_stop, t_grid <= t_stop + snap)
+        } else {
+            (t_grid, true)
+        };
+        let (t, h) = (self.t, t_new - self.t);
+        let n = self.dim;
+
+        // stages k2, k3, k4 (k1 = f(t, y) from the previous step)
+        for i in 0..n {
+            self.y_stage[i] = self.y[i] + 0.5 * h * self.f[i];
+        }
+        Self::eval(
+            &mut self.stats,
+            sys,
+            t + 0.5 * h,
+            &self.y_stage,
+            &mut self.k2,
+        )?;
+        for i in 0..n {
+            self.y_stage[i] = self.y[i] + 0.5 * h * self.k2[i];
+        }
+        Self::eval(
+            &mut self.stats,
+            sys,
+            t + 0.5 * h,
+            &self.y_stage,
+            &mut self.k3,
+        )?;
+        for i in 0..n {
+            self.y_stage[i] = self.y[i] + h * self.k3[i];
+        }
+        Self::eval(&mut self.stats, sys, t_new, &self.y_stage, &mut self.k4)?;
+
+        // new state into y_stage
+        let h6 = h / 6.0;
+        for i in 0..n {
+            self.y_stage[i] =
+                self.y[i] + h6 * (self.f[i] + 2.0 * (self.k2[i] + self.k3[i]) + self.k4[i]);
+        }
+        if let Some(index) = first_non_finite(&self.y_stage) {
+            return Err(IntegrateError::NonFiniteState { t: t_new, index });
+        }
+
+        // f at the new state (k2 is free now): the next step's k1 and the Hermite slope
+        Self::eval(&mut self.stats, sys, t_new, &self.y_stage, &mut self.k2)?;
+
+        // commit: (y, f) -> previous, new -> current; nothing changed before this point
+        std::mem::swap(&mut self.y_prev, &mut self.y);
+        std::mem::swap(&mut self.y, &mut self.y_stage);
+        std::mem::swap(&mut self.f_prev, &mut self.f);
+        std::mem::swap(&mut self.f, &mut self.k2);
+        self.t_prev = t;
+        self.t = t_new;
+        if on_grid {
+            self.k_grid += 1;
+        }
+        self.stats.steps += 1;
+        Ok(t_new)
+    }
+
+    fn t(&self) -> f64 {
+        Rk4::t(self)
+    }
+
+    fn y(&self) -> &[f64] {
+        Rk4::y(self)
+    }
+
+    fn interpolate(&self, t_query: f64, out: &mut [f64]) {
+        Rk4::interpolate(self, t_query, out)
+    }
+
+    fn stats(&self) -> Stats {
+        Rk4::stats(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_problems::{
+        ExactSolution, FailingRhs, HarmonicOscillator, Kepler, NanAfter, RationalDecay, RhsFailure,
+        RiccatiBlowup,
+    };
+    use super::*;
+
+    fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Integrates `p` from its t0 to `t_end` with step `h`; returns the max-norm error at
+    /// `t_end` and the max-norm error of the dense output at theta = 1/4, 1/2, 3/4 of every step.
+    fn rk4_errors<P: ExactSolution>(mut p: P, h: f64, t_end: f64) -> (f64, f64) {
+        let n = p.dim();
+        let y0 = p.y0();
+        let mut st = Rk4::new(n, h);
+        let (mut ex, mut yi) = (vec![0.0; n], vec![0.0; n]);
+        let t0 = p.t0();
+        st.init(&mut p, t0, &y0).expect("init");
+        let mut dense_err: f64 = 0.0;
+        while st.t() < t_end {
+            let t_old = st.t();
+            let t_new = st.step(&mut p, t_end).expect("step");
+            for th in [0.25, 0.5, 0.75] {
+                let tq = t_old + th * (t_new - t_old);
+                st.interpolate(tq, &mut yi);
+                p.exact(tq, &mut ex);
+                dense_err = dense_err.max(max_abs_diff(&yi, &ex));
+            }
+        }
+        assert_eq!(st.t(), t_end);
+        p.exact(t_end, &mut ex);
+        (max_abs_diff(st.y(), &ex), dense_err)
+    }
+
+    /// Observed order p = log2(e(h) / e(h/2)) of the end-point and dense-output errors.
+    fn observed_orders<P: ExactSolution + Copy + std::fmt::Debug>(
+        p: P,
+        h: f64,
+        t_end: f64,
+    ) -> (f64, f64) {
+        let (e1, d1) = rk4_errors(p, h, t_end);
+        let (e2, d2) = rk4_errors(p, 0.5 * h, t_end);
+        eprintln!(
+            "{p:?} h = {h}: end err {e1:.3e} -> {e2:.3e} (order {:.3}), dense err {d1:.3e} -> {d2:.3e} (order {:.3})",
+            (e1 / e2).log2(),
+            (d1 / d2).log2()
+        );
+        ((e1 / e2).log2(), (d1 / d2).log2())
+    }
+
+    // Global error at t_end must fall 16x per halving of h: observed order in [3.8, 4.2].
+    #[test]
+    fn rk4_observed_order_nonlinear() {
+        let (p, _) = observed_orders(RationalDecay, 0.1, 3.0);
+        assert!((3.8..=4.2).contains(&p), "observed order {p}");
+    }
+
+    #[test]
+    fn rk4_observed_order_oscillator() {
+        let (p, _) = observed_orders(HarmonicOscillator { omega: 2.0 }, 0.05, 10.0);
+        assert!((3.8..=4.2).contains(&p), "observed order {p}");
+    }
+
+    #[test]
+    fn rk4_observed_order_kepler() {
+        let period = std::f64::consts::TAU;
+        let (p, _) = observed_orders(Kepler { e: 0.3 }, period / 400.0, period);
+        assert!((3.8..=4.2).contains(&p), "observed order {p}");
+    }
+
+    // Hermite dense output at interior points: error O(h^4), observed order in [3.8, 4.2].
+    #[test]
+    fn rk4_hermite_dense_output_order() {
+        for (name, d) in [
+            ("rational", observed_orders(RationalDecay, 0.1, 3.0).1),
+            (
+                "oscillator",
+                observed_orders(HarmonicOscillator { omega: 2.0 }, 0.05, 10.0).1,
+            ),
+        ] {
+            assert!(
+                (3.8..=4.2).contains(&d),
+                "{name}: dense-output observed order {d}"
+            );
+        }
+    }
+
+    #[test]
+    fn rk4_dense_output_endpoints_are_exact() {
+        let mut p = HarmonicOscillator::default();
+        let mut st = Rk4::new(2, 0.1);
+        st.init(&mut p, 0.0, &[1.0, 0.0]).expect("init");
+        // before any step: the state itself
+        let mut out = [0.0; 2];
+        st.interpolate(0.0, &mut out);
+        assert_eq!(out, [1.0, 0.0]);
+        st.step(&mut p, 1.0).expect("step");
+        let y1 = [st.y()[0], st.y()[1]];
+        st.step(&mut p, 1.0).expect("step");
+        st.interpolate(st.t(), &mut out);
+        assert_eq!(out.as_slice(), st.y());
+        st.interpolate(st.t_prev(), &mut out);
+        assert_eq!(out, y1);
+    }
+
+    #[test]
+    fn rk4_step_times_are_multiples_of_h() {
+        let mut p = RationalDecay;
+        let (t0, h) = (0.1, 0.1);
+        let mut st = Rk4::new(1, h);
+        st.init(&mut p, t0, &[1.0]).expect("init");
+        for k in 1..=1000u32 {
+            let t = st.step(&mut p, 1e9).expect("step");
+            assert_eq!(t, t0 + f64::from(k) * h, "step {k}");
+        }
+    }
+
+    #[test]
+    fn rk4_final_step_lands_on_t_stop_and_grid_resumes() {
+        let mut p = HarmonicOscillator::default();
+        let mut st = Rk4::new(2, 0.1);
+        st.init(&mut p, 0.0, &[1.0, 0.0]).expect("init");
+        let mut last = 0.0;
+        while st.t() < 0.25 {
+            last = st.step(&mut p, 0.25).expect("step");
+        }
+        assert_eq!(last, 0.25);
+        assert_eq!(st.stats().steps, 3); // 0.1, 0.2, 0.25 (shortened)
+                                         // at t_stop: a no-op
+        assert_eq!(st.step(&mut p, 0.25).expect("no-op"), 0.25);
+        assert_eq!(st.stats().steps, 3);
+        // the grid resumes at 0.3 = 3 * 0.1, not 0.35
+        assert_eq!(st.step(&mut p, 1.0).expect("step"), 3.0 * 0.1);
+        // a stop time within rounding of a grid point is hit without a sliver step
+        let mut st = Rk4::new(2, 0.1);
+        st.init(&mut p, 0.0, &[1.0, 0.0]).expect("init");
+        let t_stop = 0.30000000000000004; // 0.1 + 0.2
+        while st.t() < t_stop {
+            st.step(&mut p, t_stop).expect("step");
+        }
+        assert_eq!(st.stats().steps, 3);
+        assert_eq!(st.t(), t_stop);
+    }
+
+    // Exactly 4 evaluations per step plus 1 in init (FSAL-style reuse of f at the step end).
+    #[test]
+    fn rk4_stats_count_rhs_evals_exactly() {
+        let mut p = Kepler { e: 0.2 };
+        let y0 = p.y0();
+        let mut st = Rk4::new(4, 0.01);
+        st.init(&mut p, 0.0, &y0).expect("init");
+        assert_eq!(
+            st.stats(),
+            Stats {
+                rhs_evals: 1,
+                steps: 0,
+                rejected: 0
+            }
+        );
+        while st.t() < 1.234 {
+            st.step(&mut p, 1.234).expect("step");
+        }
+        let s = st.stats();
+        assert_eq!(s.steps, 124); // 123 full steps + 1 shortened
+        assert_eq!(s.rhs_evals, 4 * s.steps + 1);
+        assert_eq!(s.rejected, 0);
+    }
+
+    #[test]
+    fn rk4_rhs_error_passes_through_and_state_is_kept() {
+        let mut p = FailingRhs { t_fail: 0.33 };
+        let mut st = Rk4::new(1, 0.1);
+        st.init(&mut p, 0.0, &[1.0]).expect("init");
+        let mut err = None;
+        while st.t() < 1.0 {
+            match st.step(&mut p, 1.0) {
+                Ok(_) => {}
+                Err(e) => {
+                    err = Some(e);
+                    break;
+                }
+            }
+        }
+        // the first evaluation at t >= 0.33 is k2 of the step from 0.3, at 0.35
+        match err {
+            Some(IntegrateError::Rhs(RhsFailure { t })) => assert!((t - 0.35).abs() < 1e-15, "{t}"),
+            other => panic!("expected Rhs error, got {other:?}"),
+        }
+        // the failed step left the last good state untouched
+        assert!((st.t() - 0.3).abs() < 1e-15);
+        assert_eq!(st.stats().steps, 3);
+    }
+
+    // A stage derivative turning NaN is reported at the time it was evaluated.
+    #[test]
+    fn rk4_nan_reports_stage_time_and_index() {
+        let mut p = NanAfter {
+            t_nan: 0.43,
+            index: 1,
+        };
+        let mut st = Rk4::new(2, 0.1);
+        st.init(&mut p, 0.0, &[1.0, 1.0]).expect("init");
+        let err = loop {
+            if let Err(e) = st.step(&mut p, 1.0) {
+                break e;
+            }
+        };
+        match err {
+            IntegrateError::NonFiniteState { t, index } => {
+                // the first evaluation at t >= 0.43 is k2 of the step [0.4, 0.5], at 0.45
+                assert!((t - 0.45).abs() < 1e-12, "t = {t}");
+                assert_eq!(index, 1);
+            }
+            other => panic!("expected NonFiniteState, got {other:?}"),
+        }
+    }
+
+    // y' = y^2 with a fixed step overflows past the singularity at t = 1.
+    #[test]
+    fn rk4_overflow_after_blowup_is_non_finite_state() {
+        let mut p = RiccatiBlowup;
+        let mut st = Rk4::new(1, 0.05);
+        st.init(&mut p, 0.0, &[1.0]).expect("init");
+        let err = loop {
+            match st.step(&mut p, 10.0) {
+                Ok(t) => assert!(t < 10.0, "integrated through the singularity"),
+                Err(e) => break e,
+            }
+        };
+        match err {
+            IntegrateError::NonFiniteState { t, index } => {
+                assert_eq!(index, 0);
+                assert!(t > 1.0 && t < 2.0, "t = {t}");
+            }
+            other => panic!("expected NonFiniteState, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn rk4_non_finite_initial_state_is_rejected() {
+        let mut p = HarmonicOscillator::default();
+        let mut st = Rk4::new(2, 0.1);
+        match st.init(&mut p, 0.5, &[1.0, f64::INFINITY]) {
+            Err(IntegrateError::NonFiniteState { t, index }) => assert_eq!((t, index), (0.5, 1)),
+            other => panic!("expected NonFiniteState, got {other:?}"),
+        }
+    }
+}

@@ -1,0 +1,377 @@
+//! Scenes: a JSON file ([`spec::SceneSpec`], unknown keys rejected) validated once into a
+//! runnable [`Scene`] (ripgrep's low-args → high-args split). Every error names the file, the
+//! field and the value. The paper's scene is built in ([`Scene::paper`]).
+
+pub mod spec;
+
+use std::path::Path;
+
+use nalgebra::{DVector, Unit, Vector3};
+
+use crate::control::{Circle, PdGains, YawPlanarIk};
+use crate::dynamics::constraints::PointOnPlane;
+use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
+use crate::dynamics::kinematics::{body_point, forward_kinematics, forward_velocities, BodyPoint};
+use crate::dynamics::motor::{Drives, MotorParams};
+use crate::dynamics::{Data, Model};
+use crate::error::SceneError;
+pub use spec::SceneSpec;
+use spec::{Branch, Direction, Method, PerJoint, PointSpec};
+
+/// The built-in paper scene and its URDF.
+pub const PAPER_SCENE_JSON: &str = include_str!("../../scenes/paper.json");
+pub const PAPER_URDF: &str = include_str!("../../scenes/paper_arm.urdf");
+
+/// Integrator choice with validated settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IntegratorSettings {
+    Rk4 { step: f64 },
+    Dopri45 { rtol: f64, atol: f64, h_max: f64, max_steps: usize },
+}
+
+/// One run of a scene: which contacts are active.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Run {
+    pub name: String,
+    /// Indices into `Scene::contacts`.
+    pub contacts: Vec<usize>,
+}
+
+/// A validated scene, ready to run.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The spec as read (with defaults filled in): recorded so that a run can be replayed.
+    pub spec: SceneSpec,
+    /// Where the scene came from (a path, or "built-in paper scene").
+    pub source: String,
+    /// URDF text, as read.
+    pub urdf_xml: String,
+    pub model: Model,
+    pub drives: Drives,
+    pub gains: PdGains,
+    pub hand: BodyPoint,
+    pub circle: Circle,
+    pub ik: YawPlanarIk,
+    pub q0: Vec<f64>,
+    pub qd0: Vec<f64>,
+    pub current0: Vec<f64>,
+    pub contacts: Vec<PointOnPlane>,
+    pub runs: Vec<Run>,
+    pub mass_matrix: MassMatrixMethod,
+    pub solver: ConstraintSolver,
+    pub integrator: IntegratorSettings,
+    pub duration: f64,
+    pub output_rate: f64,
+}
+
+/// Tolerance on the initial constraint violation |C(q0)|, m, and |Ċ|, m/s.
+pub const INITIAL_CONSTRAINT_TOL: f64 = 1e-9;
+
+impl Scene {
+    /// The paper's scene (SCENE.md), built into the binary.
+    pub fn paper() -> Result<Scene, SceneError> {
+        Self::from_json(PAPER_SCENE_JSON, "built-in paper scene", |name| {
+            if name == "paper_arm.urdf" {
+                Ok(PAPER_URDF.to_string())
+            } else {
+                Err(format!("the built-in scene has no file `{name}`"))
+            }
+        })
+    }
+
+    /// Read a scene file; its `urdf` is resolved relative to the file's directory.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError::new(&file, "(file)", "", e.to_string()))?;
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::from_json(&text, &file, |name| {
+            let p = dir.join(name);
+            std::fs::read_to_string(&p).map_err(|e| format!("cannot read {}: {e}", p.display()))
+        })
+    }
+
+    /// Parse and validate scene JSON. `read_urdf` returns the text of the named URDF.
+    pub fn from_json(
+        text: &str,
+        source: &str,
+        read_urdf: impl Fn(&str) -> Result<String, String>,
+    ) -> Result<Scene, SceneError> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        let spec: SceneSpec = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            SceneError::new(source, if path == "." { "(document)".into() } else { path }, "", e.inner().to_string())
+        })?;
+        let urdf_xml = read_urdf(&spec.urdf).map_err(|why| SceneError::new(source, "urdf", &spec.urdf, why))?;
+        build(spec, source, urdf_xml)
+    }
+
+    /// The run called `name`.
+    pub fn run(&self, name: &str) -> Option<&Run> {
+        self.runs.iter().find(|r| r.name == name)
+    }
+
+    /// The contacts active in `run`, in its order.
+    pub fn run_contacts(&self, run: &Run) -> Vec<PointOnPlane> {
+        run.contacts.iter().map(|&k| self.contacts[k].clone()).collect()
+    }
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+}
+
+impl Ctx<'_> {
+    fn err(&self, field: impl Into<String>, value: impl std::fmt::Display, why: impl Into<String>) -> SceneError {
+        SceneError::new(self.file, field, value, why)
+    }
+
+    fn number(&self, field: &str, x: f64, ok: impl Fn(f64) -> bool, why: &str) -> Result<f64, SceneError> {
+        if !x.is_finite() {
+            return Err(self.err(field, x, "must be a finite number"));
+        }
+        if !ok(x) {
+            return Err(self.err(field, x, why));
+        }
+        Ok(x)
+    }
+
+    fn per_joint(
+        &self,
+        field: &str,
+        p: &PerJoint,
+        nv: usize,
+        ok: impl Fn(f64) -> bool,
+        why: &str,
+    ) -> Result<Vec<f64>, SceneError> {
+        let v = match p {
+            PerJoint::All(x) => vec![*x; nv],
+            PerJoint::Each(v) if v.len() == nv => v.clone(),
+            PerJoint::Each(v) => {
+                return Err(self.err(field, format!("an array of {}", v.len()), format!("needs one value per joint ({nv})")))
+            }
+        };
+        for (j, &x) in v.iter().enumerate() {
+            let f = if matches!(p, PerJoint::All(_)) { field.to_string() } else { format!("{field}[{j}]") };
+            self.number(&f, x, &ok, why)?;
+        }
+        Ok(v)
+    }
+
+    fn vec3(&self, field: &str, v: [f64; 3]) -> Result<Vector3<f64>, SceneError> {
+        for (k, x) in v.iter().enumerate() {
+            self.number(&format!("{field}[{k}]"), *x, |_| true, "")?;
+        }
+        Ok(Vector3::from(v))
+    }
+
+    fn point(&self, field: &str, model: &Model, p: &PointSpec) -> Result<BodyPoint, SceneError> {
+        let offset = self.vec3(&format!("{field}.offset"), p.offset)?;
+        let link = match (&p.joint, &p.link) {
+            (Some(j), None) => match model.urdf_joints.iter().find(|u| &u.name == j) {
+                Some(u) => u.child_link.clone(),
+                None => return Err(self.err(format!("{field}.joint"), j, format!("no such joint in the URDF (joints: {})", names(model.urdf_joints.iter().map(|u| &u.name))))),
+            },
+            (None, Some(l)) => l.clone(),
+            _ => return Err(self.err(field, "", "give exactly one of `joint` (its origin) or `link`")),
+        };
+        body_point(model, &link, offset).ok_or_else(|| {
+            self.err(format!("{field}.link"), &link, format!("no such link in the URDF (links: {})", names(model.frames.iter().map(|f| &f.name))))
+        })
+    }
+
+    fn dof(&self, field: &str, model: &Model, joint: &str) -> Result<usize, SceneError> {
+        model.dof_of_joint(joint).ok_or_else(|| {
+            self.err(field, joint, format!("no revolute joint of that name (revolute joints: {})", model.joint_names().join(", ")))
+        })
+    }
+}
+
+fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {
+    it.map(String::as_str).collect::<Vec<_>>().join(", ")
+}
+
+fn positive(x: f64) -> bool {
+    x > 0.0
+}
+fn non_negative(x: f64) -> bool {
+    x >= 0.0
+}
+
+fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneError> {
+    let c = Ctx { file };
+    if spec.name.is_empty() || !spec.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch)) {
+        return Err(c.err("name", format!("{:?}", spec.name), "must be non-empty and use only letters, digits, '-', '_' and '.' (it names output files)"));
+    }
+    let gravity = c.vec3("gravity", spec.gravity)?;
+    let model = Model::from_urdf(&urdf_xml, &spec.urdf, gravity).map_err(|e| c.err("urdf", &spec.urdf, e.to_string()))?;
+    let nv = model.nv;
+    let duration = c.number("duration", spec.duration, positive, "must be > 0 s")?;
+    let output_rate = c.number("output_rate", spec.output_rate, positive, "must be > 0 Hz")?;
+    if duration * output_rate > 1e8 {
+        return Err(c.err("output_rate", output_rate, "more than 10^8 samples per run"));
+    }
+
+    // motors and joints
+    let m = &spec.motor;
+    let k = c.per_joint("motor.torque_constant", &m.torque_constant, nv, positive, "must be > 0 N m/A")?;
+    let r = c.per_joint("motor.resistance", &m.resistance, nv, positive, "must be > 0 ohm")?;
+    let l = c.per_joint("motor.inductance", &m.inductance, nv, positive, "must be > 0 H (a quasi-static motor, L = 0, is not modelled yet)")?;
+    let im = c.per_joint("motor.rotor_inertia", &m.rotor_inertia, nv, non_negative, "must be >= 0 kg m^2")?;
+    let gear = c.per_joint("motor.gear_ratio", &m.gear_ratio, nv, positive, "must be > 0")?;
+    let dmg = c.per_joint("motor.gear_damping", &m.gear_damping, nv, non_negative, "must be >= 0 N m s/rad")?;
+    let damping = c.per_joint("joint_damping", &spec.joint_damping, nv, non_negative, "must be >= 0 N m s/rad")?;
+    let motors: Vec<MotorParams> = (0..nv)
+        .map(|j| MotorParams {
+            torque_constant: k[j], resistance: r[j], inductance: l[j], rotor_inertia: im[j], gear_ratio: gear[j],
+            gear_damping: dmg[j],
+        })
+        .collect();
+    let drives = Drives::new(&motors, &damping);
+    let gains = PdGains {
+        kp: DVector::from_vec(c.per_joint("controller.kp", &spec.controller.kp, nv, non_negative, "must be >= 0 V/rad")?),
+        kd: DVector::from_vec(c.per_joint("controller.kd", &spec.controller.kd, nv, non_negative, "must be >= 0 V s/rad")?),
+    };
+
+    // initial state
+    let q0 = c.per_joint("initial.q", &spec.initial.q, nv, |_| true, "")?;
+    let qd0 = c.per_joint("initial.qd", &spec.initial.qd, nv, |_| true, "")?;
+    let current0 = c.per_joint("initial.current", &spec.initial.current, nv, |_| true, "")?;
+
+    // hand, target and inverse kinematics
+    let hand = c.point("hand", &model, &spec.hand)?;
+    let cs = &spec.target.circle;
+    let circle = Circle {
+        center: c.vec3("target.circle.center", cs.center)?,
+        radius: c.number("target.circle.radius", cs.radius, positive, "must be > 0 m")?,
+        period: c.number("target.circle.period", cs.period, positive, "must be > 0 s")?,
+        phase: c.number("target.circle.phase", cs.phase, |_| true, "")?,
+        direction: match cs.direction {
+            Direction::CounterClockwise => 1.0,
+            Direction::Clockwise => -1.0,
+        },
+    };
+    let iks = &spec.target.ik;
+    let yaw = c.dof("target.ik.yaw_joint", &model, &iks.yaw_joint)?;
+    let p1 = c.dof("target.ik.planar_joints[0]", &model, &iks.planar_joints[0])?;
+    let p2 = c.dof("target.ik.planar_joints[1]", &model, &iks.planar_joints[1])?;
+    let branch = if iks.branch == Branch::Positive { 1.0 } else { -1.0 };
+    let ik = YawPlanarIk::new(&model, &q0, yaw, [p1, p2], &hand, branch)
+        .map_err(|e| c.err("target.ik", format!("{} + {:?}", iks.yaw_joint, iks.planar_joints), e.to_string()))?;
+    // the whole path must be reachable: check it densely before running
+    let mut qdes = vec![0.0; nv];
+    let mut qd_des = vec![0.0; nv];
+    let n_check = 2000;
+    for s in 0..=n_check {
+        let t = duration * s as f64 / n_check as f64;
+        ik.solve(&circle.position(t), &circle.velocity(t), &mut qdes, &mut qd_des)
+            .map_err(|why| c.err("target", format!("t = {t:.4} s"), why))?;
+    }
+
+    // contacts: well-formed, and satisfied by the initial state
+    let mut data = Data::new(&model);
+    forward_kinematics(&model, &mut data, &q0);
+    forward_velocities(&model, &mut data, &qd0);
+    let mut contacts = Vec::with_capacity(spec.contacts.len());
+    for (i, cspec) in spec.contacts.iter().enumerate() {
+        let f = format!("contacts[{i}]");
+        if contacts.iter().any(|p: &PointOnPlane| p.name == cspec.name) {
+            return Err(c.err(format!("{f}.name"), &cspec.name, "is used twice"));
+        }
+        let point = c.point(&format!("{f}.point"), &model, &cspec.point)?;
+        let n = c.vec3(&format!("{f}.plane.normal"), cspec.plane.normal)?;
+        if n.norm() < 1e-12 {
+            return Err(c.err(format!("{f}.plane.normal"), format!("{:?}", cspec.plane.normal), "must be non-zero"));
+        }
+        let offset = c.number(&format!("{f}.plane.offset"), cspec.plane.offset, |_| true, "")?;
+        let contact = PointOnPlane { name: cspec.name.clone(), point, normal_world: Unit::new_normalize(n), offset };
+        if point.body.is_none() {
+            return Err(c.err(format!("{f}.point"), &cspec.name, "is fixed to the base: it cannot be constrained"));
+        }
+        let (pos, vel) = (contact.position(&data), contact.velocity(&data));
+        if pos.abs() > INITIAL_CONSTRAINT_TOL || vel.abs() > INITIAL_CONSTRAINT_TOL {
+            return Err(c.err(
+                format!("{f}"),
+                &cspec.name,
+                format!(
+                    "the initial state violates this contact: C(q0) = {pos:.3e} m, C'(q0, qd0) = {vel:.3e} m/s (tolerance {INITIAL_CONSTRAINT_TOL:e}); move initial.q onto the plane or drop the contact"
+                ),
+            ));
+        }
+        contacts.push(contact);
+    }
+    let mut runs = Vec::with_capacity(spec.runs.len());
+    if spec.runs.is_empty() {
+        return Err(c.err("runs", "[]", "needs at least one run"));
+    }
+    for (i, rs) in spec.runs.iter().enumerate() {
+        if rs.name.is_empty() || !rs.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch)) {
+            return Err(c.err(format!("runs[{i}].name"), format!("{:?}", rs.name), "must be non-empty and use only letters, digits, '-', '_' and '.'"));
+        }
+        if runs.iter().any(|r: &Run| r.name == rs.name) {
+            return Err(c.err(format!("runs[{i}].name"), &rs.name, "is used twice"));
+        }
+        let mut idx = Vec::new();
+        for (k, name) in rs.contacts.iter().enumerate() {
+            let Some(ci) = contacts.iter().position(|p| &p.name == name) else {
+                return Err(c.err(format!("runs[{i}].contacts[{k}]"), name, format!("no contact of that name (contacts: {})", names(contacts.iter().map(|p| &p.name)))));
+            };
+            if idx.contains(&ci) {
+                return Err(c.err(format!("runs[{i}].contacts[{k}]"), name, "is listed twice"));
+            }
+            idx.push(ci);
+        }
+        runs.push(Run { name: rs.name.clone(), contacts: idx });
+    }
+
+    // integrator
+    let is = &spec.integrator;
+    let output_dt = 1.0 / output_rate;
+    let integrator = match is.method {
+        Method::Rk4 => {
+            for (name, v) in [("rtol", is.rtol), ("atol", is.atol), ("h_max", is.h_max)] {
+                if v.is_some() {
+                    return Err(c.err(format!("integrator.{name}"), v.unwrap_or_default(), "applies to dopri45 only"));
+                }
+            }
+            let step = is.step.ok_or_else(|| c.err("integrator.step", "(missing)", "rk4 needs a fixed step, s"))?;
+            IntegratorSettings::Rk4 { step: c.number("integrator.step", step, |h| h > 0.0 && h <= duration, "must be > 0 s and <= duration")? }
+        }
+        Method::Dopri45 => {
+            if let Some(s) = is.step {
+                return Err(c.err("integrator.step", s, "applies to rk4 only (dopri45 chooses its steps; use h_max)"));
+            }
+            let rtol = is.rtol.ok_or_else(|| c.err("integrator.rtol", "(missing)", "dopri45 needs rtol"))?;
+            let atol = is.atol.ok_or_else(|| c.err("integrator.atol", "(missing)", "dopri45 needs atol"))?;
+            IntegratorSettings::Dopri45 {
+                rtol: c.number("integrator.rtol", rtol, |x| x >= 1e-14 && x < 1.0, "must be in [1e-14, 1)")?,
+                atol: c.number("integrator.atol", atol, |x| x > 0.0, "must be > 0")?,
+                h_max: c.number("integrator.h_max", is.h_max.unwrap_or(output_dt), positive, "must be > 0 s")?,
+                max_steps: is.max_steps.unwrap_or(100_000_000),
+            }
+        }
+    };
+    Ok(Scene {
+        source: file.to_string(),
+        urdf_xml,
+        model,
+        drives,
+        gains,
+        hand,
+        circle,
+        ik,
+        q0,
+        qd0,
+        current0,
+        contacts,
+        runs,
+        mass_matrix: spec.dynamics.mass_matrix,
+        solver: spec.dynamics.constraint_solver,
+        integrator,
+        duration,
+        output_rate,
+        spec,
+    })
+}
+
+#[cfg(test)]
+mod tests;

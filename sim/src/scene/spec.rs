@@ -1,0 +1,251 @@
+//! The scene file as written by people: serde types that reject unknown keys. Every number of
+//! the experiment is here, none is a constant in code. Validation into a runnable
+//! [`super::Scene`] happens once, in `super::build`.
+
+use serde::{Deserialize, Serialize};
+
+use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
+
+/// A per-joint setting: one number for every joint, or an array with one per joint (dof order).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum PerJoint {
+    All(f64),
+    Each(Vec<f64>),
+}
+
+impl<'de> Deserialize<'de> for PerJoint {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = PerJoint;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number, or an array of numbers with one per joint")
+            }
+            fn visit_f64<E>(self, v: f64) -> Result<PerJoint, E> {
+                Ok(PerJoint::All(v))
+            }
+            fn visit_i64<E>(self, v: i64) -> Result<PerJoint, E> {
+                Ok(PerJoint::All(v as f64))
+            }
+            fn visit_u64<E>(self, v: u64) -> Result<PerJoint, E> {
+                Ok(PerJoint::All(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<PerJoint, A::Error> {
+                let mut v = Vec::new();
+                while let Some(x) = seq.next_element::<f64>()? {
+                    v.push(x);
+                }
+                Ok(PerJoint::Each(v))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl PerJoint {
+    pub fn zero() -> Self {
+        PerJoint::All(0.0)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSpec {
+    /// Short name, used in output file names.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// URDF file, relative to the scene file.
+    pub urdf: String,
+    /// Gravitational acceleration in the world frame, m/s^2.
+    pub gravity: [f64; 3],
+    /// Simulated time of each run, s.
+    pub duration: f64,
+    /// Rate of the recorded samples, Hz (independent of the integrator's steps).
+    pub output_rate: f64,
+    /// Viscous friction D of each joint, N m s/rad.
+    pub joint_damping: PerJoint,
+    pub motor: MotorSpec,
+    pub controller: ControllerSpec,
+    /// The hand point whose path is tracked.
+    pub hand: PointSpec,
+    pub target: TargetSpec,
+    pub initial: InitialSpec,
+    /// Named contacts; each run picks some of them.
+    #[serde(default)]
+    pub contacts: Vec<ContactSpec>,
+    #[serde(default)]
+    pub dynamics: DynamicsSpec,
+    pub integrator: IntegratorSpec,
+    /// The runs of this scene (e.g. the paper's three elbow configurations).
+    pub runs: Vec<RunSpec>,
+}
+
+/// DC motor and gear of each joint (the paper's eqs 1–12); each entry per joint or for all.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorSpec {
+    /// K, N m/A (= V s/rad).
+    pub torque_constant: PerJoint,
+    /// R, ohm.
+    pub resistance: PerJoint,
+    /// L, H.
+    pub inductance: PerJoint,
+    /// I_m, kg m^2.
+    pub rotor_inertia: PerJoint,
+    /// k, motor turns per joint turn.
+    pub gear_ratio: PerJoint,
+    /// d_m, N m s/rad (motor side).
+    pub gear_damping: PerJoint,
+}
+
+/// PD on the motor voltage (eq 27).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerSpec {
+    /// k_p, V/rad.
+    pub kp: PerJoint,
+    /// k_d, V s/rad.
+    pub kd: PerJoint,
+}
+
+/// A point fixed on the robot: the origin of a joint, or a point in a link's frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub link: Option<String>,
+    /// Offset in the link's (or the joint's child link's) frame, m.
+    #[serde(default)]
+    pub offset: [f64; 3],
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetSpec {
+    pub circle: CircleSpec,
+    pub ik: IkSpec,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Direction {
+    CounterClockwise,
+    Clockwise,
+}
+
+/// A horizontal circle run once per `period`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CircleSpec {
+    /// m, world frame.
+    pub center: [f64; 3],
+    /// m.
+    pub radius: f64,
+    /// s per turn.
+    pub period: f64,
+    /// Angle at t = 0 from +x towards +y, rad.
+    pub phase: f64,
+    /// Seen from above (+z).
+    pub direction: Direction,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Branch {
+    Positive,
+    Negative,
+}
+
+/// Closed-form IK (eqs 28–29): a yaw joint and two planar joints; every other joint holds its
+/// initial angle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IkSpec {
+    pub yaw_joint: String,
+    pub planar_joints: [String; 2],
+    /// Sign of the second planar joint's angle relative to the first link.
+    pub branch: Branch,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// rad.
+    pub q: PerJoint,
+    /// rad/s.
+    #[serde(default = "PerJoint::zero")]
+    pub qd: PerJoint,
+    /// A.
+    #[serde(default = "PerJoint::zero")]
+    pub current: PerJoint,
+}
+
+/// A frictionless, bilateral point-on-plane contact (the paper's C = z = 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    pub name: String,
+    pub point: PointSpec,
+    pub plane: PlaneSpec,
+}
+
+/// The plane `normal · x = offset`, world frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneSpec {
+    pub normal: [f64; 3],
+    /// m.
+    pub offset: f64,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSpec {
+    #[serde(default)]
+    pub mass_matrix: MassMatrixMethod,
+    #[serde(default)]
+    pub constraint_solver: ConstraintSolver,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Classical Runge–Kutta, fixed step.
+    Rk4,
+    /// Dormand–Prince 5(4), adaptive, with dense output.
+    Dopri45,
+}
+
+/// The integrator and its settings. `rk4` needs `step`; `dopri45` needs `rtol` and `atol`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    pub method: Method,
+    /// Fixed step, s (rk4).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f64>,
+    /// Relative tolerance (dopri45).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance (dopri45).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atol: Option<f64>,
+    /// Largest step, s (dopri45; default: the output interval).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub h_max: Option<f64>,
+    /// Most steps per run before giving up (default 10^8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_steps: Option<usize>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSpec {
+    pub name: String,
+    /// Names of the contacts active in this run.
+    pub contacts: Vec<String>,
+}

@@ -1,0 +1,113 @@
+//! The paper scene as SCENE.md fixes it, the IK against forward kinematics, and bad input.
+
+use nalgebra::Vector3;
+
+use super::*;
+use crate::dynamics::kinematics::forward_kinematics;
+
+fn paper() -> Scene {
+    Scene::paper().expect("the built-in scene is valid")
+}
+
+/// SCENE.md: the elbows (joints 4 and 7) are on the table at t = 0, the hand starts 0.056 m
+/// from the circle's centre, link masses sum to 1 kg. Tolerances: 1e-15 m for the elbows
+/// (exact up to rounding of π/4), 1 mm for the quoted 0.056 m.
+#[test]
+fn paper_scene_matches_scene_md() {
+    let s = paper();
+    assert_eq!(s.model.nv, 10);
+    assert_eq!(s.runs.iter().map(|r| r.name.as_str()).collect::<Vec<_>>(), ["two-elbow", "one-elbow", "no-elbow"]);
+    assert!((s.model.total_mass() - 1.0).abs() < 1e-12);
+    let mut data = Data::new(&s.model);
+    forward_kinematics(&s.model, &mut data, &s.q0);
+    for c in &s.contacts {
+        assert!(c.position(&data).abs() < 1e-15, "{} at z = {}", c.name, c.position(&data));
+    }
+    let hand = s.hand.position(&data);
+    let dist = (hand - s.circle.center).norm();
+    assert!((dist - 0.056).abs() < 1e-3, "hand starts {dist} m from the centre");
+    // the hand is in the vertical plane through x = y
+    assert!((hand.x - hand.y).abs() < 1e-14);
+    // drives: K_m = 0.609, J_m = 0.001476, D_m = 0.09 on every joint
+    assert!(s.drives.km.iter().all(|&x| (x - 0.609).abs() < 1e-15));
+    assert!(s.drives.jm.iter().all(|&x| (x - 0.001476).abs() < 1e-15));
+}
+
+/// IK then FK returns the target (1e-12 m) on the whole circle; the IK velocity equals the
+/// central difference of the IK angles (h = 1e-6 s, tol 1e-7 rad/s); held joints keep q0;
+/// the joint-10 angle is positive (the paper's branch).
+#[test]
+fn ik_inverts_forward_kinematics_on_the_circle() {
+    let s = paper();
+    let nv = s.model.nv;
+    let mut data = Data::new(&s.model);
+    let (mut q, mut qd) = (vec![0.0; nv], vec![0.0; nv]);
+    let (mut qp, mut qm, mut scratch) = (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]);
+    for k in 0..50 {
+        let t = 5.0 * k as f64 / 50.0;
+        let r = s.circle.position(t);
+        s.ik.solve(&r, &s.circle.velocity(t), &mut q, &mut qd).unwrap();
+        forward_kinematics(&s.model, &mut data, &q);
+        assert!((s.hand.position(&data) - r).norm() < 1e-12, "t = {t}");
+        assert!(q[9] > 0.0);
+        for j in 1..8 {
+            assert_eq!(q[j], s.q0[j]);
+            assert_eq!(qd[j], 0.0);
+        }
+        let h = 1e-6;
+        s.ik.solve(&s.circle.position(t + h), &s.circle.velocity(t + h), &mut qp, &mut scratch).unwrap();
+        s.ik.solve(&s.circle.position(t - h), &s.circle.velocity(t - h), &mut qm, &mut scratch).unwrap();
+        for j in 0..nv {
+            let fd = (qp[j] - qm[j]) / (2.0 * h);
+            assert!((fd - qd[j]).abs() < 1e-7, "t = {t} joint {j}: {fd} vs {}", qd[j]);
+        }
+    }
+}
+
+/// The joint targets at t = 0 are continuous with the start: q_d1(0) = 0 (the circle starts
+/// on the bisector), and joints 9, 10 are within 0.5 rad of q0 (the hand starts 0.056 m off the circle, near full reach).
+#[test]
+fn ik_start_is_near_the_initial_pose() {
+    let s = paper();
+    let (mut q, mut qd) = (vec![0.0; 10], vec![0.0; 10]);
+    s.ik.solve(&s.circle.position(0.0), &s.circle.velocity(0.0), &mut q, &mut qd).unwrap();
+    assert!(q[0].abs() < 1e-14);
+    assert!((q[8] - s.q0[8]).abs() < 0.5 && (q[9] - s.q0[9]).abs() < 0.5, "{q:?}");
+}
+
+fn with(edit: impl FnOnce(&mut serde_json::Value)) -> Result<Scene, SceneError> {
+    let mut v: serde_json::Value = serde_json::from_str(PAPER_SCENE_JSON).unwrap();
+    edit(&mut v);
+    Scene::from_json(&v.to_string(), "edited.json", |_| Ok(PAPER_URDF.to_string()))
+}
+
+fn expect_err(edit: impl FnOnce(&mut serde_json::Value), field: &str, value: &str) {
+    let err = with(edit).expect_err("must be rejected").to_string();
+    assert!(err.starts_with("edited.json: "), "{err}");
+    assert!(err.contains(field), "`{field}` not in: {err}");
+    assert!(err.contains(value), "`{value}` not in: {err}");
+}
+
+#[test]
+fn bad_scenes_name_file_field_and_value() {
+    expect_err(|v| v["motor"]["resistance"] = (-1.1).into(), "motor.resistance", "-1.1");
+    expect_err(|v| v["motor"]["inductance"] = serde_json::json!([0.0017, 0.0017]), "motor.inductance", "array of 2");
+    expect_err(|v| v["motor"]["resistnce"] = 1.0.into(), "motor", "resistnce");
+    expect_err(|v| v["duration"] = "five".into(), "duration", "five");
+    expect_err(|v| v["contacts"][0]["point"]["joint"] = "joint42".into(), "contacts[0].point.joint", "joint42");
+    expect_err(|v| v["runs"][0]["contacts"][1] = "elbow9".into(), "runs[0].contacts[1]", "elbow9");
+    expect_err(|v| v["target"]["circle"]["radius"] = 0.0.into(), "target.circle.radius", "0");
+    expect_err(|v| v["target"]["circle"]["center"] = serde_json::json!([3.5, 3.5, 0.4]), "target", "outside its reach");
+    expect_err(|v| v["integrator"]["step"] = 1e-4.into(), "integrator.step", "0.0001");
+    expect_err(|v| v["target"]["ik"]["yaw_joint"] = "joint2".into(), "target.ik", "joint2");
+    // an elbow 1 cm above the table at the start is rejected, with the violation in the message
+    expect_err(|v| v["contacts"][0]["plane"]["offset"] = (-0.01).into(), "contacts[0]", "C(q0) = 1.000e-2");
+}
+
+#[test]
+fn per_joint_arrays_are_accepted() {
+    let s = with(|v| v["joint_damping"] = serde_json::json!([0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.7])).unwrap();
+    assert_eq!(s.drives.d[9], 0.7);
+    assert_eq!(s.drives.d[0], 0.5);
+    let _ = Vector3::<f64>::zeros();
+}
