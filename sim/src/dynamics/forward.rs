@@ -188,8 +188,9 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
         };
         chol_a.solve_mut(&mut fd.f_n);
         // the Cholesky of a numerically singular A can succeed with a tiny pivot
-        let min_pivot = chol_a.l_dirty().diagonal().iter().fold(f64::INFINITY, |m, x| m.min(x.abs()));
-        let max_pivot = chol_a.l_dirty().diagonal().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let l = chol_a.l_dirty();
+        let min_pivot = (0..nc).fold(f64::INFINITY, |m, k| m.min(l[(k, k)].abs()));
+        let max_pivot = (0..nc).fold(0.0f64, |m, k| m.max(l[(k, k)].abs()));
         fd.a = chol_a.unpack_dirty();
         if !(min_pivot > 1e-7 * max_pivot) {
             fd.m_j = chol.unpack_dirty();

@@ -1,6 +1,8 @@
 //! Driving a stepper over an interval and reporting the solution on a fixed output grid.
 //!
-//! Output times are `t_k = t0 + k dt_out` (by multiplication, no accumulated round-off),
+//! Output times are `t_k = t0 + k (t_end − t0) / N` when the span is a whole number N of
+//! output intervals (correctly rounded: 0.009 s, not 9 × 0.001 s), else `t_k = t0 + k dt_out`;
+//! by multiplication, with no accumulated round-off,
 //! independent of the solver's steps: points inside a step come from the stepper's dense output
 //! (diffsol's `interpolate`; HNW I §II.6), so an adaptive solver takes exactly the same steps
 //! whatever the output rate, and a recording never depends on step sizes.
@@ -54,6 +56,9 @@ pub fn integrate_sampled<S: OdeSystem, St: Stepper<S>>(
     let grid_time = |k: u64| {
         if k == n_out && lands_on_end {
             t_end
+        } else if lands_on_end {
+            // k (t_end - t0) / N, correctly rounded: 0.009, not 9 * 0.001 = 0.009000000000000001
+            t0 + (k as f64 * (t_end - t0)) / n_out as f64
         } else {
             t0 + k as f64 * dt_out
         }
@@ -175,7 +180,7 @@ mod tests {
                     let expected = if k as u64 == n {
                         t_end
                     } else {
-                        t0 + k as f64 * dt_out
+                        t0 + (k as f64 * (t_end - t0)) / n as f64
                     };
                     assert_eq!(t, expected, "{which}: sample {k}");
                 }

@@ -111,3 +111,13 @@ fn per_joint_arrays_are_accepted() {
     assert_eq!(s.drives.d[0], 0.5);
     let _ = Vector3::<f64>::zeros();
 }
+
+/// The small scene in sim/scenes/small loads and starts with its elbow on the table and the
+/// hand on the target (1e-12 m).
+#[test]
+fn small_scene_is_valid() {
+    let s = Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/small/small.json"))).unwrap();
+    let mut data = Data::new(&s.model);
+    forward_kinematics(&s.model, &mut data, &s.q0);
+    assert!((s.hand.position(&data) - s.circle.position(0.0)).norm() < 1e-12);
+}

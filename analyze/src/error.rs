@@ -1,0 +1,64 @@
+//! The one error type of the library.
+//!
+//! Every variant about a recording names the file (`file`: the path, or the label the
+//! recording was read with) and what is missing or wrong in it, so `analyze` and `sim` can print
+//! it as is. Reading errors come from [`schemas::Error`], which names the file, topic and field.
+
+/// Errors from computing, comparing or rendering run metrics.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The recording could not be read, or a topic / field it needs is absent or not numeric.
+    #[error(transparent)]
+    Read(#[from] schemas::Error),
+
+    /// A metadata record or key the metrics need is absent.
+    #[error("{file}: metadata record {record:?} has no key {key:?}")]
+    MissingMetadata {
+        file: String,
+        record: String,
+        key: String,
+    },
+
+    /// A metadata value does not parse (e.g. `run.contacts` is not a JSON array of strings).
+    #[error("{file}: metadata {record}.{key} = {value:?}: {detail}")]
+    BadMetadata {
+        file: String,
+        record: String,
+        key: String,
+        value: String,
+        detail: String,
+    },
+
+    /// A topic the metrics need has no messages.
+    #[error("{file}: topic {topic} has no messages")]
+    NoSamples { file: String, topic: String },
+
+    /// An array field has the wrong number of entries for the joints / contacts in the metadata.
+    #[error(
+        "{file}: topic {topic}, field {field}, message #{index} (t = {t_s} s): \
+         {found} entries, expected {expected} (one per {per})"
+    )]
+    WrongLength {
+        file: String,
+        topic: String,
+        field: String,
+        index: usize,
+        t_s: f64,
+        found: usize,
+        expected: usize,
+        per: &'static str,
+    },
+
+    /// [`crate::Comparison::new`] was given no runs.
+    #[error("no runs to compare")]
+    NoRuns,
+
+    /// The requested baseline is not the name (or file) of any run.
+    #[error("baseline {name:?} is not one of the runs {available:?}")]
+    UnknownBaseline { name: String, available: Vec<String> },
+
+    /// Serializing to JSON failed.
+    #[error("writing JSON: {0}")]
+    Json(#[from] serde_json::Error),
+}

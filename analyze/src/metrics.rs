@@ -1,0 +1,407 @@
+//! Per-run metrics of one recording: [`run_metrics`] -> [`RunMetrics`].
+//!
+//! Everything is read through the generic, schema-driven reader ([`schemas::read_recording`],
+//! [`Recording::series`], [`Recording::metadata_value`]); nothing assumes which program wrote
+//! the file, only the recording format (topics and metadata keys of the `schemas` crate).
+//! What is computed, following SCENE.md "What to report per run" (the paper's Fig. 1-25):
+//!
+//! - **Hand error** `e(t) = r(t) - r_d(t)` (`/hand` `error.{x,y,z}` and `error_norm`), per axis
+//!   and in norm: `RMS = sqrt((1/N) Σ_k e(t_k)^2)`, the plain mean over the N recorded samples
+//!   (which lie on a uniform output grid), and `max_k |e(t_k)|` with its time.
+//! - **Work and electric energy per link** at the last sample (`/energy`):
+//!   `W_j = ∫ τ_j q'_j dt` (`link_work`, Fig. 4, 6-24 even) and `E_j = ∫ i_j v_j dt`
+//!   (`electric_energy`, Fig. 5, 7-25 odd), and their recorded totals.
+//! - **Peak motor current** `max_k |i_j(t_k)|` per motor (`/motors` `current`) and overall.
+//! - **Per contact** (`/constraints`, one array entry per contact in `run.contacts`): the
+//!   minimum normal force `f_n` and its time; the time the table *pulls* (`f_n < 0`, which a
+//!   real table cannot do; SCENE.md "Physics checks"), by the trapezoid rule on the indicator
+//!   `1[f_n < 0]` (see [`ContactMetrics::pull_time_s`]); the first sample with `f_n < 0`;
+//!   the drift `max |C|` and `max |C'|`.
+//! - **Energy audit** at the last sample (SCENE.md "Energy balance"): electric energy in,
+//!   changes of kinetic, potential and magnetic energy since the first sample (t = 0),
+//!   resistive and friction losses, the recorded residual
+//!   `E - (ΔT + ΔV + ΔL i^2/2 + R-loss + friction-loss)`, and `max_k |residual|`, also
+//!   relative to the final electric energy.
+//!
+//! A non-finite sample is never hidden: a NaN wins every `max`/`min` (and spreads into RMS).
+
+use std::path::Path;
+
+use schemas::{topics, Recording};
+use serde::{Deserialize, Serialize};
+
+use crate::Error;
+
+/// Metadata record with the run's description (`scene`, `run`, `contacts`, `joint_names`).
+const RUN_RECORD: &str = "run";
+/// Metadata record with the run's outcome (`status`, `error`, `error_time`).
+const RESULT_RECORD: &str = "result";
+
+/// How the run ended (metadata `result.status`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    Complete,
+    Failed,
+}
+
+/// RMS and largest magnitude of one error component, m.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisError {
+    /// `sqrt(mean_k e(t_k)^2)`, m.
+    pub rms_m: f64,
+    /// `max_k |e(t_k)|`, m.
+    pub max_abs_m: f64,
+    /// Time of that maximum (the first, if tied), s.
+    pub t_max_s: f64,
+}
+
+/// Hand error `r - r_d` per world axis and in norm.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HandError {
+    pub x: AxisError,
+    pub y: AxisError,
+    pub z: AxisError,
+    /// Of `|r - r_d|` (so `norm.rms_m^2 = x.rms_m^2 + y.rms_m^2 + z.rms_m^2`).
+    pub norm: AxisError,
+}
+
+/// One link (actuated joint) at the end of the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkMetrics {
+    /// Joint name (metadata `run.joint_names`).
+    pub joint: String,
+    /// `W_j = ∫ τ_j q'_j dt` at the last sample, J.
+    pub work_j: f64,
+    /// `E_j = ∫ i_j v_j dt` at the last sample, J.
+    pub electric_energy_j: f64,
+    /// `max_k |i_j(t_k)|`, A.
+    pub peak_current_a: f64,
+    /// Time of that peak, s.
+    pub t_peak_current_s: f64,
+}
+
+/// The largest motor current of the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeakCurrent {
+    pub joint: String,
+    /// `max_{j,k} |i_j(t_k)|`, A.
+    pub current_a: f64,
+    pub t_s: f64,
+}
+
+/// One contact ("elbow") over the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactMetrics {
+    /// Contact name (metadata `run.contacts`).
+    pub contact: String,
+    /// `min_k f_n(t_k)`, N (negative: the table pulls).
+    pub min_normal_force_n: f64,
+    /// Time of that minimum (the first, if tied), s.
+    pub t_min_normal_force_s: f64,
+    /// Total time with `f_n < 0`, s: the trapezoid rule on the indicator `1[f_n < 0]`, i.e.
+    /// each interval `[t_k, t_k+1]` counts fully when `f_n` is negative at both ends and half
+    /// when at one end (the sign change is put at the midpoint). For a force negative on the
+    /// samples `t_a..=t_b` only, this is `t_b - t_a + dt`; each sign change adds at most
+    /// `dt/2` of error.
+    pub pull_time_s: f64,
+    /// First sample time with `f_n < 0`, s; `None` if the table never pulls.
+    pub first_pull_s: Option<f64>,
+    /// Drift `max_k |C(t_k)|`, m.
+    pub max_abs_position_m: f64,
+    /// Drift rate `max_k |C'(t_k)|`, m/s.
+    pub max_abs_velocity_m_s: f64,
+}
+
+/// Energy balance at the last sample, J (SCENE.md "Energy balance").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnergyAudit {
+    /// Electric energy in, `Σ_j E_j`.
+    pub electric_j: f64,
+    /// Kinetic energy at the end minus at the first sample.
+    pub kinetic_change_j: f64,
+    /// Potential energy at the end minus at the first sample.
+    pub potential_change_j: f64,
+    /// Magnetic energy `Σ L i^2 / 2` at the end minus at the first sample.
+    pub magnetic_change_j: f64,
+    /// `∫ Σ R i^2 dt`.
+    pub resistive_loss_j: f64,
+    /// `∫ Σ (D + D_m) q'^2 dt`.
+    pub friction_loss_j: f64,
+    /// Recorded balance residual at the end.
+    pub residual_j: f64,
+    /// `max_k |residual(t_k)|`.
+    pub max_abs_residual_j: f64,
+    /// Time of that maximum, s.
+    pub t_max_abs_residual_s: f64,
+    /// `max_abs_residual_j / |electric_j|`; `None` when no electric energy was drawn.
+    pub max_abs_residual_rel: Option<f64>,
+}
+
+/// Everything reported about one run. JSON keys are the field names (stable).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunMetrics {
+    /// Where the recording was read from.
+    pub file: String,
+    /// Metadata `run.scene`.
+    pub scene: String,
+    /// Metadata `run.run`, e.g. `two-elbow`.
+    pub run: String,
+    /// Metadata `run.contacts`, in `/constraints` array order.
+    pub contacts: Vec<String>,
+    /// Metadata `run.joint_names`, in `/motors` and `/energy` array order.
+    pub joint_names: Vec<String>,
+    /// Number of `/hand` messages.
+    pub samples: usize,
+    /// Time of the last `/hand` message, s.
+    pub t_end_s: f64,
+    pub status: Status,
+    /// Metadata `result.error`, if the run failed.
+    pub error: Option<String>,
+    /// Metadata `result.error_time`, s, if the run failed and the time is known.
+    pub error_time_s: Option<f64>,
+    pub hand_error: HandError,
+    /// One per joint, in `joint_names` order.
+    pub links: Vec<LinkMetrics>,
+    /// `Σ_j W_j` at the end (recorded total), J.
+    pub link_work_total_j: f64,
+    /// `Σ_j E_j` at the end (recorded total), J.
+    pub electric_energy_total_j: f64,
+    /// `None` only for a run without motors.
+    pub peak_current: Option<PeakCurrent>,
+    /// One per contact, in `contacts` order.
+    pub contact_forces: Vec<ContactMetrics>,
+    pub energy: EnergyAudit,
+}
+
+/// Reads the recording at `path` and computes its metrics; errors name the file.
+pub fn read_run_metrics(path: &Path) -> Result<RunMetrics, Error> {
+    run_metrics(&schemas::read_recording(path)?)
+}
+
+/// Computes the metrics of one decoded recording (see the module docs for the formulas).
+///
+/// Needs the metadata `run.{scene,run,contacts,joint_names}` and `result.status`, and at least
+/// one message on each of `/hand`, `/motors`, `/constraints` and `/energy`, with one array
+/// entry per joint (motors, energy) or per contact (constraints).
+pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
+    let src = Source(rec);
+    let joint_names = src.json_names(RUN_RECORD, "joint_names")?;
+    let contacts = src.json_names(RUN_RECORD, "contacts")?;
+    let status = match src.meta(RESULT_RECORD, "status")? {
+        "complete" => Status::Complete,
+        "failed" => Status::Failed,
+        other => return Err(src.bad_meta(RESULT_RECORD, "status", other, "expected complete or failed")),
+    };
+    let error_time_s = match rec.metadata_value(RESULT_RECORD, "error_time") {
+        None => None,
+        Some(v) => Some(v.parse::<f64>().map_err(|e| src.bad_meta(RESULT_RECORD, "error_time", v, &e.to_string()))?),
+    };
+
+    // hand error, per axis and in norm
+    let axis = |field: &str| -> Result<(Vec<f64>, AxisError), Error> {
+        let (t, e) = src.scalars(topics::HAND, field)?;
+        let (max_abs_m, t_max_s) = peak_abs(&t, &e);
+        let rms_m = (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt();
+        Ok((t, AxisError { rms_m, max_abs_m, t_max_s }))
+    };
+    let (hand_t, x) = axis("error.x")?;
+    let hand_error = HandError { x, y: axis("error.y")?.1, z: axis("error.z")?.1, norm: axis("error_norm")?.1 };
+
+    // motor currents
+    let n = joint_names.len();
+    let (cur_t, cur) = src.arrays(topics::MOTORS, "current", n, "joint")?;
+    let peaks: Vec<(f64, f64)> = (0..n).map(|j| peak_abs(&cur_t, &column(&cur, j))).collect();
+    let peak_current = argmin(peaks.iter().map(|p| -p.0)).map(|j| PeakCurrent {
+        joint: joint_names[j].clone(),
+        current_a: peaks[j].0,
+        t_s: peaks[j].1,
+    });
+
+    // per-link energy at the end
+    let (_, work) = src.arrays(topics::ENERGY, "link_work", n, "joint")?;
+    let (_, electric) = src.arrays(topics::ENERGY, "electric_energy", n, "joint")?;
+    let (work_end, electric_end) = (last(&work), last(&electric));
+    let links = (0..n)
+        .map(|j| LinkMetrics {
+            joint: joint_names[j].clone(),
+            work_j: work_end[j],
+            electric_energy_j: electric_end[j],
+            peak_current_a: peaks[j].0,
+            t_peak_current_s: peaks[j].1,
+        })
+        .collect();
+
+    // contacts
+    let nc = contacts.len();
+    let (c_t, force) = src.arrays(topics::CONSTRAINTS, "normal_force", nc, "contact")?;
+    let (_, pos) = src.arrays(topics::CONSTRAINTS, "position", nc, "contact")?;
+    let (_, vel) = src.arrays(topics::CONSTRAINTS, "velocity", nc, "contact")?;
+    let contact_forces = (0..nc)
+        .map(|c| {
+            let f = column(&force, c);
+            let (min_normal_force_n, t_min_normal_force_s) = min_with_time(&c_t, &f);
+            ContactMetrics {
+                contact: contacts[c].clone(),
+                min_normal_force_n,
+                t_min_normal_force_s,
+                pull_time_s: negative_time(&c_t, &f),
+                first_pull_s: c_t.iter().zip(&f).find(|(_, &f)| f < 0.0).map(|(&t, _)| t),
+                max_abs_position_m: peak_abs(&c_t, &column(&pos, c)).0,
+                max_abs_velocity_m_s: peak_abs(&c_t, &column(&vel, c)).0,
+            }
+        })
+        .collect();
+
+    // energy audit
+    let end = |field: &str| -> Result<(f64, f64), Error> {
+        let (_, v) = src.scalars(topics::ENERGY, field)?;
+        Ok((v[0], v[v.len() - 1]))
+    };
+    let change = |field: &str| end(field).map(|(first, last)| last - first);
+    let electric_j = end("electric_energy_total")?.1;
+    let (res_t, residual) = src.scalars(topics::ENERGY, "balance_residual")?;
+    let (max_abs_residual_j, t_max_abs_residual_s) = peak_abs(&res_t, &residual);
+    let energy = EnergyAudit {
+        electric_j,
+        kinetic_change_j: change("kinetic")?,
+        potential_change_j: change("potential")?,
+        magnetic_change_j: change("magnetic")?,
+        resistive_loss_j: end("resistive_loss")?.1,
+        friction_loss_j: end("friction_loss")?.1,
+        residual_j: residual[residual.len() - 1],
+        max_abs_residual_j,
+        t_max_abs_residual_s,
+        max_abs_residual_rel: (electric_j != 0.0).then(|| max_abs_residual_j / electric_j.abs()),
+    };
+
+    Ok(RunMetrics {
+        file: rec.source.clone(),
+        scene: src.meta(RUN_RECORD, "scene")?.to_string(),
+        run: src.meta(RUN_RECORD, "run")?.to_string(),
+        contacts,
+        joint_names,
+        samples: hand_t.len(),
+        t_end_s: hand_t[hand_t.len() - 1],
+        status,
+        error: rec.metadata_value(RESULT_RECORD, "error").map(str::to_string),
+        error_time_s,
+        hand_error,
+        links,
+        link_work_total_j: end("link_work_total")?.1,
+        electric_energy_total_j: electric_j,
+        peak_current,
+        contact_forces,
+        energy,
+    })
+}
+
+/// Reads series and metadata of one recording, with errors that name the file.
+struct Source<'a>(&'a Recording);
+
+impl Source<'_> {
+    fn file(&self) -> String {
+        self.0.source.clone()
+    }
+
+    fn meta(&self, record: &str, key: &str) -> Result<&str, Error> {
+        self.0.metadata_value(record, key).ok_or_else(|| Error::MissingMetadata {
+            file: self.file(),
+            record: record.into(),
+            key: key.into(),
+        })
+    }
+
+    fn bad_meta(&self, record: &str, key: &str, value: &str, detail: &str) -> Error {
+        Error::BadMetadata {
+            file: self.file(),
+            record: record.into(),
+            key: key.into(),
+            value: value.into(),
+            detail: detail.into(),
+        }
+    }
+
+    /// A metadata value holding a JSON array of strings.
+    fn json_names(&self, record: &str, key: &str) -> Result<Vec<String>, Error> {
+        let v = self.meta(record, key)?;
+        serde_json::from_str(v).map_err(|e| self.bad_meta(record, key, v, &format!("not a JSON array of strings: {e}")))
+    }
+
+    /// Times and rows of a field, at least one message, every row `expected` long.
+    fn arrays(&self, topic: &str, field: &str, expected: usize, per: &'static str) -> Result<(Vec<f64>, Vec<Vec<f64>>), Error> {
+        let (t, rows) = self.0.series(topic, field)?;
+        if t.is_empty() {
+            return Err(Error::NoSamples { file: self.file(), topic: topic.into() });
+        }
+        if let Some(index) = rows.iter().position(|r| r.len() != expected) {
+            return Err(Error::WrongLength {
+                file: self.file(),
+                topic: topic.into(),
+                field: field.into(),
+                index,
+                t_s: t[index],
+                found: rows[index].len(),
+                expected,
+                per,
+            });
+        }
+        Ok((t, rows))
+    }
+
+    /// Times and values of a scalar field, at least one message.
+    fn scalars(&self, topic: &str, field: &str) -> Result<(Vec<f64>, Vec<f64>), Error> {
+        let (t, rows) = self.arrays(topic, field, 1, "message (a scalar field)")?;
+        Ok((t, rows.into_iter().map(|r| r[0]).collect()))
+    }
+}
+
+/// Entry `j` of every row (rows were checked to be long enough).
+fn column(rows: &[Vec<f64>], j: usize) -> Vec<f64> {
+    rows.iter().map(|r| r[j]).collect()
+}
+
+/// The last row (rows were checked to be non-empty).
+fn last(rows: &[Vec<f64>]) -> &[f64] {
+    rows.last().map_or(&[], Vec::as_slice)
+}
+
+/// Index of the first minimum; the first NaN wins, so a non-finite sample is never hidden.
+fn argmin(values: impl Iterator<Item = f64>) -> Option<usize> {
+    let mut best: Option<(usize, f64)> = None;
+    for (k, v) in values.enumerate() {
+        if v.is_nan() {
+            return Some(k);
+        }
+        if best.is_none_or(|(_, b)| v < b) {
+            best = Some((k, v));
+        }
+    }
+    best.map(|(k, _)| k)
+}
+
+/// `(min_k v_k, t_k)` at the first minimum (a NaN wins); NaNs when empty.
+fn min_with_time(times: &[f64], values: &[f64]) -> (f64, f64) {
+    argmin(values.iter().copied()).map_or((f64::NAN, f64::NAN), |k| (values[k], times[k]))
+}
+
+/// `(max_k |v_k|, t_k)` at the first maximum (a NaN wins); NaNs when empty.
+fn peak_abs(times: &[f64], values: &[f64]) -> (f64, f64) {
+    argmin(values.iter().map(|v| -v.abs())).map_or((f64::NAN, f64::NAN), |k| (values[k].abs(), times[k]))
+}
+
+/// Time with `v < 0` by the trapezoid rule on `1[v < 0]` (see [`ContactMetrics::pull_time_s`]).
+fn negative_time(times: &[f64], values: &[f64]) -> f64 {
+    let neg = |v: f64| if v < 0.0 { 0.5 } else { 0.0 };
+    times.windows(2).zip(values.windows(2)).map(|(t, v)| (t[1] - t[0]) * (neg(v[0]) + neg(v[1]))).sum()
+}
+
+#[cfg(test)]
+mod tests;

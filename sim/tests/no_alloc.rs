@@ -1,0 +1,61 @@
+//! No heap allocation in the step loop: a counting global allocator (per thread) around the
+//! integration of the paper's two-elbow run (the RHS: IK, PD, RNEA, CRBA, contacts, Cholesky
+//! and Schur complement), for both integrators, after construction and the first step.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use sim::integrate::{Dopri5Settings, DormandPrince45, Rk4, Stepper};
+use sim::scene::Scene;
+use sim::system::ArmSystem;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCS: Cell<u64> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocs() -> u64 {
+    ALLOCS.with(Cell::get)
+}
+
+fn steps_allocate<'s, St: Stepper<ArmSystem<'s>>>(st: &mut St, sys: &mut ArmSystem<'s>) -> u64 {
+    let y0 = sys.initial_state();
+    let mut out = vec![0.0; y0.len()];
+    st.init(sys, 0.0, &y0).expect("init");
+    st.step(sys, 0.5).expect("first step");
+    let before = allocs();
+    for _ in 0..200 {
+        let t = st.step(sys, 0.5).expect("step");
+        st.interpolate(t, &mut out);
+    }
+    allocs() - before
+}
+
+#[test]
+fn the_step_loop_does_not_allocate() {
+    let scene = Scene::paper().unwrap();
+    let run = scene.run("two-elbow").unwrap().clone();
+    let mut sys = ArmSystem::new(&scene, &run);
+    let dim = sys.initial_state().len();
+    assert_eq!(steps_allocate(&mut Rk4::new(dim, 1e-4), &mut sys), 0, "rk4");
+    let settings = Dopri5Settings { rtol: 1e-10, atol: 1e-12, h_max: 1e-3, ..Dopri5Settings::default() };
+    assert_eq!(steps_allocate(&mut DormandPrince45::new(dim, settings), &mut sys), 0, "dopri45");
+}
