@@ -1,0 +1,79 @@
+//! End to end, as a user runs it: the `sim` binary on a scene writes recordings, the `analyze`
+//! binary reads them back; bad input gets a clear error and an exit status, never a panic.
+//!
+//! The binaries are the ones `cargo test --workspace` builds next to this test (the `sim` and
+//! `analyze` packages have integration tests, so cargo builds their executables first).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin(name: &str) -> PathBuf {
+    // target/<profile>/deps/e2e-<hash> -> target/<profile>/<name>
+    let exe = std::env::current_exe().expect("test executable path");
+    let dir = exe.parent().and_then(Path::parent).expect("target/<profile>");
+    let p = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
+    assert!(p.exists(), "{} not built: run the tests with `cargo test --workspace`", p.display());
+    p
+}
+
+fn small_scene() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/small/small.json")
+}
+
+fn run(cmd: &mut Command) -> Output {
+    let out = cmd.output().expect("the binary starts");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "a panic: {stderr}");
+    out
+}
+
+#[test]
+fn sim_then_analyze_on_the_small_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(Command::new(bin("sim")).arg(small_scene()).arg("-o").arg(dir.path()).args(["--format", "json", "--quiet"]));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let table: serde_json::Value = serde_json::from_slice(&out.stdout).expect("sim prints JSON with --format json");
+    assert!(table.is_object(), "{table}");
+    for run in ["elbow", "free"] {
+        assert!(dir.path().join(format!("small-{run}.mcap")).exists());
+    }
+    // analyze reads the directory and prints one CSV row per run
+    let out = run(Command::new(bin("analyze")).arg("compare").arg(dir.path()).args(["--format", "csv"]));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = csv.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 3, "{csv}");
+    let header: Vec<&str> = lines[0].split(',').collect();
+    for row in &lines[1..] {
+        assert_eq!(row.split(',').count(), header.len(), "{row}");
+    }
+    // the people's table names both runs
+    let out = run(Command::new(bin("analyze")).arg("compare").arg(dir.path()));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("elbow") && text.contains("free"), "{text}");
+}
+
+#[test]
+fn a_bad_scene_names_file_field_and_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(small_scene()).unwrap()).unwrap();
+    v["motor"]["resistance"] = serde_json::json!(-2.5);
+    let scene = dir.path().join("bad.json");
+    std::fs::write(&scene, v.to_string()).unwrap();
+    std::fs::copy(small_scene().with_file_name("small_arm.urdf"), dir.path().join("small_arm.urdf")).unwrap();
+    let out = run(Command::new(bin("sim")).arg(&scene).arg("-o").arg(dir.path().join("o")).arg("--quiet"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.json") && err.contains("motor.resistance") && err.contains("-2.5"), "{err}");
+    assert!(!dir.path().join("o").join("small-elbow.mcap").exists());
+}
+
+#[test]
+fn analyze_rejects_files_that_are_not_recordings() {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("junk.mcap");
+    std::fs::write(&junk, b"not an mcap file at all").unwrap();
+    let out = run(Command::new(bin("analyze")).arg("compare").arg(&junk));
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("junk.mcap"));
+}

@@ -56,7 +56,10 @@ pub enum Error {
 
     /// The requested baseline is not the name (or file) of any run.
     #[error("baseline {name:?} is not one of the runs {available:?}")]
-    UnknownBaseline { name: String, available: Vec<String> },
+    UnknownBaseline {
+        name: String,
+        available: Vec<String>,
+    },
 
     /// Serializing to JSON failed.
     #[error("writing JSON: {0}")]

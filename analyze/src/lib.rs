@@ -1,1 +1,37 @@
+//! `analyze`: per-run metrics of recordings and the comparison of runs (the paper's tables).
+//!
+//! - [`metrics`]: one recording -> [`RunMetrics`] (hand error, W_j and E_j, peak currents,
+//!   contact forces, energy audit), read only through the generic reader of `schemas`.
+//! - [`compare`]: several [`RunMetrics`] -> [`Comparison`] against a baseline run, with
+//!   findings stated as sentences (SCENE.md "The paper's conclusions").
+//! - [`render`]: a [`Comparison`] or a list of [`RunMetrics`] as an aligned text table, JSON
+//!   or CSV ([`Format`]).
+//!
+//! Typical use (what `sim` does after its runs):
+//! ```no_run
+//! # fn main() -> Result<(), analyze::Error> {
+//! let paths = ["out/no-elbow.mcap", "out/two-elbow.mcap"];
+//! let runs = paths
+//!     .iter()
+//!     .map(|p| analyze::read_run_metrics(std::path::Path::new(p)))
+//!     .collect::<Result<Vec<_>, _>>()?;
+//! let cmp = analyze::Comparison::new(&runs, None)?;
+//! print!("{}", analyze::render_comparison(&cmp, analyze::Format::Table)?);
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! Units are SI; JSON keys carry them as suffixes (`_m`, `_s`, `_j`, `_a`, `_n`).
+//! The library depends only on `schemas`, `serde`, `serde_json` and `thiserror`.
 
+pub mod compare;
+mod error;
+pub mod metrics;
+pub mod render;
+#[cfg(test)]
+mod testutil;
+
+pub use compare::Comparison;
+pub use error::Error;
+pub use metrics::{read_run_metrics, run_metrics, RunMetrics, Status};
+pub use render::{render_comparison, render_metrics, Format};

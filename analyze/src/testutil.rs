@@ -6,8 +6,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use schemas::{
-    to_log_time, topics, ConstraintState, EnergyState, HandState, MotorState, RecordingWriter,
-    Vec3,
+    to_log_time, topics, ConstraintState, EnergyState, HandState, MotorState, RecordingWriter, Vec3,
 };
 
 type Signal<T> = Box<dyn Fn(f64) -> T>;
@@ -89,7 +88,11 @@ impl Synth {
             }
             if !self.skip.contains(&topics::MOTORS) {
                 let current = (self.current)(t);
-                let m = MotorState { time: t, current, ..Default::default() };
+                let m = MotorState {
+                    time: t,
+                    current,
+                    ..Default::default()
+                };
                 w.write(topics::MOTORS, ns, &m).unwrap();
             }
             if !self.skip.contains(&topics::CONSTRAINTS) {
@@ -104,7 +107,10 @@ impl Synth {
                 w.write(topics::CONSTRAINTS, ns, &msg).unwrap();
             }
             if !self.skip.contains(&topics::ENERGY) {
-                let e = EnergyState { time: t, ..(self.energy)(t) };
+                let e = EnergyState {
+                    time: t,
+                    ..(self.energy)(t)
+                };
                 w.write(topics::ENERGY, ns, &e).unwrap();
             }
         }

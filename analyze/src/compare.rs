@@ -1,0 +1,375 @@
+//! Comparison of runs against a baseline: [`Comparison::new`].
+//!
+//! - **Baseline**: a run chosen by name, else the first run without contacts (the paper's
+//!   no-elbow arm), else the first run. Every ratio is `run / baseline` (`None` when the
+//!   baseline value is 0 or either is not finite).
+//! - **Per run**: its [`RunMetrics`] and the ratios of the total electric energy `Σ E_j`, the
+//!   total link work `Σ W_j` and the RMS z and norm hand errors to the baseline's.
+//! - **Per link**: `W_j` and `E_j` of every run, matched by joint name, and `E_j / E_j,base`
+//!   (the paper's Fig. 4-25 at t = end).
+//! - **Findings**, plain sentences checking SCENE.md "The paper's conclusions": which run draws
+//!   the least electric energy and which has the smallest z error; whether "more elbows → less
+//!   electric energy and smaller z error" holds over runs ordered by number of contacts (every
+//!   run with more contacts must be strictly lower than every run with fewer); which links have
+//!   the largest `|E_j - E_j,base|`; and, per contact, when and how long `f_n < 0` (the table
+//!   pulls, which a real table cannot do; SCENE.md "Physics checks").
+
+use serde::{Deserialize, Serialize};
+
+use crate::metrics::{RunMetrics, Status};
+use crate::Error;
+
+/// Ratios of one run to the baseline (`run / baseline`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ratios {
+    /// `Σ E_j / Σ E_j,base`.
+    pub electric_energy: Option<f64>,
+    /// `Σ W_j / Σ W_j,base`.
+    pub link_work: Option<f64>,
+    /// RMS z error over the baseline's.
+    pub error_z_rms: Option<f64>,
+    /// RMS |error| over the baseline's.
+    pub error_norm_rms: Option<f64>,
+}
+
+/// One run in the comparison.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunComparison {
+    pub metrics: RunMetrics,
+    pub to_baseline: Ratios,
+}
+
+/// One link of one run in the per-link table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkCell {
+    pub run: String,
+    /// `W_j` at the end, J.
+    pub work_j: f64,
+    /// `E_j` at the end, J.
+    pub electric_energy_j: f64,
+    /// `E_j / E_j,base`.
+    pub electric_energy_ratio: Option<f64>,
+}
+
+/// One link (joint) across the runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkComparison {
+    pub joint: String,
+    /// One per run, in [`Comparison::runs`] order; `None` if that run has no such joint.
+    pub runs: Vec<Option<LinkCell>>,
+}
+
+/// Runs side by side against a baseline. JSON keys are the field names (stable).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Comparison {
+    /// The baseline's run name.
+    pub baseline: String,
+    /// The baseline's index in `runs`.
+    pub baseline_index: usize,
+    /// In the order given.
+    pub runs: Vec<RunComparison>,
+    /// Joints in order of first appearance over the runs.
+    pub links: Vec<LinkComparison>,
+    /// Plain sentences (see the module docs).
+    pub findings: Vec<String>,
+}
+
+impl Comparison {
+    /// Compares `runs` (kept in order) against `baseline`: a run name, a file path or a file
+    /// stem; `None` picks the first run without contacts, else the first run.
+    pub fn new(runs: &[RunMetrics], baseline: Option<&str>) -> Result<Self, Error> {
+        if runs.is_empty() {
+            return Err(Error::NoRuns);
+        }
+        let base = match baseline {
+            Some(name) => find_run(runs, name).ok_or_else(|| Error::UnknownBaseline {
+                name: name.into(),
+                available: runs.iter().map(|r| r.run.clone()).collect(),
+            })?,
+            None => runs.iter().position(|r| r.contacts.is_empty()).unwrap_or(0),
+        };
+        let b = &runs[base];
+        let with_ratios = runs
+            .iter()
+            .map(|r| RunComparison {
+                metrics: r.clone(),
+                to_baseline: Ratios {
+                    electric_energy: ratio(r.electric_energy_total_j, b.electric_energy_total_j),
+                    link_work: ratio(r.link_work_total_j, b.link_work_total_j),
+                    error_z_rms: ratio(r.hand_error.z.rms_m, b.hand_error.z.rms_m),
+                    error_norm_rms: ratio(r.hand_error.norm.rms_m, b.hand_error.norm.rms_m),
+                },
+            })
+            .collect();
+        let links = link_table(runs, base);
+        let findings = findings(runs, base, &links);
+        Ok(Self {
+            baseline: b.run.clone(),
+            baseline_index: base,
+            runs: with_ratios,
+            links,
+            findings,
+        })
+    }
+}
+
+/// `x / base`, if both are finite and `base != 0`.
+fn ratio(x: f64, base: f64) -> Option<f64> {
+    (x.is_finite() && base.is_finite() && base != 0.0).then(|| x / base)
+}
+
+/// The run called `name`, else the one read from file `name`, else whose file stem is `name`.
+fn find_run(runs: &[RunMetrics], name: &str) -> Option<usize> {
+    let stem = |f: &str| {
+        std::path::Path::new(f)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+    };
+    runs.iter()
+        .position(|r| r.run == name)
+        .or_else(|| runs.iter().position(|r| r.file == name))
+        .or_else(|| {
+            runs.iter()
+                .position(|r| stem(&r.file).as_deref() == Some(name))
+        })
+}
+
+fn link_table(runs: &[RunMetrics], base: usize) -> Vec<LinkComparison> {
+    let mut joints: Vec<&str> = Vec::new();
+    for l in runs.iter().flat_map(|r| &r.links) {
+        if !joints.contains(&l.joint.as_str()) {
+            joints.push(&l.joint);
+        }
+    }
+    let find = |r: &RunMetrics, j: &str| r.links.iter().find(|l| l.joint == j).cloned();
+    joints
+        .into_iter()
+        .map(|joint| {
+            let base_e = find(&runs[base], joint).map(|l| l.electric_energy_j);
+            let cells = runs
+                .iter()
+                .map(|r| {
+                    find(r, joint).map(|l| LinkCell {
+                        run: r.run.clone(),
+                        work_j: l.work_j,
+                        electric_energy_j: l.electric_energy_j,
+                        electric_energy_ratio: base_e.and_then(|b| ratio(l.electric_energy_j, b)),
+                    })
+                })
+                .collect();
+            LinkComparison {
+                joint: joint.into(),
+                runs: cells,
+            }
+        })
+        .collect()
+}
+
+fn plural(n: usize, one: &str) -> String {
+    if n == 1 {
+        format!("{n} {one}")
+    } else {
+        format!("{n} {one}s")
+    }
+}
+
+/// Whether the value falls strictly with more contacts: `Some(holds)` with a sentence, or
+/// `None` when every run has the same number of contacts.
+fn trend(
+    runs: &[RunMetrics],
+    what: &str,
+    value: impl Fn(&RunMetrics) -> f64,
+    show: impl Fn(f64) -> String,
+) -> (Option<bool>, String) {
+    let mut order: Vec<usize> = (0..runs.len()).collect();
+    order.sort_by_key(|&k| runs[k].contacts.len());
+    let n = |k: usize| runs[k].contacts.len();
+    if n(order[0]) == n(order[order.len() - 1]) {
+        return (
+            None,
+            format!(
+                "More elbows → {what}: cannot be checked, every run has {}.",
+                plural(n(0), "contact")
+            ),
+        );
+    }
+    let label = |k: usize| {
+        format!(
+            "{} ({}) {}",
+            runs[k].run,
+            plural(n(k), "contact"),
+            show(value(&runs[k]))
+        )
+    };
+    let mut broken = Vec::new();
+    for &a in &order {
+        for &b in order.iter().filter(|&&b| n(b) > n(a)) {
+            // a NaN compares as not below, so it breaks the trend
+            let below =
+                value(&runs[b]).partial_cmp(&value(&runs[a])) == Some(std::cmp::Ordering::Less);
+            if !below {
+                broken.push(format!("{} is not below {}", label(b), label(a)));
+            }
+        }
+    }
+    if broken.is_empty() {
+        let chain: Vec<String> = order.iter().map(|&k| label(k)).collect();
+        (
+            Some(true),
+            format!("More elbows → {what}: holds ({}).", chain.join(" > ")),
+        )
+    } else {
+        (
+            Some(false),
+            format!(
+                "More elbows → {what}: does not hold: {}.",
+                broken.join("; ")
+            ),
+        )
+    }
+}
+
+fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<String> {
+    let mut out = Vec::new();
+    let b = &runs[base];
+    let reason = if b.contacts.is_empty() {
+        "no contacts"
+    } else {
+        "chosen"
+    };
+    out.push(format!(
+        "Baseline: {} ({reason}); ratios are run / baseline.",
+        b.run
+    ));
+    for r in runs.iter().filter(|r| r.status == Status::Failed) {
+        let at = r
+            .error_time_s
+            .map_or(String::new(), |t| format!(" at t = {t:.3} s"));
+        let why = r.error.as_deref().unwrap_or("no reason recorded");
+        out.push(format!(
+            "{} did not complete: failed{at} ({why}); its totals stop at t = {:.3} s.",
+            r.run, r.t_end_s
+        ));
+    }
+
+    // least energy, smallest z error
+    let argmin = |v: &dyn Fn(&RunMetrics) -> f64| {
+        (0..runs.len())
+            .min_by(|&i, &j| v(&runs[i]).total_cmp(&v(&runs[j])))
+            .unwrap_or(0)
+    };
+    let e = argmin(&|r| r.electric_energy_total_j);
+    let r = &runs[e];
+    let rel = ratio(r.electric_energy_total_j, b.electric_energy_total_j)
+        .map_or(String::new(), |x| format!(", {x:.3} × baseline"));
+    out.push(format!(
+        "Least total electric energy: {} ({:.3} J{rel}).",
+        r.run, r.electric_energy_total_j
+    ));
+    let z = argmin(&|r| r.hand_error.z.rms_m);
+    let r = &runs[z];
+    let (rms, max) = (r.hand_error.z.rms_m * 1e3, r.hand_error.z.max_abs_m * 1e3);
+    out.push(format!(
+        "Smallest z error: {} (RMS {rms:.3} mm, max {max:.3} mm).",
+        r.run
+    ));
+
+    // the paper's claim, over runs ordered by number of contacts
+    let (e_ok, e_text) = trend(
+        runs,
+        "less electric energy",
+        |r| r.electric_energy_total_j,
+        |x| format!("{x:.3} J"),
+    );
+    let (z_ok, z_text) = trend(
+        runs,
+        "smaller z error",
+        |r| r.hand_error.z.rms_m,
+        |x| format!("{:.3} mm", x * 1e3),
+    );
+    out.push(e_text);
+    out.push(z_text);
+    let claim = "\"more elbows → less electric energy and smaller z error\"";
+    out.push(match (e_ok, z_ok) {
+        (Some(true), Some(true)) => format!("So {claim} holds across these runs."),
+        (Some(_), Some(_)) => format!("So {claim} does not hold across these runs."),
+        _ => format!("So {claim} cannot be checked on these runs."),
+    });
+
+    // largest per-link electric-energy gaps to the baseline
+    for (k, r) in runs.iter().enumerate().filter(|&(k, _)| k != base) {
+        let mut gaps: Vec<(&str, f64, Option<f64>)> = links
+            .iter()
+            .filter_map(|l| match (&l.runs[k], &l.runs[base]) {
+                (Some(c), Some(bc)) => Some((
+                    l.joint.as_str(),
+                    c.electric_energy_j - bc.electric_energy_j,
+                    c.electric_energy_ratio,
+                )),
+                _ => None,
+            })
+            .collect();
+        gaps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        let top: Vec<String> = gaps
+            .iter()
+            .take(3)
+            .map(|(j, d, q)| {
+                format!(
+                    "{j} {d:+.3} J{}",
+                    q.map_or(String::new(), |q| format!(" ({:+.1} %)", (q - 1.0) * 100.0))
+                )
+            })
+            .collect();
+        if !top.is_empty() {
+            out.push(format!(
+                "Largest electric-energy gaps of {} to {}: {}.",
+                r.run,
+                b.run,
+                top.join(", ")
+            ));
+        }
+    }
+
+    // contacts where the table pulls
+    for r in runs.iter().filter(|r| !r.contact_forces.is_empty()) {
+        let mut any = false;
+        for c in r.contact_forces.iter().filter(|c| c.first_pull_s.is_some()) {
+            any = true;
+            out.push(format!(
+                "{}, {}: the table pulls (f_n < 0) for {:.3} s in total, from t = {:.3} s; minimum f_n = {:.3} N at t = {:.3} s. A real table cannot pull.",
+                r.run, c.contact, c.pull_time_s, c.first_pull_s.unwrap_or(f64::NAN), c.min_normal_force_n, c.t_min_normal_force_s
+            ));
+        }
+        if !any {
+            let min = r
+                .contact_forces
+                .iter()
+                .map(|c| c.min_normal_force_n)
+                .fold(f64::INFINITY, f64::min);
+            out.push(format!(
+                "{}: every normal force stays >= 0 (minimum {min:.3} N): the table only pushes.",
+                r.run
+            ));
+        }
+    }
+
+    // energy balance
+    let worst = (0..runs.len())
+        .filter_map(|k| runs[k].energy.max_abs_residual_rel.map(|x| (k, x)))
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some((k, x)) = worst {
+        out.push(format!(
+            "Energy balance: the largest |residual| is {x:.2e} of the electric energy ({}).",
+            runs[k].run
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+pub(crate) mod tests;

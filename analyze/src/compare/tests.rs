@@ -1,0 +1,211 @@
+//! Comparisons of hand-made [`RunMetrics`] with known ratios and findings.
+
+use super::*;
+use crate::metrics::{AxisError, ContactMetrics, EnergyAudit, HandError, LinkMetrics};
+
+fn axis(rms_m: f64) -> AxisError {
+    AxisError {
+        rms_m,
+        max_abs_m: 2.0 * rms_m,
+        t_max_s: 1.0,
+    }
+}
+
+/// A run with per-link E_j and W_j, an RMS z error (m) and one contact per name, all pushing.
+pub(crate) fn run(name: &str, contacts: &[&str], e: &[f64], w: &[f64], z_rms: f64) -> RunMetrics {
+    let joint_names: Vec<String> = (1..=e.len()).map(|k| format!("joint{k}")).collect();
+    let links = (0..e.len())
+        .map(|j| LinkMetrics {
+            joint: joint_names[j].clone(),
+            work_j: w[j],
+            electric_energy_j: e[j],
+            peak_current_a: 1.0,
+            t_peak_current_s: 0.5,
+        })
+        .collect();
+    let contact_forces = contacts
+        .iter()
+        .map(|c| ContactMetrics {
+            contact: c.to_string(),
+            min_normal_force_n: 0.5,
+            t_min_normal_force_s: 0.1,
+            pull_time_s: 0.0,
+            first_pull_s: None,
+            max_abs_position_m: 1e-9,
+            max_abs_velocity_m_s: 1e-8,
+        })
+        .collect();
+    let electric: f64 = e.iter().sum();
+    RunMetrics {
+        file: format!("out/{name}.mcap"),
+        scene: "paper".into(),
+        run: name.into(),
+        contacts: contacts.iter().map(|c| c.to_string()).collect(),
+        joint_names,
+        samples: 501,
+        t_end_s: 5.0,
+        status: Status::Complete,
+        error: None,
+        error_time_s: None,
+        hand_error: HandError {
+            x: axis(1e-3),
+            y: axis(1e-3),
+            z: axis(z_rms),
+            norm: axis(2e-3 + z_rms),
+        },
+        links,
+        link_work_total_j: w.iter().sum(),
+        electric_energy_total_j: electric,
+        peak_current: None,
+        contact_forces,
+        energy: EnergyAudit {
+            electric_j: electric,
+            kinetic_change_j: 0.0,
+            potential_change_j: 0.0,
+            magnetic_change_j: 0.0,
+            resistive_loss_j: 0.0,
+            friction_loss_j: 0.0,
+            residual_j: 0.0,
+            max_abs_residual_j: 1e-6,
+            t_max_abs_residual_s: 5.0,
+            max_abs_residual_rel: Some(1e-6 / electric),
+        },
+    }
+}
+
+/// The paper's three runs, out of order: E = 6, 8, 10 J, W = 3 J each, z RMS 1, 2, 4 mm.
+pub(crate) fn paper_runs() -> Vec<RunMetrics> {
+    vec![
+        run(
+            "two-elbow",
+            &["elbow4", "elbow7"],
+            &[2.0, 3.0, 1.0],
+            &[1.0; 3],
+            1e-3,
+        ),
+        run("one-elbow", &["elbow4"], &[3.0, 3.5, 1.5], &[1.0; 3], 2e-3),
+        run("no-elbow", &[], &[5.0, 4.0, 1.0], &[1.0; 3], 4e-3),
+    ]
+}
+
+fn has(c: &Comparison, text: &str) -> bool {
+    c.findings.iter().any(|f| f.contains(text))
+}
+
+/// Ratios are exact quotients of the totals (tolerance 1e-15).
+#[test]
+fn default_baseline_is_the_run_without_contacts() {
+    let c = Comparison::new(&paper_runs(), None).unwrap();
+    assert_eq!((c.baseline.as_str(), c.baseline_index), ("no-elbow", 2));
+    let e: Vec<f64> = c
+        .runs
+        .iter()
+        .map(|r| r.to_baseline.electric_energy.unwrap())
+        .collect();
+    for (got, want) in e.iter().zip([0.6, 0.8, 1.0]) {
+        assert!((got - want).abs() <= 1e-15, "{e:?}");
+    }
+    assert!(c.runs.iter().all(|r| r.to_baseline.link_work == Some(1.0)));
+    assert_eq!(c.runs[0].to_baseline.error_z_rms, Some(0.25));
+    let names: Vec<&str> = c.runs.iter().map(|r| r.metrics.run.as_str()).collect();
+    assert_eq!(names, ["two-elbow", "one-elbow", "no-elbow"]); // input order kept
+}
+
+#[test]
+fn baseline_by_name_file_or_stem_else_an_error_listing_runs() {
+    let runs = paper_runs();
+    for name in ["one-elbow", "out/one-elbow.mcap"] {
+        let c = Comparison::new(&runs, Some(name)).unwrap();
+        assert_eq!(c.baseline_index, 1, "{name}");
+        assert_eq!(c.runs[1].to_baseline.electric_energy, Some(1.0));
+    }
+    let err = Comparison::new(&runs, Some("three-elbow"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("three-elbow") && err.contains("no-elbow"),
+        "{err}"
+    );
+    let only_contacts = &runs[..2];
+    assert_eq!(
+        Comparison::new(only_contacts, None).unwrap().baseline,
+        "two-elbow"
+    );
+    assert!(matches!(Comparison::new(&[], None), Err(Error::NoRuns)));
+}
+
+#[test]
+fn per_link_table_matches_joints_by_name() {
+    let mut runs = paper_runs();
+    runs[0].links.pop(); // two-elbow without joint3
+    let c = Comparison::new(&runs, None).unwrap();
+    let joints: Vec<&str> = c.links.iter().map(|l| l.joint.as_str()).collect();
+    assert_eq!(joints, ["joint1", "joint2", "joint3"]);
+    let j1 = &c.links[0].runs;
+    assert_eq!(j1[0].as_ref().unwrap().electric_energy_ratio, Some(0.4)); // 2 / 5
+    assert_eq!(j1[1].as_ref().unwrap().electric_energy_j, 3.0);
+    assert_eq!(j1[2].as_ref().unwrap().run, "no-elbow");
+    assert!(c.links[2].runs[0].is_none());
+}
+
+#[test]
+fn findings_name_the_best_runs_and_check_the_claim() {
+    let c = Comparison::new(&paper_runs(), None).unwrap();
+    assert!(
+        has(
+            &c,
+            "Least total electric energy: two-elbow (6.000 J, 0.600 × baseline)"
+        ),
+        "{:#?}",
+        c.findings
+    );
+    assert!(
+        has(&c, "Smallest z error: two-elbow (RMS 1.000 mm"),
+        "{:#?}",
+        c.findings
+    );
+    assert!(has(&c, "less electric energy: holds (no-elbow (0 contacts) 10.000 J > one-elbow (1 contact) 8.000 J > two-elbow (2 contacts) 6.000 J)"), "{:#?}", c.findings);
+    assert!(has(&c, "smaller z error: holds"));
+    assert!(has(&c, "z error\" holds across these runs"));
+    assert!(!c.findings.iter().any(|f| f.contains("pulls")));
+    assert!(has(&c, "two-elbow: every normal force stays >= 0"));
+}
+
+#[test]
+fn a_broken_trend_names_the_offending_runs() {
+    let mut runs = paper_runs();
+    runs[1] = run("one-elbow", &["elbow4"], &[6.0, 4.0, 1.0], &[1.0; 3], 2e-3); // 11 J > 10 J
+    let c = Comparison::new(&runs, None).unwrap();
+    assert!(has(&c, "less electric energy: does not hold: one-elbow (1 contact) 11.000 J is not below no-elbow (0 contacts) 10.000 J"), "{:#?}", c.findings);
+    assert!(has(&c, "smaller z error: holds"));
+    assert!(has(&c, "does not hold across these runs"));
+    let same = [runs[0].clone(), runs[0].clone()];
+    assert!(has(
+        &Comparison::new(&same, None).unwrap(),
+        "cannot be checked"
+    ));
+}
+
+/// Gaps to no-elbow: two-elbow -3, -1, 0 J; one-elbow -2, -0.5, +0.5 J. Largest |gap| first.
+#[test]
+fn largest_link_gaps_come_first() {
+    let c = Comparison::new(&paper_runs(), None).unwrap();
+    assert!(has(&c, "gaps of two-elbow to no-elbow: joint1 -3.000 J (-60.0 %), joint2 -1.000 J (-25.0 %), joint3 +0.000 J (+0.0 %)."), "{:#?}", c.findings);
+    assert!(has(
+        &c,
+        "gaps of one-elbow to no-elbow: joint1 -2.000 J (-40.0 %), joint2 -0.500 J"
+    ));
+}
+
+#[test]
+fn a_pulling_table_is_reported_with_duration_start_and_minimum() {
+    let mut runs = paper_runs();
+    let c7 = &mut runs[0].contact_forces[1];
+    (c7.pull_time_s, c7.first_pull_s) = (0.31, Some(0.2));
+    (c7.min_normal_force_n, c7.t_min_normal_force_s) = (-4.0, 0.5);
+    let c = Comparison::new(&runs, None).unwrap();
+    let want = "two-elbow, elbow7: the table pulls (f_n < 0) for 0.310 s in total, from t = 0.200 s; minimum f_n = -4.000 N at t = 0.500 s. A real table cannot pull.";
+    assert!(has(&c, want), "{:#?}", c.findings);
+    assert!(!has(&c, "two-elbow: every normal force"));
+    assert!(has(&c, "one-elbow: every normal force stays >= 0"));
+}

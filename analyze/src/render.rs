@@ -1,0 +1,130 @@
+//! Output of a [`Comparison`] or of per-run [`RunMetrics`], for people and for machines.
+//!
+//! - [`Format::Table`]: aligned text in sections (runs, hand error in mm, energy totals,
+//!   per-link energy `W_j`/`E_j` at the end, contacts, energy balance, findings), units in the
+//!   headers, `-` where a value does not exist (e.g. a ratio to a zero baseline).
+//! - [`Format::Json`]: the serde form of the structs, pretty-printed; keys are the field names
+//!   and stable. Non-finite numbers come out as `null` (serde_json's rule), so only finite
+//!   values round-trip.
+//! - [`Format::Csv`]: one header row, one row per run (RFC 4180 quoting). Per-link columns are
+//!   `W_<joint>_J`, `E_<joint>_J` (and `E_<joint>_ratio` in a comparison), per-contact columns
+//!   `fn_min_<contact>_N`, `pull_<contact>_s`, `first_pull_<contact>_s`; empty cells where a run
+//!   lacks the joint or contact or the value does not exist. Numbers use Rust's shortest
+//!   round-trip form.
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::compare::{Comparison, Ratios};
+use crate::metrics::{RunMetrics, Status};
+use crate::Error;
+
+mod csv;
+mod table;
+
+/// Output format. `FromStr` accepts `table`, `json`, `csv` (any case); `Display` writes them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Format {
+    /// Aligned text for people (the default).
+    #[default]
+    Table,
+    /// Pretty JSON of the serde structs.
+    Json,
+    /// One header row and one row per run.
+    Csv,
+}
+
+impl Format {
+    /// Every format, in `--help` order.
+    pub const ALL: [Format; 3] = [Format::Table, Format::Json, Format::Csv];
+
+    /// The name `FromStr` accepts.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Format::Table => "table",
+            Format::Json => "json",
+            Format::Csv => "csv",
+        }
+    }
+}
+
+impl fmt::Display for Format {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A format name that is not `table`, `json` or `csv`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown format {0:?} (expected table, json or csv)")]
+pub struct UnknownFormat(pub String);
+
+impl FromStr for Format {
+    type Err = UnknownFormat;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Format::ALL
+            .into_iter()
+            .find(|f| f.as_str().eq_ignore_ascii_case(s.trim()))
+            .ok_or_else(|| UnknownFormat(s.into()))
+    }
+}
+
+/// Renders a comparison; text ends with a newline.
+pub fn render_comparison(cmp: &Comparison, format: Format) -> Result<String, Error> {
+    let runs: Vec<&RunMetrics> = cmp.runs.iter().map(|r| &r.metrics).collect();
+    Ok(match format {
+        Format::Table => table::render(&runs, Some(cmp)),
+        Format::Json => serde_json::to_string_pretty(cmp)? + "\n",
+        Format::Csv => {
+            let ratios: Vec<&Ratios> = cmp.runs.iter().map(|r| &r.to_baseline).collect();
+            csv::render(&runs, Some((cmp, &ratios)))
+        }
+    })
+}
+
+/// Renders per-run metrics (JSON: an array of [`RunMetrics`]); text ends with a newline.
+pub fn render_metrics(runs: &[RunMetrics], format: Format) -> Result<String, Error> {
+    let refs: Vec<&RunMetrics> = runs.iter().collect();
+    Ok(match format {
+        Format::Table => table::render(&refs, None),
+        Format::Json => serde_json::to_string_pretty(runs)? + "\n",
+        Format::Csv => csv::render(&refs, None),
+    })
+}
+
+/// Joints in order of first appearance over the runs.
+fn joints<'a>(runs: &[&'a RunMetrics]) -> Vec<&'a str> {
+    union(
+        runs.iter()
+            .flat_map(|r| r.joint_names.iter().map(String::as_str)),
+    )
+}
+
+/// Contacts in order of first appearance over the runs.
+fn contacts<'a>(runs: &[&'a RunMetrics]) -> Vec<&'a str> {
+    union(
+        runs.iter()
+            .flat_map(|r| r.contacts.iter().map(String::as_str)),
+    )
+}
+
+fn union<'a>(names: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for n in names {
+        if !out.contains(&n) {
+            out.push(n);
+        }
+    }
+    out
+}
+
+fn status(s: Status) -> &'static str {
+    match s {
+        Status::Complete => "complete",
+        Status::Failed => "failed",
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,174 @@
+//! CSV: one header row, one row per run (column names in the parent module's docs).
+
+use super::{contacts, joints, status};
+use crate::compare::{Comparison, Ratios};
+use crate::metrics::RunMetrics;
+
+/// One cell per column; `None` is an empty cell.
+struct Row(Vec<Option<String>>);
+
+impl Row {
+    fn text(&mut self, s: &str) {
+        self.0.push(Some(s.to_string()));
+    }
+    fn num(&mut self, x: f64) {
+        self.0.push(Some(x.to_string()));
+    }
+    fn opt(&mut self, x: Option<f64>) {
+        self.0.push(x.map(|x| x.to_string()));
+    }
+}
+
+/// RFC 4180: quote a field holding a comma, quote or line break; double the quotes.
+fn field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+fn line(cells: impl IntoIterator<Item = String>) -> String {
+    let cells: Vec<String> = cells.into_iter().map(|c| field(&c)).collect();
+    cells.join(",") + "\n"
+}
+
+pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])>) -> String {
+    let joints = joints(runs);
+    let contacts = contacts(runs);
+    let mut head: Vec<String> = [
+        "run",
+        "file",
+        "scene",
+        "status",
+        "contacts",
+        "n_contacts",
+        "samples",
+        "t_end_s",
+        "error_time_s",
+        "err_x_rms_m",
+        "err_x_max_m",
+        "err_y_rms_m",
+        "err_y_max_m",
+        "err_z_rms_m",
+        "err_z_max_m",
+        "err_norm_rms_m",
+        "err_norm_max_m",
+        "E_total_J",
+        "W_total_J",
+    ]
+    .map(String::from)
+    .to_vec();
+    if cmp.is_some() {
+        head.extend(
+            [
+                "E_ratio",
+                "W_ratio",
+                "err_z_rms_ratio",
+                "err_norm_rms_ratio",
+            ]
+            .map(String::from),
+        );
+    }
+    head.extend(
+        [
+            "peak_current_A",
+            "peak_current_joint",
+            "dT_J",
+            "dV_J",
+            "dMagnetic_J",
+            "resistive_loss_J",
+            "friction_loss_J",
+            "residual_J",
+            "residual_max_abs_J",
+            "residual_max_rel",
+        ]
+        .map(String::from),
+    );
+    for j in &joints {
+        head.push(format!("W_{j}_J"));
+        head.push(format!("E_{j}_J"));
+        if cmp.is_some() {
+            head.push(format!("E_{j}_ratio"));
+        }
+    }
+    for c in &contacts {
+        head.extend([
+            format!("fn_min_{c}_N"),
+            format!("pull_{c}_s"),
+            format!("first_pull_{c}_s"),
+        ]);
+    }
+
+    let mut out = line(head);
+    for (k, r) in runs.iter().enumerate() {
+        let mut row = Row(Vec::with_capacity(64));
+        for s in [
+            &r.run,
+            &r.file,
+            &r.scene,
+            status(r.status),
+            &r.contacts.join(";"),
+        ] {
+            row.text(s);
+        }
+        row.num(r.contacts.len() as f64);
+        row.num(r.samples as f64);
+        row.num(r.t_end_s);
+        row.opt(r.error_time_s);
+        let e = &r.hand_error;
+        for a in [&e.x, &e.y, &e.z, &e.norm] {
+            row.num(a.rms_m);
+            row.num(a.max_abs_m);
+        }
+        row.num(r.electric_energy_total_j);
+        row.num(r.link_work_total_j);
+        if let Some((_, ratios)) = cmp {
+            let q = ratios[k];
+            for x in [
+                q.electric_energy,
+                q.link_work,
+                q.error_z_rms,
+                q.error_norm_rms,
+            ] {
+                row.opt(x);
+            }
+        }
+        row.opt(r.peak_current.as_ref().map(|p| p.current_a));
+        row.0.push(r.peak_current.as_ref().map(|p| p.joint.clone()));
+        let a = &r.energy;
+        for x in [
+            a.kinetic_change_j,
+            a.potential_change_j,
+            a.magnetic_change_j,
+            a.resistive_loss_j,
+            a.friction_loss_j,
+            a.residual_j,
+            a.max_abs_residual_j,
+        ] {
+            row.num(x);
+        }
+        row.opt(a.max_abs_residual_rel);
+        for j in &joints {
+            let link = r.links.iter().find(|l| l.joint == *j);
+            row.opt(link.map(|l| l.work_j));
+            row.opt(link.map(|l| l.electric_energy_j));
+            if let Some((c, _)) = cmp {
+                let cell = c
+                    .links
+                    .iter()
+                    .find(|l| l.joint == *j)
+                    .and_then(|l| l.runs[k].as_ref());
+                row.opt(cell.and_then(|c| c.electric_energy_ratio));
+            }
+        }
+        for name in &contacts {
+            let c = r.contact_forces.iter().find(|c| c.contact == *name);
+            row.opt(c.map(|c| c.min_normal_force_n));
+            row.opt(c.map(|c| c.pull_time_s));
+            row.opt(c.and_then(|c| c.first_pull_s));
+        }
+        out += &line(row.0.into_iter().map(Option::unwrap_or_default));
+    }
+    out
+}

@@ -1,0 +1,314 @@
+//! Aligned text tables in sections, for people.
+
+use super::{contacts, joints, status};
+use crate::compare::{Comparison, Ratios};
+use crate::metrics::RunMetrics;
+
+/// One section: a title, a header row and rows, columns two spaces apart. The first `left`
+/// columns (names) are left-aligned, the others (numbers) right-aligned.
+struct Table {
+    title: String,
+    head: Vec<String>,
+    rows: Vec<Vec<String>>,
+    left: usize,
+}
+
+impl Table {
+    fn new(title: impl Into<String>, head: &[&str]) -> Self {
+        let head = head.iter().map(|h| h.to_string()).collect();
+        Self {
+            title: title.into(),
+            head,
+            rows: Vec::new(),
+            left: 1,
+        }
+    }
+
+    fn write(&self, out: &mut String) {
+        let width = |s: &str| s.chars().count();
+        let mut w: Vec<usize> = self.head.iter().map(|h| width(h)).collect();
+        for row in &self.rows {
+            for (c, cell) in row.iter().enumerate() {
+                w[c] = w[c].max(width(cell));
+            }
+        }
+        let fmt_row = |cells: &[String]| {
+            let parts: Vec<String> = cells
+                .iter()
+                .enumerate()
+                .map(|(c, s)| {
+                    let pad = " ".repeat(w[c] - width(s));
+                    if c < self.left {
+                        format!("{s}{pad}")
+                    } else {
+                        format!("{pad}{s}")
+                    }
+                })
+                .collect();
+            parts.join("  ").trim_end().to_string() + "\n"
+        };
+        out.push_str(&self.title);
+        out.push('\n');
+        out.push_str(&fmt_row(&self.head));
+        let rule: Vec<String> = w.iter().map(|&n| "-".repeat(n)).collect();
+        out.push_str(&fmt_row(&rule));
+        for row in &self.rows {
+            out.push_str(&fmt_row(row));
+        }
+        out.push('\n');
+    }
+}
+
+/// `x` with `d` decimals.
+fn f(x: f64, d: usize) -> String {
+    format!("{x:.d$}")
+}
+
+/// In mm with 3 decimals, from m.
+fn mm(x_m: f64) -> String {
+    f(x_m * 1e3, 3)
+}
+
+/// Scientific with 2 decimals.
+fn e(x: f64) -> String {
+    format!("{x:.2e}")
+}
+
+/// A ratio with 3 decimals, `-` when it does not exist.
+fn q(x: Option<f64>) -> String {
+    x.map_or("-".into(), |x| f(x, 3))
+}
+
+pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>) -> String {
+    let ratios: Option<Vec<&Ratios>> = cmp.map(|c| c.runs.iter().map(|r| &r.to_baseline).collect());
+    let base = cmp.map(|c| c.baseline_index);
+    let name = |k: usize| {
+        let r = &runs[k].run;
+        if Some(k) == base {
+            format!("{r} *")
+        } else {
+            r.clone()
+        }
+    };
+    let mut out = String::new();
+
+    // runs
+    let title = if cmp.is_some() {
+        "Runs (* = baseline; ratios are run / baseline)"
+    } else {
+        "Runs"
+    };
+    let mut t = Table::new(
+        title,
+        &[
+            "run",
+            "scene",
+            "contacts",
+            "status",
+            "t_end [s]",
+            "samples",
+            "peak |i| [A]",
+            "at joint",
+        ],
+    );
+    t.left = 4;
+    for (k, r) in runs.iter().enumerate() {
+        let contacts = if r.contacts.is_empty() {
+            "-".to_string()
+        } else {
+            r.contacts.join(",")
+        };
+        let at = r
+            .error_time_s
+            .map_or(String::new(), |t| format!(" at {t:.3} s"));
+        let (peak, joint) = r
+            .peak_current
+            .as_ref()
+            .map_or(("-".into(), "-".into()), |p| {
+                (f(p.current_a, 3), p.joint.clone())
+            });
+        let st = format!("{}{at}", status(r.status));
+        t.rows.push(vec![
+            name(k),
+            r.scene.clone(),
+            contacts,
+            st,
+            f(r.t_end_s, 3),
+            r.samples.to_string(),
+            peak,
+            joint,
+        ]);
+    }
+    t.write(&mut out);
+
+    // hand error
+    let mut head = vec![
+        "run",
+        "x rms [mm]",
+        "y rms [mm]",
+        "z rms [mm]",
+        "|e| rms [mm]",
+        "x max [mm]",
+        "y max [mm]",
+        "z max [mm]",
+        "|e| max [mm]",
+    ];
+    if cmp.is_some() {
+        head.extend(["z rms / base", "|e| rms / base"]);
+    }
+    let mut t = Table::new("Hand error r - r_d", &head);
+    for (k, r) in runs.iter().enumerate() {
+        let h = &r.hand_error;
+        let mut row = vec![name(k)];
+        row.extend([&h.x, &h.y, &h.z, &h.norm].map(|a| mm(a.rms_m)));
+        row.extend([&h.x, &h.y, &h.z, &h.norm].map(|a| mm(a.max_abs_m)));
+        if let Some(q_) = &ratios {
+            row.extend([q(q_[k].error_z_rms), q(q_[k].error_norm_rms)]);
+        }
+        t.rows.push(row);
+    }
+    t.write(&mut out);
+
+    // energy totals
+    let mut head = vec!["run", "E = Σ ∫ i v dt [J]", "W = Σ ∫ τ q' dt [J]"];
+    if cmp.is_some() {
+        head.extend(["E / E_base", "W / W_base"]);
+    }
+    let mut t = Table::new("Energy totals at t_end", &head);
+    for (k, r) in runs.iter().enumerate() {
+        let mut row = vec![
+            name(k),
+            f(r.electric_energy_total_j, 4),
+            f(r.link_work_total_j, 4),
+        ];
+        if let Some(q_) = &ratios {
+            row.extend([q(q_[k].electric_energy), q(q_[k].link_work)]);
+        }
+        t.rows.push(row);
+    }
+    t.write(&mut out);
+
+    // per-link energy
+    let mut head: Vec<String> = vec!["joint".into()];
+    head.extend(runs.iter().map(|r| format!("W {} [J]", r.run)));
+    head.extend(runs.iter().map(|r| format!("E {} [J]", r.run)));
+    if cmp.is_some() {
+        head.extend(
+            runs.iter()
+                .enumerate()
+                .filter(|&(k, _)| Some(k) != base)
+                .map(|(_, r)| format!("E/E_base {}", r.run)),
+        );
+    }
+    let head: Vec<&str> = head.iter().map(String::as_str).collect();
+    let mut t = Table::new(
+        "Per-link energy at t_end (W_j work on the link, E_j electric energy of its motor)",
+        &head,
+    );
+    for j in joints(runs) {
+        let links: Vec<_> = runs
+            .iter()
+            .map(|r| r.links.iter().find(|l| l.joint == j))
+            .collect();
+        let mut row = vec![j.to_string()];
+        row.extend(
+            links
+                .iter()
+                .map(|l| l.map_or("-".into(), |l| f(l.work_j, 4))),
+        );
+        row.extend(
+            links
+                .iter()
+                .map(|l| l.map_or("-".into(), |l| f(l.electric_energy_j, 4))),
+        );
+        if let Some(c) = cmp {
+            let cells = c.links.iter().find(|l| l.joint == j).map(|l| &l.runs);
+            for k in (0..runs.len()).filter(|&k| Some(k) != base) {
+                let cell = cells.and_then(|c| c[k].as_ref());
+                row.push(q(cell.and_then(|c| c.electric_energy_ratio)));
+            }
+        }
+        t.rows.push(row);
+    }
+    t.write(&mut out);
+
+    // contacts
+    if !contacts(runs).is_empty() {
+        let mut t = Table::new(
+            "Contacts (f_n < 0: the table pulls)",
+            &[
+                "run",
+                "contact",
+                "min f_n [N]",
+                "at [s]",
+                "f_n < 0 for [s]",
+                "first f_n < 0 [s]",
+                "max |C| [m]",
+                "max |C'| [m/s]",
+            ],
+        );
+        t.left = 2;
+        for (k, r) in runs.iter().enumerate() {
+            for c in &r.contact_forces {
+                let first = c.first_pull_s.map_or("-".into(), |t| f(t, 3));
+                t.rows.push(vec![
+                    name(k),
+                    c.contact.clone(),
+                    f(c.min_normal_force_n, 3),
+                    f(c.t_min_normal_force_s, 3),
+                    f(c.pull_time_s, 3),
+                    first,
+                    e(c.max_abs_position_m),
+                    e(c.max_abs_velocity_m_s),
+                ]);
+            }
+        }
+        t.write(&mut out);
+    }
+
+    // energy balance
+    let mut t = Table::new(
+        "Energy balance at t_end [J]: E = ΔT + ΔV + Δ(L i²/2) + R loss + friction loss + residual",
+        &[
+            "run",
+            "E",
+            "ΔT",
+            "ΔV",
+            "Δ(L i²/2)",
+            "R loss",
+            "friction loss",
+            "residual",
+            "max |residual|",
+            "max |res| / E",
+        ],
+    );
+    for (k, r) in runs.iter().enumerate() {
+        let a = &r.energy;
+        let rel = a.max_abs_residual_rel.map_or("-".into(), e);
+        t.rows.push(vec![
+            name(k),
+            f(a.electric_j, 4),
+            f(a.kinetic_change_j, 4),
+            f(a.potential_change_j, 4),
+            f(a.magnetic_change_j, 4),
+            f(a.resistive_loss_j, 4),
+            f(a.friction_loss_j, 4),
+            e(a.residual_j),
+            e(a.max_abs_residual_j),
+            rel,
+        ]);
+    }
+    t.write(&mut out);
+
+    // findings
+    if let Some(c) = cmp {
+        out.push_str("Findings\n");
+        for s in &c.findings {
+            out.push_str(&format!("- {s}\n"));
+        }
+    }
+    while out.ends_with("\n\n") {
+        out.pop();
+    }
+    out
+}

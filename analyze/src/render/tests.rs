@@ -1,0 +1,164 @@
+//! Rendering: JSON round-trips, CSV shape, table alignment and content.
+
+use super::*;
+use crate::compare::tests::paper_runs;
+
+/// The paper's three runs; two-elbow's elbow7 pulls, and one ratio does not exist.
+fn comparison() -> Comparison {
+    let mut runs = paper_runs();
+    let c7 = &mut runs[0].contact_forces[1];
+    (c7.pull_time_s, c7.first_pull_s, c7.min_normal_force_n) = (0.31, Some(0.2), -4.0);
+    runs[2].links[2].electric_energy_j = 0.0; // baseline E_3 = 0: no E_3 ratios
+    Comparison::new(&runs, None).unwrap()
+}
+
+#[test]
+fn format_parses_and_displays() {
+    assert_eq!("table".parse::<Format>(), Ok(Format::Table));
+    assert_eq!(" JSON ".parse::<Format>(), Ok(Format::Json));
+    assert_eq!("Csv".parse::<Format>(), Ok(Format::Csv));
+    let err = "xml".parse::<Format>().unwrap_err().to_string();
+    assert!(
+        err.contains("\"xml\"") && err.contains("table, json or csv"),
+        "{err}"
+    );
+    for f in Format::ALL {
+        assert_eq!(f.to_string().parse::<Format>(), Ok(f));
+    }
+    assert_eq!(Format::default(), Format::Table);
+}
+
+#[test]
+fn json_round_trips_through_serde_with_stable_keys() {
+    let cmp = comparison();
+    let text = render_comparison(&cmp, Format::Json).unwrap();
+    assert_eq!(serde_json::from_str::<Comparison>(&text).unwrap(), cmp);
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    assert_eq!(
+        keys,
+        ["baseline", "baseline_index", "findings", "links", "runs"]
+    );
+    assert!(v["runs"][0]["to_baseline"]["electric_energy"].is_f64());
+    assert!(v["links"][2]["runs"][0]["electric_energy_ratio"].is_null());
+
+    let runs = paper_runs();
+    let text = render_metrics(&runs, Format::Json).unwrap();
+    assert_eq!(
+        serde_json::from_str::<Vec<RunMetrics>>(&text).unwrap(),
+        runs
+    );
+}
+
+fn cells(line: &str) -> usize {
+    line.split(',').count()
+}
+
+/// 19 run columns + 4 ratios + 10 peak/energy columns + 3 per joint (3 joints) + 3 per contact
+/// (2 contacts) = 48; metrics only: 19 + 10 + 2 * 3 + 3 * 2 = 41.
+#[test]
+fn csv_has_a_header_and_one_row_per_run_of_equal_width() {
+    let text = render_comparison(&comparison(), Format::Csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 1 + 3);
+    assert!(lines.iter().all(|l| cells(l) == 48), "{text}");
+    let head: Vec<&str> = lines[0].split(',').collect();
+    for col in [
+        "run",
+        "E_total_J",
+        "E_ratio",
+        "W_joint1_J",
+        "E_joint1_J",
+        "E_joint3_ratio",
+        "pull_elbow7_s",
+    ] {
+        assert!(head.contains(&col), "{col} not in {head:?}");
+    }
+    let row: Vec<&str> = lines[1].split(',').collect();
+    let at = |col: &str| row[head.iter().position(|h| *h == col).unwrap()];
+    assert_eq!(
+        (at("run"), at("E_total_J"), at("E_ratio")),
+        ("two-elbow", "6", "0.6")
+    );
+    assert_eq!(
+        (at("W_joint2_J"), at("E_joint2_J"), at("E_joint1_ratio")),
+        ("1", "3", "0.4")
+    );
+    assert_eq!(
+        (
+            at("pull_elbow7_s"),
+            at("first_pull_elbow7_s"),
+            at("E_joint3_ratio")
+        ),
+        ("0.31", "0.2", "")
+    );
+    let last: Vec<&str> = lines[3].split(',').collect(); // no-elbow has no contacts: empty cells
+    assert_eq!(last[head.len() - 3..], ["", "", ""]);
+
+    let text = render_metrics(&paper_runs(), Format::Csv).unwrap();
+    assert!(
+        text.lines().all(|l| cells(l) == 41) && text.lines().count() == 4,
+        "{text}"
+    );
+    assert!(!text.contains("ratio"));
+}
+
+#[test]
+fn csv_quotes_fields_with_commas_and_quotes() {
+    let mut runs = paper_runs();
+    runs[0].run = "a,\"b\"".into();
+    let text = render_metrics(&runs, Format::Csv).unwrap();
+    assert!(
+        text.lines().nth(1).unwrap().starts_with("\"a,\"\"b\"\"\","),
+        "{text}"
+    );
+}
+
+/// Every line of a section (header, rule, rows) has the same width: columns are aligned.
+#[test]
+fn table_sections_are_aligned_with_units_and_findings() {
+    let text = render_comparison(&comparison(), Format::Table).unwrap();
+    for want in [
+        "Runs (* = baseline",
+        "no-elbow *",
+        "z rms [mm]",
+        "E / E_base",
+        "Per-link energy",
+        "W two-elbow [J]",
+        "E/E_base two-elbow",
+        "Contacts",
+        "max |C'| [m/s]",
+        "Energy balance",
+        "Findings",
+        "A real table cannot pull.",
+    ] {
+        assert!(text.contains(want), "{want:?} missing in\n{text}");
+    }
+    for section in text.split("\n\n").filter(|s| !s.starts_with("Findings")) {
+        let widths: Vec<usize> = section.lines().skip(1).map(|l| l.chars().count()).collect();
+        assert!(
+            widths.len() >= 3 && widths.iter().all(|&w| w == widths[0]),
+            "{section}"
+        );
+    }
+    // one joint row per joint, values with their decimals: two-elbow W_1 = 1 J, E_1 = 2 J
+    let link_row = text.lines().find(|l| l.starts_with("joint1 ")).unwrap();
+    let v: Vec<&str> = link_row.split_whitespace().collect();
+    assert_eq!(
+        v,
+        ["joint1", "1.0000", "1.0000", "1.0000", "2.0000", "3.0000", "5.0000", "0.400", "0.600"]
+    );
+}
+
+#[test]
+fn metrics_table_has_no_ratios_or_findings() {
+    let text = render_metrics(&paper_runs(), Format::Table).unwrap();
+    assert!(
+        text.starts_with("Runs\n") && text.contains("Hand error"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("base") && !text.contains("Findings"),
+        "{text}"
+    );
+}

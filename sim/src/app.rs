@@ -1,0 +1,159 @@
+//! What the `sim` commands do: load the scene, run the selected runs in parallel with progress
+//! bars, then read the recordings back and print the comparison table (through the `analyze`
+//! library, so the numbers shown are those any reader of the files gets).
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use sim::run::run_to_file;
+use sim::scene::{Scene, PAPER_SCENE_JSON, PAPER_URDF};
+
+use crate::cli::{Format, RunArgs};
+
+/// Exit status for a run that failed numerically (bad input exits with 2).
+pub const EXIT_RUN_FAILED: u8 = 1;
+
+pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    Ok(match path {
+        Some(p) => Scene::load(p)?,
+        None => Scene::paper()?,
+    })
+}
+
+/// `sim check`: validate and describe.
+pub fn check(scene: Option<&Path>) -> Result<()> {
+    let s = load_scene(scene)?;
+    println!("scene `{}` ({}) is valid", s.spec.name, s.source);
+    println!("  robot `{}`: {} joints ({}), {:.3} kg moving", s.model.name, s.model.nv, s.model.joint_names().join(", "), s.model.total_mass());
+    println!("  contacts: {}", s.contacts.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", "));
+    for r in &s.runs {
+        let names: Vec<&str> = r.contacts.iter().map(|&k| s.contacts[k].name.as_str()).collect();
+        println!("  run `{}`: contacts [{}]", r.name, names.join(", "));
+    }
+    println!("  {} s at {} Hz output, integrator {:?}, mass matrix {:?}, solver {:?}", s.duration, s.output_rate, s.integrator, s.mass_matrix, s.solver);
+    Ok(())
+}
+
+/// `sim export-scene DIR`.
+pub fn export_scene(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    for (name, text) in [("paper.json", PAPER_SCENE_JSON), ("paper_arm.urdf", PAPER_URDF)] {
+        let p = dir.join(name);
+        if p.exists() {
+            bail!("{} exists; not overwriting it", p.display());
+        }
+        std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))?;
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// The outcome of `sim run`: paths written, and whether every run completed.
+pub struct RunOutcome {
+    pub written: Vec<PathBuf>,
+    pub failures: Vec<String>,
+}
+
+/// `sim [run]`.
+pub fn run(args: &RunArgs) -> Result<RunOutcome> {
+    let scene = load_scene(args.scene.as_deref())?;
+    let runs: Vec<_> = if args.runs.is_empty() {
+        scene.runs.clone()
+    } else {
+        args.runs
+            .iter()
+            .map(|n| {
+                scene.run(n).cloned().with_context(|| {
+                    format!("no run `{n}` in scene `{}` (runs: {})", scene.spec.name, scene.runs.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "))
+                })
+            })
+            .collect::<Result<_>>()?
+    };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create output directory {}", args.out.display()))?;
+
+    let multi = MultiProgress::with_draw_target(if args.quiet { ProgressDrawTarget::hidden() } else { ProgressDrawTarget::stderr() });
+    let style = ProgressStyle::with_template("{prefix:>12} [{bar:30.cyan/blue}] {msg:>9} simulated  {elapsed_precise}")
+        .expect("a valid template")
+        .progress_chars("=> ");
+    let total_ms = (scene.duration * 1e3).round() as u64;
+    let bars: Vec<ProgressBar> = runs
+        .iter()
+        .map(|r| {
+            let b = multi.add(ProgressBar::new(total_ms));
+            b.set_style(style.clone());
+            b.set_prefix(r.name.clone());
+            b.set_message("0.000 s");
+            b
+        })
+        .collect();
+
+    let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1).min(runs.len());
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<(Result<PathBuf, String>, f64)>>> = Mutex::new(vec![None; runs.len()]);
+    let started = Instant::now();
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            s.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                let Some(run) = runs.get(k) else { break };
+                let path = args.out.join(format!("{}-{}.mcap", scene.spec.name, run.name));
+                let bar = &bars[k];
+                let t0 = Instant::now();
+                let mut count = 0u32;
+                let res = run_to_file(&scene, run, &path, |t| {
+                    count += 1;
+                    if count % 64 == 0 {
+                        bar.set_position((t * 1e3).round() as u64);
+                        bar.set_message(format!("{t:.3} s"));
+                    }
+                });
+                let wall = t0.elapsed().as_secs_f64();
+                match &res {
+                    Ok(_) => bar.finish_with_message(format!("{:.3} s", scene.duration)),
+                    Err(e) => bar.abandon_with_message(format!("failed at {}", e.time().map_or("?".into(), |t| format!("{t:.3} s")))),
+                }
+                let res = res.map(|r| r.path).map_err(|e| format!("run `{}`: {e}", run.name));
+                results.lock().expect("no panics while holding the lock")[k] = Some((res, wall));
+            });
+        }
+    });
+    let wall_total = started.elapsed().as_secs_f64();
+    let mut written = Vec::new();
+    let mut failures = Vec::new();
+    for (k, r) in results.into_inner().expect("threads joined").into_iter().enumerate() {
+        match r {
+            Some((Ok(p), wall)) => {
+                if !args.quiet {
+                    eprintln!("wrote {} ({:.0}x real time)", p.display(), scene.duration / wall.max(1e-9));
+                }
+                written.push(p);
+            }
+            Some((Err(e), _)) => failures.push(e),
+            None => failures.push(format!("run `{}` did not start", runs[k].name)),
+        }
+    }
+    if !args.quiet {
+        eprintln!("{} run(s) in {:.2} s wall time on {} thread(s)", runs.len(), wall_total, jobs);
+    }
+    Ok(RunOutcome { written, failures })
+}
+
+/// Read the recordings back and print the comparison of the runs.
+pub fn print_comparison(paths: &[PathBuf], format: Format, baseline: Option<&str>) -> Result<()> {
+    let mut metrics = Vec::with_capacity(paths.len());
+    for p in paths {
+        metrics.push(analyze::read_run_metrics(p).with_context(|| format!("reading back {}", p.display()))?);
+    }
+    let cmp = analyze::Comparison::new(&metrics, baseline)?;
+    let fmt = match format {
+        Format::Table => analyze::Format::Table,
+        Format::Json => analyze::Format::Json,
+        Format::Csv => analyze::Format::Csv,
+    };
+    print!("{}", analyze::render_comparison(&cmp, fmt)?);
+    Ok(())
+}
