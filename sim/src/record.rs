@@ -92,6 +92,15 @@ impl<'a> Recorder<'a> {
         m.insert("output_rate".into(), format!("{:e}", scene.output_rate));
         m.insert("mass_matrix".into(), serde_json::to_string(&scene.mass_matrix).unwrap_or_default().trim_matches('"').into());
         m.insert("constraint_solver".into(), serde_json::to_string(&scene.solver).unwrap_or_default().trim_matches('"').into());
+        m.insert("stabilization".into(), serde_json::to_string(&scene.stabilization).unwrap_or_default());
+        // the model that ran: only the terms the scene has are assembled
+        m.insert(
+            "model.electrical".into(),
+            if scene.drives.quasi_static { "quasi-static current (L = 0)" } else { "L di/dt (one state per motor)" }.into(),
+        );
+        m.insert("model.contacts".into(), run.contacts.len().to_string());
+        m.insert("model.friction".into(), if scene.drives.has_friction { "on" } else { "off" }.into());
+        m.insert("model.gravity".into(), if scene.model.gravity == nalgebra::Vector3::zeros() { "off" } else { "on" }.into());
         m.insert("hand_frame".into(), WORLD_FRAME.into());
         m.insert("tool".into(), TOOL.into());
         writer.write_metadata(records::RUN, &m).map_err(err)?;

@@ -2,7 +2,8 @@
 //! and the IK targets of eqs 28–29), and the derived outputs recorded at each sample.
 //!
 //! State `y` (all that is integrated, nothing else), with n = nv:
-//! `[ q (n) | q̇ (n) | i (n) | W (n) | E (n) | E_R | E_D ]` where
+//! `[ q (n) | q̇ (n) | i (n) | W (n) | E (n) | E_R | E_D ]` where the currents i are present
+//! only when the motors have inductance (L = 0: quasi-static current, no electrical state), and
 //! `W_j = ∫ τ_j q̇_j dt` (work of motor j on link j, τ of eq 12), `E_j = ∫ i_j v_j dt` (electric
 //! energy into motor j), `E_R = ∫ Σ R i² dt` and `E_D = ∫ Σ (D + D_m) q̇² dt` (losses). The
 //! quadratures ride along with the dynamics so that they are integrated to the same accuracy.
@@ -26,11 +27,13 @@ use crate::scene::{Run, Scene};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Layout {
     pub nv: usize,
+    /// Number of electrical states: nv, or 0 for quasi-static motors.
+    pub ni: usize,
 }
 
 impl Layout {
     pub fn dim(&self) -> usize {
-        5 * self.nv + 2
+        4 * self.nv + self.ni + 2
     }
     pub fn q(&self) -> std::ops::Range<usize> {
         0..self.nv
@@ -38,32 +41,41 @@ impl Layout {
     pub fn qd(&self) -> std::ops::Range<usize> {
         self.nv..2 * self.nv
     }
+    /// The currents; empty for quasi-static motors.
     pub fn current(&self) -> std::ops::Range<usize> {
-        2 * self.nv..3 * self.nv
+        2 * self.nv..2 * self.nv + self.ni
     }
     pub fn work(&self) -> std::ops::Range<usize> {
-        3 * self.nv..4 * self.nv
+        let s = 2 * self.nv + self.ni;
+        s..s + self.nv
     }
     pub fn electric(&self) -> std::ops::Range<usize> {
-        4 * self.nv..5 * self.nv
+        let s = 3 * self.nv + self.ni;
+        s..s + self.nv
     }
     pub fn loss_r(&self) -> usize {
-        5 * self.nv
+        4 * self.nv + self.ni
     }
     pub fn loss_d(&self) -> usize {
-        5 * self.nv + 1
+        4 * self.nv + self.ni + 1
     }
     /// A readable name of state component `k`, for error messages.
     pub fn name(&self, k: usize, joints: &[String]) -> String {
-        let n = self.nv;
-        match k / n.max(1) {
-            _ if k == self.loss_r() => "resistive loss".into(),
-            _ if k == self.loss_d() => "friction loss".into(),
-            0 => format!("q of {}", joints[k]),
-            1 => format!("q' of {}", joints[k - n]),
-            2 => format!("current of {}", joints[k - 2 * n]),
-            3 => format!("link work of {}", joints[k - 3 * n]),
-            _ => format!("electric energy of {}", joints[k - 4 * n]),
+        let within = |r: std::ops::Range<usize>| r.contains(&k).then(|| joints[k - r.start].clone());
+        if let Some(j) = within(self.q()) {
+            format!("q of {j}")
+        } else if let Some(j) = within(self.qd()) {
+            format!("q' of {j}")
+        } else if let Some(j) = within(self.current()) {
+            format!("current of {j}")
+        } else if let Some(j) = within(self.work()) {
+            format!("link work of {j}")
+        } else if let Some(j) = within(self.electric()) {
+            format!("electric energy of {j}")
+        } else if k == self.loss_r() {
+            "resistive loss".into()
+        } else {
+            "friction loss".into()
         }
     }
 }
@@ -106,6 +118,8 @@ pub struct ArmSystem<'a> {
     q_des: Vec<f64>,
     qd_des: Vec<f64>,
     voltage: Vec<f64>,
+    /// Currents of quasi-static motors (computed, not integrated), A.
+    current_qs: Vec<f64>,
     /// T + V + ½ L i² at t = 0, J (for the balance residual).
     stored0: f64,
 }
@@ -118,12 +132,13 @@ impl<'a> ArmSystem<'a> {
         let mut sys = Self {
             scene,
             contacts,
-            layout: Layout { nv },
+            layout: Layout { nv, ni: if scene.drives.quasi_static { 0 } else { nv } },
             data: Data::new(&scene.model),
             fd: ForwardData::new(nv, nc),
             q_des: vec![0.0; nv],
             qd_des: vec![0.0; nv],
             voltage: vec![0.0; nv],
+            current_qs: vec![0.0; nv],
             stored0: 0.0,
         };
         sys.stored0 = sys.stored_energy(&scene.q0, &scene.qd0, &scene.current0);
@@ -135,7 +150,9 @@ impl<'a> ArmSystem<'a> {
         let mut y = vec![0.0; self.layout.dim()];
         y[self.layout.q()].copy_from_slice(&self.scene.q0);
         y[self.layout.qd()].copy_from_slice(&self.scene.qd0);
-        y[self.layout.current()].copy_from_slice(&self.scene.current0);
+        if self.layout.ni > 0 {
+            y[self.layout.current()].copy_from_slice(&self.scene.current0);
+        }
         y
     }
 
@@ -151,18 +168,27 @@ impl<'a> ArmSystem<'a> {
     /// Targets and voltages at (t, q, q̇), then eq 21. Fills `fd` and `voltage`.
     fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
         let l = self.layout;
-        let (q, qd, cur) = (&y[l.q()], &y[l.qd()], &y[l.current()]);
+        let (q, qd) = (&y[l.q()], &y[l.qd()]);
         let s = self.scene;
         s.ik
             .solve(&s.circle.position(t), &s.circle.velocity(t), &mut self.q_des, &mut self.qd_des)
             .map_err(|why| DynamicsError::Unreachable { t, why })?;
         s.gains.voltage(q, qd, &self.q_des, &self.qd_des, &mut self.voltage);
+        let cur = if l.ni == 0 {
+            for j in 0..l.nv {
+                self.current_qs[j] = s.drives.quasi_static_current(j, self.voltage[j], qd[j]);
+            }
+            &self.current_qs[..]
+        } else {
+            &y[l.current()]
+        };
         let plant = Plant {
             model: &s.model,
             drives: &s.drives,
             contacts: &self.contacts,
             mass_matrix: s.mass_matrix,
             solver: s.solver,
+            stabilization: s.stabilization,
         };
         forward_dynamics(&plant, &mut self.data, &mut self.fd, t, q, qd, cur, &self.voltage)
     }
@@ -173,7 +199,8 @@ impl<'a> ArmSystem<'a> {
         let l = self.layout;
         let s = self.scene;
         let d = &s.drives;
-        let (q, qd, cur) = (&y[l.q()], &y[l.qd()], &y[l.current()]);
+        let (q, qd) = (&y[l.q()], &y[l.qd()]);
+        let cur = if l.ni == 0 { &self.current_qs[..] } else { &y[l.current()] };
         out.t = t;
         set(&mut out.q, q);
         set(&mut out.qd, qd);
@@ -225,16 +252,23 @@ impl OdeSystem for ArmSystem<'_> {
         self.evaluate(t, y)?;
         let l = self.layout;
         let d = &self.scene.drives;
-        let (qd, cur) = (&y[l.qd()], &y[l.current()]);
+        let qd = &y[l.qd()];
+        let cur = if l.ni == 0 { &self.current_qs[..] } else { &y[l.current()] };
         dydt[l.q()].copy_from_slice(qd);
         dydt[l.qd()].copy_from_slice(self.fd.qdd.as_slice());
-        dydt[l.current()].copy_from_slice(self.fd.di.as_slice());
+        if l.ni > 0 {
+            dydt[l.current()].copy_from_slice(self.fd.di.as_slice());
+        }
         let (mut p_r, mut p_d) = (0.0, 0.0);
         for j in 0..l.nv {
             dydt[l.work().start + j] = self.fd.tau_motor[j] * qd[j];
             dydt[l.electric().start + j] = cur[j] * self.voltage[j];
             p_r += d.r[j] * cur[j] * cur[j];
-            p_d += (d.d[j] + d.dm[j]) * qd[j] * qd[j];
+        }
+        if d.has_friction {
+            for j in 0..l.nv {
+                p_d += (d.d[j] + d.dm[j]) * qd[j] * qd[j];
+            }
         }
         dydt[l.loss_r()] = p_r;
         dydt[l.loss_d()] = p_d;

@@ -38,6 +38,20 @@ pub enum MassMatrixMethod {
     WalkerOrin,
 }
 
+/// Constraint stabilisation: the acceleration-level constraint of eq 15 lets C and Ċ drift.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "method", deny_unknown_fields)]
+pub enum Stabilization {
+    /// Eq 15 as in the paper: `J_c q̈ = −J̇_c q̇`.
+    #[default]
+    None,
+    /// Baumgarte (1972): `J_c q̈ = −J̇_c q̇ − 2 α Ċ − β² C`, α and β in 1/s.
+    Baumgarte { alpha: f64, beta: f64 },
+    /// After every accepted step, project q onto C = 0 and q̇ onto Ċ = 0 (mass-weighted
+    /// Gauss–Newton; Hairer, Lubich & Wanner, *Geometric Numerical Integration*, §IV.4).
+    Projection,
+}
+
 /// How the constrained system is solved.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -62,10 +76,17 @@ pub struct ForwardData {
     pub jac: DMatrix<f64>,
     /// `J̇_c q̇` (nc), m/s^2.
     pub jdqd: DVector<f64>,
+    /// Constraint positions `C` (nc), m, and velocities `Ċ` (nc), m/s.
+    pub c: DVector<f64>,
+    pub cd: DVector<f64>,
     /// `M_J^{-1} J_c^T` (nv x nc).
     pub y: DMatrix<f64>,
     /// Schur complement `J_c M_J^{-1} J_c^T` (nc x nc).
     pub a: DMatrix<f64>,
+    /// Its Cholesky factor (nc x nc).
+    pub a_factor: DMatrix<f64>,
+    /// Whether the last solve had to regularise a singular Schur complement (redundant contacts).
+    pub regularized: bool,
     /// Normal forces `f_n` (nc), N.
     pub f_n: DVector<f64>,
     /// Block matrix of eq 21 without the electrical rows ((nv + nc)^2), for `Kkt`.
@@ -85,8 +106,12 @@ impl ForwardData {
             qdd: DVector::zeros(nv),
             jac: DMatrix::zeros(nc, nv),
             jdqd: DVector::zeros(nc),
+            c: DVector::zeros(nc),
+            cd: DVector::zeros(nc),
             y: DMatrix::zeros(nv, nc),
             a: DMatrix::zeros(nc, nc),
+            a_factor: DMatrix::zeros(nc, nc),
+            regularized: false,
             f_n: DVector::zeros(nc),
             kkt: DMatrix::zeros(nv + nc, nv + nc),
             kkt_rhs: DVector::zeros(nv + nc),
@@ -104,6 +129,7 @@ pub struct Plant<'a> {
     pub contacts: &'a [PointOnPlane],
     pub mass_matrix: MassMatrixMethod,
     pub solver: ConstraintSolver,
+    pub stabilization: Stabilization,
 }
 
 /// Solve eq 21 at time `t` (used only in error messages) for the state `q` (rad), `qd`
@@ -126,7 +152,12 @@ pub fn forward_dynamics(
     // bias forces h + G, and b = K_m i − h − G − (D + D_m) q̇
     bias_forces(model, data, q, qd);
     for j in 0..nv {
-        fd.b[j] = drives.km[j] * current[j] - data.tau[j] - (drives.d[j] + drives.dm[j]) * qd[j];
+        fd.b[j] = drives.km[j] * current[j] - data.tau[j];
+    }
+    if drives.has_friction {
+        for j in 0..nv {
+            fd.b[j] -= (drives.d[j] + drives.dm[j]) * qd[j];
+        }
     }
     // M_J = M + J_m
     match plant.mass_matrix {
@@ -142,6 +173,16 @@ pub fn forward_dynamics(
         forward_kinematics(model, data, q);
         forward_velocities(model, data, qd);
         constraint_jacobian(model, data, plant.contacts, &mut fd.jac, &mut fd.jdqd);
+        for (k, c) in plant.contacts.iter().enumerate() {
+            fd.c[k] = c.position(data);
+            fd.cd[k] = c.velocity(data);
+        }
+        // Baumgarte: the right-hand side −J̇q̇ becomes −J̇q̇ − 2αĊ − β²C
+        if let Stabilization::Baumgarte { alpha, beta } = plant.stabilization {
+            for k in 0..nc {
+                fd.jdqd[k] += 2.0 * alpha * fd.cd[k] + beta * beta * fd.c[k];
+            }
+        }
     }
     match plant.solver {
         ConstraintSolver::Schur => solve_schur(plant, fd, t)?,
@@ -149,7 +190,7 @@ pub fn forward_dynamics(
     }
     // electrical rows and the motor torque of eq 12
     for j in 0..nv {
-        fd.di[j] = drives.current_rate(j, voltage[j], current[j], qd[j]);
+        fd.di[j] = if drives.quasi_static { 0.0 } else { drives.current_rate(j, voltage[j], current[j], qd[j]) };
         fd.tau_motor[j] = drives.link_torque(j, current[j], qd[j], fd.qdd[j]);
     }
     if let Some(j) = fd.qdd.iter().position(|x| !x.is_finite()) {
@@ -180,19 +221,39 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
         // f_n = A^{-1} (−J̇q̇ − J q̈_free)
         fd.f_n.copy_from(&fd.jdqd);
         fd.f_n.gemv(-1.0, &fd.jac, &fd.qdd, -1.0);
-        let a = std::mem::replace(&mut fd.a, DMatrix::zeros(0, 0));
-        let Some(chol_a) = Cholesky::new(a) else {
-            fd.a = DMatrix::zeros(nc, nc);
-            fd.m_j = chol.unpack_dirty();
-            return Err(DynamicsError::SingularConstraints { t, constraints: contact_names(plant) });
-        };
-        chol_a.solve_mut(&mut fd.f_n);
-        // the Cholesky of a numerically singular A can succeed with a tiny pivot
-        let l = chol_a.l_dirty();
-        let min_pivot = (0..nc).fold(f64::INFINITY, |m, k| m.min(l[(k, k)].abs()));
-        let max_pivot = (0..nc).fold(0.0f64, |m, k| m.max(l[(k, k)].abs()));
-        fd.a = chol_a.unpack_dirty();
-        if !(min_pivot > 1e-7 * max_pivot) {
+        // a redundant set (the same point twice, a rank-deficient J_c) has a singular A: then
+        // solve (A + ε I) f = r with ε = 1e-10 max diag(A), which splits the force among the
+        // redundant rows and leaves q̈ unique up to O(ε) (Tikhonov; Golub & Van Loan §6.1.4)
+        fd.regularized = false;
+        let max_diag = (0..nc).fold(0.0f64, |m, k| m.max(fd.a[(k, k)].abs()));
+        let mut solved = false;
+        for eps in [0.0, 1e-10 * max_diag] {
+            fd.a_factor.copy_from(&fd.a);
+            for k in 0..nc {
+                fd.a_factor[(k, k)] += eps;
+            }
+            let a = std::mem::replace(&mut fd.a_factor, DMatrix::zeros(0, 0));
+            match Cholesky::new(a) {
+                Some(chol_a) => {
+                    let l = chol_a.l_dirty();
+                    let min_pivot = (0..nc).fold(f64::INFINITY, |m, k| m.min(l[(k, k)].abs()));
+                    let max_pivot = (0..nc).fold(0.0f64, |m, k| m.max(l[(k, k)].abs()));
+                    // pivots are square roots: a ratio of 1e-6 is a condition number of 1e12
+                    let well_posed = eps > 0.0 || min_pivot > 1e-6 * max_pivot;
+                    if well_posed {
+                        chol_a.solve_mut(&mut fd.f_n);
+                        fd.regularized = eps > 0.0;
+                        solved = true;
+                    }
+                    fd.a_factor = chol_a.unpack_dirty();
+                }
+                None => fd.a_factor = DMatrix::zeros(nc, nc),
+            }
+            if solved {
+                break;
+            }
+        }
+        if !solved || fd.f_n.iter().any(|x| !x.is_finite()) {
             fd.m_j = chol.unpack_dirty();
             return Err(DynamicsError::SingularConstraints { t, constraints: contact_names(plant) });
         }

@@ -3,6 +3,9 @@
 //! `τ = K_m i − J_m q̈ − D_m q̇` (eq 12), with, for a motor of torque/back-EMF constant K, rotor
 //! inertia I_m, gear ratio k and gear viscous friction d_m: `K_m = K k`, `J_m = I_m k^2`,
 //! `D_m = d_m k^2` (eqs 9–10). Angles and speeds are those of the link side of the gear.
+//!
+//! With L = 0 on every joint the current is algebraic (quasi-static): `i = (v − K_m q̇) / R`,
+//! and the motor is a torque source with back-EMF damping; no electrical state is integrated.
 
 use nalgebra::DVector;
 
@@ -53,6 +56,10 @@ pub struct Drives {
     pub dm: DVector<f64>,
     /// D: the joint's own viscous friction, N m s/rad.
     pub d: DVector<f64>,
+    /// L = 0 on every joint: the current follows the voltage instantly.
+    pub quasi_static: bool,
+    /// Some D + D_m is non-zero (else the friction terms are skipped).
+    pub has_friction: bool,
 }
 
 impl Drives {
@@ -65,7 +72,15 @@ impl Drives {
             jm: DVector::from_iterator(motors.len(), motors.iter().map(MotorParams::jm)),
             dm: DVector::from_iterator(motors.len(), motors.iter().map(MotorParams::dm)),
             d: DVector::from_column_slice(joint_damping),
+            quasi_static: motors.iter().all(|m| m.inductance == 0.0),
+            has_friction: motors.iter().zip(joint_damping).any(|(m, d)| m.dm() + d != 0.0),
         }
+    }
+
+    /// The quasi-static current of joint j (L = 0), `(v − K_m q̇) / R`, A.
+    #[inline]
+    pub fn quasi_static_current(&self, j: usize, v: f64, qd: f64) -> f64 {
+        (v - self.km[j] * qd) / self.r[j]
     }
 
     pub fn nv(&self) -> usize {

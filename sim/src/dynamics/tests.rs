@@ -210,7 +210,7 @@ fn constrained_accelerations_satisfy_the_constraints() {
             (MassMatrixMethod::Crba, ConstraintSolver::Kkt),
             (MassMatrixMethod::WalkerOrin, ConstraintSolver::Kkt),
         ] {
-            let plant = Plant { model: &model, drives: &drives, contacts: &contacts, mass_matrix: mm, solver };
+            let plant = Plant { model: &model, drives: &drives, contacts: &contacts, mass_matrix: mm, solver, stabilization: Default::default() };
             let mut fd = ForwardData::new(n, contacts.len());
             forward_dynamics(&plant, &mut data, &mut fd, 0.0, &q, &qd, &cur, &volt).expect("solvable");
             // residual of eq 15
@@ -230,27 +230,67 @@ fn constrained_accelerations_satisfy_the_constraints() {
     }
 }
 
-/// The same point twice makes J_c rank deficient: reported as singular, not NaN.
+/// The same point twice makes J_c rank deficient: solved without NaN by the regularised
+/// Schur complement. q̈ equals the single-contact q̈ (1e-8 relative), the constraint residual
+/// stays ~0 (1e-8), and the two forces split the single contact's force equally (1e-5: the
+/// split is set only by ε = 1e-10 against rounding of 1e-16, so to about 1e-6).
 #[test]
-fn redundant_contacts_are_reported_not_nan() {
+fn redundant_contacts_are_solved_not_nan() {
     let n = 5;
     let model = random_chain(n, 5);
     let drives = paper_like_drives(n);
     let c = PointOnPlane {
         name: "p".into(),
-        point: BodyPoint { body: Some(3), p_body: Vector3::zeros() },
+        point: BodyPoint { body: Some(3), p_body: Vector3::new(0.0, 0.0, 0.1) },
         normal_world: Vector3::z_axis(),
         offset: 0.0,
     };
-    let contacts = vec![c.clone(), PointOnPlane { name: "p-again".into(), ..c }];
+    let twice = vec![c.clone(), PointOnPlane { name: "p-again".into(), ..c.clone() }];
+    let once = vec![c];
+    let mut data = Data::new(&model);
+    let x = vec![0.1; n];
+    let solve = |contacts: &[PointOnPlane], data: &mut Data| {
+        let plant = Plant {
+            model: &model, drives: &drives, contacts, mass_matrix: MassMatrixMethod::Crba,
+            solver: ConstraintSolver::Schur,
+        stabilization: Default::default(),
+        };
+        let mut fd = ForwardData::new(n, contacts.len());
+        forward_dynamics(&plant, data, &mut fd, 1.25, &x, &x, &x, &x).expect("solved");
+        fd
+    };
+    let one = solve(&once, &mut data);
+    let two = solve(&twice, &mut data);
+    assert!(!one.regularized && two.regularized);
+    assert!(two.qdd.iter().all(|v| v.is_finite()));
+    assert!((&two.qdd - &one.qdd).amax() < 1e-8 * one.qdd.amax().max(1.0));
+    let split = (two.f_n[0] - 0.5 * one.f_n[0]).abs().max((two.f_n[1] - 0.5 * one.f_n[0]).abs());
+    assert!(split < 1e-5 * one.f_n[0].abs().max(1.0), "{} {} vs {}", two.f_n[0], two.f_n[1], one.f_n[0]);
+    let res = &two.jac * &two.qdd + &two.jdqd;
+    assert!(res.amax() < 1e-8 * (1.0 + two.qdd.amax()), "{res}");
+}
+
+/// A contact on a point that cannot move along the normal (on the base axis of a vertical
+/// revolute joint) makes A exactly zero: reported as singular with the time, never NaN.
+#[test]
+fn an_immovable_contact_is_reported() {
+    let model = random_chain(1, 3);
+    let drives = paper_like_drives(1);
+    // the origin of body 0 lies on its own joint axis: it cannot move at all
+    let contacts = vec![PointOnPlane {
+        name: "stuck".into(),
+        point: BodyPoint { body: Some(0), p_body: Vector3::zeros() },
+        normal_world: Vector3::z_axis(),
+        offset: 0.0,
+    }];
     let plant = Plant {
         model: &model, drives: &drives, contacts: &contacts, mass_matrix: MassMatrixMethod::Crba,
         solver: ConstraintSolver::Schur,
+        stabilization: Default::default(),
     };
     let mut data = Data::new(&model);
-    let mut fd = ForwardData::new(n, 2);
-    let z = vec![0.1; n];
-    let err = forward_dynamics(&plant, &mut data, &mut fd, 1.25, &z, &z, &z, &z).unwrap_err();
-    assert!(err.to_string().contains("t = 1.25"), "{err}");
+    let mut fd = ForwardData::new(1, 1);
+    let err = forward_dynamics(&plant, &mut data, &mut fd, 2.5, &[0.1], &[0.2], &[1.0], &[3.0]).unwrap_err();
+    assert!(err.to_string().contains("t = 2.5"), "{err}");
     assert!(err.to_string().contains("singular"), "{err}");
 }

@@ -10,7 +10,7 @@ use nalgebra::{DVector, Unit, Vector3};
 
 use crate::control::{Circle, PdGains, YawPlanarIk};
 use crate::dynamics::constraints::PointOnPlane;
-use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
+use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 use crate::dynamics::kinematics::{body_point, forward_kinematics, forward_velocities, BodyPoint};
 use crate::dynamics::motor::{Drives, MotorParams};
 use crate::dynamics::{Data, Model};
@@ -59,6 +59,7 @@ pub struct Scene {
     pub runs: Vec<Run>,
     pub mass_matrix: MassMatrixMethod,
     pub solver: ConstraintSolver,
+    pub stabilization: Stabilization,
     pub integrator: IntegratorSettings,
     pub duration: f64,
     pub output_rate: f64,
@@ -215,7 +216,10 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
     let m = &spec.motor;
     let k = c.per_joint("motor.torque_constant", &m.torque_constant, nv, positive, "must be > 0 N m/A")?;
     let r = c.per_joint("motor.resistance", &m.resistance, nv, positive, "must be > 0 ohm")?;
-    let l = c.per_joint("motor.inductance", &m.inductance, nv, positive, "must be > 0 H (a quasi-static motor, L = 0, is not modelled yet)")?;
+    let l = c.per_joint("motor.inductance", &m.inductance, nv, non_negative, "must be >= 0 H (0: quasi-static current)")?;
+    if l.iter().any(|&x| x == 0.0) && l.iter().any(|&x| x > 0.0) {
+        return Err(c.err("motor.inductance", format!("{l:?}"), "must be 0 on every joint (quasi-static motors) or > 0 on every joint"));
+    }
     let im = c.per_joint("motor.rotor_inertia", &m.rotor_inertia, nv, non_negative, "must be >= 0 kg m^2")?;
     let gear = c.per_joint("motor.gear_ratio", &m.gear_ratio, nv, positive, "must be > 0")?;
     let dmg = c.per_joint("motor.gear_damping", &m.gear_damping, nv, non_negative, "must be >= 0 N m s/rad")?;
@@ -236,6 +240,9 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
     let q0 = c.per_joint("initial.q", &spec.initial.q, nv, |_| true, "")?;
     let qd0 = c.per_joint("initial.qd", &spec.initial.qd, nv, |_| true, "")?;
     let current0 = c.per_joint("initial.current", &spec.initial.current, nv, |_| true, "")?;
+    if drives.quasi_static && current0.iter().any(|&i| i != 0.0) {
+        return Err(c.err("initial.current", format!("{current0:?}"), "quasi-static motors (L = 0) have no current state: leave it 0"));
+    }
 
     // hand, target and inverse kinematics
     let hand = c.point("hand", &model, &spec.hand)?;
@@ -323,6 +330,12 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
         runs.push(Run { name: rs.name.clone(), contacts: idx });
     }
 
+    let stabilization = spec.dynamics.stabilization;
+    if let Stabilization::Baumgarte { alpha, beta } = stabilization {
+        c.number("dynamics.stabilization.alpha", alpha, non_negative, "must be >= 0 1/s")?;
+        c.number("dynamics.stabilization.beta", beta, non_negative, "must be >= 0 1/s")?;
+    }
+
     // integrator
     let is = &spec.integrator;
     let output_dt = 1.0 / output_rate;
@@ -366,6 +379,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
         runs,
         mass_matrix: spec.dynamics.mass_matrix,
         solver: spec.dynamics.constraint_solver,
+        stabilization,
         integrator,
         duration,
         output_rate,

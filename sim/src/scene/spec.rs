@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
+use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 
 /// A per-joint setting: one number for every joint, or an array with one per joint (dof order).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -209,6 +209,9 @@ pub struct DynamicsSpec {
     pub mass_matrix: MassMatrixMethod,
     #[serde(default)]
     pub constraint_solver: ConstraintSolver,
+    /// Constraint stabilisation (default none, as in the paper).
+    #[serde(default)]
+    pub stabilization: Stabilization,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
