@@ -24,18 +24,37 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     })
 }
 
+/// Write to stdout; a closed pipe (`sim ... | head`) ends the output quietly.
+pub fn print_out(text: &str) -> Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => Ok(r.context("writing to stdout")?),
+    }
+}
+
 /// `sim check`: validate and describe.
 pub fn check(scene: Option<&Path>) -> Result<()> {
+    use std::fmt::Write;
     let s = load_scene(scene)?;
-    println!("scene `{}` ({}) is valid", s.spec.name, s.source);
-    println!("  robot `{}`: {} joints ({}), {:.3} kg moving", s.model.name, s.model.nv, s.model.joint_names().join(", "), s.model.total_mass());
-    println!("  contacts: {}", s.contacts.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", "));
+    let mut o = String::new();
+    let joints = s.model.joint_names();
+    let joints = if joints.len() <= 12 { joints.join(", ") } else { format!("{} … {}", joints[..3].join(", "), joints[joints.len() - 2..].join(", ")) };
+    writeln!(o, "scene `{}` ({}) is valid", s.spec.name, s.source)?;
+    writeln!(o, "  robot `{}`: {} joints ({joints}), {:.3} kg moving", s.model.name, s.model.nv, s.model.total_mass())?;
+    writeln!(o, "  contacts: {}", s.contacts.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", "))?;
     for r in &s.runs {
         let names: Vec<&str> = r.contacts.iter().map(|&k| s.contacts[k].name.as_str()).collect();
-        println!("  run `{}`: contacts [{}]", r.name, names.join(", "));
+        writeln!(o, "  run `{}`: contacts [{}]", r.name, names.join(", "))?;
     }
-    println!("  {} s at {} Hz output, integrator {:?}, mass matrix {:?}, solver {:?}", s.duration, s.output_rate, s.integrator, s.mass_matrix, s.solver);
-    Ok(())
+    writeln!(
+        o,
+        "  {} s at {} Hz output; integrator {:?}; mass matrix {:?}; solver {:?}; stabilisation {:?}; motors {}",
+        s.duration, s.output_rate, s.integrator, s.mass_matrix, s.solver, s.stabilization,
+        if s.drives.quasi_static { "quasi-static (L = 0)" } else { "with inductance" }
+    )?;
+    print_out(&o)
 }
 
 /// `sim export-scene DIR`.
@@ -47,7 +66,7 @@ pub fn export_scene(dir: &Path) -> Result<()> {
             bail!("{} exists; not overwriting it", p.display());
         }
         std::fs::write(&p, text).with_context(|| format!("cannot write {}", p.display()))?;
-        println!("wrote {}", p.display());
+        eprintln!("wrote {}", p.display());
     }
     Ok(())
 }
@@ -154,6 +173,5 @@ pub fn print_comparison(paths: &[PathBuf], format: Format, baseline: Option<&str
         Format::Json => analyze::Format::Json,
         Format::Csv => analyze::Format::Csv,
     };
-    print!("{}", analyze::render_comparison(&cmp, fmt)?);
-    Ok(())
+    print_out(&analyze::render_comparison(&cmp, fmt)?)
 }

@@ -1,6 +1,7 @@
 //! The hand's target: a horizontal circle run at constant speed (the paper's §4),
 //! `r_d(t) = c + ρ (cos φ(t), sin φ(t), 0)`, `φ(t) = φ_0 ± 2π t / T` (+ counter-clockwise seen
-//! from above, i.e. about +z), with its exact time derivative.
+//! from above, i.e. about +z), with its exact time derivative; optionally plus a step
+//! `Δr H(t − t_s)` (the derivative of the step, a Dirac, is left out of ṙ_d).
 
 use nalgebra::Vector3;
 
@@ -16,6 +17,8 @@ pub struct Circle {
     pub phase: f64,
     /// +1 counter-clockwise seen from above, −1 clockwise.
     pub direction: f64,
+    /// A jump of the target: (time, offset), s and m.
+    pub step: Option<(f64, Vector3<f64>)>,
 }
 
 impl Circle {
@@ -26,7 +29,11 @@ impl Circle {
     /// `r_d(t)`, world frame, m.
     pub fn position(&self, t: f64) -> Vector3<f64> {
         let a = self.angle(t);
-        self.center + Vector3::new(a.cos(), a.sin(), 0.0) * self.radius
+        let jump = match self.step {
+            Some((ts, dr)) if t >= ts => dr,
+            _ => Vector3::zeros(),
+        };
+        self.center + Vector3::new(a.cos(), a.sin(), 0.0) * self.radius + jump
     }
 
     /// `ṙ_d(t)`, world frame, m/s.
@@ -47,7 +54,7 @@ mod tests {
     fn start_point_and_derivative() {
         let c = Circle {
             center: Vector3::new(1.5, 1.5, 0.4), radius: 0.1, period: 5.0,
-            phase: std::f64::consts::FRAC_PI_4, direction: 1.0,
+            phase: std::f64::consts::FRAC_PI_4, direction: 1.0, step: None,
         };
         let s = 0.1 / 2f64.sqrt();
         assert!((c.position(0.0) - Vector3::new(1.5 + s, 1.5 + s, 0.4)).norm() < 1e-15);

@@ -256,6 +256,13 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
             Direction::CounterClockwise => 1.0,
             Direction::Clockwise => -1.0,
         },
+        step: match &cs.step {
+            Some(st) => Some((
+                c.number("target.circle.step.time", st.time, |_| true, "")?,
+                c.vec3("target.circle.step.offset", st.offset)?,
+            )),
+            None => None,
+        },
     };
     let iks = &spec.target.ik;
     let yaw = c.dof("target.ik.yaw_joint", &model, &iks.yaw_joint)?;

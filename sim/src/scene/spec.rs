@@ -151,6 +151,19 @@ pub struct CircleSpec {
     pub phase: f64,
     /// Seen from above (+z).
     pub direction: Direction,
+    /// Optional jump of the target: `offset` (m) is added from `time` (s) on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<StepSpec>,
+}
+
+/// A step in the target.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepSpec {
+    /// s.
+    pub time: f64,
+    /// m, world frame.
+    pub offset: [f64; 3],
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
