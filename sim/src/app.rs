@@ -12,7 +12,7 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sim::run::run_to_file;
 use sim::scene::{Scene, PAPER_SCENE_JSON, PAPER_URDF};
 
-use crate::cli::{Format, RunArgs};
+use crate::cli::{Format, PrecisionArgs, RunArgs};
 
 /// Exit status for a run that failed numerically (bad input exits with 2).
 pub const EXIT_RUN_FAILED: u8 = 1;
@@ -174,4 +174,60 @@ pub fn print_comparison(paths: &[PathBuf], format: Format, baseline: Option<&str
         Format::Csv => analyze::Format::Csv,
     };
     print_out(&analyze::render_comparison(&cmp, fmt)?)
+}
+
+/// `sim precision`: the work–precision table and plot of one run of a scene.
+pub fn precision(args: &PrecisionArgs) -> Result<()> {
+    use std::fmt::Write;
+    let mut scene = load_scene(args.scene.as_deref())?;
+    if let Some(d) = args.duration {
+        if !(d > 0.0 && d.is_finite()) {
+            bail!("--duration {d}: must be a positive number of seconds");
+        }
+        scene.duration = d;
+    }
+    let run = match &args.run {
+        Some(n) => scene.run(n).cloned().with_context(|| format!("no run `{n}` in scene `{}`", scene.spec.name))?,
+        None => scene.runs[0].clone(),
+    };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let ladder = sim::precision::default_ladder(&scene);
+    let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(ladder.len() as u64 + 1) };
+    bar.set_style(ProgressStyle::with_template("{prefix:>10} [{bar:30.cyan/blue}] {pos}/{len} {msg}").expect("a valid template").progress_chars("=> "));
+    bar.set_prefix("precision");
+    bar.set_message("reference (dopri45, rtol 1e-12)");
+    let reference = sim::precision::reference(&scene, &run)?;
+    bar.inc(1);
+    let mut rows = Vec::with_capacity(ladder.len());
+    for v in &ladder {
+        bar.set_message(format!("{} {}", v.series, v.setting));
+        rows.push(sim::precision::measure(&scene, &run, v, &reference, args.repeats));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    // files for machines
+    let json = serde_json::to_string_pretty(&rows)?;
+    std::fs::write(args.out.join("precision.json"), json)?;
+    let mut csv = String::from("series,setting,status,wall_s,rhs_evals,steps,rejected,max_hand_error_m,max_link_energy_error_j,max_drift_m,speed_vs_real_time\n");
+    for r in &rows {
+        writeln!(csv, "\"{}\",\"{}\",\"{}\",{:e},{},{},{},{:e},{:e},{:e},{:e}", r.series, r.setting, r.status.replace('"', "'"), r.wall_s, r.rhs_evals, r.steps, r.rejected, r.max_hand_error_m, r.max_link_energy_error_j, r.max_drift_m, r.speed_vs_real_time)?;
+    }
+    std::fs::write(args.out.join("precision.csv"), csv)?;
+    let title = format!("{} / {}: {} s simulated", scene.spec.name, run.name, scene.duration);
+    sim::plot::work_precision(&rows, &title, &args.out.join("work-precision")).map_err(anyhow::Error::msg)?;
+
+    // the table for people
+    let mut o = String::new();
+    writeln!(o, "Speed against error: scene `{}`, run `{}`, {} s simulated; reference dopri45 rtol 1e-12", scene.spec.name, run.name, scene.duration)?;
+    writeln!(o, "{:<42} {:<12} {:>10} {:>9} {:>9} {:>7} {:>11} {:>11} {:>10} {:>9}", "method", "setting", "wall [ms]", "RHS", "steps", "rejected", "hand [m]", "energy [J]", "drift [m]", "x real")?;
+    for r in &rows {
+        if r.status == "ok" {
+            writeln!(o, "{:<42} {:<12} {:>10.2} {:>9} {:>9} {:>7} {:>11.2e} {:>11.2e} {:>10.1e} {:>9.0}", r.series, r.setting, r.wall_s * 1e3, r.rhs_evals, r.steps, r.rejected, r.max_hand_error_m, r.max_link_energy_error_j, r.max_drift_m, r.speed_vs_real_time)?;
+        } else {
+            writeln!(o, "{:<42} {:<12} {}", r.series, r.setting, r.status)?;
+        }
+    }
+    writeln!(o, "wrote {}/precision.csv, precision.json, work-precision.svg, work-precision.png", args.out.display())?;
+    print_out(&o)
 }

@@ -45,11 +45,35 @@ pub enum Command {
         /// Scene JSON file (default: the built-in paper scene).
         scene: Option<PathBuf>,
     },
+    /// Speed against error: every method over a ladder of tolerances or steps, and each model
+    /// reduction, against a tight reference run; writes a table and a work–precision plot.
+    Precision(PrecisionArgs),
     /// Write the built-in paper scene (paper.json) and its URDF into a directory, to edit.
     ExportScene {
         /// Directory to write into (created if missing).
         dir: PathBuf,
     },
+}
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct PrecisionArgs {
+    /// Scene JSON file (default: the built-in paper scene).
+    pub scene: Option<PathBuf>,
+    /// The run of the scene to measure (default: its first run).
+    #[arg(long = "run", value_name = "NAME")]
+    pub run: Option<String>,
+    /// Simulated time of every run, s (default: the scene's duration).
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Directory for precision.csv, precision.json, work-precision.svg and .png.
+    #[arg(short, long, default_value = "out/precision")]
+    pub out: PathBuf,
+    /// Timed repetitions of each run; the best is kept.
+    #[arg(long, default_value_t = 3)]
+    pub repeats: usize,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Clone, clap::Args)]

@@ -21,3 +21,5 @@ pub mod integrate;
 pub mod system;
 pub mod run;
 pub mod record;
+pub mod precision;
+pub mod plot;

@@ -12,6 +12,7 @@ fn main() -> ExitCode {
     let cli = cli::Cli::parse();
     let result = match cli.command {
         Some(cli::Command::Check { scene }) => app::check(scene.as_deref()).map(|_| ExitCode::SUCCESS),
+        Some(cli::Command::Precision(args)) => app::precision(&args).map(|_| ExitCode::SUCCESS),
         Some(cli::Command::ExportScene { dir }) => app::export_scene(&dir).map(|_| ExitCode::SUCCESS),
         Some(cli::Command::Run(args)) => run(&args),
         None => run(&cli.run),

@@ -1,0 +1,179 @@
+//! Speed against error: run one scene with every method over a ladder of tolerances or steps
+//! (and with each model reduction) against a tight reference run of the same scene, and
+//! measure wall time, work (RHS evaluations, steps, rejections) and error (max hand error,
+//! worst per-link energy error, max constraint drift). A work–precision diagram in the sense of
+//! Hairer & Wanner, *Solving ODEs II*, §IV.10.
+//!
+//! All runs share the output grid, so errors are compared sample by sample; wall time is the
+//! best of `repeats` runs without recording (the simulation itself).
+
+use std::time::Instant;
+
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
+use crate::error::RunError;
+use crate::scene::{IntegratorSettings, Run, Scene};
+
+/// One configuration to measure.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    /// Series name in the table and the plot (method + model).
+    pub series: String,
+    /// The rung on the ladder: a tolerance or a step, as text.
+    pub setting: String,
+    pub integrator: IntegratorSettings,
+    pub mass_matrix: MassMatrixMethod,
+    pub solver: ConstraintSolver,
+    /// A modified scene (a model reduction) instead of the scene itself.
+    pub reduced: Option<Box<Scene>>,
+}
+
+/// The measurement of one variant.
+#[derive(Clone, Debug, Serialize)]
+pub struct Row {
+    pub series: String,
+    pub setting: String,
+    pub status: String,
+    /// Best wall time of the simulation, s.
+    pub wall_s: f64,
+    pub rhs_evals: u64,
+    pub steps: u64,
+    pub rejected: u64,
+    /// max over samples of |r_hand − r_hand,ref|, m.
+    pub max_hand_error_m: f64,
+    /// max over samples and joints of |W_j − W_j,ref| and |E_j − E_j,ref|, J.
+    pub max_link_energy_error_j: f64,
+    /// max over samples and contacts of |C|, m.
+    pub max_drift_m: f64,
+    /// Simulated time / wall time.
+    pub speed_vs_real_time: f64,
+}
+
+/// The reference trajectory: per sample, the hand and every W_j, E_j.
+pub struct Reference {
+    pub hand: Vec<Vector3<f64>>,
+    pub energies: Vec<Vec<f64>>,
+}
+
+fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Stats, f64), RunError> {
+    let mut r = Reference { hand: Vec::new(), energies: Vec::new() };
+    let mut drift = 0.0f64;
+    let rep = crate::run::simulate(scene, run, |o| {
+        r.hand.push(o.hand);
+        let mut e = o.link_work.clone();
+        e.extend_from_slice(&o.electric_energy);
+        r.energies.push(e);
+        drift = o.constraint_position.iter().fold(drift, |m, c| m.max(c.abs()));
+        Ok(())
+    })?;
+    Ok((r, rep.stats, drift))
+}
+
+/// The tight reference: Dormand–Prince at rtol 1e-12, atol 1e-14, CRBA + Schur.
+pub fn reference(scene: &Scene, run: &Run) -> Result<Reference, RunError> {
+    let mut s = scene.clone();
+    s.integrator = IntegratorSettings::Dopri45 { rtol: 1e-12, atol: 1e-14, h_max: 1.0 / scene.output_rate, max_steps: usize::MAX };
+    s.mass_matrix = MassMatrixMethod::Crba;
+    s.solver = ConstraintSolver::Schur;
+    Ok(collect(&s, run)?.0)
+}
+
+/// Measure one variant against the reference.
+pub fn measure(scene: &Scene, run: &Run, v: &Variant, reference: &Reference, repeats: usize) -> Row {
+    let mut s = v.reduced.as_deref().cloned().unwrap_or_else(|| scene.clone());
+    s.integrator = v.integrator;
+    s.mass_matrix = v.mass_matrix;
+    s.solver = v.solver;
+    let mut row = Row {
+        series: v.series.clone(),
+        setting: v.setting.clone(),
+        status: "ok".into(),
+        wall_s: f64::INFINITY,
+        rhs_evals: 0,
+        steps: 0,
+        rejected: 0,
+        max_hand_error_m: f64::NAN,
+        max_link_energy_error_j: f64::NAN,
+        max_drift_m: f64::NAN,
+        speed_vs_real_time: f64::NAN,
+    };
+    // timing: the simulation alone, best of `repeats`
+    for _ in 0..repeats.max(1) {
+        let t0 = Instant::now();
+        match crate::run::simulate(&s, run, |_| Ok(())) {
+            Ok(rep) => {
+                row.wall_s = row.wall_s.min(t0.elapsed().as_secs_f64());
+                row.rhs_evals = rep.stats.rhs_evals;
+                row.steps = rep.stats.steps;
+                row.rejected = rep.stats.rejected;
+            }
+            Err(e) => {
+                row.status = format!("failed: {e}");
+                return row;
+            }
+        }
+    }
+    row.speed_vs_real_time = s.duration / row.wall_s;
+    // errors: one more run that keeps the samples
+    match collect(&s, run) {
+        Ok((r, _, drift)) => {
+            row.max_drift_m = drift;
+            row.max_hand_error_m = r.hand.iter().zip(&reference.hand).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+            row.max_link_energy_error_j = r
+                .energies
+                .iter()
+                .zip(&reference.energies)
+                .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+                .fold(0.0, f64::max);
+        }
+        Err(e) => row.status = format!("failed: {e}"),
+    }
+    row
+}
+
+/// The default ladder for a scene: RK4 over steps, Dormand–Prince over tolerances, the
+/// paper-style baseline (Walker–Orin + the full block solve + RK4), and the model reductions
+/// that apply (quasi-static motors when the scene has inductance).
+pub fn default_ladder(scene: &Scene) -> Vec<Variant> {
+    let h_max = 1.0 / scene.output_rate;
+    let mut v = Vec::new();
+    let plain = |series: &str, setting: String, integrator| Variant {
+        series: series.into(),
+        setting,
+        integrator,
+        mass_matrix: MassMatrixMethod::Crba,
+        solver: ConstraintSolver::Schur,
+        reduced: None,
+    };
+    for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
+        v.push(plain("dopri45", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max, max_steps: 100_000_000 }));
+    }
+    for h in [5e-4, 2e-4, 1e-4, 5e-5, 2e-5] {
+        v.push(plain("rk4", format!("h {h:.0e} s"), IntegratorSettings::Rk4 { step: h }));
+    }
+    for h in [5e-4, 2e-4, 1e-4, 5e-5, 2e-5] {
+        v.push(Variant {
+            series: "paper baseline (walker-orin + kkt + rk4)".into(),
+            setting: format!("h {h:.0e} s"),
+            integrator: IntegratorSettings::Rk4 { step: h },
+            mass_matrix: MassMatrixMethod::WalkerOrin,
+            solver: ConstraintSolver::Kkt,
+            reduced: None,
+        });
+    }
+    if !scene.drives.quasi_static {
+        let mut q = scene.clone();
+        let l = vec![0.0; scene.model.nv];
+        q.drives.l = nalgebra::DVector::from_vec(l);
+        q.drives.quasi_static = true;
+        q.current0 = vec![0.0; scene.model.nv];
+        for tol in [1e-6, 1e-8, 1e-10] {
+            let mut r = plain("dopri45, L = 0 (quasi-static)", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max, max_steps: 100_000_000 });
+            r.reduced = Some(Box::new(q.clone()));
+            v.push(r);
+        }
+    }
+    v
+}
