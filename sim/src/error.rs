@@ -61,6 +61,8 @@ pub enum RunError {
     Dynamics(#[from] DynamicsError),
     #[error("the integrator stopped: step size collapsed to h = {h:e} s at t = {t:.9} s")]
     StepSizeTooSmall { t: f64, h: f64 },
+    #[error("the implicit integrator stopped: its iteration matrix I - h gamma J is singular at t = {t:.9} s (h = {h:e} s)")]
+    SingularIterationMatrix { t: f64, h: f64 },
     #[error("the integrator stopped: state component {index} ({name}) became non-finite at t = {t:.9} s")]
     NonFiniteState { t: f64, index: usize, name: String },
     #[error("the integrator stopped: more than {max_steps} steps before t = {t:.9} s")]
@@ -87,6 +89,7 @@ impl RunError {
         match self {
             RunError::Dynamics(e) => Some(e.time()),
             RunError::StepSizeTooSmall { t, .. }
+            | RunError::SingularIterationMatrix { t, .. }
             | RunError::NonFiniteState { t, .. }
             | RunError::TooManySteps { t, .. } => Some(*t),
             RunError::Recording { .. } => None,

@@ -23,3 +23,5 @@ pub mod run;
 pub mod record;
 pub mod precision;
 pub mod plot;
+pub mod projection;
+pub mod stiff;

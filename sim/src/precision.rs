@@ -150,6 +150,18 @@ pub fn default_ladder(scene: &Scene) -> Vec<Variant> {
     for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
         v.push(plain("dopri45", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max, max_steps: 100_000_000 }));
     }
+    // the stiff methods may take steps far longer than the output interval
+    let h_long = scene.duration / 10.0;
+    for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] {
+        v.push(plain(
+            "rosenbrock (structured J)",
+            format!("rtol {tol:.0e}"),
+            IntegratorSettings::Rosenbrock { rtol: tol, atol: tol * 1e-2, h_max: h_long, max_steps: 100_000_000, jacobian_reuse: 1 },
+        ));
+    }
+    for tol in [1e-4, 1e-6, 1e-8] {
+        v.push(plain("imex (circuits implicit)", format!("rtol {tol:.0e}"), IntegratorSettings::Imex { rtol: tol, atol: tol * 1e-2, h_max: h_long, max_steps: 100_000_000 }));
+    }
     for h in [5e-4, 2e-4, 1e-4, 5e-5, 2e-5] {
         v.push(plain("rk4", format!("h {h:.0e} s"), IntegratorSettings::Rk4 { step: h }));
     }

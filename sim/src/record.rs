@@ -46,6 +46,21 @@ pub fn integrator_description(s: &IntegratorSettings) -> BTreeMap<String, String
             m.insert("integrator.h_max".into(), format!("{h_max:e}"));
             m.insert("integrator.max_steps".into(), max_steps.to_string());
         }
+        IntegratorSettings::Rosenbrock { rtol, atol, h_max, max_steps, jacobian_reuse } => {
+            m.insert("integrator".into(), "rosenbrock (ROS34PW2, structured Jacobian)".into());
+            m.insert("integrator.rtol".into(), format!("{rtol:e}"));
+            m.insert("integrator.atol".into(), format!("{atol:e}"));
+            m.insert("integrator.h_max".into(), format!("{h_max:e}"));
+            m.insert("integrator.max_steps".into(), max_steps.to_string());
+            m.insert("integrator.jacobian_reuse".into(), jacobian_reuse.to_string());
+        }
+        IntegratorSettings::Imex { rtol, atol, h_max, max_steps } => {
+            m.insert("integrator".into(), "imex (ARK4(3)6L[2]SA, armature circuits implicit)".into());
+            m.insert("integrator.rtol".into(), format!("{rtol:e}"));
+            m.insert("integrator.atol".into(), format!("{atol:e}"));
+            m.insert("integrator.h_max".into(), format!("{h_max:e}"));
+            m.insert("integrator.max_steps".into(), max_steps.to_string());
+        }
     }
     m
 }

@@ -3,7 +3,10 @@
 //! sink (the recorder, or a test). Knows nothing about the recording format.
 
 use crate::error::RunError;
-use crate::integrate::{integrate_sampled, Dopri5Settings, DormandPrince45, IntegrateError, Rk4, Stats, Stepper};
+use crate::integrate::{
+    integrate_sampled, ArkImex, ArkImexSettings, Dopri5Settings, DormandPrince45, IntegrateError, Rk4, Rosenbrock,
+    RosenbrockSettings, Stats, Stepper,
+};
 use crate::scene::{IntegratorSettings, Run, Scene};
 use crate::system::{ArmSystem, Outputs};
 
@@ -20,6 +23,7 @@ fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String) -> RunE
     match e {
         IntegrateError::Rhs(e) | IntegrateError::Sample { source: e, .. } => e,
         IntegrateError::StepSizeTooSmall { t, h } => RunError::StepSizeTooSmall { t, h },
+        IntegrateError::SingularMatrix { t, h } => RunError::SingularIterationMatrix { t, h },
         IntegrateError::NonFiniteState { t, index } => RunError::NonFiniteState { t, index, name: names(index) },
         IntegrateError::TooManySteps { t, max_steps } => RunError::TooManySteps { t, max_steps },
         IntegrateError::InvalidOutputGrid { t0, t_end, dt_out } => RunError::Dynamics(crate::error::DynamicsError::NonFinite {
@@ -59,6 +63,16 @@ pub fn simulate(
         IntegratorSettings::Dopri45 { rtol, atol, h_max, max_steps } => {
             let settings = Dopri5Settings { rtol, atol, h_max, max_steps, ..Dopri5Settings::default() };
             let mut st = DormandPrince45::new(dim, settings);
+            drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
+        }
+        IntegratorSettings::Rosenbrock { rtol, atol, h_max, max_steps, jacobian_reuse } => {
+            let settings = RosenbrockSettings { rtol, atol, h_max, max_steps, jacobian_reuse, ..RosenbrockSettings::default() };
+            let mut st = Rosenbrock::new(dim, settings);
+            drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
+        }
+        IntegratorSettings::Imex { rtol, atol, h_max, max_steps } => {
+            let settings = ArkImexSettings { rtol, atol, h_max, max_steps, ..ArkImexSettings::default() };
+            let mut st = ArkImex::new(dim, settings);
             drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
         }
     }

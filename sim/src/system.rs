@@ -117,9 +117,13 @@ pub struct ArmSystem<'a> {
     pub fd: ForwardData,
     q_des: Vec<f64>,
     qd_des: Vec<f64>,
-    voltage: Vec<f64>,
+    pub(crate) voltage: Vec<f64>,
     /// Currents of quasi-static motors (computed, not integrated), A.
     current_qs: Vec<f64>,
+    /// Scratch of the structured Jacobian (`stiff.rs`).
+    pub(crate) jac: crate::stiff::JacobianScratch,
+    /// Scratch of the constraint projection (`projection.rs`).
+    pub(crate) projection: crate::projection::ProjectionScratch,
     /// T + V + ½ L i² at t = 0, J (for the balance residual).
     stored0: f64,
 }
@@ -139,6 +143,8 @@ impl<'a> ArmSystem<'a> {
             qd_des: vec![0.0; nv],
             voltage: vec![0.0; nv],
             current_qs: vec![0.0; nv],
+            jac: crate::stiff::JacobianScratch::new(nv, nc, 4 * nv + if scene.drives.quasi_static { 0 } else { nv } + 2),
+            projection: crate::projection::ProjectionScratch::new(nv, nc),
             stored0: 0.0,
         };
         sys.stored0 = sys.stored_energy(&scene.q0, &scene.qd0, &scene.current0);
@@ -165,15 +171,22 @@ impl<'a> ArmSystem<'a> {
         t + potential_energy(&s.model, &self.data) + magnetic_energy(&s.drives, current)
     }
 
-    /// Targets and voltages at (t, q, q̇), then eq 21. Fills `fd` and `voltage`.
-    fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
-        let l = self.layout;
-        let (q, qd) = (&y[l.q()], &y[l.qd()]);
+    /// The PD voltages (eq 27) at (t, q, q̇), into `self.voltage`.
+    pub(crate) fn voltage_at(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), DynamicsError> {
         let s = self.scene;
         s.ik
             .solve(&s.circle.position(t), &s.circle.velocity(t), &mut self.q_des, &mut self.qd_des)
             .map_err(|why| DynamicsError::Unreachable { t, why })?;
         s.gains.voltage(q, qd, &self.q_des, &self.qd_des, &mut self.voltage);
+        Ok(())
+    }
+
+    /// Targets and voltages at (t, q, q̇), then eq 21. Fills `fd` and `voltage`.
+    fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+        let l = self.layout;
+        let (q, qd) = (&y[l.q()], &y[l.qd()]);
+        let s = self.scene;
+        self.voltage_at(t, q, qd)?;
         let cur = if l.ni == 0 {
             for j in 0..l.nv {
                 self.current_qs[j] = s.drives.quasi_static_current(j, self.voltage[j], qd[j]);
@@ -273,5 +286,13 @@ impl OdeSystem for ArmSystem<'_> {
         dydt[l.loss_r()] = p_r;
         dydt[l.loss_d()] = p_d;
         Ok(())
+    }
+
+    fn project(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
+        if self.scene.stabilization == crate::dynamics::forward::Stabilization::Projection {
+            Ok(ArmSystem::project(self, t, y)?)
+        } else {
+            Ok(false)
+        }
     }
 }

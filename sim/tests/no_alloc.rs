@@ -5,7 +5,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use sim::integrate::{Dopri5Settings, DormandPrince45, Rk4, Stepper};
+use sim::integrate::{ArkImex, ArkImexSettings, Dopri5Settings, DormandPrince45, Rk4, Rosenbrock, RosenbrockSettings, Stepper};
 use sim::scene::Scene;
 use sim::system::ArmSystem;
 
@@ -58,4 +58,26 @@ fn the_step_loop_does_not_allocate() {
     assert_eq!(steps_allocate(&mut Rk4::new(dim, 1e-4), &mut sys), 0, "rk4");
     let settings = Dopri5Settings { rtol: 1e-10, atol: 1e-12, h_max: 1e-3, ..Dopri5Settings::default() };
     assert_eq!(steps_allocate(&mut DormandPrince45::new(dim, settings), &mut sys), 0, "dopri45");
+    let settings = RosenbrockSettings { rtol: 1e-8, atol: 1e-10, h_max: 1e-3, ..RosenbrockSettings::default() };
+    assert_eq!(steps_allocate(&mut Rosenbrock::new(dim, settings), &mut sys), 0, "rosenbrock (with its Jacobian)");
+    let settings = ArkImexSettings { rtol: 1e-8, atol: 1e-10, h_max: 1e-3, ..ArkImexSettings::default() };
+    assert_eq!(steps_allocate(&mut ArkImex::new(dim, settings), &mut sys), 0, "imex");
+}
+
+/// Projection after every step (the constraint stabilisation) does not allocate either.
+#[test]
+fn projection_does_not_allocate() {
+    let mut scene = Scene::paper().unwrap();
+    scene.stabilization = sim::dynamics::forward::Stabilization::Projection;
+    let run = scene.run("two-elbow").unwrap().clone();
+    let mut sys = ArmSystem::new(&scene, &run);
+    let mut y = sys.initial_state();
+    y[0] += 1e-3;
+    y[2] += 1e-3;
+    sys.project(0.0, &mut y).unwrap();
+    let before = allocs();
+    y[1] += 1e-4;
+    y[12] += 1e-4;
+    assert!(sys.project(0.1, &mut y).unwrap());
+    assert_eq!(allocs() - before, 0);
 }

@@ -2,8 +2,9 @@
 //!
 //! The split follows diffsol: the *problem* is an [`OdeSystem`] (what gets integrated, a pure
 //! function of `(t, y)` apart from scratch), the *method* is a [`Stepper`] ([`Rk4`],
-//! [`DormandPrince45`]), and the *state* (`t`, `y`, the stage derivatives and the dense-output
-//! coefficients of the last step) lives inside the stepper, sized once in its constructor.
+//! [`DormandPrince45`], [`Rosenbrock`], [`ArkImex`]), and the *state* (`t`, `y`, the stage
+//! derivatives and the dense-output coefficients of the last step) lives inside the stepper,
+//! sized once in its constructor.
 //! [`integrate_sampled`] drives a stepper over an interval and reports the solution on a fixed
 //! output grid via dense output, so recorded times never depend on the solver's step sizes.
 //!
@@ -15,6 +16,18 @@
 //!   with the error estimation and step-size control of HNW I §II.4 and the 4th-order
 //!   continuous extension of HNW I §II.6, following Hairer's `dopri5.f`.
 //!
+//! For stiff systems (Hairer & Wanner, *Solving Ordinary Differential Equations II*, 2nd ed.,
+//! Springer 1996, "HNW II"), where an explicit method's step is bounded by stability rather
+//! than accuracy:
+//! - [`Rosenbrock`]: the Rosenbrock-W method ROS34PW2 of Rang & Angermann, BIT 45 (2005)
+//!   761–787 (4 stages, order 3(2), L-stable, stiffly accurate, order kept with an approximate
+//!   Jacobian), for an [`OdeJacobian`]: an analytic Jacobian, or [`FdJacobian`] around any
+//!   [`OdeSystem`] (forward differences, [`fd_jacobian`]). Linear algebra: a dense in-place LU
+//!   with partial pivoting (`lu.rs`).
+//! - [`ArkImex`]: the additive Runge–Kutta pair `ARK4(3)6L[2]SA` of Kennedy & Carpenter, Appl.
+//!   Numer. Math. 44 (2003) 139–181 (explicit part + L-stable ESDIRK part, order 4(3)), for a
+//!   [`SplitSystem`] that solves its own implicit stage equations.
+//!
 //! Conventions: integration runs forward in time only (`t_stop > t`); times in seconds if the
 //! system's are; all slices have length `dim`. A dimension mismatch is a programmer error and
 //! panics; everything that depends on the numbers (a failing right-hand side, a NaN, a step-size
@@ -22,13 +35,22 @@
 
 use std::fmt;
 
+mod adaptive;
 mod dopri5;
+mod imex;
+mod jacobian;
+mod lu;
 mod rk4;
+mod rosenbrock;
 mod sampled;
 pub mod test_problems;
 
-pub use self::dopri5::{Dopri5Settings, DormandPrince45, SettingsError};
+pub use self::adaptive::SettingsError;
+pub use self::dopri5::{Dopri5Settings, DormandPrince45};
+pub use self::imex::{ArkImex, ArkImexSettings};
+pub use self::jacobian::{fd_jacobian, FdJacobian};
 pub use self::rk4::Rk4;
+pub use self::rosenbrock::{Rosenbrock, RosenbrockSettings};
 pub use self::sampled::integrate_sampled;
 
 /// What gets integrated: y' = f(t, y). Must be a pure function of (t, y) apart from scratch.
@@ -43,6 +65,72 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Writes `f(t, y)` into `dydt` (both of length `dim`).
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), Self::Error>;
+    /// Called by [`integrate_sampled`] after every accepted step: may move `y` back onto an
+    /// invariant manifold (e.g. constraints C = 0, Ċ = 0) and returns whether it changed it.
+    /// The default leaves `y` alone.
+    fn project(&mut self, t: f64, y: &mut [f64]) -> Result<bool, Self::Error> {
+        let _ = (t, y);
+        Ok(false)
+    }
+}
+
+/// A system that can give (an approximation of) `∂f/∂y`, for [`Rosenbrock`].
+///
+/// Rosenbrock-W methods keep their order with any bounded approximation (HNW II §IV.7,
+/// "W-methods"), so a lagged, simplified or finite-difference Jacobian is fine for accuracy;
+/// the closer it is to the true one on the stiff modes, the better the stability.
+pub trait OdeJacobian: OdeSystem {
+    /// Writes `∂f/∂y (t, y)` into `jac`, row-major `dim x dim` (`jac[i * dim + j] = ∂f_i/∂y_j`).
+    /// `fy = f(t, y)` is supplied (for finite differences).
+    fn jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        fy: &[f64],
+        jac: &mut [f64],
+    ) -> Result<(), Self::Error>;
+
+    /// Writes `∂f/∂t (t, y)` into `dfdt` and returns `Ok(true)`; the default returns `Ok(false)`
+    /// without writing, and the stepper then uses a forward difference in `t` (one evaluation
+    /// of `rhs` per step; [`Rosenbrock`] refreshes `f_t` every step even when it reuses `J`).
+    /// Like the Jacobian, an approximation is allowed.
+    fn time_derivative(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        fy: &[f64],
+        dfdt: &mut [f64],
+    ) -> Result<bool, Self::Error> {
+        let _ = (t, y, fy, dfdt);
+        Ok(false)
+    }
+}
+
+/// A system split as `f = f_E + f_I` into a non-stiff part `f_E`, treated explicitly, and a
+/// stiff part `f_I`, treated implicitly, whose stage equations the system solves itself
+/// (for [`ArkImex`]).
+pub trait SplitSystem: OdeSystem {
+    /// `f = f_E + f_I`; writes both parts (`f_E + f_I` must equal [`OdeSystem::rhs`]).
+    fn rhs_split(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        f_e: &mut [f64],
+        f_i: &mut [f64],
+    ) -> Result<(), Self::Error>;
+
+    /// Solves `z - gamma f_I(t, z) = r` for `z` (`gamma = h a_ii > 0`). `z` holds no useful
+    /// initial guess. An exact (e.g. closed-form, for `f_I` linear in `z`) solution keeps the
+    /// method's order; the stepper recovers `f_I(t, z)` as `(z - r) / gamma`. Also called
+    /// twice per step with `r` = the new state and the new state plus the error estimate, to
+    /// filter that estimate (see [`ArkImex`]).
+    fn solve_implicit(
+        &mut self,
+        t: f64,
+        gamma: f64,
+        r: &[f64],
+        z: &mut [f64],
+    ) -> Result<(), Self::Error>;
 }
 
 /// Why an integration stopped.
@@ -54,7 +142,8 @@ pub enum IntegrateError<E> {
     /// resolve (`0.1 h <= |t| eps`): a singularity or a very stiff problem at `t`.
     StepSizeTooSmall { t: f64, h: f64 },
     /// NaN/inf in state component `index`: in the state after a step (`t` is the step's end),
-    /// or in a stage derivative (`t` is the time at which `rhs` produced it).
+    /// or in a stage derivative (`t` is the time at which `rhs` produced it), or in row `index`
+    /// of the Jacobian or of `∂f/∂t` ([`Rosenbrock`]; `t` is where they were evaluated).
     NonFiniteState { t: f64, index: usize },
     /// More than `max_steps` step attempts (accepted + rejected) since `init`; `t` is where
     /// the stepper stands.
@@ -65,6 +154,10 @@ pub enum IntegrateError<E> {
     /// [`integrate_sampled`] was asked for an empty or non-finite output grid (`dt_out <= 0`,
     /// `t_end < t0`, a non-finite value, or more than 2^53 samples).
     InvalidOutputGrid { t0: f64, t_end: f64, dt_out: f64 },
+    /// The iteration matrix `I - gamma h J` of [`Rosenbrock`] was (numerically) singular in the
+    /// step from `t`, still at the last step size tried, `h` (the step is halved up to 5 times
+    /// in a row, and not below `h_min`, before giving up).
+    SingularMatrix { t: f64, h: f64 },
 }
 
 impl<E: fmt::Display> fmt::Display for IntegrateError<E> {
@@ -95,6 +188,11 @@ impl<E: fmt::Display> fmt::Display for IntegrateError<E> {
                 "invalid output grid: t0 = {t0}, t_end = {t_end}, dt_out = {dt_out} \
                  (need finite values, dt_out > 0, t_end >= t0)"
             ),
+            IntegrateError::SingularMatrix { t, h } => write!(
+                f,
+                "singular iteration matrix I - gamma h J in the step from t = {t} \
+                 (last step size tried h = {h:e})"
+            ),
         }
     }
 }
@@ -115,8 +213,16 @@ pub struct Stats {
     pub rhs_evals: u64,
     /// Accepted steps.
     pub steps: u64,
-    /// Rejected step attempts (error test failed, or a non-finite stage).
+    /// Rejected step attempts (error test failed — for [`ArkImex`] also its interpolation
+    /// check —, or a non-finite stage, or a singular iteration matrix).
     pub rejected: u64,
+    /// Calls to [`OdeJacobian::jacobian`] ([`Rosenbrock`]; 0 for the explicit methods).
+    /// Evaluations of `rhs` made inside it (e.g. by [`FdJacobian`]) are not in `rhs_evals`.
+    pub jacobian_evals: u64,
+    /// LU factorisations of the iteration matrix ([`Rosenbrock`]; 0 for the others).
+    pub lu_decompositions: u64,
+    /// Calls to [`SplitSystem::solve_implicit`] ([`ArkImex`]; 0 for the others).
+    pub implicit_solves: u64,
 }
 
 /// A one-step method that owns its state between steps.
@@ -144,6 +250,10 @@ pub trait Stepper<S: OdeSystem> {
     fn interpolate(&self, t_query: f64, out: &mut [f64]);
     /// Work counters since `init`.
     fn stats(&self) -> Stats;
+    /// Replace the current state `y(t)` (after a projection onto an invariant manifold, say)
+    /// and re-evaluate what the method keeps about it (one `rhs` call); the step size, the
+    /// controller and the statistics carry on. Dense output of the last step is not updated.
+    fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>>;
 }
 
 /// Index of the first NaN/inf in `v`, if any.
@@ -172,6 +282,12 @@ mod tests {
         };
         assert!(e.to_string().contains("max_steps = 10"));
         assert!(e.source().is_none());
+        let e: IntegrateError<RhsFailure> = IntegrateError::SingularMatrix { t: 0.75, h: 0.125 };
+        let s = e.to_string();
+        assert!(
+            s.contains("t = 0.75") && s.contains("1.25e-1") && s.contains("singular"),
+            "{s}"
+        );
     }
 
     #[test]

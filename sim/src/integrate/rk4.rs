@@ -256,6 +256,11 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
     fn stats(&self) -> Stats {
         Rk4::stats(self)
     }
+
+    fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        self.y.copy_from_slice(y);
+        Self::eval(&mut self.stats, sys, self.t, y, &mut self.f)
+    }
 }
 
 #[cfg(test)]
@@ -420,7 +425,8 @@ mod tests {
             Stats {
                 rhs_evals: 1,
                 steps: 0,
-                rejected: 0
+                rejected: 0,
+                ..Stats::default()
             }
         );
         while st.t() < 1.234 {

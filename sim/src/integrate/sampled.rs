@@ -5,7 +5,8 @@
 //! by multiplication, with no accumulated round-off,
 //! independent of the solver's steps: points inside a step come from the stepper's dense output
 //! (diffsol's `interpolate`; HNW I §II.6), so an adaptive solver takes exactly the same steps
-//! whatever the output rate, and a recording never depends on step sizes.
+//! whatever the output rate, and a recording never depends on step sizes. After every accepted
+//! step the system may project the state ([`OdeSystem::project`]).
 
 use super::{IntegrateError, OdeSystem, Stats, Stepper};
 
@@ -88,6 +89,14 @@ pub fn integrate_sampled<S: OdeSystem, St: Stepper<S>>(
         }
         if stepper.t() >= t_end {
             break;
+        }
+        // let the system move the state back onto its invariant manifold (after sampling the
+        // step, so the samples are the method's own dense output)
+        if k > 1 || stepper.t() > t0 {
+            buf.copy_from_slice(stepper.y());
+            if sys.project(stepper.t(), &mut buf).map_err(IntegrateError::Rhs)? {
+                stepper.set_state(sys, &buf)?;
+            }
         }
         let t_before = stepper.t();
         let t_after = stepper.step(sys, t_end)?;

@@ -27,6 +27,8 @@ pub const PAPER_URDF: &str = include_str!("../../scenes/paper_arm.urdf");
 pub enum IntegratorSettings {
     Rk4 { step: f64 },
     Dopri45 { rtol: f64, atol: f64, h_max: f64, max_steps: usize },
+    Rosenbrock { rtol: f64, atol: f64, h_max: f64, max_steps: usize, jacobian_reuse: usize },
+    Imex { rtol: f64, atol: f64, h_max: f64, max_steps: usize },
 }
 
 /// One run of a scene: which contacts are active.
@@ -348,6 +350,9 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
     let output_dt = 1.0 / output_rate;
     let integrator = match is.method {
         Method::Rk4 => {
+            if let Some(r) = is.jacobian_reuse {
+                return Err(c.err("integrator.jacobian_reuse", r, "applies to rosenbrock only"));
+            }
             for (name, v) in [("rtol", is.rtol), ("atol", is.atol), ("h_max", is.h_max)] {
                 if v.is_some() {
                     return Err(c.err(format!("integrator.{name}"), v.unwrap_or_default(), "applies to dopri45 only"));
@@ -356,17 +361,34 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
             let step = is.step.ok_or_else(|| c.err("integrator.step", "(missing)", "rk4 needs a fixed step, s"))?;
             IntegratorSettings::Rk4 { step: c.number("integrator.step", step, |h| h > 0.0 && h <= duration, "must be > 0 s and <= duration")? }
         }
-        Method::Dopri45 => {
-            if let Some(s) = is.step {
-                return Err(c.err("integrator.step", s, "applies to rk4 only (dopri45 chooses its steps; use h_max)"));
+        Method::Dopri45 | Method::Rosenbrock | Method::Imex => {
+            let method = match is.method {
+                Method::Dopri45 => "dopri45",
+                Method::Rosenbrock => "rosenbrock",
+                _ => "imex",
+            };
+            if let Some(st) = is.step {
+                return Err(c.err("integrator.step", st, format!("applies to rk4 only ({method} chooses its steps; use h_max)")));
             }
-            let rtol = is.rtol.ok_or_else(|| c.err("integrator.rtol", "(missing)", "dopri45 needs rtol"))?;
-            let atol = is.atol.ok_or_else(|| c.err("integrator.atol", "(missing)", "dopri45 needs atol"))?;
-            IntegratorSettings::Dopri45 {
-                rtol: c.number("integrator.rtol", rtol, |x| x >= 1e-14 && x < 1.0, "must be in [1e-14, 1)")?,
-                atol: c.number("integrator.atol", atol, |x| x > 0.0, "must be > 0")?,
-                h_max: c.number("integrator.h_max", is.h_max.unwrap_or(output_dt), positive, "must be > 0 s")?,
-                max_steps: is.max_steps.unwrap_or(100_000_000),
+            if is.jacobian_reuse.is_some() && is.method != Method::Rosenbrock {
+                return Err(c.err("integrator.jacobian_reuse", is.jacobian_reuse.unwrap_or(0), "applies to rosenbrock only"));
+            }
+            let rtol = is.rtol.ok_or_else(|| c.err("integrator.rtol", "(missing)", format!("{method} needs rtol")))?;
+            let atol = is.atol.ok_or_else(|| c.err("integrator.atol", "(missing)", format!("{method} needs atol")))?;
+            let rtol = c.number("integrator.rtol", rtol, |x| (1e-14..1.0).contains(&x), "must be in [1e-14, 1)")?;
+            let atol = c.number("integrator.atol", atol, |x| x > 0.0, "must be > 0")?;
+            let h_max = c.number("integrator.h_max", is.h_max.unwrap_or(output_dt), positive, "must be > 0 s")?;
+            let max_steps = is.max_steps.unwrap_or(100_000_000);
+            match is.method {
+                Method::Dopri45 => IntegratorSettings::Dopri45 { rtol, atol, h_max, max_steps },
+                Method::Rosenbrock => {
+                    let jacobian_reuse = is.jacobian_reuse.unwrap_or(1);
+                    if jacobian_reuse == 0 {
+                        return Err(c.err("integrator.jacobian_reuse", 0, "must be >= 1"));
+                    }
+                    IntegratorSettings::Rosenbrock { rtol, atol, h_max, max_steps, jacobian_reuse }
+                }
+                _ => IntegratorSettings::Imex { rtol, atol, h_max, max_steps },
             }
         }
     };

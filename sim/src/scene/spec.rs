@@ -234,9 +234,16 @@ pub enum Method {
     Rk4,
     /// Dormand–Prince 5(4), adaptive, with dense output.
     Dopri45,
+    /// Rosenbrock-W ROS34PW2 (order 3, L-stable), adaptive, with the structured motor-arm
+    /// Jacobian (`sim/src/stiff.rs`).
+    Rosenbrock,
+    /// IMEX additive Runge–Kutta ARK4(3)6L[2]SA: the armature circuits implicit (closed form),
+    /// the mechanics explicit.
+    Imex,
 }
 
-/// The integrator and its settings. `rk4` needs `step`; `dopri45` needs `rtol` and `atol`.
+/// The integrator and its settings. `rk4` needs `step`; the adaptive methods (`dopri45`,
+/// `rosenbrock`, `imex`) need `rtol` and `atol`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
@@ -256,6 +263,9 @@ pub struct IntegratorSpec {
     /// Most steps per run before giving up (default 10^8).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_steps: Option<usize>,
+    /// Steps between Jacobian refreshes (rosenbrock; default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jacobian_reuse: Option<usize>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,0 +1,256 @@
+//! Pieces shared by the adaptive steppers: the settings error, validation of the common
+//! step-control fields, the tolerance-weighted error norm, Hairer's starting step and the
+//! elementary step-size controller.
+//!
+//! References (HNW I = Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*,
+//! 2nd ed., 1993): error norm and controller HNW I §II.4 (4.11)–(4.13); starting step HNW I
+//! §II.4 "Starting Step Size" (a)–(f). [`super::DormandPrince45`] keeps its own copies (with
+//! its PI controller); [`super::Rosenbrock`] and [`super::ArkImex`] use these.
+
+use std::fmt;
+
+use super::{IntegrateError, OdeSystem, Stats};
+
+/// An out-of-range field of a settings struct ([`super::Dopri5Settings`],
+/// [`super::RosenbrockSettings`], [`super::ArkImexSettings`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SettingsError {
+    /// Name of the settings struct, e.g. `"RosenbrockSettings"`.
+    pub settings: &'static str,
+    /// Field name.
+    pub field: &'static str,
+    /// Offending value (integers converted to f64).
+    pub value: f64,
+    /// What the value must satisfy.
+    pub requirement: &'static str,
+}
+
+impl fmt::Display for SettingsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "invalid {}.{} = {}: must be {}",
+            self.settings, self.field, self.value, self.requirement
+        )
+    }
+}
+
+impl std::error::Error for SettingsError {}
+
+/// The step-control fields common to [`super::RosenbrockSettings`] and
+/// [`super::ArkImexSettings`] (same meaning as in [`super::Dopri5Settings`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Control {
+    pub rtol: f64,
+    pub atol: f64,
+    pub h_init: Option<f64>,
+    pub h_max: f64,
+    pub h_min: f64,
+    pub max_steps: usize,
+    pub safety: f64,
+    pub fac_min: f64,
+    pub fac_max: f64,
+}
+
+impl Control {
+    /// Range checks, with the same requirements as [`super::Dopri5Settings::validate`].
+    pub fn validate(&self, settings: &'static str) -> Result<(), SettingsError> {
+        let bad = |field, value, requirement| {
+            Err(SettingsError {
+                settings,
+                field,
+                value,
+                requirement,
+            })
+        };
+        if !(self.rtol.is_finite() && self.rtol >= 0.0) {
+            return bad("rtol", self.rtol, "finite and >= 0");
+        }
+        if !(self.atol.is_finite() && self.atol > 0.0) {
+            return bad("atol", self.atol, "finite and > 0");
+        }
+        if let Some(h) = self.h_init {
+            if !(h.is_finite() && h > 0.0 && h >= self.h_min) {
+                return bad("h_init", h, "finite, > 0 and >= h_min");
+            }
+        }
+        if self.h_max.is_nan() || self.h_max <= 0.0 {
+            return bad("h_max", self.h_max, "> 0 (may be infinite)");
+        }
+        if !(self.h_min.is_finite() && self.h_min >= 0.0 && self.h_min <= self.h_max) {
+            return bad("h_min", self.h_min, "finite, >= 0 and <= h_max");
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", 0.0, "> 0");
+        }
+        if !(self.safety > 0.0 && self.safety <= 1.0) {
+            return bad("safety", self.safety, "in (0, 1]");
+        }
+        if !(self.fac_min > 0.0 && self.fac_min <= 1.0) {
+            return bad("fac_min", self.fac_min, "in (0, 1]");
+        }
+        if !(self.fac_max.is_finite() && self.fac_max >= 1.0) {
+            return bad("fac_max", self.fac_max, "finite and >= 1");
+        }
+        Ok(())
+    }
+
+    /// Step-size factor `h_new / h` for the scaled error `err` of a method whose error
+    /// estimate is `O(h^(1/expo))` (HNW I (4.13)): `safety err^(-expo)` bounded to
+    /// `[fac_min, fac_max]`; a NaN or infinite `err` gives `fac_min`.
+    pub fn factor(&self, err: f64, expo: f64) -> f64 {
+        let finite = err < f64::INFINITY; // false for inf and NaN
+        if !finite {
+            return self.fac_min;
+        }
+        if err == 0.0 {
+            return self.fac_max;
+        }
+        (self.safety * err.powf(-expo)).clamp(self.fac_min, self.fac_max)
+    }
+}
+
+/// `sqrt(1/n sum (e_i / sc_i)^2)`, `sc_i = atol + rtol max(|y_i|, |y_new_i|)` (HNW I (4.11));
+/// 0 for `n = 0`. NaN/inf propagate.
+pub(super) fn error_norm(e: &[f64], y: &[f64], y_new: &[f64], atol: f64, rtol: f64) -> f64 {
+    let n = e.len();
+    if n == 0 {
+        return 0.0;
+    }
+    let mut sum = 0.0;
+    for i in 0..n {
+        let sk = atol + rtol * y[i].abs().max(y_new[i].abs());
+        sum += (e[i] / sk).powi(2);
+    }
+    (sum / n as f64).sqrt()
+}
+
+/// How the last rejected attempt failed, for the error returned when the step size collapses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Failure {
+    /// Error test (or nothing yet).
+    None,
+    /// A non-finite stage value or derivative, produced at time `t` in component `index`.
+    NonFinite { t: f64, index: usize },
+    /// A singular iteration matrix in the step from `t` with step `h`.
+    Singular { t: f64, h: f64 },
+}
+
+impl Failure {
+    /// The error for a step size that fell below `h_min` or what `t` can resolve.
+    pub fn collapse<E>(self, t: f64, h: f64) -> IntegrateError<E> {
+        match self {
+            Failure::None => IntegrateError::StepSizeTooSmall { t, h },
+            Failure::NonFinite { t, index } => IntegrateError::NonFiniteState { t, index },
+            Failure::Singular { t, h } => IntegrateError::SingularMatrix { t, h },
+        }
+    }
+}
+
+/// `h` is too small: below `h_min`, or `0.1 h <= |t| eps` (`dopri5.f`), or not positive.
+pub(super) fn step_collapsed(h: f64, t: f64, h_min: f64) -> bool {
+    !(h >= h_min && 0.1 * h > t.abs() * f64::EPSILON && h > 0.0)
+}
+
+/// Hairer's starting step (HNW I §II.4, (a)–(f)) for a method of order `order`, in the RMS
+/// norm above; `f0 = f(t, y)`. Uses one evaluation of `rhs` (counted), with `y1`, `f1` as
+/// scratch. A non-finite probe is ignored (the step then comes from `f0` alone).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn initial_step<S: OdeSystem>(
+    sys: &mut S,
+    stats: &mut Stats,
+    t: f64,
+    y: &[f64],
+    f0: &[f64],
+    y1: &mut [f64],
+    f1: &mut [f64],
+    c: &Control,
+    order: i32,
+) -> Result<f64, IntegrateError<S::Error>> {
+    let n = y.len();
+    let inv_n = 1.0 / n.max(1) as f64;
+    let (mut d0, mut d1) = (0.0, 0.0);
+    for i in 0..n {
+        let sk = c.atol + c.rtol * y[i].abs();
+        d0 += (y[i] / sk).powi(2);
+        d1 += (f0[i] / sk).powi(2);
+    }
+    let (d0, d1) = ((d0 * inv_n).sqrt(), (d1 * inv_n).sqrt());
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    let h0 = h0.min(c.h_max);
+    for i in 0..n {
+        y1[i] = y[i] + h0 * f0[i];
+    }
+    stats.rhs_evals += 1;
+    sys.rhs(t + h0, y1, f1).map_err(IntegrateError::Rhs)?;
+    let mut d2 = 0.0;
+    for i in 0..n {
+        let sk = c.atol + c.rtol * y[i].abs();
+        d2 += ((f1[i] - f0[i]) / sk).powi(2);
+    }
+    let d2 = (d2 * inv_n).sqrt() / h0;
+    let dmax = d1.max(d2);
+    let h1 = if dmax <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / dmax).powf(1.0 / f64::from(order + 1))
+    };
+    let h = (100.0 * h0).min(h1).min(c.h_max);
+    Ok(if h.is_finite() && h > 0.0 { h } else { h0 })
+}
+
+/// Where the next attempt from `t` with the controller's step `h` ends: on `t_stop` when
+/// `t + 1.01 h` reaches it (stretching by up to 1% rather than leaving a sliver), else `t + h`.
+/// Returns `(h_try, t_new)`.
+pub(super) fn land(t: f64, h: f64, t_stop: f64) -> (f64, f64) {
+    if t + 1.01 * h >= t_stop {
+        (t_stop - t, t_stop)
+    } else {
+        (h, t + h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn controller_factor_is_bounded() {
+        let c = Control {
+            rtol: 1e-6,
+            atol: 1e-6,
+            h_init: None,
+            h_max: 1.0,
+            h_min: 0.0,
+            max_steps: 10,
+            safety: 0.9,
+            fac_min: 0.2,
+            fac_max: 6.0,
+        };
+        assert_eq!(c.factor(0.0, 1.0 / 3.0), 6.0);
+        assert_eq!(c.factor(f64::NAN, 1.0 / 3.0), 0.2);
+        assert_eq!(c.factor(f64::INFINITY, 1.0 / 3.0), 0.2);
+        assert!((c.factor(1.0, 1.0 / 3.0) - 0.9).abs() < 1e-15);
+        assert!((c.factor(8.0, 1.0 / 3.0) - 0.45).abs() < 1e-15);
+        assert!(c.validate("X").is_ok());
+        let e = Control { fac_max: 0.5, ..c }.validate("RosenbrockSettings");
+        let e = e.expect_err("fac_max < 1");
+        assert_eq!((e.settings, e.field), ("RosenbrockSettings", "fac_max"));
+        assert!(e.to_string().contains("RosenbrockSettings.fac_max = 0.5"));
+    }
+
+    #[test]
+    fn error_norm_is_weighted_rms() {
+        let e = [1e-6, -2e-6];
+        let y = [0.0, 1.0];
+        let y_new = [0.0, -3.0];
+        // sc = [1e-6, 1e-6 + 3e-6]
+        let expect = ((1.0f64 + 0.25) / 2.0).sqrt();
+        assert!((error_norm(&e, &y, &y_new, 1e-6, 1e-6) - expect).abs() < 1e-15);
+        assert_eq!(error_norm(&[], &[], &[], 1.0, 1.0), 0.0);
+    }
+}

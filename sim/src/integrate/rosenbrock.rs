@@ -1,0 +1,553 @@
+//! ROS34PW2: adaptive Rosenbrock-W method of order 3(2) for stiff systems, with a reusable
+//! Jacobian and cubic Hermite dense output.
+//!
+//! References (HNW II = Hairer & Wanner, *Solving Ordinary Differential Equations II*, 2nd ed.,
+//! Springer 1996):
+//! - method: J. Rang & L. Angermann, "New Rosenbrock W-methods of order 3 for partial
+//!   differential algebraic equations of index 1", BIT 45 (2005) 761–787, method ROS34PW2:
+//!   4 stages, order 3 with an embedded order-2 solution, L-stable (`R(∞) = 0`), stiffly
+//!   accurate, and a *W-method*: the order conditions hold for any matrix `W` in place of the
+//!   Jacobian `J`, so a lagged or approximate Jacobian costs stability margin, not order.
+//!   Coefficients (`gamma`, `alpha_ij`, `gamma_ij`, `b`, `b_hat`) as printed in the paper to 17
+//!   digits (the same values are in PETSc's `TSROSWRA34PW2` and MATLODE); the tests check the
+//!   W-method order conditions to 1e-14 and the observed orders.
+//! - formulation: one step from `(t, y)` with step `h` is (HNW II §IV.7, (7.4) with the
+//!   autonomisation `t' = 1`, whose Jacobian row for `t` is zero):
+//!   `(I - h gamma J) k_i = h f(t + alpha_i h, y + sum_j alpha_ij k_j) +
+//!   h J sum_j gamma_ij k_j + gamma_i h^2 f_t`, `y_new = y + sum b_i k_i`, with `J ≈ ∂f/∂y`,
+//!   `f_t ≈ ∂f/∂t`, `alpha_i = sum_j alpha_ij`, `gamma_i = sum_{j<=i} gamma_ij`. It is
+//!   computed in the transformed variables `u_i = sum_{j<=i} gamma_ij k_j` of HNW II (7.25),
+//!   which need no product with `J`: `(I/(h gamma) - J) u_i = f(t + alpha_i h, y +
+//!   sum_j a_ij u_j) + sum_j (c_ij / h) u_j + gamma_i h f_t`, `y_new = y + sum_j m_j u_j`,
+//!   with `(a_ij) = (alpha_ij) Gamma^-1`, `(c_ij) = diag(1/gamma) - Gamma^-1`,
+//!   `m = b Gamma^-1` computed here from the paper's coefficients. One LU of
+//!   `I/(h gamma) - J` per new step size or Jacobian (in-place, partial pivoting, `lu.rs`);
+//!   4 solves and 3 new evaluations of `f` per attempt, 1 more (`f` at the new point, the
+//!   next first stage) per accepted step.
+//! - error estimate and step-size control: `err = ||y_new - y_hat||` in the RMS norm of
+//!   HNW I §II.4 with `atol + rtol max(|y|, |y_new|)`; `h_new = h min(fac_max, max(fac_min,
+//!   safety err^(-1/3)))` (the embedded solution has order 2), as in Hairer's `ros4.f`; after a
+//!   rejection the next accepted step may not grow.
+//! - Jacobian reuse (the W property): `J` is evaluated at the start of a step and kept for
+//!   `jacobian_reuse` accepted steps; a rejection with a stale `J` triggers a refresh. `f_t`
+//!   (one column of the autonomised Jacobian, cheap) is evaluated at the start of every step:
+//!   a stale `f_t` of a stiff forcing (`-k sin t` in Prothero–Robinson) is off by `O(k h)`
+//!   (measured on the stiff Kepler test problem at reuse 5: 507 tol with `f_t` reused with
+//!   `J`, 209 tol refreshed, 213 tol with a fresh `J` every step). It comes from
+//!   [`OdeJacobian::time_derivative`] or, if the system does not give it, a forward
+//!   difference in `t` with increment `sqrt(eps max(1e-5, |t|))` (Hairer's `rodas.f`; one
+//!   evaluation of `rhs`), falling back to a backward difference, then to 0, if the probe is
+//!   not finite.
+//! - singular matrix: as in `rodas.f`, a singular `I/(h gamma) - J` halves the step (counted as
+//!   a rejection) up to 5 times in a row, then [`IntegrateError::SingularMatrix`].
+//! - dense output: the cubic Hermite interpolant through `(y, f)` at both ends of the step
+//!   (HNW I §II.6), exact at the ends; `f(t_new, y_new)` is the next step's first stage, so it
+//!   costs no extra evaluation. Its local error is `O(h^4)` whatever Jacobian was used. (A
+//!   stage-based cubic `y_prev + sum b_i(theta) k_i` satisfying the order-2 W conditions was
+//!   tried: same error on the non-stiff problems, 2x larger on Prothero–Robinson with
+//!   `lambda = -1e4`; Hermite's slope error `lambda x (global error)` on stiff components stays
+//!   small because that global error is `O(h^2 / |lambda|)` there.)
+//!
+//! Other behaviour as in [`super::DormandPrince45`]: a non-finite stage shrinks `h` by
+//! `fac_min` and is reported only if the step size collapses; steps shortened to land on
+//! `t_stop` do not reduce the next step; `max_steps` counts attempts.
+
+pub use self::settings::RosenbrockSettings;
+use self::tableau::{Tableau, GAMMA};
+use super::adaptive::{error_norm, initial_step, land, step_collapsed, Control, Failure};
+use super::lu::{lu_factor, lu_solve};
+use super::{first_non_finite, IntegrateError, OdeJacobian, SettingsError, Stats, Stepper};
+
+mod settings;
+mod tableau;
+
+/// Adaptive ROS34PW2 Rosenbrock-W stepper (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Rosenbrock {
+    dim: usize,
+    settings: RosenbrockSettings,
+    control: Control,
+    tab: Tableau,
+    /// Current time and state, `f0 = f(t, y)`.
+    t: f64,
+    y: Vec<f64>,
+    f0: Vec<f64>,
+    /// Last accepted step: start, size (0 before the first), and `y`, `f` at its start (the
+    /// Hermite data at the left end).
+    t_prev: f64,
+    h_last: f64,
+    y_prev: Vec<f64>,
+    f_prev: Vec<f64>,
+    h_next: Option<f64>,
+    rejected_last: bool,
+    failure: Failure,
+    singular_run: u32,
+    /// Jacobian (row-major) and `f_t`; `jac_valid`: evaluated since `init`; `jac_fresh`:
+    /// evaluated at the current `(t, y)`; accepted steps since the evaluation; `max |J_ij|`.
+    jac: Vec<f64>,
+    dfdt: Vec<f64>,
+    jac_valid: bool,
+    jac_fresh: bool,
+    /// `f_t` was evaluated at the current `(t, y)`.
+    dfdt_fresh: bool,
+    steps_since_jac: usize,
+    jac_max: f64,
+    /// LU of `I/(h gamma) - J` and the `h` it was formed for (NaN: none).
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    lu_h: f64,
+    /// Transformed stages, stage argument, stage right-hand side, trial solution, f at it.
+    u: [Vec<f64>; 4],
+    y_stage: Vec<f64>,
+    f_stage: Vec<f64>,
+    y_new: Vec<f64>,
+    f_new: Vec<f64>,
+    stats: Stats,
+    initialized: bool,
+}
+
+enum Attempt {
+    Accepted,
+    Rejected,
+    Singular,
+}
+
+impl Rosenbrock {
+    /// A stepper for systems of dimension `dim`; all buffers (two `dim x dim` matrices) are
+    /// allocated here.
+    ///
+    /// # Panics
+    /// If `settings.validate()` fails; use [`Rosenbrock::try_new`] for user input.
+    pub fn new(dim: usize, settings: RosenbrockSettings) -> Self {
+        match Self::try_new(dim, settings) {
+            Ok(s) => s,
+            Err(e) => panic!("Rosenbrock::new: {e}"),
+        }
+    }
+
+    /// Like [`Rosenbrock::new`], returning the settings error instead of panicking.
+    ///
+    /// # Errors
+    /// The first out-of-range field of `settings`.
+    pub fn try_new(dim: usize, settings: RosenbrockSettings) -> Result<Self, SettingsError> {
+        settings.validate()?;
+        let z = || vec![0.0; dim];
+        Ok(Self {
+            dim,
+            settings,
+            control: settings.control(),
+            tab: Tableau::new(),
+            t: 0.0,
+            y: z(),
+            f0: z(),
+            t_prev: 0.0,
+            h_last: 0.0,
+            y_prev: z(),
+            f_prev: z(),
+            h_next: None,
+            rejected_last: false,
+            failure: Failure::None,
+            singular_run: 0,
+            jac: vec![0.0; dim * dim],
+            dfdt: z(),
+            jac_valid: false,
+            jac_fresh: false,
+            dfdt_fresh: false,
+            steps_since_jac: 0,
+            jac_max: 0.0,
+            lu: vec![0.0; dim * dim],
+            piv: vec![0; dim],
+            lu_h: f64::NAN,
+            u: [z(), z(), z(), z()],
+            y_stage: z(),
+            f_stage: z(),
+            y_new: z(),
+            f_new: z(),
+            stats: Stats::default(),
+            initialized: false,
+        })
+    }
+
+    /// The settings this stepper was built with.
+    pub fn settings(&self) -> &RosenbrockSettings {
+        &self.settings
+    }
+
+    /// Start of the last accepted step (equals `t()` before the first step).
+    pub fn t_prev(&self) -> f64 {
+        self.t_prev
+    }
+
+    /// Current time (same as [`Stepper::t`]).
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Current state (same as [`Stepper::y`]).
+    pub fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    /// Work counters since `init` (same as [`Stepper::stats`]).
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// Step size the next attempt will use (before `h_max` and `t_stop`); `None` before the
+    /// first step.
+    pub fn h_next(&self) -> Option<f64> {
+        self.h_next
+    }
+
+    /// Cubic Hermite interpolation on `[t_prev, t]`. Outside that interval it extrapolates the
+    /// same cubic.
+    pub fn interpolate(&self, t_query: f64, out: &mut [f64]) {
+        assert_eq!(
+            out.len(),
+            self.dim,
+            "Rosenbrock::interpolate: out length vs dim"
+        );
+        if t_query == self.t || self.h_last == 0.0 {
+            out.copy_from_slice(&self.y);
+            return;
+        }
+        if t_query == self.t_prev {
+            out.copy_from_slice(&self.y_prev);
+            return;
+        }
+        let h = self.h_last;
+        let th = (t_query - self.t_prev) / h;
+        let th2 = th * th;
+        let th3 = th2 * th;
+        let h00 = 2.0 * th3 - 3.0 * th2 + 1.0;
+        let h10 = th3 - 2.0 * th2 + th;
+        let h01 = -2.0 * th3 + 3.0 * th2;
+        let h11 = th3 - th2;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = h00 * self.y_prev[i]
+                + h01 * self.y[i]
+                + h * (h10 * self.f_prev[i] + h11 * self.f0[i]);
+        }
+    }
+
+    /// Evaluates `J` at the current point. A non-finite entry is an error: shrinking the step
+    /// cannot change a Jacobian taken at an accepted state.
+    fn evaluate_jacobian<S: OdeJacobian>(
+        &mut self,
+        sys: &mut S,
+    ) -> Result<(), IntegrateError<S::Error>> {
+        let (t, n) = (self.t, self.dim);
+        self.stats.jacobian_evals += 1;
+        sys.jacobian(t, &self.y, &self.f0, &mut self.jac)
+            .map_err(IntegrateError::Rhs)?;
+        if let Some(k) = first_non_finite(&self.jac) {
+            return Err(IntegrateError::NonFiniteState {
+                t,
+                index: k / n.max(1),
+            });
+        }
+        self.jac_max = self.jac.iter().fold(0.0, |m, v| m.max(v.abs()));
+        self.jac_valid = true;
+        self.jac_fresh = true;
+        self.steps_since_jac = 0;
+        self.lu_h = f64::NAN;
+        Ok(())
+    }
+
+    /// Evaluates `f_t` at the current point: analytic, else a forward difference in `t`, else
+    /// a backward one, else 0 (any value keeps the order).
+    fn evaluate_dfdt<S: OdeJacobian>(
+        &mut self,
+        sys: &mut S,
+    ) -> Result<(), IntegrateError<S::Error>> {
+        let (t, n) = (self.t, self.dim);
+        if !sys
+            .time_derivative(t, &self.y, &self.f0, &mut self.dfdt)
+            .map_err(IntegrateError::Rhs)?
+        {
+            let delta = (f64::EPSILON * t.abs().max(1e-5)).sqrt();
+            self.dfdt.fill(0.0);
+            for d in [delta, -delta] {
+                self.stats.rhs_evals += 1;
+                sys.rhs(t + d, &self.y, &mut self.f_stage)
+                    .map_err(IntegrateError::Rhs)?;
+                if first_non_finite(&self.f_stage).is_none() {
+                    let dt = (t + d) - t;
+                    for i in 0..n {
+                        self.dfdt[i] = (self.f_stage[i] - self.f0[i]) / dt;
+                    }
+                    break;
+                }
+            }
+        }
+        if let Some(i) = first_non_finite(&self.dfdt) {
+            return Err(IntegrateError::NonFiniteState { t, index: i });
+        }
+        self.dfdt_fresh = true;
+        Ok(())
+    }
+
+    /// LU of `I/(h gamma) - J`; `false` if singular.
+    fn factor(&mut self, h: f64) -> bool {
+        let n = self.dim;
+        let d = 1.0 / (h * GAMMA);
+        for (w, j) in self.lu.iter_mut().zip(&self.jac) {
+            *w = -j;
+        }
+        for i in 0..n {
+            self.lu[i * n + i] += d;
+        }
+        self.stats.lu_decompositions += 1;
+        let ok = lu_factor(&mut self.lu, n, &mut self.piv, d + self.jac_max).is_ok();
+        self.lu_h = if ok { h } else { f64::NAN };
+        ok
+    }
+
+    fn reject_non_finite(&mut self, h: f64, t_bad: f64, index: usize) -> Attempt {
+        self.h_next = Some(h * self.settings.fac_min);
+        self.rejected_last = true;
+        self.failure = Failure::NonFinite { t: t_bad, index };
+        self.stats.rejected += 1;
+        Attempt::Rejected
+    }
+
+    /// One attempt from `(t, y)` with step `h` ending at `t_new`; commits on acceptance.
+    fn attempt<S: OdeJacobian>(
+        &mut self,
+        sys: &mut S,
+        h: f64,
+        t_new: f64,
+        h_proposed: f64,
+    ) -> Result<Attempt, IntegrateError<S::Error>> {
+        let need_jac = !self.jac_valid
+            || self.steps_since_jac >= self.settings.jacobian_reuse
+            || (self.rejected_last && !self.jac_fresh);
+        if need_jac {
+            self.evaluate_jacobian(sys)?;
+        }
+        if !self.dfdt_fresh {
+            self.evaluate_dfdt(sys)?;
+        }
+        if self.lu_h != h && !self.factor(h) {
+            return Ok(Attempt::Singular);
+        }
+        self.singular_run = 0;
+        let (t, n, tab) = (self.t, self.dim, self.tab);
+
+        for s in 0..4 {
+            // stage argument and f at it (stage 0: f0)
+            let ts = if s == 3 { t_new } else { t + tab.alpha[s] * h };
+            if s > 0 {
+                for i in 0..n {
+                    let mut v = self.y[i];
+                    for j in 0..s {
+                        v += tab.a[s][j] * self.u[j][i];
+                    }
+                    self.y_stage[i] = v;
+                }
+                self.stats.rhs_evals += 1;
+                sys.rhs(ts, &self.y_stage, &mut self.f_stage)
+                    .map_err(IntegrateError::Rhs)?;
+                if let Some(i) = first_non_finite(&self.f_stage) {
+                    return Ok(self.reject_non_finite(h, ts, i));
+                }
+            } else {
+                self.f_stage.copy_from_slice(&self.f0);
+            }
+            let hg = h * tab.gamma[s];
+            let (done, rest) = self.u.split_at_mut(s);
+            let us = &mut rest[0];
+            for i in 0..n {
+                let mut v = self.f_stage[i] + hg * self.dfdt[i];
+                for (j, uj) in done.iter().enumerate() {
+                    v += tab.c[s][j] / h * uj[i];
+                }
+                us[i] = v;
+            }
+            lu_solve(&self.lu, n, &self.piv, us);
+            if let Some(i) = first_non_finite(us) {
+                return Ok(self.reject_non_finite(h, ts, i));
+            }
+        }
+
+        // solution and error estimate (the error vector goes to y_stage)
+        for i in 0..n {
+            let (mut yn, mut e) = (self.y[i], 0.0);
+            for j in 0..4 {
+                yn += tab.m[j] * self.u[j][i];
+                e += tab.e[j] * self.u[j][i];
+            }
+            self.y_new[i] = yn;
+            self.y_stage[i] = e;
+        }
+        let c = self.control;
+        let err = error_norm(&self.y_stage, &self.y, &self.y_new, c.atol, c.rtol);
+        let fac = c.factor(err, 1.0 / 3.0);
+        let passed = err <= 1.0;
+        if !passed {
+            self.h_next = Some(h * fac.min(1.0));
+            self.rejected_last = true;
+            self.failure = Failure::None;
+            self.stats.rejected += 1;
+            return Ok(Attempt::Rejected);
+        }
+        if let Some(i) = first_non_finite(&self.y_new) {
+            return Ok(self.reject_non_finite(h, t_new, i));
+        }
+        self.stats.rhs_evals += 1;
+        sys.rhs(t_new, &self.y_new, &mut self.f_new)
+            .map_err(IntegrateError::Rhs)?;
+        if let Some(i) = first_non_finite(&self.f_new) {
+            return Ok(self.reject_non_finite(h, t_new, i));
+        }
+
+        let mut h_new = h * fac;
+        if self.rejected_last {
+            h_new = h_new.min(h);
+        }
+        if h < h_proposed {
+            h_new = h_new.max(h_proposed);
+        }
+        // commit: (y, f0) become the left Hermite data, the new point the current one
+        std::mem::swap(&mut self.y_prev, &mut self.y);
+        std::mem::swap(&mut self.y, &mut self.y_new);
+        std::mem::swap(&mut self.f_prev, &mut self.f0);
+        std::mem::swap(&mut self.f0, &mut self.f_new);
+        self.t_prev = t;
+        self.t = t_new;
+        self.h_last = h;
+        self.h_next = Some(h_new.min(self.settings.h_max));
+        self.rejected_last = false;
+        self.failure = Failure::None;
+        self.jac_fresh = false;
+        self.dfdt_fresh = false;
+        self.steps_since_jac += 1;
+        self.stats.steps += 1;
+        Ok(Attempt::Accepted)
+    }
+}
+
+impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
+    /// Evaluates `f(t0, y0)` once; the Jacobian is evaluated by the first step.
+    fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        assert_eq!(
+            sys.dim(),
+            self.dim,
+            "Rosenbrock::init: system dim vs stepper dim"
+        );
+        assert_eq!(y0.len(), self.dim, "Rosenbrock::init: y0 length vs dim");
+        self.initialized = false;
+        self.stats = Stats::default();
+        if let Some(index) = first_non_finite(y0) {
+            return Err(IntegrateError::NonFiniteState { t: t0, index });
+        }
+        self.t = t0;
+        self.t_prev = t0;
+        self.h_last = 0.0;
+        self.h_next = None;
+        self.rejected_last = false;
+        self.failure = Failure::None;
+        self.singular_run = 0;
+        self.jac_valid = false;
+        self.jac_fresh = false;
+        self.dfdt_fresh = false;
+        self.lu_h = f64::NAN;
+        self.y.copy_from_slice(y0);
+        self.y_prev.copy_from_slice(y0);
+        self.stats.rhs_evals += 1;
+        sys.rhs(t0, y0, &mut self.f0).map_err(IntegrateError::Rhs)?;
+        if let Some(index) = first_non_finite(&self.f0) {
+            return Err(IntegrateError::NonFiniteState { t: t0, index });
+        }
+        self.f_prev.copy_from_slice(&self.f0);
+        self.initialized = true;
+        Ok(())
+    }
+
+    fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {
+        assert!(
+            self.initialized,
+            "Rosenbrock::step called before a successful init"
+        );
+        if t_stop.is_nan() || t_stop <= self.t {
+            return Ok(self.t);
+        }
+        let h_first = match (self.h_next, self.settings.h_init) {
+            (Some(h), _) | (None, Some(h)) => h,
+            (None, None) => initial_step(
+                sys,
+                &mut self.stats,
+                self.t,
+                &self.y,
+                &self.f0,
+                &mut self.y_stage,
+                &mut self.f_stage,
+                &self.control,
+                3,
+            )?,
+        };
+        self.h_next = Some(h_first);
+        loop {
+            if self.stats.steps + self.stats.rejected >= self.settings.max_steps as u64 {
+                return Err(IntegrateError::TooManySteps {
+                    t: self.t,
+                    max_steps: self.settings.max_steps,
+                });
+            }
+            let h = self.h_next.unwrap_or(h_first).min(self.settings.h_max);
+            if step_collapsed(h, self.t, self.settings.h_min) {
+                return Err(self.failure.collapse(self.t, h));
+            }
+            let (h_try, t_new) = land(self.t, h, t_stop);
+            match self.attempt(sys, h_try, t_new, h)? {
+                Attempt::Accepted => return Ok(self.t),
+                Attempt::Rejected => {}
+                Attempt::Singular => {
+                    self.stats.rejected += 1;
+                    self.singular_run += 1;
+                    self.rejected_last = true;
+                    self.failure = Failure::Singular {
+                        t: self.t,
+                        h: h_try,
+                    };
+                    if self.singular_run >= 5 {
+                        return Err(IntegrateError::SingularMatrix {
+                            t: self.t,
+                            h: h_try,
+                        });
+                    }
+                    self.h_next = Some(0.5 * h_try);
+                }
+            }
+        }
+    }
+
+    fn t(&self) -> f64 {
+        Rosenbrock::t(self)
+    }
+
+    fn y(&self) -> &[f64] {
+        Rosenbrock::y(self)
+    }
+
+    fn interpolate(&self, t_query: f64, out: &mut [f64]) {
+        Rosenbrock::interpolate(self, t_query, out)
+    }
+
+    fn stats(&self) -> Stats {
+        Rosenbrock::stats(self)
+    }
+
+    fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        self.y.copy_from_slice(y);
+        self.stats.rhs_evals += 1;
+        sys.rhs(self.t, y, &mut self.f0).map_err(IntegrateError::Rhs)?;
+        match first_non_finite(&self.f0) {
+            Some(index) => Err(IntegrateError::NonFiniteState { t: self.t, index }),
+            None => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
