@@ -231,7 +231,9 @@ impl<'a> ArmSystem<'a> {
         out.loss_resistance = y[l.loss_r()];
         out.loss_friction = y[l.loss_d()];
         // kinematics at this state (the dynamics left body velocities of RNEA in `data`)
-        out.kinetic = link_kinetic_energy(&s.model, &self.data) + rotor_kinetic_energy(d, qd);
+        // ½ q̇ᵀ M q̇ from the mass matrix of this evaluation (valid for CRBA and Walker–Orin)
+        let m_qd: f64 = (0..l.nv).map(|r| qd[r] * (0..l.nv).map(|c| self.data.m[(r, c)] * qd[c]).sum::<f64>()).sum();
+        out.kinetic = 0.5 * m_qd + rotor_kinetic_energy(d, qd);
         forward_kinematics(&s.model, &mut self.data, q);
         forward_velocities(&s.model, &mut self.data, qd);
         out.potential = potential_energy(&s.model, &self.data);

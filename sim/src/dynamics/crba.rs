@@ -11,18 +11,27 @@ use super::spatial::Motion;
 /// Joint-space inertia of the rigid bodies (nv x nv, kg m^2), stored in `data.m`, symmetric.
 /// Also writes `data.x_parent_body` and `data.ic`.
 pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64> {
+    assert_eq!(q.len(), model.nv, "q: expected nv");
+    for i in 0..model.nv {
+        let x = model.joint_placement(i, q[i]);
+        data.x_parent_body[i] = x;
+        data.xm_parent_body[i] = (&x).into();
+    }
+    crba_placed(model, data)
+}
+
+/// [`crba`] at the placements already in `data.xm_parent_body`.
+pub fn crba_placed<'d>(model: &Model, data: &'d mut Data) -> &'d DMatrix<f64> {
     let nv = model.nv;
-    assert_eq!(q.len(), nv, "q: expected nv");
     // entries of bodies on different branches of a tree stay zero
     data.m.fill(0.0);
     for (i, body) in model.bodies.iter().enumerate() {
-        data.x_parent_body[i] = model.joint_placement(i, q[i]);
         data.ic[i] = body.inertia;
     }
     // composite inertias, leaves first (a parent has a lower index)
     for i in (0..nv).rev() {
         if let Some(p) = model.bodies[i].parent {
-            let moved = data.ic[i].to_parent(&data.x_parent_body[i]);
+            let moved = data.ic[i].to_parent_x(&data.xm_parent_body[i]);
             data.ic[p] = data.ic[p].add(&moved);
         }
     }
@@ -32,7 +41,7 @@ pub fn crba<'d>(model: &Model, data: &'d mut Data, q: &[f64]) -> &'d DMatrix<f64
         data.m[(i, i)] = s_i.w.dot(&f.n);
         let mut j = i;
         while let Some(p) = model.bodies[j].parent {
-            f = f.to_parent(&data.x_parent_body[j]);
+            f = f.to_parent_x(&data.xm_parent_body[j]);
             j = p;
             let m_ij = model.bodies[j].axis.dot(&f.n);
             data.m[(i, j)] = m_ij;

@@ -5,13 +5,15 @@
 use nalgebra::{DMatrix, DVector, Isometry3, Vector3};
 
 use super::model::Model;
-use super::spatial::{Force, Inertia, Motion};
+use super::spatial::{Force, Inertia, Motion, Xform};
 
 #[derive(Clone, Debug)]
 pub struct Data {
     /// Placement of body i in its parent (or the world) at the current q; written by
     /// `kinematics::forward_kinematics`, `rnea::rnea`, `crba::crba`.
     pub x_parent_body: Vec<Isometry3<f64>>,
+    /// The same placements as matrices, for the recursions; written with `x_parent_body`.
+    pub xm_parent_body: Vec<Xform>,
     /// Placement of body i in the world; written by `kinematics::forward_kinematics`.
     pub x_world_body: Vec<Isometry3<f64>>,
     /// Body spatial velocity in body coordinates (nv); written by `rnea::rnea`.
@@ -47,6 +49,7 @@ impl Data {
         let nv = model.nv;
         Self {
             x_parent_body: vec![Isometry3::identity(); nv],
+            xm_parent_body: vec![Xform::identity(); nv],
             x_world_body: vec![Isometry3::identity(); nv],
             v_body: vec![Motion::ZERO; nv],
             a_body: vec![Motion::ZERO; nv],

@@ -18,12 +18,12 @@
 use nalgebra::{Cholesky, DMatrix, DVector, LU};
 
 use super::constraints::{constraint_jacobian, PointOnPlane};
-use super::crba::crba;
+use super::crba::crba_placed;
 use super::data::Data;
 use super::kinematics::{forward_kinematics, forward_velocities};
 use super::model::Model;
 use super::motor::Drives;
-use super::rnea::bias_forces;
+use super::rnea::bias_forces_placed;
 use super::walker_orin;
 use crate::error::DynamicsError;
 
@@ -149,8 +149,10 @@ pub fn forward_dynamics(
     let nv = model.nv;
     let nc = plant.contacts.len();
 
-    // bias forces h + G, and b = K_m i − h − G − (D + D_m) q̇
-    bias_forces(model, data, q, qd);
+    // placements once (RNEA, CRBA and the contacts share them), then the bias forces h + G
+    // and b = K_m i − h − G − (D + D_m) q̇
+    forward_kinematics(model, data, q);
+    bias_forces_placed(model, data, qd);
     for j in 0..nv {
         fd.b[j] = drives.km[j] * current[j] - data.tau[j];
     }
@@ -161,7 +163,7 @@ pub fn forward_dynamics(
     }
     // M_J = M + J_m
     match plant.mass_matrix {
-        MassMatrixMethod::Crba => crba(model, data, q),
+        MassMatrixMethod::Crba => crba_placed(model, data),
         MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
     };
     fd.m_j.copy_from(&data.m);
@@ -170,7 +172,6 @@ pub fn forward_dynamics(
     }
     // constraint rows
     if nc > 0 {
-        forward_kinematics(model, data, q);
         forward_velocities(model, data, qd);
         constraint_jacobian(model, data, plant.contacts, &mut fd.jac, &mut fd.jdqd);
         for (k, c) in plant.contacts.iter().enumerate() {

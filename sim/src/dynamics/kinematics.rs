@@ -13,13 +13,14 @@ use nalgebra::{DMatrix, Vector3};
 use super::data::Data;
 use super::model::Model;
 
-/// Placements of every body, in its parent (`data.x_parent_body`) and in the world
-/// (`data.x_world_body`). `q`: joint angles (nv), rad.
+/// Placements of every body, in its parent (`data.x_parent_body`, `data.xm_parent_body`) and
+/// in the world (`data.x_world_body`). `q`: joint angles (nv), rad.
 pub fn forward_kinematics(model: &Model, data: &mut Data, q: &[f64]) {
     assert_eq!(q.len(), model.nv, "q: expected nv");
     for (i, body) in model.bodies.iter().enumerate() {
         let x_parent_body = model.joint_placement(i, q[i]);
         data.x_parent_body[i] = x_parent_body;
+        data.xm_parent_body[i] = (&x_parent_body).into();
         data.x_world_body[i] = match body.parent {
             Some(p) => data.x_world_body[p] * x_parent_body,
             None => x_parent_body,

@@ -21,23 +21,39 @@ pub fn rnea<'d>(
     qdd: &[f64],
     gravity_world: &Vector3<f64>,
 ) -> &'d DVector<f64> {
+    assert_eq!(q.len(), model.nv, "q: expected nv");
+    for i in 0..model.nv {
+        let x = model.joint_placement(i, q[i]);
+        data.x_parent_body[i] = x;
+        data.xm_parent_body[i] = (&x).into();
+    }
+    rnea_placed(model, data, qd, qdd, gravity_world)
+}
+
+/// [`rnea`] at the placements already in `data.xm_parent_body` (from `forward_kinematics` or
+/// `rnea` at the same q), so that one evaluation of the dynamics computes them once.
+pub fn rnea_placed<'d>(
+    model: &Model,
+    data: &'d mut Data,
+    qd: &[f64],
+    qdd: &[f64],
+    gravity_world: &Vector3<f64>,
+) -> &'d DVector<f64> {
     let nv = model.nv;
-    assert_eq!(q.len(), nv, "q: expected nv");
     assert_eq!(qd.len(), nv, "qd: expected nv");
     assert_eq!(qdd.len(), nv, "qdd: expected nv");
     let a_world = Motion::new(Vector3::zeros(), -gravity_world);
     // forward pass: velocities and accelerations, outward from the root
     for (i, body) in model.bodies.iter().enumerate() {
-        let x = model.joint_placement(i, q[i]);
-        data.x_parent_body[i] = x;
-        let s = Motion::new(body.axis.into_inner(), Vector3::zeros());
-        let vj = s.scale(qd[i]);
+        let x = &data.xm_parent_body[i];
+        let axis = body.axis.into_inner();
         let (v_parent, a_parent) = match body.parent {
             Some(p) => (data.v_body[p], data.a_body[p]),
             None => (Motion::ZERO, a_world),
         };
-        let v = v_parent.to_child(&x).add(&vj);
-        let a = a_parent.to_child(&x).add(&s.scale(qdd[i])).add(&v.cross_motion(&vj));
+        let vj = Motion::new(axis * qd[i], Vector3::zeros());
+        let v = v_parent.to_child_x(x).add(&vj);
+        let a = a_parent.to_child_x(x).add(&Motion::new(axis * qdd[i], Vector3::zeros())).add(&v.cross_motion(&vj));
         let inertia = &body.inertia;
         data.f_body[i] = inertia.mul(&a).add(&v.cross_force(&inertia.mul(&v)));
         data.v_body[i] = v;
@@ -48,7 +64,7 @@ pub fn rnea<'d>(
         let body = &model.bodies[i];
         data.tau[i] = body.axis.dot(&data.f_body[i].n);
         if let Some(p) = body.parent {
-            let f = data.f_body[i].to_parent(&data.x_parent_body[i]);
+            let f = data.f_body[i].to_parent_x(&data.xm_parent_body[i]);
             data.f_body[p] = data.f_body[p].add(&f);
         }
     }
@@ -59,6 +75,14 @@ pub fn rnea<'d>(
 pub fn bias_forces<'d>(model: &Model, data: &'d mut Data, q: &[f64], qd: &[f64]) -> &'d DVector<f64> {
     let zeros = std::mem::take(&mut data.zeros_nv);
     rnea(model, data, q, qd, zeros.as_slice(), &model.gravity);
+    data.zeros_nv = zeros;
+    &data.tau
+}
+
+/// [`bias_forces`] at the placements already in `data` (see [`rnea_placed`]).
+pub fn bias_forces_placed<'d>(model: &Model, data: &'d mut Data, qd: &[f64]) -> &'d DVector<f64> {
+    let zeros = std::mem::take(&mut data.zeros_nv);
+    rnea_placed(model, data, qd, zeros.as_slice(), &model.gravity);
     data.zeros_nv = zeros;
     &data.tau
 }

@@ -12,6 +12,26 @@
 
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
+/// A placement `x_parent_child` as a rotation matrix and a translation: the form the
+/// recursive algorithms apply (a 3x3 product is cheaper than a quaternion rotation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Xform {
+    pub rot: Matrix3<f64>,
+    pub trans: Vector3<f64>,
+}
+
+impl Xform {
+    pub fn identity() -> Self {
+        Self { rot: Matrix3::identity(), trans: Vector3::zeros() }
+    }
+}
+
+impl From<&Isometry3<f64>> for Xform {
+    fn from(x: &Isometry3<f64>) -> Self {
+        Self { rot: *x.rotation.to_rotation_matrix().matrix(), trans: x.translation.vector }
+    }
+}
+
 /// Spatial motion vector (angular, linear), rad/s and m/s (or their rates).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Motion {
@@ -62,6 +82,12 @@ impl Motion {
         Motion { w: r.inverse_transform_vector(&self.w), v: r.inverse_transform_vector(&(self.v + self.w.cross(&t))) }
     }
 
+    /// [`Motion::to_child`] with a matrix placement.
+    #[inline]
+    pub fn to_child_x(&self, x: &Xform) -> Motion {
+        Motion { w: x.rot.tr_mul(&self.w), v: x.rot.tr_mul(&(self.v + self.w.cross(&x.trans))) }
+    }
+
     /// Express a child-frame motion in the parent frame.
     #[inline]
     pub fn to_parent(&self, x_parent_child: &Isometry3<f64>) -> Motion {
@@ -104,6 +130,13 @@ impl Force {
         let t = x_parent_child.translation.vector;
         let f = r.transform_vector(&self.f);
         Force { n: r.transform_vector(&self.n) + t.cross(&f), f }
+    }
+
+    /// [`Force::to_parent`] with a matrix placement.
+    #[inline]
+    pub fn to_parent_x(&self, x: &Xform) -> Force {
+        let f = x.rot * self.f;
+        Force { n: x.rot * self.n + x.trans.cross(&f), f }
     }
 
     #[inline]
@@ -166,6 +199,20 @@ impl Inertia {
         }
     }
 
+    /// [`Inertia::to_parent`] with a matrix placement.
+    pub fn to_parent_x(&self, x: &Xform) -> Inertia {
+        let r = &x.rot;
+        let p = x.trans;
+        let rh = r * self.h;
+        let sp = skew(&p);
+        let srh = skew(&rh);
+        Inertia {
+            mass: self.mass,
+            h: rh + p * self.mass,
+            i_o: r * self.i_o * r.transpose() - srh * sp - sp * srh - sp * sp * self.mass,
+        }
+    }
+
     #[inline]
     pub fn add(&self, o: &Inertia) -> Inertia {
         Inertia { mass: self.mass + o.mass, h: self.h + o.h, i_o: self.i_o + o.i_o }
@@ -195,6 +242,22 @@ mod tests {
         assert!((f_parent.dot(&m_parent) - f.dot(&m)).abs() < 1e-14);
         let back = m_parent.to_child(&x);
         assert!((back.w - m.w).norm() < 1e-15 && (back.v - m.v).norm() < 1e-15);
+    }
+
+    /// The matrix-placement forms equal the isometry forms (1e-15).
+    #[test]
+    fn matrix_placements_match_isometries() {
+        let x = placement();
+        let xm = Xform::from(&x);
+        let m = Motion::new(Vector3::new(0.1, 2.0, -0.3), Vector3::new(1.0, -0.5, 0.25));
+        let f = Force { n: Vector3::new(0.4, 0.2, -1.0), f: Vector3::new(-2.0, 0.3, 0.9) };
+        let i = Inertia::from_com(0.7, Vector3::new(0.01, 0.02, 0.15), Matrix3::new(0.003, 0.0001, 0.0, 0.0001, 0.002, 0.0, 0.0, 0.0, 0.001));
+        let (a, b) = (m.to_child(&x), m.to_child_x(&xm));
+        assert!((a.w - b.w).norm() < 1e-15 && (a.v - b.v).norm() < 1e-15);
+        let (a, b) = (f.to_parent(&x), f.to_parent_x(&xm));
+        assert!((a.n - b.n).norm() < 1e-15 && (a.f - b.f).norm() < 1e-15);
+        let (a, b) = (i.to_parent(&x), i.to_parent_x(&xm));
+        assert!((a.i_o - b.i_o).norm() < 1e-15 && (a.h - b.h).norm() < 1e-15);
     }
 
     /// Inertia transform agrees with transforming momentum: X^T I X m = X^T (I (X m)), to 1e-14.
