@@ -228,6 +228,14 @@ pub fn precision(args: &PrecisionArgs) -> Result<()> {
             writeln!(o, "{:<42} {:<12} {}", r.series, r.setting, r.status)?;
         }
     }
+    let target = 1e-6;
+    let best = sim::precision::cheapest_within(&rows, target);
+    let baseline = best.iter().find(|r| r.series.starts_with("paper baseline")).map(|r| r.wall_s);
+    writeln!(o, "\nCheapest run per method with max hand error <= {target:.0e} m:")?;
+    for r in &best {
+        let ratio = baseline.map_or(String::from("-"), |b| format!("{:.1}x faster than the paper baseline", b / r.wall_s));
+        writeln!(o, "  {:<42} {:<12} {:>9.2} ms  {:>6.0}x real time  {ratio}", r.series, r.setting, r.wall_s * 1e3, r.speed_vs_real_time)?;
+    }
     writeln!(o, "wrote {}/precision.csv, precision.json, work-precision.svg, work-precision.png", args.out.display())?;
     print_out(&o)
 }

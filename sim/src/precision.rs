@@ -150,8 +150,12 @@ pub fn default_ladder(scene: &Scene) -> Vec<Variant> {
     for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
         v.push(plain("dopri45", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max, max_steps: 100_000_000 }));
     }
-    // the stiff methods may take steps far longer than the output interval
+    // the stiff methods may take steps far longer than the output interval; so may dopri45,
+    // up to its stability limit
     let h_long = scene.duration / 10.0;
+    for tol in [1e-4, 1e-6, 1e-8] {
+        v.push(plain("dopri45 (h_max free)", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max: h_long, max_steps: 100_000_000 }));
+    }
     for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] {
         v.push(plain(
             "rosenbrock (structured J)",
@@ -188,4 +192,18 @@ pub fn default_ladder(scene: &Scene) -> Vec<Variant> {
         }
     }
     v
+}
+
+/// Per series, the cheapest run whose max hand error is at most `target_m`.
+pub fn cheapest_within<'r>(rows: &'r [Row], target_m: f64) -> Vec<&'r Row> {
+    let mut best: Vec<&Row> = Vec::new();
+    for r in rows.iter().filter(|r| r.status == "ok" && r.max_hand_error_m <= target_m) {
+        match best.iter_mut().find(|b| b.series == r.series) {
+            Some(b) if r.wall_s < b.wall_s => *b = r,
+            Some(_) => {}
+            None => best.push(r),
+        }
+    }
+    best.sort_by(|a, b| a.wall_s.total_cmp(&b.wall_s));
+    best
 }
