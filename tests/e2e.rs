@@ -77,3 +77,30 @@ fn analyze_rejects_files_that_are_not_recordings() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("junk.mcap"));
 }
+
+#[test]
+fn precision_writes_its_table_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(Command::new(bin("sim"))
+        .args(["precision"])
+        .arg(small_scene())
+        .args(["--run", "elbow", "--duration", "0.1", "--repeats", "1", "--quiet", "-o"])
+        .arg(dir.path()));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8(out.stdout).unwrap();
+    for series in ["dopri45", "rosenbrock", "imex", "rk4", "paper baseline"] {
+        assert!(table.contains(series), "{series} missing from\n{table}");
+    }
+    let rows: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.path().join("precision.json")).unwrap()).unwrap();
+    let rows = rows.as_array().unwrap();
+    assert!(rows.len() >= 20);
+    // the tightest Dormand-Prince rung is within 1e-9 m of the reference
+    let tight = rows.iter().find(|r| r["series"] == "dopri45" && r["setting"] == "rtol 1e-10").unwrap();
+    assert!(tight["max_hand_error_m"].as_f64().unwrap() < 1e-9, "{tight}");
+    // the plots are real images: PNG signature and size, SVG with the axes' labels
+    let png = std::fs::read(dir.path().join("work-precision.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert!(png.len() > 10_000, "{} bytes", png.len());
+    let svg = std::fs::read_to_string(dir.path().join("work-precision.svg")).unwrap();
+    assert!(svg.contains("max hand error") && svg.contains("wall time"));
+}
