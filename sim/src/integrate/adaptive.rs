@@ -4,8 +4,9 @@
 //!
 //! References (HNW I = Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*,
 //! 2nd ed., 1993): error norm and controller HNW I §II.4 (4.11)–(4.13); starting step HNW I
-//! §II.4 "Starting Step Size" (a)–(f). [`super::DormandPrince45`] keeps its own copies (with
-//! its PI controller); [`super::Rosenbrock`] and [`super::ArkImex`] use these.
+//! §II.4 "Starting Step Size" (a)–(f). [`super::DormandPrince45`], [`super::Rosenbrock`] and
+//! [`super::ArkImex`] share these, the state they carry between attempts ([`Core`]) and the
+//! step loop ([`step`]); [`super::DormandPrince45`] keeps its own (PI) controller.
 
 use std::fmt;
 
@@ -37,8 +38,8 @@ impl fmt::Display for SettingsError {
 
 impl std::error::Error for SettingsError {}
 
-/// The step-control fields common to [`super::RosenbrockSettings`] and
-/// [`super::ArkImexSettings`] (same meaning as in [`super::Dopri5Settings`]).
+/// The step-control fields common to [`super::Dopri5Settings`],
+/// [`super::RosenbrockSettings`] and [`super::ArkImexSettings`] (same meaning in all three).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Control {
     pub rtol: f64,
@@ -52,8 +53,27 @@ pub(super) struct Control {
     pub fac_max: f64,
 }
 
+/// The [`Control`] part of a settings struct with the same field names (all three have them).
+macro_rules! control_of {
+    ($settings:expr) => {{
+        let s = &$settings;
+        $crate::integrate::adaptive::Control {
+            rtol: s.rtol,
+            atol: s.atol,
+            h_init: s.h_init,
+            h_max: s.h_max,
+            h_min: s.h_min,
+            max_steps: s.max_steps,
+            safety: s.safety,
+            fac_min: s.fac_min,
+            fac_max: s.fac_max,
+        }
+    }};
+}
+pub(super) use control_of;
+
 impl Control {
-    /// Range checks, with the same requirements as [`super::Dopri5Settings::validate`].
+    /// Range checks of the common fields (the settings' `validate` add their own fields).
     pub fn validate(&self, settings: &'static str) -> Result<(), SettingsError> {
         let bad = |field, value, requirement| {
             Err(SettingsError {
@@ -143,6 +163,177 @@ impl Failure {
             Failure::None => IntegrateError::StepSizeTooSmall { t, h },
             Failure::NonFinite { t, index } => IntegrateError::NonFiniteState { t, index },
             Failure::Singular { t, h } => IntegrateError::SingularMatrix { t, h },
+        }
+    }
+}
+
+/// Outcome of one step attempt.
+pub(super) enum Attempt {
+    Accepted,
+    Rejected,
+}
+
+/// What every adaptive stepper keeps between attempts besides its vectors.
+#[derive(Clone, Debug)]
+pub(super) struct Core {
+    pub control: Control,
+    /// Current time.
+    pub t: f64,
+    /// Start and size of the last accepted step (`h_last = 0` before the first step).
+    pub t_prev: f64,
+    pub h_last: f64,
+    /// Next step size to try; `None` until the first `step` computes or takes `h_init`.
+    pub h_next: Option<f64>,
+    /// The last attempt was rejected (the next accepted step may not grow).
+    pub rejected_last: bool,
+    /// How the last rejected attempt failed.
+    pub failure: Failure,
+    pub stats: Stats,
+    pub initialized: bool,
+}
+
+impl Core {
+    pub fn new(control: Control) -> Self {
+        Self {
+            control,
+            t: 0.0,
+            t_prev: 0.0,
+            h_last: 0.0,
+            h_next: None,
+            rejected_last: false,
+            failure: Failure::None,
+            stats: Stats::default(),
+            initialized: false,
+        }
+    }
+
+    /// The start of every `init`: checks the dimensions (panics, naming the stepper `name`),
+    /// resets the statistics, rejects a non-finite `y0` and restarts the step control at `t0`.
+    pub fn init<E>(
+        &mut self,
+        name: &str,
+        dim: usize,
+        sys_dim: usize,
+        t0: f64,
+        y0: &[f64],
+    ) -> Result<(), IntegrateError<E>> {
+        assert_eq!(sys_dim, dim, "{name}::init: system dim vs stepper dim");
+        assert_eq!(y0.len(), dim, "{name}::init: y0 length vs dim");
+        self.initialized = false;
+        self.stats = Stats::default();
+        if let Some(index) = super::first_non_finite(y0) {
+            return Err(IntegrateError::NonFiniteState { t: t0, index });
+        }
+        self.t = t0;
+        self.t_prev = t0;
+        self.h_last = 0.0;
+        self.h_next = None;
+        self.rejected_last = false;
+        self.failure = Failure::None;
+        Ok(())
+    }
+
+    /// Records a rejected attempt; the next one uses `h_next`.
+    pub fn reject(&mut self, h_next: f64, failure: Failure) -> Attempt {
+        self.h_next = Some(h_next);
+        self.rejected_last = true;
+        self.failure = failure;
+        self.stats.rejected += 1;
+        Attempt::Rejected
+    }
+
+    /// Records a rejection caused by a non-finite value produced at time `t_bad` in component
+    /// `index` of an attempt with step `h`: the next attempt uses `fac_min h`.
+    pub fn reject_non_finite(&mut self, h: f64, t_bad: f64, index: usize) -> Attempt {
+        self.reject(
+            h * self.control.fac_min,
+            Failure::NonFinite { t: t_bad, index },
+        )
+    }
+
+    /// The controller's proposal `h_new` after an accepted step `h`, limited: no growth right
+    /// after a rejection, and a step shortened to land on `t_stop` (`h < h_proposed`) keeps the
+    /// step the controller had planned.
+    pub fn limit_growth(&self, h_new: f64, h: f64, h_proposed: f64) -> f64 {
+        let mut h_new = h_new;
+        if self.rejected_last {
+            h_new = h_new.min(h);
+        }
+        if h < h_proposed {
+            h_new = h_new.max(h_proposed);
+        }
+        h_new
+    }
+
+    /// Commits an accepted step `h` from `t` to `t_new`; the next one tries `h_new` (at most
+    /// `h_max`).
+    pub fn accept(&mut self, t_new: f64, h: f64, h_new: f64) {
+        self.t_prev = self.t;
+        self.t = t_new;
+        self.h_last = h;
+        self.h_next = Some(h_new.min(self.control.h_max));
+        self.rejected_last = false;
+        self.failure = Failure::None;
+        self.stats.steps += 1;
+    }
+}
+
+/// An adaptive one-step method, driven by [`step`].
+pub(super) trait Adaptive<S: OdeSystem> {
+    /// The stepper's type name, for panic messages.
+    const NAME: &'static str;
+    fn core(&mut self) -> &mut Core;
+    /// The first step size when the settings give none (Hairer's algorithm, [`initial_step`]).
+    fn starting_step(&mut self, sys: &mut S) -> Result<f64, IntegrateError<S::Error>>;
+    /// One attempt from `(t, y)` with step `h` ending at `t_new`; commits on acceptance.
+    /// `h_proposed` is the controller's step before it was shortened to land on `t_stop`.
+    fn attempt(
+        &mut self,
+        sys: &mut S,
+        h: f64,
+        t_new: f64,
+        h_proposed: f64,
+    ) -> Result<Attempt, IntegrateError<S::Error>>;
+}
+
+/// [`super::Stepper::step`] of an adaptive stepper: attempts until one is accepted, landing on
+/// `t_stop`, within `max_steps` attempts and above the smallest step.
+pub(super) fn step<S: OdeSystem, A: Adaptive<S>>(
+    st: &mut A,
+    sys: &mut S,
+    t_stop: f64,
+) -> Result<f64, IntegrateError<S::Error>> {
+    let core = st.core();
+    assert!(
+        core.initialized,
+        "{}::step called before a successful init",
+        A::NAME
+    );
+    // nothing to do at or past the stop time (forward integration only)
+    if t_stop.is_nan() || t_stop <= core.t {
+        return Ok(core.t);
+    }
+    let h_first = match (core.h_next, core.control.h_init) {
+        (Some(h), _) | (None, Some(h)) => h,
+        (None, None) => st.starting_step(sys)?,
+    };
+    st.core().h_next = Some(h_first);
+    loop {
+        let core = st.core();
+        let max_steps = core.control.max_steps;
+        if core.stats.steps + core.stats.rejected >= max_steps as u64 {
+            return Err(IntegrateError::TooManySteps {
+                t: core.t,
+                max_steps,
+            });
+        }
+        let h = core.h_next.unwrap_or(h_first).min(core.control.h_max);
+        if step_collapsed(h, core.t, core.control.h_min) {
+            return Err(core.failure.collapse(core.t, h));
+        }
+        let (h_try, t_new) = land(core.t, h, t_stop);
+        if let Attempt::Accepted = st.attempt(sys, h_try, t_new, h)? {
+            return Ok(st.core().t);
         }
     }
 }

@@ -53,8 +53,13 @@
 //! stages shrink the step; `max_steps` counts attempts; stop times are hit exactly).
 
 use self::tableau::{AE, AI, B, B_DENSE, B_HAT, C, GAMMA};
-use super::adaptive::{error_norm, initial_step, land, step_collapsed, Control, Failure};
-use super::{first_non_finite, IntegrateError, SettingsError, SplitSystem, Stats, Stepper};
+use super::adaptive::{
+    self, control_of, error_norm, initial_step, Adaptive, Attempt, Core, Failure,
+};
+use super::{
+    dense_output, first_non_finite, hermite, IntegrateError, SettingsError, SplitSystem, Stats,
+    Stepper,
+};
 
 mod tableau;
 
@@ -99,26 +104,12 @@ impl Default for ArkImexSettings {
 }
 
 impl ArkImexSettings {
-    fn control(&self) -> Control {
-        Control {
-            rtol: self.rtol,
-            atol: self.atol,
-            h_init: self.h_init,
-            h_max: self.h_max,
-            h_min: self.h_min,
-            max_steps: self.max_steps,
-            safety: self.safety,
-            fac_min: self.fac_min,
-            fac_max: self.fac_max,
-        }
-    }
-
     /// Checks every field's range (see the field docs).
     ///
     /// # Errors
     /// The first field out of range, with its value and the requirement.
     pub fn validate(&self) -> Result<(), SettingsError> {
-        self.control().validate("ArkImexSettings")
+        control_of!(self).validate("ArkImexSettings")
     }
 }
 
@@ -131,18 +122,13 @@ const DENSE_SLACK: f64 = 10.0;
 pub struct ArkImex {
     dim: usize,
     settings: ArkImexSettings,
-    control: Control,
-    t: f64,
+    /// Time, last step, step-size control and statistics.
+    core: Core,
     y: Vec<f64>,
-    /// Last accepted step: start, size (0 before the first), and `y`, `f = f_E + f_I` at its
-    /// start (the Hermite data at the left end; the right end's `f` is `fe[0] + fi[0]`).
-    t_prev: f64,
-    h_last: f64,
+    /// `y`, `f = f_E + f_I` at the start of the last accepted step (the Hermite data at the
+    /// left end; the right end's `f` is `fe[0] + fi[0]`).
     y_prev: Vec<f64>,
     f_prev: Vec<f64>,
-    h_next: Option<f64>,
-    rejected_last: bool,
-    failure: Failure,
     /// Stage derivatives; `fe[0]`, `fi[0]` are `f_E`, `f_I` at `(t, y)`.
     fe: [Vec<f64>; 6],
     fi: [Vec<f64>; 6],
@@ -153,13 +139,6 @@ pub struct ArkImex {
     fe_new: Vec<f64>,
     fi_new: Vec<f64>,
     scratch: Vec<f64>,
-    stats: Stats,
-    initialized: bool,
-}
-
-enum Attempt {
-    Accepted,
-    Rejected,
 }
 
 impl ArkImex {
@@ -185,16 +164,10 @@ impl ArkImex {
         Ok(Self {
             dim,
             settings,
-            control: settings.control(),
-            t: 0.0,
+            core: Core::new(control_of!(settings)),
             y: z(),
-            t_prev: 0.0,
-            h_last: 0.0,
             y_prev: z(),
             f_prev: z(),
-            h_next: None,
-            rejected_last: false,
-            failure: Failure::None,
             fe: six(),
             fi: six(),
             r: z(),
@@ -203,8 +176,6 @@ impl ArkImex {
             fe_new: z(),
             fi_new: z(),
             scratch: z(),
-            stats: Stats::default(),
-            initialized: false,
         })
     }
 
@@ -213,79 +184,81 @@ impl ArkImex {
         &self.settings
     }
 
-    /// Start of the last accepted step (equals `t()` before the first step).
-    pub fn t_prev(&self) -> f64 {
-        self.t_prev
-    }
-
-    /// Current time (same as [`Stepper::t`]).
-    pub fn t(&self) -> f64 {
-        self.t
-    }
-
-    /// Current state (same as [`Stepper::y`]).
-    pub fn y(&self) -> &[f64] {
-        &self.y
-    }
-
-    /// Work counters since `init` (same as [`Stepper::stats`]).
-    pub fn stats(&self) -> Stats {
-        self.stats
-    }
-
-    /// Step size the next attempt will use (before `h_max` and `t_stop`); `None` before the
-    /// first step.
-    pub fn h_next(&self) -> Option<f64> {
-        self.h_next
-    }
+    adaptive_accessors!();
 
     /// Cubic Hermite interpolation on `[t_prev, t]` (module docs). Outside that interval it
     /// extrapolates the same cubic.
     pub fn interpolate(&self, t_query: f64, out: &mut [f64]) {
-        assert_eq!(
-            out.len(),
-            self.dim,
-            "ArkImex::interpolate: out length vs dim"
+        let Core {
+            t_prev,
+            t,
+            h_last: h,
+            ..
+        } = self.core;
+        let (y_prev, y, fe, fi) = (&self.y_prev, &self.y, &self.fe[0], &self.fi[0]);
+        dense_output(
+            "ArkImex",
+            t_query,
+            out,
+            t_prev,
+            t,
+            h,
+            y_prev,
+            y,
+            |th, out| hermite(th, h, y_prev, &self.f_prev, y, |i| fe[i] + fi[i], out),
         );
-        if t_query == self.t || self.h_last == 0.0 {
-            out.copy_from_slice(&self.y);
-            return;
-        }
-        if t_query == self.t_prev {
-            out.copy_from_slice(&self.y_prev);
-            return;
-        }
-        let h = self.h_last;
-        let th = (t_query - self.t_prev) / h;
-        let th2 = th * th;
-        let th3 = th2 * th;
-        let h00 = 2.0 * th3 - 3.0 * th2 + 1.0;
-        let h10 = th3 - 2.0 * th2 + th;
-        let h01 = -2.0 * th3 + 3.0 * th2;
-        let h11 = th3 - th2;
-        for (i, o) in out.iter_mut().enumerate() {
-            let f1 = self.fe[0][i] + self.fi[0][i];
-            *o = h00 * self.y_prev[i] + h01 * self.y[i] + h * (h10 * self.f_prev[i] + h11 * f1);
-        }
     }
 
-    fn reject_non_finite(&mut self, h: f64, t_bad: f64, index: usize) -> Attempt {
-        self.h_next = Some(h * self.settings.fac_min);
-        self.rejected_last = true;
-        self.failure = Failure::NonFinite { t: t_bad, index };
-        self.stats.rejected += 1;
-        Attempt::Rejected
+    /// Evaluates `rhs_split(t, y)` into `fe`, `fi`, counting it; returns the first non-finite
+    /// component.
+    fn eval_split<S: SplitSystem>(
+        stats: &mut Stats,
+        sys: &mut S,
+        t: f64,
+        y: &[f64],
+        fe: &mut [f64],
+        fi: &mut [f64],
+    ) -> Result<Option<usize>, IntegrateError<S::Error>> {
+        stats.rhs_evals += 1;
+        sys.rhs_split(t, y, fe, fi).map_err(IntegrateError::Rhs)?;
+        Ok(first_non_finite(fe).or_else(|| first_non_finite(fi)))
+    }
+}
+
+impl<S: SplitSystem> Adaptive<S> for ArkImex {
+    const NAME: &'static str = "ArkImex";
+
+    fn core(&mut self) -> &mut Core {
+        &mut self.core
     }
 
-    /// One attempt from `(t, y)` with step `h` ending at `t_new`; commits on acceptance.
-    fn attempt<S: SplitSystem>(
+    fn starting_step(&mut self, sys: &mut S) -> Result<f64, IntegrateError<S::Error>> {
+        // f = f_E + f_I at (t, y) into y_new (scratch) for the starting-step algorithm
+        for i in 0..self.dim {
+            self.y_new[i] = self.fe[0][i] + self.fi[0][i];
+        }
+        let core = &mut self.core;
+        initial_step(
+            sys,
+            &mut core.stats,
+            core.t,
+            &self.y,
+            &self.y_new,
+            &mut self.z,
+            &mut self.scratch,
+            &core.control,
+            4,
+        )
+    }
+
+    fn attempt(
         &mut self,
         sys: &mut S,
         h: f64,
         t_new: f64,
         h_proposed: f64,
     ) -> Result<Attempt, IntegrateError<S::Error>> {
-        let (t, n) = (self.t, self.dim);
+        let (t, n) = (self.core.t, self.dim);
         let hg = h * GAMMA;
         for s in 1..6 {
             let ts = if s == 5 { t_new } else { t + C[s] * h };
@@ -296,21 +269,21 @@ impl ArkImex {
                 }
                 self.r[i] = self.y[i] + h * v;
             }
-            self.stats.implicit_solves += 1;
+            self.core.stats.implicit_solves += 1;
             sys.solve_implicit(ts, hg, &self.r, &mut self.z)
                 .map_err(IntegrateError::Rhs)?;
             if let Some(i) = first_non_finite(&self.z) {
-                return Ok(self.reject_non_finite(h, ts, i));
+                return Ok(self.core.reject_non_finite(h, ts, i));
             }
             for i in 0..n {
                 self.fi[s][i] = (self.z[i] - self.r[i]) / hg;
             }
-            self.stats.rhs_evals += 1;
+            self.core.stats.rhs_evals += 1;
             sys.rhs_split(ts, &self.z, &mut self.fe[s], &mut self.scratch)
                 .map_err(IntegrateError::Rhs)?;
             if let Some(i) = first_non_finite(&self.fe[s]).or_else(|| first_non_finite(&self.fi[s]))
             {
-                return Ok(self.reject_non_finite(h, ts, i));
+                return Ok(self.core.reject_non_finite(h, ts, i));
             }
         }
 
@@ -326,10 +299,10 @@ impl ArkImex {
             self.r[i] = self.y_new[i] + h * e;
         }
         if let Some(i) = first_non_finite(&self.r) {
-            return Ok(self.reject_non_finite(h, t_new, i));
+            return Ok(self.core.reject_non_finite(h, t_new, i));
         }
         // filtered estimate (I - h gamma J_I)^-1 e = S(y_new + e) - S(y_new), S the stage solve
-        self.stats.implicit_solves += 2;
+        self.core.stats.implicit_solves += 2;
         sys.solve_implicit(t_new, hg, &self.r, &mut self.z)
             .map_err(IntegrateError::Rhs)?;
         sys.solve_implicit(t_new, hg, &self.y_new, &mut self.scratch)
@@ -337,25 +310,20 @@ impl ArkImex {
         for i in 0..n {
             self.r[i] = self.z[i] - self.scratch[i];
         }
-        let c = self.control;
+        let c = self.core.control;
         let err = error_norm(&self.r, &self.y, &self.y_new, c.atol, c.rtol);
         let fac = c.factor(err, 0.25);
         let passed = err <= 1.0;
         if !passed {
-            self.h_next = Some(h * fac.min(1.0));
-            self.rejected_last = true;
-            self.failure = Failure::None;
-            self.stats.rejected += 1;
-            return Ok(Attempt::Rejected);
+            return Ok(self.core.reject(h * fac.min(1.0), Failure::None));
         }
         if let Some(i) = first_non_finite(&self.y_new) {
-            return Ok(self.reject_non_finite(h, t_new, i));
+            return Ok(self.core.reject_non_finite(h, t_new, i));
         }
-        self.stats.rhs_evals += 1;
-        sys.rhs_split(t_new, &self.y_new, &mut self.fe_new, &mut self.fi_new)
-            .map_err(IntegrateError::Rhs)?;
-        if let Some(i) = first_non_finite(&self.fe_new).or_else(|| first_non_finite(&self.fi_new)) {
-            return Ok(self.reject_non_finite(h, t_new, i));
+        let stats = &mut self.core.stats;
+        let (fe_new, fi_new) = (&mut self.fe_new, &mut self.fi_new);
+        if let Some(i) = Self::eval_split(stats, sys, t_new, &self.y_new, fe_new, fi_new)? {
+            return Ok(self.core.reject_non_finite(h, t_new, i));
         }
 
         // interpolation check at the midpoint: the Hermite interpolant (the dense output)
@@ -374,21 +342,12 @@ impl ArkImex {
         let err_dense = error_norm(&self.r, &self.y, &self.y_new, c.atol, c.rtol) / DENSE_SLACK;
         let interpolation_ok = err_dense <= 1.0;
         if !interpolation_ok {
-            self.h_next = Some(h * c.factor(err_dense, 0.25).min(1.0));
-            self.rejected_last = true;
-            self.failure = Failure::None;
-            self.stats.rejected += 1;
-            return Ok(Attempt::Rejected);
+            let h_next = h * c.factor(err_dense, 0.25).min(1.0);
+            return Ok(self.core.reject(h_next, Failure::None));
         }
         let fac = fac.min(c.factor(err_dense, 0.25));
 
-        let mut h_new = h * fac;
-        if self.rejected_last {
-            h_new = h_new.min(h);
-        }
-        if h < h_proposed {
-            h_new = h_new.max(h_proposed);
-        }
+        let h_new = self.core.limit_growth(h * fac, h, h_proposed);
         for i in 0..n {
             self.f_prev[i] = self.fe[0][i] + self.fi[0][i];
         }
@@ -396,13 +355,7 @@ impl ArkImex {
         std::mem::swap(&mut self.y, &mut self.y_new);
         std::mem::swap(&mut self.fe[0], &mut self.fe_new);
         std::mem::swap(&mut self.fi[0], &mut self.fi_new);
-        self.t_prev = t;
-        self.t = t_new;
-        self.h_last = h;
-        self.h_next = Some(h_new.min(self.settings.h_max));
-        self.rejected_last = false;
-        self.failure = Failure::None;
-        self.stats.steps += 1;
+        self.core.accept(t_new, h, h_new);
         Ok(Attempt::Accepted)
     }
 }
@@ -410,108 +363,31 @@ impl ArkImex {
 impl<S: SplitSystem> Stepper<S> for ArkImex {
     /// Evaluates `rhs_split(t0, y0)` once (the first stage of the first step).
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
-        assert_eq!(
-            sys.dim(),
-            self.dim,
-            "ArkImex::init: system dim vs stepper dim"
-        );
-        assert_eq!(y0.len(), self.dim, "ArkImex::init: y0 length vs dim");
-        self.initialized = false;
-        self.stats = Stats::default();
-        if let Some(index) = first_non_finite(y0) {
-            return Err(IntegrateError::NonFiniteState { t: t0, index });
-        }
-        self.t = t0;
-        self.t_prev = t0;
-        self.h_last = 0.0;
-        self.h_next = None;
-        self.rejected_last = false;
-        self.failure = Failure::None;
+        self.core.init("ArkImex", self.dim, sys.dim(), t0, y0)?;
         self.y.copy_from_slice(y0);
         self.y_prev.copy_from_slice(y0);
-        self.stats.rhs_evals += 1;
-        sys.rhs_split(t0, y0, &mut self.fe[0], &mut self.fi[0])
-            .map_err(IntegrateError::Rhs)?;
-        if let Some(index) = first_non_finite(&self.fe[0]).or_else(|| first_non_finite(&self.fi[0]))
-        {
+        let (fe, fi) = (&mut self.fe[0], &mut self.fi[0]);
+        if let Some(index) = Self::eval_split(&mut self.core.stats, sys, t0, y0, fe, fi)? {
             return Err(IntegrateError::NonFiniteState { t: t0, index });
         }
         for i in 0..self.dim {
             self.f_prev[i] = self.fe[0][i] + self.fi[0][i];
         }
-        self.initialized = true;
+        self.core.initialized = true;
         Ok(())
     }
 
     fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {
-        assert!(
-            self.initialized,
-            "ArkImex::step called before a successful init"
-        );
-        if t_stop.is_nan() || t_stop <= self.t {
-            return Ok(self.t);
-        }
-        let h_first = match (self.h_next, self.settings.h_init) {
-            (Some(h), _) | (None, Some(h)) => h,
-            (None, None) => {
-                // f = f_E + f_I at (t, y) into y_new (scratch) for the starting-step algorithm
-                for i in 0..self.dim {
-                    self.y_new[i] = self.fe[0][i] + self.fi[0][i];
-                }
-                initial_step(
-                    sys,
-                    &mut self.stats,
-                    self.t,
-                    &self.y,
-                    &self.y_new,
-                    &mut self.z,
-                    &mut self.scratch,
-                    &self.control,
-                    4,
-                )?
-            }
-        };
-        self.h_next = Some(h_first);
-        loop {
-            if self.stats.steps + self.stats.rejected >= self.settings.max_steps as u64 {
-                return Err(IntegrateError::TooManySteps {
-                    t: self.t,
-                    max_steps: self.settings.max_steps,
-                });
-            }
-            let h = self.h_next.unwrap_or(h_first).min(self.settings.h_max);
-            if step_collapsed(h, self.t, self.settings.h_min) {
-                return Err(self.failure.collapse(self.t, h));
-            }
-            let (h_try, t_new) = land(self.t, h, t_stop);
-            if let Attempt::Accepted = self.attempt(sys, h_try, t_new, h)? {
-                return Ok(self.t);
-            }
-        }
+        adaptive::step(self, sys, t_stop)
     }
 
-    fn t(&self) -> f64 {
-        ArkImex::t(self)
-    }
-
-    fn y(&self) -> &[f64] {
-        ArkImex::y(self)
-    }
-
-    fn interpolate(&self, t_query: f64, out: &mut [f64]) {
-        ArkImex::interpolate(self, t_query, out)
-    }
-
-    fn stats(&self) -> Stats {
-        ArkImex::stats(self)
-    }
+    forward_stepper_accessors!(ArkImex);
 
     fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.y.copy_from_slice(y);
-        self.stats.rhs_evals += 1;
-        sys.rhs_split(self.t, y, &mut self.fe[0], &mut self.fi[0]).map_err(IntegrateError::Rhs)?;
-        match first_non_finite(&self.fe[0]).or_else(|| first_non_finite(&self.fi[0])) {
-            Some(index) => Err(IntegrateError::NonFiniteState { t: self.t, index }),
+        let (t, fe, fi) = (self.core.t, &mut self.fe[0], &mut self.fi[0]);
+        match Self::eval_split(&mut self.core.stats, sys, t, y, fe, fi)? {
+            Some(index) => Err(IntegrateError::NonFiniteState { t, index }),
             None => Ok(()),
         }
     }

@@ -35,6 +35,59 @@
 
 use std::fmt;
 
+/// The [`Stepper`] accessors, forwarded to the stepper type's inherent methods of the same names.
+macro_rules! forward_stepper_accessors {
+    ($ty:ident) => {
+        fn t(&self) -> f64 {
+            $ty::t(self)
+        }
+
+        fn y(&self) -> &[f64] {
+            $ty::y(self)
+        }
+
+        fn interpolate(&self, t_query: f64, out: &mut [f64]) {
+            $ty::interpolate(self, t_query, out)
+        }
+
+        fn stats(&self) -> Stats {
+            $ty::stats(self)
+        }
+    };
+}
+
+/// The inherent accessors of an adaptive stepper with fields `core` ([`adaptive::Core`]) and
+/// `y`.
+macro_rules! adaptive_accessors {
+    () => {
+        /// Start of the last accepted step (equals `t()` before the first step).
+        pub fn t_prev(&self) -> f64 {
+            self.core.t_prev
+        }
+
+        /// Current time (same as [`Stepper::t`], without naming the system type).
+        pub fn t(&self) -> f64 {
+            self.core.t
+        }
+
+        /// Current state (same as [`Stepper::y`]).
+        pub fn y(&self) -> &[f64] {
+            &self.y
+        }
+
+        /// Work counters since `init` (same as [`Stepper::stats`]).
+        pub fn stats(&self) -> Stats {
+            self.core.stats
+        }
+
+        /// Step size the next attempt will use (before the `h_max` and `t_stop` limits);
+        /// `None` before the first step.
+        pub fn h_next(&self) -> Option<f64> {
+            self.core.h_next
+        }
+    };
+}
+
 mod adaptive;
 mod dopri5;
 mod imex;
@@ -44,6 +97,8 @@ mod rk4;
 mod rosenbrock;
 mod sampled;
 pub mod test_problems;
+#[cfg(test)]
+mod testutil;
 
 pub use self::adaptive::SettingsError;
 pub use self::dopri5::{Dopri5Settings, DormandPrince45};
@@ -260,6 +315,84 @@ pub trait Stepper<S: OdeSystem> {
 #[inline]
 fn first_non_finite(v: &[f64]) -> Option<usize> {
     v.iter().position(|x| !x.is_finite())
+}
+
+/// Evaluates `sys.rhs(t, y)` into `out`, counting it; returns the first non-finite component.
+fn eval<S: OdeSystem>(
+    stats: &mut Stats,
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    out: &mut [f64],
+) -> Result<Option<usize>, IntegrateError<S::Error>> {
+    stats.rhs_evals += 1;
+    sys.rhs(t, y, out).map_err(IntegrateError::Rhs)?;
+    Ok(first_non_finite(out))
+}
+
+/// [`eval`], with a non-finite value an [`IntegrateError::NonFiniteState`] at `t`.
+fn eval_finite<S: OdeSystem>(
+    stats: &mut Stats,
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    out: &mut [f64],
+) -> Result<(), IntegrateError<S::Error>> {
+    match eval(stats, sys, t, y, out)? {
+        Some(index) => Err(IntegrateError::NonFiniteState { t, index }),
+        None => Ok(()),
+    }
+}
+
+/// Dense output on the last step `[t_prev, t]` of size `h` (`h = 0` before the first step):
+/// `y` at `t` (and before the first step), `y_prev` at `t_prev`, else `interior(theta, out)`
+/// with `theta = (t_query - t_prev) / h`. Panics (naming the stepper `name`) if
+/// `out.len() != y.len()`.
+#[allow(clippy::too_many_arguments)]
+fn dense_output(
+    name: &str,
+    t_query: f64,
+    out: &mut [f64],
+    t_prev: f64,
+    t: f64,
+    h: f64,
+    y_prev: &[f64],
+    y: &[f64],
+    interior: impl FnOnce(f64, &mut [f64]),
+) {
+    assert_eq!(out.len(), y.len(), "{name}::interpolate: out length vs dim");
+    if t_query == t || h == 0.0 {
+        out.copy_from_slice(y);
+        return;
+    }
+    if t_query == t_prev {
+        out.copy_from_slice(y_prev);
+        return;
+    }
+    interior((t_query - t_prev) / h, out);
+}
+
+/// The cubic Hermite interpolant (HNW I §II.6) at `theta` through `(y_prev, f_prev)` at the
+/// start and `(y, f(i))` at the end of a step of size `h`, into `out`.
+fn hermite(
+    theta: f64,
+    h: f64,
+    y_prev: &[f64],
+    f_prev: &[f64],
+    y: &[f64],
+    f: impl Fn(usize) -> f64,
+    out: &mut [f64],
+) {
+    let th = theta;
+    let th2 = th * th;
+    let th3 = th2 * th;
+    let h00 = 2.0 * th3 - 3.0 * th2 + 1.0;
+    let h10 = th3 - 2.0 * th2 + th;
+    let h01 = -2.0 * th3 + 3.0 * th2;
+    let h11 = th3 - th2;
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = h00 * y_prev[i] + h01 * y[i] + h * (h10 * f_prev[i] + h11 * f(i));
+    }
 }
 
 #[cfg(test)]

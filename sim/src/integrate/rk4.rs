@@ -12,7 +12,9 @@
 //! interpolant costs no extra evaluation: 4 evaluations per step, plus 1 in `init`.
 //! Its error is O(h^4), matching the method's global error.
 
-use super::{first_non_finite, IntegrateError, OdeSystem, Stats, Stepper};
+use super::{
+    dense_output, eval_finite, first_non_finite, hermite, IntegrateError, OdeSystem, Stats, Stepper,
+};
 
 /// Fixed-step classical Runge–Kutta method (4 stages, order 4).
 #[derive(Clone, Debug)]
@@ -98,50 +100,33 @@ impl Rk4 {
     /// Cubic Hermite interpolation on `[t_prev, t]`. Outside that interval it extrapolates the
     /// same cubic (accuracy degrades quickly).
     pub fn interpolate(&self, t_query: f64, out: &mut [f64]) {
-        assert_eq!(out.len(), self.dim, "Rk4::interpolate: out length vs dim");
-        let h = self.t - self.t_prev;
-        if t_query == self.t || h == 0.0 {
-            out.copy_from_slice(&self.y);
-            return;
-        }
-        if t_query == self.t_prev {
-            out.copy_from_slice(&self.y_prev);
-            return;
-        }
-        // Hermite basis in theta = (t_query - t_prev) / h
-        let th = (t_query - self.t_prev) / h;
-        let th2 = th * th;
-        let th3 = th2 * th;
-        let h00 = 2.0 * th3 - 3.0 * th2 + 1.0;
-        let h10 = th3 - 2.0 * th2 + th;
-        let h01 = -2.0 * th3 + 3.0 * th2;
-        let h11 = th3 - th2;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = h00 * self.y_prev[i]
-                + h01 * self.y[i]
-                + h * (h10 * self.f_prev[i] + h11 * self.f[i]);
-        }
+        let (t_prev, h) = (self.t_prev, self.t - self.t_prev);
+        dense_output(
+            "Rk4",
+            t_query,
+            out,
+            t_prev,
+            self.t,
+            h,
+            &self.y_prev,
+            &self.y,
+            |th, out| {
+                hermite(
+                    th,
+                    h,
+                    &self.y_prev,
+                    &self.f_prev,
+                    &self.y,
+                    |i| self.f[i],
+                    out,
+                )
+            },
+        );
     }
 
     /// Work counters since `init` (same as [`Stepper::stats`]).
     pub fn stats(&self) -> Stats {
         self.stats
-    }
-
-    /// Evaluates `sys.rhs(t, y_stage)` into `out`, counting it and checking it is finite.
-    fn eval<S: OdeSystem>(
-        stats: &mut Stats,
-        sys: &mut S,
-        t: f64,
-        y: &[f64],
-        out: &mut [f64],
-    ) -> Result<(), IntegrateError<S::Error>> {
-        stats.rhs_evals += 1;
-        sys.rhs(t, y, out).map_err(IntegrateError::Rhs)?;
-        match first_non_finite(out) {
-            Some(index) => Err(IntegrateError::NonFiniteState { t, index }),
-            None => Ok(()),
-        }
     }
 }
 
@@ -160,7 +145,7 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
         self.t_prev = t0;
         self.y.copy_from_slice(y0);
         self.y_prev.copy_from_slice(y0);
-        Self::eval(&mut self.stats, sys, t0, y0, &mut self.f)?;
+        eval_finite(&mut self.stats, sys, t0, y0, &mut self.f)?;
         self.f_prev.copy_from_slice(&self.f);
         self.initialized = true;
         Ok(())
@@ -192,7 +177,7 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
         for i in 0..n {
             self.y_stage[i] = self.y[i] + 0.5 * h * self.f[i];
         }
-        Self::eval(
+        eval_finite(
             &mut self.stats,
             sys,
             t + 0.5 * h,
@@ -202,7 +187,7 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
         for i in 0..n {
             self.y_stage[i] = self.y[i] + 0.5 * h * self.k2[i];
         }
-        Self::eval(
+        eval_finite(
             &mut self.stats,
             sys,
             t + 0.5 * h,
@@ -212,7 +197,7 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
         for i in 0..n {
             self.y_stage[i] = self.y[i] + h * self.k3[i];
         }
-        Self::eval(&mut self.stats, sys, t_new, &self.y_stage, &mut self.k4)?;
+        eval_finite(&mut self.stats, sys, t_new, &self.y_stage, &mut self.k4)?;
 
         // new state into y_stage
         let h6 = h / 6.0;
@@ -225,7 +210,7 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
         }
 
         // f at the new state (k2 is free now): the next step's k1 and the Hermite slope
-        Self::eval(&mut self.stats, sys, t_new, &self.y_stage, &mut self.k2)?;
+        eval_finite(&mut self.stats, sys, t_new, &self.y_stage, &mut self.k2)?;
 
         // commit: (y, f) -> previous, new -> current; nothing changed before this point
         std::mem::swap(&mut self.y_prev, &mut self.y);
@@ -241,25 +226,11 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
         Ok(t_new)
     }
 
-    fn t(&self) -> f64 {
-        Rk4::t(self)
-    }
-
-    fn y(&self) -> &[f64] {
-        Rk4::y(self)
-    }
-
-    fn interpolate(&self, t_query: f64, out: &mut [f64]) {
-        Rk4::interpolate(self, t_query, out)
-    }
-
-    fn stats(&self) -> Stats {
-        Rk4::stats(self)
-    }
+    forward_stepper_accessors!(Rk4);
 
     fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.y.copy_from_slice(y);
-        Self::eval(&mut self.stats, sys, self.t, y, &mut self.f)
+        eval_finite(&mut self.stats, sys, self.t, y, &mut self.f)
     }
 }
 

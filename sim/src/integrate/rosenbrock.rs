@@ -54,9 +54,14 @@
 
 pub use self::settings::RosenbrockSettings;
 use self::tableau::{Tableau, GAMMA};
-use super::adaptive::{error_norm, initial_step, land, step_collapsed, Control, Failure};
+use super::adaptive::{
+    self, control_of, error_norm, initial_step, Adaptive, Attempt, Core, Failure,
+};
 use super::lu::{lu_factor, lu_solve};
-use super::{first_non_finite, IntegrateError, OdeJacobian, SettingsError, Stats, Stepper};
+use super::{
+    dense_output, eval, eval_finite, first_non_finite, hermite, IntegrateError, OdeJacobian,
+    SettingsError, Stats, Stepper,
+};
 
 mod settings;
 mod tableau;
@@ -66,21 +71,15 @@ mod tableau;
 pub struct Rosenbrock {
     dim: usize,
     settings: RosenbrockSettings,
-    control: Control,
+    /// Time, last step, step-size control and statistics.
+    core: Core,
     tab: Tableau,
-    /// Current time and state, `f0 = f(t, y)`.
-    t: f64,
+    /// Current state, `f0 = f(t, y)`.
     y: Vec<f64>,
     f0: Vec<f64>,
-    /// Last accepted step: start, size (0 before the first), and `y`, `f` at its start (the
-    /// Hermite data at the left end).
-    t_prev: f64,
-    h_last: f64,
+    /// `y`, `f` at the start of the last accepted step (the Hermite data at the left end).
     y_prev: Vec<f64>,
     f_prev: Vec<f64>,
-    h_next: Option<f64>,
-    rejected_last: bool,
-    failure: Failure,
     singular_run: u32,
     /// Jacobian (row-major) and `f_t`; `jac_valid`: evaluated since `init`; `jac_fresh`:
     /// evaluated at the current `(t, y)`; accepted steps since the evaluation; `max |J_ij|`.
@@ -102,14 +101,6 @@ pub struct Rosenbrock {
     f_stage: Vec<f64>,
     y_new: Vec<f64>,
     f_new: Vec<f64>,
-    stats: Stats,
-    initialized: bool,
-}
-
-enum Attempt {
-    Accepted,
-    Rejected,
-    Singular,
 }
 
 impl Rosenbrock {
@@ -135,18 +126,12 @@ impl Rosenbrock {
         Ok(Self {
             dim,
             settings,
-            control: settings.control(),
+            core: Core::new(control_of!(settings)),
             tab: Tableau::new(),
-            t: 0.0,
             y: z(),
             f0: z(),
-            t_prev: 0.0,
-            h_last: 0.0,
             y_prev: z(),
             f_prev: z(),
-            h_next: None,
-            rejected_last: false,
-            failure: Failure::None,
             singular_run: 0,
             jac: vec![0.0; dim * dim],
             dfdt: z(),
@@ -163,8 +148,6 @@ impl Rosenbrock {
             f_stage: z(),
             y_new: z(),
             f_new: z(),
-            stats: Stats::default(),
-            initialized: false,
         })
     }
 
@@ -173,61 +156,29 @@ impl Rosenbrock {
         &self.settings
     }
 
-    /// Start of the last accepted step (equals `t()` before the first step).
-    pub fn t_prev(&self) -> f64 {
-        self.t_prev
-    }
-
-    /// Current time (same as [`Stepper::t`]).
-    pub fn t(&self) -> f64 {
-        self.t
-    }
-
-    /// Current state (same as [`Stepper::y`]).
-    pub fn y(&self) -> &[f64] {
-        &self.y
-    }
-
-    /// Work counters since `init` (same as [`Stepper::stats`]).
-    pub fn stats(&self) -> Stats {
-        self.stats
-    }
-
-    /// Step size the next attempt will use (before `h_max` and `t_stop`); `None` before the
-    /// first step.
-    pub fn h_next(&self) -> Option<f64> {
-        self.h_next
-    }
+    adaptive_accessors!();
 
     /// Cubic Hermite interpolation on `[t_prev, t]`. Outside that interval it extrapolates the
     /// same cubic.
     pub fn interpolate(&self, t_query: f64, out: &mut [f64]) {
-        assert_eq!(
-            out.len(),
-            self.dim,
-            "Rosenbrock::interpolate: out length vs dim"
+        let Core {
+            t_prev,
+            t,
+            h_last: h,
+            ..
+        } = self.core;
+        let (y_prev, y) = (&self.y_prev, &self.y);
+        dense_output(
+            "Rosenbrock",
+            t_query,
+            out,
+            t_prev,
+            t,
+            h,
+            y_prev,
+            y,
+            |th, out| hermite(th, h, y_prev, &self.f_prev, y, |i| self.f0[i], out),
         );
-        if t_query == self.t || self.h_last == 0.0 {
-            out.copy_from_slice(&self.y);
-            return;
-        }
-        if t_query == self.t_prev {
-            out.copy_from_slice(&self.y_prev);
-            return;
-        }
-        let h = self.h_last;
-        let th = (t_query - self.t_prev) / h;
-        let th2 = th * th;
-        let th3 = th2 * th;
-        let h00 = 2.0 * th3 - 3.0 * th2 + 1.0;
-        let h10 = th3 - 2.0 * th2 + th;
-        let h01 = -2.0 * th3 + 3.0 * th2;
-        let h11 = th3 - th2;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = h00 * self.y_prev[i]
-                + h01 * self.y[i]
-                + h * (h10 * self.f_prev[i] + h11 * self.f0[i]);
-        }
     }
 
     /// Evaluates `J` at the current point. A non-finite entry is an error: shrinking the step
@@ -236,8 +187,8 @@ impl Rosenbrock {
         &mut self,
         sys: &mut S,
     ) -> Result<(), IntegrateError<S::Error>> {
-        let (t, n) = (self.t, self.dim);
-        self.stats.jacobian_evals += 1;
+        let (t, n) = (self.core.t, self.dim);
+        self.core.stats.jacobian_evals += 1;
         sys.jacobian(t, &self.y, &self.f0, &mut self.jac)
             .map_err(IntegrateError::Rhs)?;
         if let Some(k) = first_non_finite(&self.jac) {
@@ -260,7 +211,7 @@ impl Rosenbrock {
         &mut self,
         sys: &mut S,
     ) -> Result<(), IntegrateError<S::Error>> {
-        let (t, n) = (self.t, self.dim);
+        let (t, n) = (self.core.t, self.dim);
         if !sys
             .time_derivative(t, &self.y, &self.f0, &mut self.dfdt)
             .map_err(IntegrateError::Rhs)?
@@ -268,10 +219,7 @@ impl Rosenbrock {
             let delta = (f64::EPSILON * t.abs().max(1e-5)).sqrt();
             self.dfdt.fill(0.0);
             for d in [delta, -delta] {
-                self.stats.rhs_evals += 1;
-                sys.rhs(t + d, &self.y, &mut self.f_stage)
-                    .map_err(IntegrateError::Rhs)?;
-                if first_non_finite(&self.f_stage).is_none() {
+                if eval(&mut self.core.stats, sys, t + d, &self.y, &mut self.f_stage)?.is_none() {
                     let dt = (t + d) - t;
                     for i in 0..n {
                         self.dfdt[i] = (self.f_stage[i] - self.f0[i]) / dt;
@@ -297,22 +245,51 @@ impl Rosenbrock {
         for i in 0..n {
             self.lu[i * n + i] += d;
         }
-        self.stats.lu_decompositions += 1;
+        self.core.stats.lu_decompositions += 1;
         let ok = lu_factor(&mut self.lu, n, &mut self.piv, d + self.jac_max).is_ok();
         self.lu_h = if ok { h } else { f64::NAN };
         ok
     }
 
-    fn reject_non_finite(&mut self, h: f64, t_bad: f64, index: usize) -> Attempt {
-        self.h_next = Some(h * self.settings.fac_min);
-        self.rejected_last = true;
-        self.failure = Failure::NonFinite { t: t_bad, index };
-        self.stats.rejected += 1;
-        Attempt::Rejected
+    /// A singular iteration matrix in the attempt with step `h` from `t`: halves the step
+    /// (a rejection), up to 5 times in a row, then [`IntegrateError::SingularMatrix`].
+    fn reject_singular<E>(&mut self, h: f64) -> Result<Attempt, IntegrateError<E>> {
+        let t = self.core.t;
+        self.core.stats.rejected += 1;
+        self.singular_run += 1;
+        self.core.rejected_last = true;
+        self.core.failure = Failure::Singular { t, h };
+        if self.singular_run >= 5 {
+            return Err(IntegrateError::SingularMatrix { t, h });
+        }
+        self.core.h_next = Some(0.5 * h);
+        Ok(Attempt::Rejected)
+    }
+}
+
+impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
+    const NAME: &'static str = "Rosenbrock";
+
+    fn core(&mut self) -> &mut Core {
+        &mut self.core
     }
 
-    /// One attempt from `(t, y)` with step `h` ending at `t_new`; commits on acceptance.
-    fn attempt<S: OdeJacobian>(
+    fn starting_step(&mut self, sys: &mut S) -> Result<f64, IntegrateError<S::Error>> {
+        let core = &mut self.core;
+        initial_step(
+            sys,
+            &mut core.stats,
+            core.t,
+            &self.y,
+            &self.f0,
+            &mut self.y_stage,
+            &mut self.f_stage,
+            &core.control,
+            3,
+        )
+    }
+
+    fn attempt(
         &mut self,
         sys: &mut S,
         h: f64,
@@ -321,7 +298,7 @@ impl Rosenbrock {
     ) -> Result<Attempt, IntegrateError<S::Error>> {
         let need_jac = !self.jac_valid
             || self.steps_since_jac >= self.settings.jacobian_reuse
-            || (self.rejected_last && !self.jac_fresh);
+            || (self.core.rejected_last && !self.jac_fresh);
         if need_jac {
             self.evaluate_jacobian(sys)?;
         }
@@ -329,10 +306,10 @@ impl Rosenbrock {
             self.evaluate_dfdt(sys)?;
         }
         if self.lu_h != h && !self.factor(h) {
-            return Ok(Attempt::Singular);
+            return self.reject_singular(h);
         }
         self.singular_run = 0;
-        let (t, n, tab) = (self.t, self.dim, self.tab);
+        let (t, n, tab) = (self.core.t, self.dim, self.tab);
 
         for s in 0..4 {
             // stage argument and f at it (stage 0: f0)
@@ -345,11 +322,14 @@ impl Rosenbrock {
                     }
                     self.y_stage[i] = v;
                 }
-                self.stats.rhs_evals += 1;
-                sys.rhs(ts, &self.y_stage, &mut self.f_stage)
-                    .map_err(IntegrateError::Rhs)?;
-                if let Some(i) = first_non_finite(&self.f_stage) {
-                    return Ok(self.reject_non_finite(h, ts, i));
+                if let Some(i) = eval(
+                    &mut self.core.stats,
+                    sys,
+                    ts,
+                    &self.y_stage,
+                    &mut self.f_stage,
+                )? {
+                    return Ok(self.core.reject_non_finite(h, ts, i));
                 }
             } else {
                 self.f_stage.copy_from_slice(&self.f0);
@@ -366,7 +346,7 @@ impl Rosenbrock {
             }
             lu_solve(&self.lu, n, &self.piv, us);
             if let Some(i) = first_non_finite(us) {
-                return Ok(self.reject_non_finite(h, ts, i));
+                return Ok(self.core.reject_non_finite(h, ts, i));
             }
         }
 
@@ -380,49 +360,36 @@ impl Rosenbrock {
             self.y_new[i] = yn;
             self.y_stage[i] = e;
         }
-        let c = self.control;
+        let c = self.core.control;
         let err = error_norm(&self.y_stage, &self.y, &self.y_new, c.atol, c.rtol);
         let fac = c.factor(err, 1.0 / 3.0);
         let passed = err <= 1.0;
         if !passed {
-            self.h_next = Some(h * fac.min(1.0));
-            self.rejected_last = true;
-            self.failure = Failure::None;
-            self.stats.rejected += 1;
-            return Ok(Attempt::Rejected);
+            return Ok(self.core.reject(h * fac.min(1.0), Failure::None));
         }
         if let Some(i) = first_non_finite(&self.y_new) {
-            return Ok(self.reject_non_finite(h, t_new, i));
+            return Ok(self.core.reject_non_finite(h, t_new, i));
         }
-        self.stats.rhs_evals += 1;
-        sys.rhs(t_new, &self.y_new, &mut self.f_new)
-            .map_err(IntegrateError::Rhs)?;
-        if let Some(i) = first_non_finite(&self.f_new) {
-            return Ok(self.reject_non_finite(h, t_new, i));
+        if let Some(i) = eval(
+            &mut self.core.stats,
+            sys,
+            t_new,
+            &self.y_new,
+            &mut self.f_new,
+        )? {
+            return Ok(self.core.reject_non_finite(h, t_new, i));
         }
 
-        let mut h_new = h * fac;
-        if self.rejected_last {
-            h_new = h_new.min(h);
-        }
-        if h < h_proposed {
-            h_new = h_new.max(h_proposed);
-        }
+        let h_new = self.core.limit_growth(h * fac, h, h_proposed);
         // commit: (y, f0) become the left Hermite data, the new point the current one
         std::mem::swap(&mut self.y_prev, &mut self.y);
         std::mem::swap(&mut self.y, &mut self.y_new);
         std::mem::swap(&mut self.f_prev, &mut self.f0);
         std::mem::swap(&mut self.f0, &mut self.f_new);
-        self.t_prev = t;
-        self.t = t_new;
-        self.h_last = h;
-        self.h_next = Some(h_new.min(self.settings.h_max));
-        self.rejected_last = false;
-        self.failure = Failure::None;
+        self.core.accept(t_new, h, h_new);
         self.jac_fresh = false;
         self.dfdt_fresh = false;
         self.steps_since_jac += 1;
-        self.stats.steps += 1;
         Ok(Attempt::Accepted)
     }
 }
@@ -430,23 +397,7 @@ impl Rosenbrock {
 impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
     /// Evaluates `f(t0, y0)` once; the Jacobian is evaluated by the first step.
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
-        assert_eq!(
-            sys.dim(),
-            self.dim,
-            "Rosenbrock::init: system dim vs stepper dim"
-        );
-        assert_eq!(y0.len(), self.dim, "Rosenbrock::init: y0 length vs dim");
-        self.initialized = false;
-        self.stats = Stats::default();
-        if let Some(index) = first_non_finite(y0) {
-            return Err(IntegrateError::NonFiniteState { t: t0, index });
-        }
-        self.t = t0;
-        self.t_prev = t0;
-        self.h_last = 0.0;
-        self.h_next = None;
-        self.rejected_last = false;
-        self.failure = Failure::None;
+        self.core.init("Rosenbrock", self.dim, sys.dim(), t0, y0)?;
         self.singular_run = 0;
         self.jac_valid = false;
         self.jac_fresh = false;
@@ -454,98 +405,21 @@ impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
         self.lu_h = f64::NAN;
         self.y.copy_from_slice(y0);
         self.y_prev.copy_from_slice(y0);
-        self.stats.rhs_evals += 1;
-        sys.rhs(t0, y0, &mut self.f0).map_err(IntegrateError::Rhs)?;
-        if let Some(index) = first_non_finite(&self.f0) {
-            return Err(IntegrateError::NonFiniteState { t: t0, index });
-        }
+        eval_finite(&mut self.core.stats, sys, t0, y0, &mut self.f0)?;
         self.f_prev.copy_from_slice(&self.f0);
-        self.initialized = true;
+        self.core.initialized = true;
         Ok(())
     }
 
     fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {
-        assert!(
-            self.initialized,
-            "Rosenbrock::step called before a successful init"
-        );
-        if t_stop.is_nan() || t_stop <= self.t {
-            return Ok(self.t);
-        }
-        let h_first = match (self.h_next, self.settings.h_init) {
-            (Some(h), _) | (None, Some(h)) => h,
-            (None, None) => initial_step(
-                sys,
-                &mut self.stats,
-                self.t,
-                &self.y,
-                &self.f0,
-                &mut self.y_stage,
-                &mut self.f_stage,
-                &self.control,
-                3,
-            )?,
-        };
-        self.h_next = Some(h_first);
-        loop {
-            if self.stats.steps + self.stats.rejected >= self.settings.max_steps as u64 {
-                return Err(IntegrateError::TooManySteps {
-                    t: self.t,
-                    max_steps: self.settings.max_steps,
-                });
-            }
-            let h = self.h_next.unwrap_or(h_first).min(self.settings.h_max);
-            if step_collapsed(h, self.t, self.settings.h_min) {
-                return Err(self.failure.collapse(self.t, h));
-            }
-            let (h_try, t_new) = land(self.t, h, t_stop);
-            match self.attempt(sys, h_try, t_new, h)? {
-                Attempt::Accepted => return Ok(self.t),
-                Attempt::Rejected => {}
-                Attempt::Singular => {
-                    self.stats.rejected += 1;
-                    self.singular_run += 1;
-                    self.rejected_last = true;
-                    self.failure = Failure::Singular {
-                        t: self.t,
-                        h: h_try,
-                    };
-                    if self.singular_run >= 5 {
-                        return Err(IntegrateError::SingularMatrix {
-                            t: self.t,
-                            h: h_try,
-                        });
-                    }
-                    self.h_next = Some(0.5 * h_try);
-                }
-            }
-        }
+        adaptive::step(self, sys, t_stop)
     }
 
-    fn t(&self) -> f64 {
-        Rosenbrock::t(self)
-    }
-
-    fn y(&self) -> &[f64] {
-        Rosenbrock::y(self)
-    }
-
-    fn interpolate(&self, t_query: f64, out: &mut [f64]) {
-        Rosenbrock::interpolate(self, t_query, out)
-    }
-
-    fn stats(&self) -> Stats {
-        Rosenbrock::stats(self)
-    }
+    forward_stepper_accessors!(Rosenbrock);
 
     fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.y.copy_from_slice(y);
-        self.stats.rhs_evals += 1;
-        sys.rhs(self.t, y, &mut self.f0).map_err(IntegrateError::Rhs)?;
-        match first_non_finite(&self.f0) {
-            Some(index) => Err(IntegrateError::NonFiniteState { t: self.t, index }),
-            None => Ok(()),
-        }
+        eval_finite(&mut self.core.stats, sys, self.core.t, y, &mut self.f0)
     }
 }
 

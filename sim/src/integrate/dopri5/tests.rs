@@ -2,6 +2,7 @@ use super::super::test_problems::{
     ExactSolution, ExponentialDecay, FailingRhs, HarmonicOscillator, Kepler, NanAfter,
     RationalDecay, RhsFailure, RiccatiBlowup, StiffLinear,
 };
+use super::super::testutil::{run_exact, scaled_err, Run};
 use super::*;
 
 fn tol_settings(tol: f64) -> Dopri5Settings {
@@ -12,49 +13,9 @@ fn tol_settings(tol: f64) -> Dopri5Settings {
     }
 }
 
-/// Error scaled the way the tolerance is: max_i |y_i - exact_i| / (1 + |exact_i|), so that
-/// rtol = atol = tol asks for roughly `tol` per step.
-fn scaled_err(y: &[f64], exact: &[f64]) -> f64 {
-    y.iter()
-        .zip(exact)
-        .map(|(a, b)| (a - b).abs() / (1.0 + b.abs()))
-        .fold(0.0, f64::max)
-}
-
-struct Run {
-    /// scaled error at t_end
-    err_end: f64,
-    /// max scaled error of dense output at 7 interior points of every step
-    err_dense: f64,
-    stats: Stats,
-}
-
-fn run<P: ExactSolution>(mut p: P, settings: Dopri5Settings, t_end: f64) -> Run {
-    let n = p.dim();
-    let y0 = p.y0();
-    let mut st = DormandPrince45::new(n, settings);
-    let (mut ex, mut yi) = (vec![0.0; n], vec![0.0; n]);
-    let t0 = p.t0();
-    st.init(&mut p, t0, &y0).expect("init");
-    let mut err_dense: f64 = 0.0;
-    while st.t() < t_end {
-        let t_old = st.t();
-        let t_new = st.step(&mut p, t_end).expect("step");
-        assert!(t_new <= t_end, "stepped past t_stop: {t_new} > {t_end}");
-        for j in 1..8 {
-            let tq = t_old + f64::from(j) / 8.0 * (t_new - t_old);
-            st.interpolate(tq, &mut yi);
-            p.exact(tq, &mut ex);
-            err_dense = err_dense.max(scaled_err(&yi, &ex));
-        }
-    }
-    assert_eq!(st.t(), t_end);
-    p.exact(t_end, &mut ex);
-    Run {
-        err_end: scaled_err(st.y(), &ex),
-        err_dense,
-        stats: st.stats(),
-    }
+fn run<P: ExactSolution>(p: P, settings: Dopri5Settings, t_end: f64) -> Run {
+    let st = DormandPrince45::new(p.dim(), settings);
+    run_exact(p, st, t_end)
 }
 
 const TOLS: [f64; 3] = [1e-6, 1e-8, 1e-10];

@@ -1,6 +1,7 @@
 use super::super::test_problems::{
     ExactSolution, NanAfter, OscillatorSplit, RhsFailure, StiffKepler, StiffLinear, StiffOscillator,
 };
+use super::super::testutil::{run_exact, scaled_err, Run};
 use super::super::{integrate_sampled, Dopri5Settings, DormandPrince45, OdeSystem};
 use super::*;
 use std::convert::Infallible;
@@ -23,45 +24,9 @@ fn fixed_settings(h: f64) -> ArkImexSettings {
     }
 }
 
-/// max_i |y_i - exact_i| / (1 + |exact_i|).
-fn scaled_err(y: &[f64], exact: &[f64]) -> f64 {
-    y.iter()
-        .zip(exact)
-        .map(|(a, b)| (a - b).abs() / (1.0 + b.abs()))
-        .fold(0.0, f64::max)
-}
-
-struct Run {
-    err_end: f64,
-    err_dense: f64,
-    stats: Stats,
-}
-
-fn run<P: ExactSolution + SplitSystem>(mut p: P, settings: ArkImexSettings, t_end: f64) -> Run {
-    let n = p.dim();
-    let y0 = p.y0();
-    let mut st = ArkImex::new(n, settings);
-    let (mut ex, mut yi) = (vec![0.0; n], vec![0.0; n]);
-    let t0 = p.t0();
-    st.init(&mut p, t0, &y0).expect("init");
-    let mut err_dense: f64 = 0.0;
-    while st.t() < t_end {
-        let t_old = st.t();
-        let t_new = st.step(&mut p, t_end).expect("step");
-        for j in 1..8 {
-            let tq = t_old + f64::from(j) / 8.0 * (t_new - t_old);
-            st.interpolate(tq, &mut yi);
-            p.exact(tq, &mut ex);
-            err_dense = err_dense.max(scaled_err(&yi, &ex));
-        }
-    }
-    assert_eq!(st.t(), t_end);
-    p.exact(t_end, &mut ex);
-    Run {
-        err_end: scaled_err(st.y(), &ex),
-        err_dense,
-        stats: st.stats(),
-    }
+fn run<P: ExactSolution + SplitSystem>(p: P, settings: ArkImexSettings, t_end: f64) -> Run {
+    let st = ArkImex::new(p.dim(), settings);
+    run_exact(p, st, t_end)
 }
 
 /// `sum_i w_i (A c^k)_i`-style sums: `phi(b, v) = sum_i b_i v_i`, `mv(A, v) = A v`.

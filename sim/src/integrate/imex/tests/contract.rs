@@ -1,6 +1,7 @@
 //! The stepper contract for `ArkImex`: evaluation counts, dense output, failures (NaN, system
 //! errors, too many steps), stop times, settings, `integrate_sampled`.
 
+use super::super::super::testutil::local_dense_err;
 use super::*;
 
 // Counts: 1 (init) + 5 rhs_split and 7 solves (5 stages, 2 for the filtered estimate) per
@@ -53,25 +54,8 @@ fn ark436_stats_count_evaluations_exactly() {
 #[test]
 fn ark436_dense_output_local_order_four_and_exact_ends() {
     fn local(h: f64) -> f64 {
-        let mut p = StiffKepler { e: 0.3, k: 10.0 };
-        let t0 = 0.3;
-        let mut y0 = [0.0; 5];
-        p.exact(t0, &mut y0);
-        let mut st = ArkImex::new(5, fixed_settings(h));
-        st.init(&mut p, t0, &y0).expect("init");
-        assert_eq!(st.step(&mut p, 100.0).expect("step"), t0 + h);
-        let (mut yi, mut ex) = ([0.0; 5], [0.0; 5]);
-        st.interpolate(t0, &mut yi);
-        assert_eq!(yi, y0);
-        st.interpolate(t0 + h, &mut yi);
-        assert_eq!(yi.as_slice(), st.y());
-        let mut e: f64 = 0.0;
-        for th in [0.25, 0.5, 0.75] {
-            st.interpolate(t0 + th * h, &mut yi);
-            p.exact(t0 + th * h, &mut ex);
-            e = e.max(scaled_err(&yi, &ex));
-        }
-        e
+        let st = ArkImex::new(5, fixed_settings(h));
+        local_dense_err(StiffKepler { e: 0.3, k: 10.0 }, st, 0.3, h)
     }
     for h in [0.1, 0.05] {
         let order = (local(h) / local(0.5 * h)).log2();

@@ -1,6 +1,7 @@
 //! The stepper contract for `Rosenbrock`: dense output, evaluation counts, failures (singular
 //! matrix, NaN, system errors, too many steps), stop times, settings, `integrate_sampled`.
 
+use super::super::super::testutil::local_dense_err as local_dense_err_of;
 use super::*;
 
 // The Hermite dense output's local error from the exact state over one step is O(h^4):
@@ -9,31 +10,11 @@ use super::*;
 #[test]
 fn rosenbrock_dense_output_local_order_four_and_exact_ends() {
     fn local_dense_err(h: f64) -> f64 {
-        let mut p = Kepler { e: 0.3 };
-        let t0 = 0.3;
-        let mut y0 = [0.0; 4];
-        p.exact(t0, &mut y0);
-        let mut st = Rosenbrock::new(
-            4,
-            RosenbrockSettings {
-                h_init: Some(h),
-                ..fixed_settings(h)
-            },
-        );
-        st.init(&mut p, t0, &y0).expect("init");
-        assert_eq!(st.step(&mut p, 100.0).expect("step"), t0 + h);
-        let (mut yi, mut ex) = ([0.0; 4], [0.0; 4]);
-        st.interpolate(t0, &mut yi);
-        assert_eq!(yi, y0);
-        st.interpolate(t0 + h, &mut yi);
-        assert_eq!(yi.as_slice(), st.y());
-        let mut e: f64 = 0.0;
-        for th in [0.25, 0.5, 0.75] {
-            st.interpolate(t0 + th * h, &mut yi);
-            p.exact(t0 + th * h, &mut ex);
-            e = e.max(scaled_err(&yi, &ex));
-        }
-        e
+        let s = RosenbrockSettings {
+            h_init: Some(h),
+            ..fixed_settings(h)
+        };
+        local_dense_err_of(Kepler { e: 0.3 }, Rosenbrock::new(4, s), 0.3, h)
     }
     for h in [0.05, 0.025] {
         let order = (local_dense_err(h) / local_dense_err(0.5 * h)).log2();
