@@ -104,3 +104,81 @@ fn precision_writes_its_table_and_plots() {
     let svg = std::fs::read_to_string(dir.path().join("work-precision.svg")).unwrap();
     assert!(svg.contains("max hand error") && svg.contains("wall time"));
 }
+
+fn same_bytes(a: &Path, b: &Path) -> bool {
+    std::fs::read(a).unwrap() == std::fs::read(b).unwrap()
+}
+
+/// The main command twice, on one thread and on every core: byte-identical recordings.
+#[test]
+fn the_main_command_is_deterministic_whatever_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    for (out, jobs) in [(&a, "1"), (&b, "3")] {
+        let o = run(Command::new(bin("sim")).arg("-o").arg(out).args(["-j", jobs, "--quiet", "--format", "csv"]));
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    for r in ["two-elbow", "one-elbow", "no-elbow"] {
+        let f = format!("paper-{r}.mcap");
+        assert!(same_bytes(&a.join(&f), &b.join(&f)), "{f} differs between -j 1 and -j 3");
+    }
+}
+
+/// Replaying each archived recording from its own metadata reproduces it exactly.
+#[test]
+fn replaying_the_archive_reproduces_it_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let archive = Path::new(env!("CARGO_MANIFEST_DIR")).join("recordings");
+    for r in ["two-elbow", "one-elbow", "no-elbow"] {
+        let f = archive.join(format!("paper-archive-{r}.mcap"));
+        let o = run(Command::new(bin("sim")).arg("replay").arg(&f).arg("-o").arg(dir.path()).arg("--quiet"));
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(same_bytes(&f, &dir.path().join(f.file_name().unwrap())), "{r}: the replay differs from the archive");
+    }
+}
+
+/// A `sim` killed mid-run leaves no file at its destination (only its hidden partial file).
+#[test]
+fn a_killed_run_leaves_no_file_at_the_destination() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/hard/long-60s-plain.json");
+    let mut child = Command::new(bin("sim"))
+        .arg(&scene)
+        .arg("-o")
+        .arg(dir.path())
+        .arg("--quiet")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // wait until it has started writing (the hidden partial file appears), then kill it
+    let t0 = std::time::Instant::now();
+    while std::fs::read_dir(dir.path()).unwrap().count() == 0 && t0.elapsed().as_secs() < 30 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let names: Vec<String> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(!names.is_empty(), "the run never started writing");
+    assert!(!names.iter().any(|n| n.ends_with(".mcap")), "a finished-looking file after a kill: {names:?}");
+}
+
+/// A run that fails numerically exits with status 1 and leaves a valid recording that says
+/// when and why.
+#[test]
+fn a_numerical_failure_exits_1_with_a_valid_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(small_scene()).unwrap()).unwrap();
+    v["integrator"] = serde_json::json!({"method": "rk4", "step": 5e-3});
+    v["runs"] = serde_json::json!([{"name": "free", "contacts": []}]);
+    let scene = dir.path().join("unstable.json");
+    std::fs::write(&scene, v.to_string()).unwrap();
+    std::fs::copy(small_scene().with_file_name("small_arm.urdf"), dir.path().join("small_arm.urdf")).unwrap();
+    let out = run(Command::new(bin("sim")).arg(&scene).arg("-o").arg(dir.path()).arg("--quiet"));
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("t = "), "{err}");
+    let rec = schemas::read_recording(&dir.path().join("small-free.mcap")).unwrap();
+    assert_eq!(rec.metadata_value("result", "status"), Some("failed"));
+}

@@ -12,7 +12,7 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sim::run::run_to_file;
 use sim::scene::{Scene, PAPER_SCENE_JSON, PAPER_URDF};
 
-use crate::cli::{Format, PrecisionArgs, RunArgs};
+use crate::cli::{Format, PrecisionArgs, ReplayArgs, RunArgs};
 
 /// Exit status for a run that failed numerically (bad input exits with 2).
 pub const EXIT_RUN_FAILED: u8 = 1;
@@ -238,4 +238,25 @@ pub fn precision(args: &PrecisionArgs) -> Result<()> {
     }
     writeln!(o, "wrote {}/precision.csv, precision.json, work-precision.svg, work-precision.png", args.out.display())?;
     print_out(&o)
+}
+
+/// `sim replay`: rebuild the scene from a recording's metadata and run it again.
+pub fn replay(args: &ReplayArgs) -> Result<()> {
+    let (scene, run_name) = sim::replay::scene_from_recording(&args.recording)?;
+    let run = scene
+        .run(&run_name)
+        .cloned()
+        .with_context(|| format!("{}: the embedded scene has no run `{run_name}`", args.recording.display()))?;
+    let name = args.recording.file_name().context("the recording path has no file name")?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let path = args.out.join(name);
+    if path.canonicalize().ok() == args.recording.canonicalize().ok() {
+        bail!("{}: replaying into the same file would overwrite the original; choose another -o", path.display());
+    }
+    let t0 = Instant::now();
+    let written = run_to_file(&scene, &run, &path, |_| {})?;
+    if !args.quiet {
+        eprintln!("replayed run `{}` of scene `{}` into {} in {:.2} s", run.name, scene.spec.name, written.path.display(), t0.elapsed().as_secs_f64());
+    }
+    Ok(())
 }

@@ -48,11 +48,28 @@ pub enum Command {
     /// Speed against error: every method over a ladder of tolerances or steps, and each model
     /// reduction, against a tight reference run; writes a table and a work–precision plot.
     Precision(PrecisionArgs),
+    /// Re-run an experiment from a recording alone (its embedded scene, URDF and settings);
+    /// the new recording is byte-identical to the original when the version is the same.
+    Replay(ReplayArgs),
+    /// Run a grid of scene variations in parallel (optionally one shard of it, for job arrays).
+    Sweep(crate::sweep_cmd::SweepArgs),
     /// Write the built-in paper scene (paper.json) and its URDF into a directory, to edit.
     ExportScene {
         /// Directory to write into (created if missing).
         dir: PathBuf,
     },
+}
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct ReplayArgs {
+    /// A recording written by `sim`.
+    pub recording: PathBuf,
+    /// Directory for the new recording (same file name as the original).
+    #[arg(short, long, default_value = "out/replay")]
+    pub out: PathBuf,
+    /// No progress output.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Clone, clap::Args)]

@@ -25,3 +25,5 @@ pub mod precision;
 pub mod plot;
 pub mod projection;
 pub mod stiff;
+pub mod replay;
+pub mod sweep;

@@ -3,6 +3,7 @@
 
 mod app;
 mod cli;
+mod sweep_cmd;
 
 use std::process::ExitCode;
 
@@ -12,6 +13,8 @@ fn main() -> ExitCode {
     let cli = cli::Cli::parse();
     let result = match cli.command {
         Some(cli::Command::Check { scene }) => app::check(scene.as_deref()).map(|_| ExitCode::SUCCESS),
+        Some(cli::Command::Replay(args)) => app::replay(&args).map(|_| ExitCode::SUCCESS),
+        Some(cli::Command::Sweep(args)) => sweep_cmd::run(&args),
         Some(cli::Command::Precision(args)) => app::precision(&args).map(|_| ExitCode::SUCCESS),
         Some(cli::Command::ExportScene { dir }) => app::export_scene(&dir).map(|_| ExitCode::SUCCESS),
         Some(cli::Command::Run(args)) => run(&args),

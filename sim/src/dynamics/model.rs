@@ -275,6 +275,9 @@ fn validate_inertial(file: &str, link: &urdf_rs::Link) -> Result<(), ModelError>
     if vals.iter().any(|v| !v.is_finite()) {
         return Err(bad("inertial/inertia", format!("{vals:?}"), "must be finite"));
     }
+    if m == 0.0 && vals.iter().any(|&v| v != 0.0) {
+        return Err(bad("inertial/mass", m.to_string(), "zero mass with a non-zero inertia is not a physical body"));
+    }
     if !finite3(&link.inertial.origin.xyz.0) || !finite3(&link.inertial.origin.rpy.0) {
         return Err(bad("inertial/origin", format!("{:?}", link.inertial.origin.xyz.0), "must be finite"));
     }

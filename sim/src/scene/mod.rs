@@ -101,8 +101,11 @@ impl Scene {
     ) -> Result<Scene, SceneError> {
         let de = &mut serde_json::Deserializer::from_str(text);
         let spec: SceneSpec = serde_path_to_error::deserialize(de).map_err(|e| {
+            // a syntax error's path ends in `?` (the position serde had not reached)
             let path = e.path().to_string();
-            SceneError::new(source, if path == "." { "(document)".into() } else { path }, "", e.inner().to_string())
+            let path = path.trim_end_matches('?').trim_end_matches('.');
+            let field = if path.is_empty() { "(document)" } else { path };
+            SceneError::new(source, field, json_literal_at(text, e.inner()), e.inner().to_string())
         })?;
         let urdf_xml = read_urdf(&spec.urdf).map_err(|why| SceneError::new(source, "urdf", &spec.urdf, why))?;
         build(spec, source, urdf_xml)
@@ -117,6 +120,18 @@ impl Scene {
     pub fn run_contacts(&self, run: &Run) -> Vec<PointOnPlane> {
         run.contacts.iter().map(|&k| self.contacts[k].clone()).collect()
     }
+}
+
+/// The number literal a "number out of range" error points at (e.g. `1e999`), else "".
+fn json_literal_at(text: &str, e: &serde_json::Error) -> String {
+    if !e.to_string().starts_with("number out of range") {
+        return String::new();
+    }
+    let line = text.lines().nth(e.line().saturating_sub(1)).unwrap_or("");
+    let end = e.column().min(line.len());
+    let head = line.get(..end).unwrap_or("");
+    let start = head.rfind(|ch: char| !(ch.is_ascii_alphanumeric() || "+-.".contains(ch))).map_or(0, |i| i + head[i..].chars().next().map_or(1, char::len_utf8));
+    head[start..].to_string()
 }
 
 struct Ctx<'a> {
