@@ -23,7 +23,8 @@ Examples:
 const METRICS_EXAMPLES: &str = "\
 Examples:
   analyze metrics out/two-elbow.mcap
-  analyze metrics out/ --format json";
+  analyze metrics out/ --format json
+  analyze metrics --recover out/.paper-two-elbow.mcap.partial   what a killed run left";
 
 /// Reads recordings of `sim` runs and reports hand error, link work W_j, motor electric
 /// energy E_j, contact forces and the energy balance, and compares runs.
@@ -54,6 +55,9 @@ pub struct CompareArgs {
     /// contacts, else the first run].
     #[arg(long, value_name = "RUN")]
     pub baseline: Option<String>,
+    /// Read what is intact of damaged (e.g. truncated) recordings; see `metrics --help`.
+    #[arg(long)]
+    pub recover: bool,
     #[command(flatten)]
     pub output: Output,
 }
@@ -63,6 +67,12 @@ pub struct MetricsArgs {
     /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
     #[arg(required = true, value_name = "FILES_OR_DIRS")]
     pub inputs: Vec<PathBuf>,
+    /// Read what is intact of damaged (e.g. truncated) recordings: the messages of every
+    /// complete chunk and the metadata before the damage. A warning on stderr names each
+    /// damaged file, the byte offset where reading stopped and what was recovered; a run cut
+    /// short before its result is reported as status `incomplete`.
+    #[arg(long)]
+    pub recover: bool,
     #[command(flatten)]
     pub output: Output,
 }

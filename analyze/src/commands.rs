@@ -3,7 +3,10 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use analyze::{read_run_metrics, render_comparison, render_metrics, Comparison, RunMetrics};
+use analyze::{
+    read_run_metrics, render_comparison, render_metrics, run_metrics_recovered, Comparison,
+    RunMetrics,
+};
 use anyhow::{bail, Context, Result};
 
 use crate::cli::{Cli, Command, Output};
@@ -12,12 +15,12 @@ use crate::cli::{Cli, Command, Output};
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Compare(a) => {
-            let runs = load(&a.inputs)?;
+            let runs = load(&a.inputs, a.recover)?;
             let cmp = Comparison::new(&runs, a.baseline.as_deref())?;
             emit(&a.output, &render_comparison(&cmp, a.output.format)?)
         }
         Command::Metrics(a) => {
-            let runs = load(&a.inputs)?;
+            let runs = load(&a.inputs, a.recover)?;
             emit(&a.output, &render_metrics(&runs, a.output.format)?)
         }
     }
@@ -55,10 +58,28 @@ pub fn expand_inputs(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
 }
 
 /// Metrics of every input, in order; the first unreadable file stops with an error naming it.
-fn load(inputs: &[PathBuf]) -> Result<Vec<RunMetrics>> {
+/// With `recover`, damaged files give the metrics of their intact part and a warning on stderr.
+fn load(inputs: &[PathBuf], recover: bool) -> Result<Vec<RunMetrics>> {
     expand_inputs(inputs)?
         .iter()
-        .map(|p| read_run_metrics(p).with_context(|| format!("analyzing {}", p.display())))
+        .map(|p| {
+            let context = || format!("analyzing {}", p.display());
+            if !recover {
+                return read_run_metrics(p).with_context(context);
+            }
+            let (rec, report) = schemas::read_recording_recover(p).with_context(context)?;
+            if !report.complete {
+                eprintln!("analyze: warning: {report}");
+            }
+            run_metrics_recovered(&rec, &report).with_context(|| {
+                format!(
+                    "analyzing {} (recovered {} messages from its first {} bytes)",
+                    p.display(),
+                    report.messages,
+                    report.stopped_at
+                )
+            })
+        })
         .collect()
 }
 

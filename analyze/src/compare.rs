@@ -256,6 +256,12 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
             r.run, r.t_end_s
         ));
     }
+    for r in runs.iter().filter(|r| r.status == Status::Incomplete) {
+        out.push(format!(
+            "{} is incomplete (recovered from a damaged recording): its totals stop at t = {:.3} s.",
+            r.run, r.t_end_s
+        ));
+    }
 
     // least energy, smallest z error
     let argmin = |v: &dyn Fn(&RunMetrics) -> f64| {

@@ -33,5 +33,9 @@ mod testutil;
 
 pub use compare::Comparison;
 pub use error::Error;
-pub use metrics::{read_run_metrics, run_metrics, RunMetrics, Status};
+pub use metrics::{
+    read_run_metrics, read_run_metrics_recover, run_metrics, run_metrics_recovered, RunMetrics,
+    Status,
+};
 pub use render::{render_comparison, render_metrics, Format};
+pub use schemas::RecoverReport;

@@ -27,7 +27,7 @@
 
 use std::path::Path;
 
-use schemas::{topics, Recording};
+use schemas::{topics, Recording, RecoverReport};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
@@ -46,6 +46,10 @@ const RESULT_RECORD: &str = "result";
 pub enum Status {
     Complete,
     Failed,
+    /// Read with `--recover` from a damaged recording that has no `result` record (the run
+    /// was cut short, e.g. killed): the metrics cover the recovered part only, and `error`
+    /// says where the recording stops.
+    Incomplete,
 }
 
 /// RMS and largest magnitude of one error component, m.
@@ -189,16 +193,52 @@ pub fn read_run_metrics(path: &Path) -> Result<RunMetrics, Error> {
     run_metrics(&schemas::read_recording(path)?)
 }
 
+/// Reads the intact part of a possibly damaged recording at `path`
+/// ([`schemas::read_recording_recover`]) and computes its metrics
+/// ([`run_metrics_recovered`]). The report says how much was read; print it when it is not
+/// `complete`.
+pub fn read_run_metrics_recover(path: &Path) -> Result<(RunMetrics, RecoverReport), Error> {
+    let (rec, report) = schemas::read_recording_recover(path)?;
+    Ok((run_metrics_recovered(&rec, &report)?, report))
+}
+
+/// [`run_metrics`] of a recording read by [`schemas::read_recording_recover`]: the same,
+/// except that a damaged recording without a `result` record is [`Status::Incomplete`], its
+/// `error` stating where the recording stops and why. The metrics cover the messages
+/// recovered (`t_end_s` is the last recovered `/hand` sample).
+pub fn run_metrics_recovered(rec: &Recording, report: &RecoverReport) -> Result<RunMetrics, Error> {
+    let incomplete = (!report.complete && rec.metadata_value(RESULT_RECORD, "status").is_none())
+        .then(|| {
+            format!(
+                "recording damaged, stops at byte {} of {}: {}",
+                report.stopped_at,
+                report.file_len,
+                report.reason.as_deref().unwrap_or("unknown")
+            )
+        });
+    metrics(rec, incomplete)
+}
+
 /// Computes the metrics of one decoded recording (see the module docs for the formulas).
 ///
 /// Needs the metadata `run.{scene,run,contacts,joint_names}` and `result.status`, and at least
 /// one message on each of `/hand`, `/motors`, `/constraints` and `/energy`, with one array
 /// entry per joint (motors, energy) or per contact (constraints).
 pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
+    metrics(rec, None)
+}
+
+/// `incomplete`: the recording was recovered without its `result` record; the reason.
+fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Error> {
     let src = Source(rec);
     let joint_names = src.json_names(RUN_RECORD, "joint_names")?;
     let contacts = src.json_names(RUN_RECORD, "contacts")?;
-    let status = match src.meta(RESULT_RECORD, "status")? {
+    let result_status = match &incomplete {
+        Some(_) => "incomplete",
+        None => src.meta(RESULT_RECORD, "status")?,
+    };
+    let status = match result_status {
+        "incomplete" if incomplete.is_some() => Status::Incomplete,
         "complete" => Status::Complete,
         "failed" => Status::Failed,
         other => {
@@ -316,9 +356,10 @@ pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
         samples: hand_t.len(),
         t_end_s: hand_t[hand_t.len() - 1],
         status,
-        error: rec
-            .metadata_value(RESULT_RECORD, "error")
-            .map(str::to_string),
+        error: incomplete.or_else(|| {
+            rec.metadata_value(RESULT_RECORD, "error")
+                .map(str::to_string)
+        }),
         error_time_s,
         hand_error,
         links,

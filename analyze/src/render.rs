@@ -123,6 +123,7 @@ fn status(s: Status) -> &'static str {
     match s {
         Status::Complete => "complete",
         Status::Failed => "failed",
+        Status::Incomplete => "incomplete",
     }
 }
 

@@ -38,7 +38,10 @@ pub use messages::{
     frame_transform, hand_points, timestamp, ConstraintState, EnergyState, HandState, JointState,
     Message, MotorState, RosString, Vec3,
 };
-pub use reader::{read_recording, read_recording_bytes, ChannelInfo, Recording};
+pub use reader::{
+    read_recording, read_recording_bytes, read_recording_recover, read_recording_recover_bytes,
+    ChannelInfo, Recording, RecoverReport,
+};
 pub use value::Value;
 pub use writer::RecordingWriter;
 

@@ -23,7 +23,10 @@ use mcap::records::Record;
 use prost_reflect::{DescriptorPool, DynamicMessage, MessageDescriptor, ReflectMessage};
 
 use crate::value::Value;
+
+mod recover;
 use crate::{from_log_time, ros2msg, Error, FORMAT_VERSION_KEY, RECORDING_METADATA};
+pub use recover::{read_recording_recover, read_recording_recover_bytes, RecoverReport};
 
 /// One channel of the file.
 #[derive(Debug, Clone, PartialEq)]
@@ -140,29 +143,27 @@ pub fn read_recording_bytes(bytes: &[u8], source: &str) -> Result<Recording, Err
     })
 }
 
-fn read_mcap(bytes: &[u8], source: &str) -> Result<Recording, Error> {
-    use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
-
-    let file = source.to_string();
-    if !bytes.starts_with(mcap::MAGIC) {
-        return Err(Error::NotMcap {
-            file,
-            len: bytes.len(),
-        });
-    }
-    // every CRC the format has is checked, chunks before any of their records are used
-    let options = LinearReaderOptions::default()
-        .with_record_length_limit(bytes.len().max(MIN_RECORD_LENGTH_LIMIT))
+/// The reader options: every CRC the format has is checked, chunks before any of their records
+/// are used, and no record may be longer than the larger of the input and
+/// [`MIN_RECORD_LENGTH_LIMIT`].
+fn reader_options(len: usize) -> mcap::sans_io::LinearReaderOptions {
+    mcap::sans_io::LinearReaderOptions::default()
+        .with_record_length_limit(len.max(MIN_RECORD_LENGTH_LIMIT))
         .with_validate_chunk_crcs(true)
         .with_prevalidate_chunk_crcs(true)
         .with_validate_data_section_crc(true)
         .with_validate_summary_section_crc(true)
-        .with_check_finishes_after_end_magic(true);
+        .with_check_finishes_after_end_magic(true)
+}
+
+/// Runs `bytes` through a linear reader with `options`, handing every record to `state`.
+fn feed(
+    bytes: &[u8],
+    options: mcap::sans_io::LinearReaderOptions,
+    state: &mut State,
+) -> Result<(), Error> {
+    use mcap::sans_io::{LinearReadEvent, LinearReader};
     let mut reader = LinearReader::new_with_options(options);
-    let mut state = State {
-        file,
-        ..State::default()
-    };
     let mut rest = bytes;
     while let Some(event) = reader.next_event() {
         let event = event.map_err(|source| Error::McapRead {
@@ -186,6 +187,22 @@ fn read_mcap(bytes: &[u8], source: &str) -> Result<Recording, Error> {
             }
         }
     }
+    Ok(())
+}
+
+fn read_mcap(bytes: &[u8], source: &str) -> Result<Recording, Error> {
+    let file = source.to_string();
+    if !bytes.starts_with(mcap::MAGIC) {
+        return Err(Error::NotMcap {
+            file,
+            len: bytes.len(),
+        });
+    }
+    let mut state = State {
+        file,
+        ..State::default()
+    };
+    feed(bytes, reader_options(bytes.len()), &mut state)?;
     state.finish()
 }
 
@@ -321,7 +338,7 @@ impl State {
         Ok(())
     }
 
-    fn finish(mut self) -> Result<Recording, Error> {
+    fn finish(self) -> Result<Recording, Error> {
         if !self.footer {
             return Err(Error::Truncated { file: self.file });
         }
@@ -331,15 +348,20 @@ impl State {
                 self.total
             )));
         }
+        Ok(self.into_recording())
+    }
+
+    /// The recording read so far, messages sorted by log time (stable).
+    fn into_recording(mut self) -> Recording {
         for list in self.messages.values_mut() {
             list.sort_by_key(|(t, _)| *t);
         }
-        Ok(Recording {
+        Recording {
             source: self.file,
             metadata: self.metadata,
             channels: self.channels.into_values().collect(),
             messages: self.messages,
-        })
+        }
     }
 }
 

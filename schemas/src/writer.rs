@@ -55,6 +55,18 @@ impl RecordingWriter {
     /// [`finish`](Self::finish) renames it to `path`. If dropped without `finish` (error,
     /// panic), the temp file is removed. A kill leaves at most the hidden temp file, never `path`.
     pub fn create(path: &Path) -> Result<Self, Error> {
+        Self::create_with(path, None)
+    }
+
+    /// [`create`](Self::create), but closing a chunk once it holds more than `chunk_size`
+    /// uncompressed bytes instead of the `mcap` default (1 MiB): smaller chunks lose less of
+    /// a file that is cut short (see [`crate::read_recording_recover`]). `create` output is
+    /// unchanged by this option's existence.
+    pub fn create_with_chunk_size(path: &Path, chunk_size: u64) -> Result<Self, Error> {
+        Self::create_with(path, Some(chunk_size))
+    }
+
+    fn create_with(path: &Path, chunk_size: Option<u64>) -> Result<Self, Error> {
         let file = path.display().to_string();
         let name = path
             .file_name()
@@ -77,6 +89,10 @@ impl RecordingWriter {
             .library(library_string())
             .compression(Some(mcap::Compression::Zstd))
             .compression_threads(0);
+        let options = match chunk_size {
+            Some(n) => options.chunk_size(Some(n)),
+            None => options,
+        };
         let mcap = options
             .create(BufWriter::new(out))
             .map_err(|source| Error::McapWrite {

@@ -1,0 +1,217 @@
+//! `read_recording_recover`: the intact part of a damaged recording, written by our own writer
+//! with small chunks so that a cut leaves several complete chunks before it.
+
+use std::collections::BTreeMap;
+
+use schemas::{
+    read_recording_bytes, read_recording_recover, read_recording_recover_bytes, topics, Error,
+    HandState, MotorState, Recording, RecordingWriter, Value, Vec3,
+};
+
+const SAMPLES: u32 = 600;
+
+/// 600 samples of /motors and /hand (1 ms apart), `run` metadata first, `result` last;
+/// chunks of at most ~4 KiB uncompressed.
+fn recording() -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let mut w = RecordingWriter::create_with_chunk_size(&dir.path().join("r.mcap"), 4096).unwrap();
+    let mut run = BTreeMap::new();
+    run.insert("run".to_string(), "two-elbow".to_string());
+    w.write_metadata("run", &run).unwrap();
+    for k in 0..SAMPLES {
+        let t = f64::from(k) * 1e-3;
+        let ns = schemas::to_log_time(t);
+        let m = MotorState {
+            time: t,
+            current: vec![t.sin(), 2.0 * t.cos(), -t / 3.0],
+            voltage: vec![1.0 / (1.0 + t), 0.5, f64::from(k)],
+            ..Default::default()
+        };
+        w.write(topics::MOTORS, ns, &m).unwrap();
+        let h = HandState {
+            time: t,
+            error: Vec3 {
+                x: t,
+                y: -t,
+                z: t * t,
+            },
+            error_norm: t * 2.0,
+            ..Default::default()
+        };
+        w.write(topics::HAND, ns, &h).unwrap();
+    }
+    let mut result = BTreeMap::new();
+    result.insert("status".to_string(), "complete".to_string());
+    w.write_metadata("result", &result).unwrap();
+    std::fs::read(w.finish().unwrap()).unwrap()
+}
+
+fn assert_prefix(part: &Recording, full: &Recording, what: &str) {
+    for (topic, list) in &part.messages {
+        let all = &full.messages[topic];
+        assert!(list.len() <= all.len(), "{what}: {topic}");
+        assert_eq!(
+            list[..],
+            all[..list.len()],
+            "{what}: {topic} is not a prefix"
+        );
+    }
+}
+
+fn count(rec: &Recording) -> u64 {
+    rec.messages.values().map(|l| l.len() as u64).sum()
+}
+
+/// An intact file: the recovered recording is the normal reader's, and the report says complete.
+#[test]
+fn an_intact_file_reads_as_with_the_normal_reader() {
+    let full = recording();
+    let normal = read_recording_bytes(&full, "r.mcap").unwrap();
+    let (rec, report) = read_recording_recover_bytes(&full, "r.mcap").unwrap();
+    assert!(report.complete && report.reason.is_none(), "{report}");
+    assert_eq!(rec.messages, normal.messages);
+    assert_eq!(rec.metadata, normal.metadata);
+    assert_eq!(rec.channels, normal.channels);
+    assert_eq!(report.messages, u64::from(SAMPLES) * 2);
+    assert_eq!(
+        report.t_end_ns,
+        Some(schemas::to_log_time(f64::from(SAMPLES - 1) * 1e-3))
+    );
+    assert_eq!(report.stopped_at, full.len() as u64);
+    assert!(report.chunks >= 5, "only {} chunks", report.chunks);
+    assert!(report.metadata.contains(&"result".to_string()));
+}
+
+/// Cut at many offsets: always Ok, a prefix of the original messages (same values), never
+/// fewer messages for a longer prefix, the `run` metadata (written first) once its record is
+/// whole, the warning text naming the file and the offset; the stop offset is a record start
+/// at or before the cut.
+#[test]
+fn truncated_files_give_a_prefix_of_the_messages() {
+    let full = recording();
+    let normal = read_recording_bytes(&full, "r.mcap").unwrap();
+    let (_, intact) = read_recording_recover_bytes(&full, "r.mcap").unwrap();
+    let mut last = 0;
+    let mut cuts: Vec<usize> = (0..60).map(|k| 8 + k * (full.len() - 8) / 60).collect();
+    cuts.push(full.len() - 1);
+    let mut partial_seen = 0;
+    for &cut in &cuts {
+        let (rec, report) = read_recording_recover_bytes(&full[..cut], "cut.mcap").unwrap();
+        assert!(!report.complete, "cut at {cut}");
+        assert!(
+            report.stopped_at <= cut as u64 && report.file_len == cut as u64,
+            "{report}"
+        );
+        assert_prefix(&rec, &normal, &format!("cut at {cut}"));
+        let n = count(&rec);
+        assert_eq!(n, report.messages, "{report}");
+        assert!(n >= last, "cut at {cut}: {n} < {last} messages");
+        last = n;
+        assert!(report.chunks <= intact.chunks);
+        let text = report.to_string();
+        assert!(
+            text.starts_with("cut.mcap: damaged recording: stopped at byte ")
+                && text.contains(&format!(" of {cut}: ")),
+            "{text}"
+        );
+        if n > 0 {
+            assert_eq!(rec.metadata_value("run", "run"), Some("two-elbow"));
+            assert_eq!(
+                report.t_end_ns,
+                rec.messages
+                    .values()
+                    .flat_map(|l| l.last())
+                    .map(|(t, _)| *t)
+                    .max()
+            );
+            partial_seen += usize::from(n < u64::from(SAMPLES) * 2);
+        }
+    }
+    // the whole data section survives when only the summary is cut
+    assert_eq!(last, u64::from(SAMPLES) * 2);
+    assert!(partial_seen > 40, "{partial_seen} partial recoveries");
+}
+
+/// A flipped byte inside a middle chunk: reading stops at that chunk (its CRC fails), keeping
+/// every chunk before it and nothing of it.
+#[test]
+fn a_corrupt_chunk_stops_recovery_before_it() {
+    let full = recording();
+    let normal = read_recording_bytes(&full, "r.mcap").unwrap();
+    // top-level records: opcode, u64 length, body; chunks are opcode 0x06
+    let mut chunks = Vec::new();
+    let mut at = 8;
+    while at + 9 <= full.len() {
+        let len = u64::from_le_bytes(full[at + 1..at + 9].try_into().unwrap()) as usize;
+        if full[at] == 0x06 {
+            chunks.push((at, len));
+        }
+        at += 9 + len;
+    }
+    let (start, len) = chunks[chunks.len() / 2];
+    let mid = start + 9 + len - 5; // in the compressed records
+    let mut b = full.clone();
+    b[mid] ^= 0x40;
+    assert!(read_recording_bytes(&b, "x").is_err());
+    let (rec, report) = read_recording_recover_bytes(&b, "flip.mcap").unwrap();
+    assert!(!report.complete);
+    assert_eq!(report.stopped_at, start as u64, "{report}");
+    assert!(
+        report.reason.as_deref().unwrap().contains("unreadable"),
+        "{report}"
+    );
+    assert_prefix(&rec, &normal, "flip");
+    let n = count(&rec);
+    assert!(n > 0 && n < u64::from(SAMPLES) * 2, "{n}");
+    // the prefix ends where the damage starts: recovery of the file cut there gives the same
+    let (rec2, _) =
+        read_recording_recover_bytes(&full[..report.stopped_at as usize], "cut").unwrap();
+    assert_eq!(rec2.messages, rec.messages);
+}
+
+#[test]
+fn nothing_to_recover_is_an_error_or_empty() {
+    let e = read_recording_recover_bytes(b"hello", "t.mcap").unwrap_err();
+    assert!(
+        matches!(e, Error::NotMcap { .. }) && e.to_string().contains("t.mcap"),
+        "{e}"
+    );
+    let e = read_recording_recover(std::path::Path::new("/nonexistent/y.mcap")).unwrap_err();
+    assert!(e.to_string().contains("/nonexistent/y.mcap"), "{e}");
+    let (rec, report) = read_recording_recover_bytes(mcap::MAGIC, "m.mcap").unwrap();
+    assert!(rec.messages.is_empty() && rec.metadata.is_empty() && report.messages == 0);
+    assert_eq!(report.stopped_at, 8);
+    assert!(report.to_string().contains("no messages"), "{report}");
+}
+
+/// The writer's default output is unchanged by the chunk-size option: `create` writes one
+/// chunk for a small file; a small chunk size writes several, and both read the same.
+#[test]
+fn chunk_size_option_reads_the_same() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |w: &mut RecordingWriter| {
+        for k in 0..200u32 {
+            let m = MotorState {
+                time: f64::from(k),
+                current: vec![f64::from(k); 4],
+                ..Default::default()
+            };
+            w.write(topics::MOTORS, u64::from(k), &m).unwrap();
+        }
+    };
+    let mut a = RecordingWriter::create(&dir.path().join("a.mcap")).unwrap();
+    write(&mut a);
+    let a = std::fs::read(a.finish().unwrap()).unwrap();
+    let mut b = RecordingWriter::create_with_chunk_size(&dir.path().join("b.mcap"), 1024).unwrap();
+    write(&mut b);
+    let b = std::fs::read(b.finish().unwrap()).unwrap();
+    let (ra, pa) = read_recording_recover_bytes(&a, "a").unwrap();
+    let (rb, pb) = read_recording_recover_bytes(&b, "b").unwrap();
+    assert_eq!((pa.chunks, pb.chunks > 3), (1, true), "{pa} / {pb}");
+    assert_eq!(ra.messages, rb.messages);
+    let v: &Value = &ra.messages[topics::MOTORS][7].1;
+    assert_eq!(
+        v.get("current").and_then(Value::as_f64_vec),
+        Some(vec![7.0; 4])
+    );
+}
