@@ -41,8 +41,9 @@ pub enum Command {
     /// W_j and E_j, contact forces, energy balance, and findings in plain sentences.
     #[command(after_help = COMPARE_EXAMPLES)]
     Compare(CompareArgs),
-    /// Per-run metrics only (no baseline, no findings).
-    #[command(after_help = METRICS_EXAMPLES)]
+    /// Per-run metrics only (no baseline, no findings): one row per recording, so it also merges
+    /// the shards of a sweep (`analyze summary results/`).
+    #[command(after_help = METRICS_EXAMPLES, visible_alias = "summary")]
     Metrics(MetricsArgs),
 }
 
@@ -132,6 +133,7 @@ mod tests {
             (a.output.format, a.output.output, a.baseline),
             (Format::Table, None, None)
         );
+        assert!(matches!(parse(&["summary", "dir/"]).unwrap().command, Command::Metrics(_)));
         let Command::Metrics(m) = parse(&["metrics", "a.mcap", "-f", "csv"]).unwrap().command
         else {
             panic!()
