@@ -26,6 +26,12 @@ Examples:
   analyze metrics out/ --format json
   analyze metrics --recover out/.paper-two-elbow.mcap.partial   what a killed run left";
 
+const FIGURES_EXAMPLES: &str = "\
+Examples:
+  analyze figures out/                      the paper's Fig. 1-25 and more -> out/figures/
+  analyze figures out/ -o paper-figures     then open paper-figures/index.html (or index.md)
+  analyze figures out/paper-no-elbow.mcap out/paper-two-elbow.mcap -o two-runs";
+
 /// Reads recordings of `sim` runs and reports hand error, link work W_j, motor electric
 /// energy E_j, contact forces and the energy balance, and compares runs.
 #[derive(Debug, Parser)]
@@ -45,6 +51,54 @@ pub enum Command {
     /// the shards of a sweep (`analyze summary results/`).
     #[command(after_help = METRICS_EXAMPLES, visible_alias = "summary")]
     Metrics(MetricsArgs),
+    /// Compare two recordings or exported tables run by run (matched by run name): hand error,
+    /// E and W totals, per-link W_j and E_j, currents, contact forces, energy residual, with
+    /// absolute and relative differences. Exit status 0: nothing moved beyond the tolerances;
+    /// 1: something moved (or is missing on one side); 2: bad input. `--format json`
+    /// and `csv` list every quantity (one row each).
+    #[command(after_help = "Examples:
+  analyze diff old/run.mcap new/run.mcap          one run against itself, or another version
+  analyze diff old-table.json out/                a table exported by `analyze metrics -f json`
+  analyze diff a.mcap b.mcap --rtol 1e-6 --all    looser, and list every quantity
+  analyze diff a.csv b.csv --format json")]
+    Diff(DiffArgs),
+    /// The paper's figures (hand paths Fig. 1-3, total and per-link work and electric energy
+    /// Fig. 4-25) and more (currents, voltages, elbow normal forces, hand error), every run in
+    /// each, as SVG and PNG, with index.md and index.html listing them in order.
+    #[command(after_help = FIGURES_EXAMPLES)]
+    Figures(FiguresArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct FiguresArgs {
+    /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
+    #[arg(required = true, value_name = "FILES_OR_DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// Directory to write the figures and index pages to (created if needed).
+    #[arg(long, short = 'o', value_name = "DIR", default_value = "out/figures")]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct DiffArgs {
+    /// A: a recording (.mcap), a directory of recordings, or a table exported by
+    /// `analyze metrics|compare --format json|csv`.
+    #[arg(value_name = "A")]
+    pub a: PathBuf,
+    /// B: the same kinds of input as A.
+    #[arg(value_name = "B")]
+    pub b: PathBuf,
+    /// Relative tolerance: a quantity moved when |B - A| > atol + rtol * max(|A|, |B|).
+    #[arg(long, value_name = "RTOL", default_value = "1e-9")]
+    pub rtol: f64,
+    /// Absolute tolerance (in the quantity's SI unit).
+    #[arg(long, value_name = "ATOL", default_value = "1e-12")]
+    pub atol: f64,
+    /// List every compared quantity in the table, not only those that moved.
+    #[arg(long)]
+    pub all: bool,
+    #[command(flatten)]
+    pub output: Output,
 }
 
 #[derive(Debug, Args)]
@@ -159,6 +213,54 @@ mod tests {
             kind(&[]),
             ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
         );
+    }
+
+    #[test]
+    fn figures_takes_inputs_and_an_output_directory() {
+        let Command::Figures(a) = parse(&["figures", "out/", "b.mcap", "-o", "figs"])
+            .unwrap()
+            .command
+        else {
+            panic!()
+        };
+        assert_eq!(a.inputs, [PathBuf::from("out/"), PathBuf::from("b.mcap")]);
+        assert_eq!(a.output, PathBuf::from("figs"));
+        let Command::Figures(a) = parse(&["figures", "out"]).unwrap().command else {
+            panic!()
+        };
+        assert_eq!(a.output, PathBuf::from("out/figures"));
+        assert_eq!(
+            parse(&["figures"]).unwrap_err().kind(),
+            ErrorKind::MissingRequiredArgument
+        );
+    }
+
+    #[test]
+    fn diff_takes_two_inputs_and_tolerances() {
+        let Command::Diff(a) = parse(&["diff", "a.mcap", "t.json"]).unwrap().command else {
+            panic!()
+        };
+        assert_eq!(
+            (a.a, a.b),
+            (PathBuf::from("a.mcap"), PathBuf::from("t.json"))
+        );
+        assert_eq!(
+            (a.rtol, a.atol, a.all, a.output.format),
+            (1e-9, 1e-12, false, Format::Table)
+        );
+        let cli = parse(&[
+            "diff", "a", "b", "--rtol", "0.02", "--atol", "1e-6", "--all", "-f", "json",
+        ]);
+        let Command::Diff(a) = cli.unwrap().command else {
+            panic!()
+        };
+        assert_eq!(
+            (a.rtol, a.atol, a.all, a.output.format),
+            (0.02, 1e-6, true, Format::Json)
+        );
+        let kind = |args: &[&str]| parse(args).unwrap_err().kind();
+        assert_eq!(kind(&["diff", "a"]), ErrorKind::MissingRequiredArgument);
+        assert_eq!(kind(&["diff", "a", "b", "--rtol", "x"]), ErrorKind::ValueValidation);
     }
 
     #[test]

@@ -23,7 +23,51 @@ pub fn run(cli: Cli) -> Result<()> {
             let runs = load(&a.inputs, a.recover)?;
             emit(&a.output, &render_metrics(&runs, a.output.format)?)
         }
+        Command::Figures(a) => figures(&a),
+        // exit status: 0 nothing moved, 1 something moved, 2 bad input (not main's 1)
+        Command::Diff(a) => match diff(&a) {
+            Ok(false) => Ok(()),
+            Ok(true) => std::process::exit(1),
+            Err(err) => {
+                eprintln!("analyze: error: {err:#}");
+                std::process::exit(2)
+            }
+        },
     }
+}
+
+/// `analyze figures`: every figure of every input into `a.output`, then the index pages.
+fn figures(a: &crate::cli::FiguresArgs) -> Result<()> {
+    let paths = expand_inputs(&a.inputs)?;
+    let runs = paths
+        .iter()
+        .map(|p| analyze::figures::read_run(p).with_context(|| format!("reading {}", p.display())))
+        .collect::<Result<Vec<_>>>()?;
+    let figures = analyze::figures::write_all(&runs, &paths, &a.output)?;
+    eprintln!(
+        "analyze: {} figures (SVG and PNG) of {} runs in {}; open {}",
+        figures.len(),
+        runs.len(),
+        a.output.display(),
+        a.output.join("index.html").display()
+    );
+    Ok(())
+}
+
+/// `analyze diff`: reads both inputs, compares, writes the report; `Ok(true)` when something
+/// differs beyond the tolerances.
+fn diff(a: &crate::cli::DiffArgs) -> Result<bool> {
+    let (left, right) = (analyze::read_input(&a.a)?, analyze::read_input(&a.b)?);
+    let tol = analyze::Tolerance {
+        rtol: a.rtol,
+        atol: a.atol,
+    };
+    let d = analyze::diff::diff(&left, &right, tol)?;
+    emit(
+        &a.output,
+        &analyze::render_diff(&d, a.output.format, a.all)?,
+    )?;
+    Ok(d.differs())
 }
 
 /// Files as given; a directory stands for every `*.mcap` file directly in it, sorted by name.

@@ -6,6 +6,8 @@
 //!   findings stated as sentences (SCENE.md "The paper's conclusions").
 //! - [`render`]: a [`Comparison`] or a list of [`RunMetrics`] as an aligned text table, JSON
 //!   or CSV ([`Format`]).
+//! - `figures` (feature `figures`, on by default): the paper's Fig. 1-25 and more as SVG and PNG
+//!   with an index page, drawn with plotters (`analyze figures`).
 //!
 //! Typical use (what `sim` does after its runs):
 //! ```no_run
@@ -22,16 +24,21 @@
 //! ```
 //!
 //! Units are SI; JSON keys carry them as suffixes (`_m`, `_s`, `_j`, `_a`, `_n`).
-//! The library depends only on `schemas`, `serde`, `serde_json` and `thiserror`.
+//! The library depends only on `schemas`, `serde`, `serde_json` and `thiserror` (and `plotters`
+//! with the feature `figures`).
 
 pub mod compare;
+pub mod diff;
 mod error;
+#[cfg(feature = "figures")]
+pub mod figures;
 pub mod metrics;
 pub mod render;
 #[cfg(test)]
 mod testutil;
 
 pub use compare::Comparison;
+pub use diff::{read_input, render_diff, Diff, DiffError, Tolerance};
 pub use error::Error;
 pub use metrics::{
     read_run_metrics, read_run_metrics_recover, run_metrics, run_metrics_recovered, RunMetrics,

@@ -221,7 +221,8 @@ pub fn run_metrics_recovered(rec: &Recording, report: &RecoverReport) -> Result<
 
 /// Computes the metrics of one decoded recording (see the module docs for the formulas).
 ///
-/// Needs the metadata `run.{scene,run,contacts,joint_names}` and `result.status`, and at least
+/// Needs the metadata `run.{scene,run,contacts,joint_names}` (`joint_names` may be absent from a
+/// file of format version 0: joints are then `joint1..jointN`) and `result.status`, and at least
 /// one message on each of `/hand`, `/motors`, `/constraints` and `/energy`, with one array
 /// entry per joint (motors, energy) or per contact (constraints).
 pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
@@ -231,7 +232,16 @@ pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
 /// `incomplete`: the recording was recovered without its `result` record; the reason.
 fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Error> {
     let src = Source(rec);
-    let joint_names = src.json_names(RUN_RECORD, "joint_names")?;
+    // Format version 0 had no `run.joint_names` (analyze/tests/fixtures/README.md): its arrays
+    // are in joint order, named joint1..jointN here. Any other version must have the key.
+    let joint_names = match rec.metadata_value(RUN_RECORD, "joint_names") {
+        None if rec.format_version() == Some(0) => {
+            let (_, current) = rec.series(topics::MOTORS, "current")?;
+            let n = current.first().map_or(0, Vec::len);
+            (1..=n).map(|k| format!("joint{k}")).collect()
+        }
+        _ => src.json_names(RUN_RECORD, "joint_names")?,
+    };
     let contacts = src.json_names(RUN_RECORD, "contacts")?;
     let result_status = match &incomplete {
         Some(_) => "incomplete",

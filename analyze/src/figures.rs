@@ -1,0 +1,212 @@
+//! The paper's figures from recordings, as SVG and PNG, with an index page (`analyze figures`).
+//!
+//! [`load_run`] reads the series of one recording ([`RunSeries`]); [`write_figures`] draws,
+//! for all runs together (one colour per run, the same in every figure):
+//!
+//! - Fig. 1-3 (`fig01_xy`, `fig02_xz`, `fig03_yz`): the hand path r(t) in the xy, xz and yz
+//!   planes, every run over the target path r_d(t) (dashed), equal scales on both axes, a dot
+//!   where each path starts (`/hand` `actual`, `desired`);
+//! - Fig. 4, 5 (`fig04_work_total`, `fig05_electric_total`): W(t) = Σ_j ∫ τ_j q'_j dt and
+//!   E(t) = Σ_j ∫ i_j v_j dt (`/energy` totals);
+//! - Fig. 6-25 (`fig06_work_link01` … `fig25_electric_link10`): W_j(t) (even numbers) and
+//!   E_j(t) (odd numbers) of link j = 1 … n, as the paper numbers them (Fig. 6 + 2 (j - 1));
+//! - and beyond the paper (`extra_*`): motor currents and voltages (one panel per run, one line
+//!   per joint), the table's normal force on each elbow with a zero line (f_n < 0: the table
+//!   pulls), and the hand error |r - r_d| over time.
+//!
+//! A figure whose data no recording has is still written, saying so. [`write_index`] writes
+//! `index.md` and `index.html`, every figure in order with its caption.
+
+use std::path::{Path, PathBuf};
+
+use plotters::style::FontStyle;
+use schemas::{topics, Recording};
+
+use crate::Error;
+
+mod catalogue;
+mod draw;
+mod index;
+
+pub use index::write_index;
+
+static FONT: &[u8] = include_bytes!("../../sim/assets/DejaVuSans.ttf");
+
+/// Registers DejaVu Sans as plotters' "sans-serif" (once), so PNGs look the same everywhere.
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // an embedded, valid font: registration cannot fail at run time
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// Errors of [`write_figures`].
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FigureError {
+    /// Creating the output directory or writing the index failed.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// plotters could not draw or write a figure.
+    #[error("drawing {0}")]
+    Draw(String),
+}
+
+/// Sample times (s) and one column per array entry (joint or contact).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    pub t: Vec<f64>,
+    pub cols: Vec<Vec<f64>>,
+}
+
+impl Series {
+    /// From [`Recording::series`] rows; a short row leaves NaN (not drawn) in its columns.
+    fn from_rows(t: Vec<f64>, rows: &[Vec<f64>]) -> Self {
+        let width = rows.iter().map(Vec::len).max().unwrap_or(0);
+        let cols = (0..width)
+            .map(|j| {
+                rows.iter()
+                    .map(|r| r.get(j).copied().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect();
+        Series { t, cols }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty() || self.cols.is_empty()
+    }
+}
+
+/// What the figures show of one recording. A topic the recording does not have is empty.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunSeries {
+    /// Metadata `run.run`, else the file stem.
+    pub name: String,
+    /// Metadata `run.contacts` (elbow names, in `/constraints` array order); may be empty.
+    pub contacts: Vec<String>,
+    /// Hand position r, m: columns x, y, z.
+    pub actual: Series,
+    /// Target r_d, m: columns x, y, z.
+    pub desired: Series,
+    /// |r - r_d|, m.
+    pub error_norm: Series,
+    /// W_j(t), J, one column per link; and the total.
+    pub work: Series,
+    pub work_total: Series,
+    /// E_j(t), J, one column per motor; and the total.
+    pub electric: Series,
+    pub electric_total: Series,
+    /// Motor currents, A, and terminal voltages, V, one column per motor.
+    pub current: Series,
+    pub voltage: Series,
+    /// Normal force on each elbow, N, one column per contact.
+    pub normal_force: Series,
+}
+
+/// `rec.series(topic, field)`, or an empty series if the recording has no such topic.
+fn series(rec: &Recording, topic: &str, field: &str) -> Result<Series, Error> {
+    match rec.series(topic, field) {
+        Ok((t, rows)) => Ok(Series::from_rows(t, &rows)),
+        Err(schemas::Error::UnknownTopic { .. }) => Ok(Series::default()),
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// Three scalar fields `prefix.x`, `.y`, `.z` of `topic` as one series with three columns.
+fn vec3(rec: &Recording, topic: &str, prefix: &str) -> Result<Series, Error> {
+    let mut out = Series::default();
+    for axis in ["x", "y", "z"] {
+        let s = series(rec, topic, &format!("{prefix}.{axis}"))?;
+        out.t = s.t;
+        out.cols.push(s.cols.into_iter().next().unwrap_or_default());
+    }
+    if out.t.is_empty() {
+        out.cols.clear();
+    }
+    Ok(out)
+}
+
+/// The series of one recording; `fallback_name` names it if metadata `run.run` is absent.
+pub fn load_run(rec: &Recording, fallback_name: &str) -> Result<RunSeries, Error> {
+    let name = rec
+        .metadata_value("run", "run")
+        .unwrap_or(fallback_name)
+        .to_string();
+    let contacts = match rec.metadata_value("run", "contacts") {
+        None => Vec::new(),
+        Some(v) => serde_json::from_str(v).map_err(|e| Error::BadMetadata {
+            file: rec.source.clone(),
+            record: "run".into(),
+            key: "contacts".into(),
+            value: v.into(),
+            detail: format!("not a JSON array of strings: {e}"),
+        })?,
+    };
+    Ok(RunSeries {
+        name,
+        contacts,
+        actual: vec3(rec, topics::HAND, "actual")?,
+        desired: vec3(rec, topics::HAND, "desired")?,
+        error_norm: series(rec, topics::HAND, "error_norm")?,
+        work: series(rec, topics::ENERGY, "link_work")?,
+        work_total: series(rec, topics::ENERGY, "link_work_total")?,
+        electric: series(rec, topics::ENERGY, "electric_energy")?,
+        electric_total: series(rec, topics::ENERGY, "electric_energy_total")?,
+        current: series(rec, topics::MOTORS, "current")?,
+        voltage: series(rec, topics::MOTORS, "voltage")?,
+        normal_force: series(rec, topics::CONSTRAINTS, "normal_force")?,
+    })
+}
+
+/// Reads a recording file and [`load_run`]s it (named by its file stem if it has no run name).
+pub fn read_run(path: &Path) -> Result<RunSeries, Error> {
+    let rec = schemas::read_recording(path)?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    load_run(&rec, &stem)
+}
+
+/// One written figure: `<stem>.svg` and `<stem>.png` in the output directory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// The paper's figure number (1-25), `None` for the figures beyond the paper.
+    pub number: Option<u32>,
+    pub stem: String,
+    /// "Fig. 4: All link work (∫ τ·q' dt)", as drawn over the figure.
+    pub caption: String,
+    /// One or two sentences for the index page: what is drawn and how to read it.
+    pub note: String,
+}
+
+/// Draws every figure of `runs` into `dir` (created if needed) and returns them in order.
+pub fn write_figures(runs: &[RunSeries], dir: &Path) -> Result<Vec<Figure>, FigureError> {
+    register_font();
+    std::fs::create_dir_all(dir).map_err(|source| FigureError::Io {
+        path: dir.into(),
+        source,
+    })?;
+    let mut out = Vec::new();
+    for (figure, plot) in catalogue::plots(runs) {
+        draw::write(&plot, &dir.join(&figure.stem)).map_err(FigureError::Draw)?;
+        out.push(figure);
+    }
+    Ok(out)
+}
+
+/// [`write_figures`] and [`write_index`] together: the paper's figures from one call.
+pub fn write_all(
+    runs: &[RunSeries],
+    sources: &[PathBuf],
+    dir: &Path,
+) -> Result<Vec<Figure>, FigureError> {
+    let figures = write_figures(runs, dir)?;
+    write_index(&figures, runs, sources, dir)?;
+    Ok(figures)
+}
