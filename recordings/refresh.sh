@@ -56,7 +56,8 @@ if [ "${1:-}" = "--check" ]; then
     fi
   done
   if [ $status != 0 ]; then
-    diff "recordings/paper-archive-energy.csv" "$tmp/new/paper-archive-energy.csv" >&2 || true
+    # what moved, per run and per link (analyze diff exits 1 when something did)
+    "$analyze" diff recordings "$tmp/new" >&2 || true
     echo "archive: the physics or the format changed. If that is intended, run recordings/refresh.sh and commit the new archive." >&2
     exit 1
   fi
