@@ -3,12 +3,13 @@
 //! (iterated to |C| ≤ 1e-13 m, at most 5 times), then velocities onto `J_c q̇ = 0` by
 //! `Δq̇ = −J_cᵀ (J_c J_cᵀ)⁻¹ J_c q̇` (Hairer, Lubich & Wanner, *Geometric Numerical
 //! Integration*, §IV.4; Ascher et al., "Stabilization of constrained mechanical systems with
-//! DAEs and invariant manifolds", 1995). Redundant rows are regularised as in the force solve.
+//! DAEs and invariant manifolds", 1995). Redundant rows are regularised as in the force solve (`dynamics/spd.rs`).
 
-use nalgebra::{Cholesky, DMatrix, DVector};
+use nalgebra::{DMatrix, DVector};
 
 use crate::dynamics::constraints::constraint_jacobian;
 use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
+use crate::dynamics::spd::solve_regularized;
 use crate::error::DynamicsError;
 use crate::system::ArmSystem;
 
@@ -18,12 +19,13 @@ pub struct ProjectionScratch {
     jac: DMatrix<f64>,
     jdqd: DVector<f64>,
     jjt: DMatrix<f64>,
+    work: DMatrix<f64>,
     rhs: DVector<f64>,
 }
 
 impl ProjectionScratch {
     pub fn new(nv: usize, nc: usize) -> Self {
-        Self { jac: DMatrix::zeros(nc, nv), jdqd: DVector::zeros(nc), jjt: DMatrix::zeros(nc, nc), rhs: DVector::zeros(nc) }
+        Self { jac: DMatrix::zeros(nc, nv), jdqd: DVector::zeros(nc), jjt: DMatrix::zeros(nc, nc), work: DMatrix::zeros(nc, nc), rhs: DVector::zeros(nc) }
     }
 }
 
@@ -36,36 +38,13 @@ fn form_jjt(p: &mut ProjectionScratch, nc: usize) {
     }
 }
 
-/// Solve (J Jᵀ + ε I) x = rhs in place (ε only if J Jᵀ is singular).
+/// Solve `J Jᵀ x = rhs` in place, regularised like the force solve when J Jᵀ is singular.
 fn solve_jjt(p: &mut ProjectionScratch, t: f64, nc: usize) -> Result<(), DynamicsError> {
     form_jjt(p, nc);
-    let max_diag = (0..nc).fold(0.0f64, |m, k| m.max(p.jjt[(k, k)]));
-    for eps in [0.0, 1e-10 * max_diag] {
-        let mut a = std::mem::replace(&mut p.jjt, DMatrix::zeros(0, 0));
-        for k in 0..nc {
-            a[(k, k)] += eps;
-        }
-        match Cholesky::new(a) {
-            Some(ch) => {
-                let l = ch.l_dirty();
-                let (mn, mx) = (0..nc).fold((f64::INFINITY, 0.0f64), |(mn, mx), k| (mn.min(l[(k, k)]), mx.max(l[(k, k)])));
-                let ok = eps > 0.0 || mn > 1e-6 * mx;
-                if ok {
-                    ch.solve_mut(&mut p.rhs);
-                }
-                p.jjt = ch.unpack_dirty();
-                if ok {
-                    return Ok(());
-                }
-                form_jjt(p, nc);
-            }
-            None => {
-                p.jjt = DMatrix::zeros(nc, nc);
-                form_jjt(p, nc);
-            }
-        }
+    match solve_regularized(&p.jjt, &mut p.work, &mut p.rhs) {
+        Some(_) => Ok(()),
+        None => Err(DynamicsError::SingularConstraints { t, constraints: "projection".into() }),
     }
-    Err(DynamicsError::SingularConstraints { t, constraints: "projection".into() })
 }
 
 impl ArmSystem<'_> {

@@ -17,6 +17,7 @@
 
 use nalgebra::{Cholesky, DMatrix};
 
+use crate::dynamics::spd::solve_regularized;
 use crate::error::RunError;
 use crate::integrate::{OdeJacobian, OdeSystem, SplitSystem};
 use crate::system::ArmSystem;
@@ -65,20 +66,10 @@ impl ArmSystem<'_> {
         chol.solve_mut(&mut js.minv);
         js.tmp = chol.unpack_dirty();
         if nc > 0 {
-            js.a.copy_from(&self.fd.a);
-            for k in 0..nc {
-                // the same regularisation as the force solve, so redundant contacts work here too
-                js.a[(k, k)] += if self.fd.regularized { 1e-10 * js.a[(k, k)].abs() } else { 0.0 };
-            }
-            let a = std::mem::replace(&mut js.a, DMatrix::zeros(0, 0));
-            match Cholesky::new(a) {
-                Some(chol_a) => {
-                    js.ayt.tr_copy_from(&self.fd.y);
-                    chol_a.solve_mut(&mut js.ayt);
-                    js.a = chol_a.unpack_dirty();
-                    js.minv.gemm(-1.0, &self.fd.y, &js.ayt, 1.0);
-                }
-                None => js.a = DMatrix::zeros(nc, nc),
+            // A⁻¹ Yᵀ with the same regularisation as the force solve (dynamics/spd.rs)
+            js.ayt.tr_copy_from(&self.fd.y);
+            if solve_regularized(&self.fd.a, &mut js.a, &mut js.ayt).is_some() {
+                js.minv.gemm(-1.0, &self.fd.y, &js.ayt, 1.0);
             }
         }
         Ok(())

@@ -24,6 +24,7 @@ use super::kinematics::{forward_kinematics, forward_velocities};
 use super::model::Model;
 use super::motor::Drives;
 use super::rnea::bias_forces_placed;
+use super::spd::solve_regularized;
 use super::walker_orin;
 use crate::error::DynamicsError;
 
@@ -222,38 +223,15 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
         // f_n = A^{-1} (−J̇q̇ − J q̈_free)
         fd.f_n.copy_from(&fd.jdqd);
         fd.f_n.gemv(-1.0, &fd.jac, &fd.qdd, -1.0);
-        // a redundant set (the same point twice, a rank-deficient J_c) has a singular A: then
-        // solve (A + ε I) f = r with ε = 1e-10 max diag(A), which splits the force among the
-        // redundant rows and leaves q̈ unique up to O(ε) (Tikhonov; Golub & Van Loan §6.1.4)
-        fd.regularized = false;
-        let max_diag = (0..nc).fold(0.0f64, |m, k| m.max(fd.a[(k, k)].abs()));
-        let mut solved = false;
-        for eps in [0.0, 1e-10 * max_diag] {
-            fd.a_factor.copy_from(&fd.a);
-            for k in 0..nc {
-                fd.a_factor[(k, k)] += eps;
+        // a redundant set (the same point twice, a rank-deficient J_c) has a singular A:
+        // regularised so that q̈ stays unique up to O(ε) (spd.rs)
+        let solved = match solve_regularized(&fd.a, &mut fd.a_factor, &mut fd.f_n) {
+            Some(regularized) => {
+                fd.regularized = regularized;
+                true
             }
-            let a = std::mem::replace(&mut fd.a_factor, DMatrix::zeros(0, 0));
-            match Cholesky::new(a) {
-                Some(chol_a) => {
-                    let l = chol_a.l_dirty();
-                    let min_pivot = (0..nc).fold(f64::INFINITY, |m, k| m.min(l[(k, k)].abs()));
-                    let max_pivot = (0..nc).fold(0.0f64, |m, k| m.max(l[(k, k)].abs()));
-                    // pivots are square roots: a ratio of 1e-6 is a condition number of 1e12
-                    let well_posed = eps > 0.0 || min_pivot > 1e-6 * max_pivot;
-                    if well_posed {
-                        chol_a.solve_mut(&mut fd.f_n);
-                        fd.regularized = eps > 0.0;
-                        solved = true;
-                    }
-                    fd.a_factor = chol_a.unpack_dirty();
-                }
-                None => fd.a_factor = DMatrix::zeros(nc, nc),
-            }
-            if solved {
-                break;
-            }
-        }
+            None => false,
+        };
         if !solved || fd.f_n.iter().any(|x| !x.is_finite()) {
             fd.m_j = chol.unpack_dirty();
             return Err(DynamicsError::SingularConstraints { t, constraints: contact_names(plant) });

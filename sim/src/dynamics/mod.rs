@@ -12,6 +12,7 @@ pub mod motor;
 pub mod rnea;
 pub mod samples;
 pub mod spatial;
+pub mod spd;
 pub mod walker_orin;
 
 pub use data::Data;
