@@ -147,10 +147,15 @@ fn link_table(runs: &[RunMetrics], base: usize) -> Vec<LinkComparison> {
         }
     }
     let find = |r: &RunMetrics, j: &str| r.links.iter().find(|l| l.joint == j).cloned();
+    // a link whose baseline energy is a rounding residue of the run's (a joint that never
+    // moved) has no meaningful ratio
+    let floor = 1e-9 * runs[base].electric_energy_total_j.abs();
     joints
         .into_iter()
         .map(|joint| {
-            let base_e = find(&runs[base], joint).map(|l| l.electric_energy_j);
+            let base_e = find(&runs[base], joint)
+                .map(|l| l.electric_energy_j)
+                .filter(|b| b.abs() > floor);
             let cells = runs
                 .iter()
                 .map(|r| {

@@ -61,6 +61,19 @@ pub enum Error {
         available: Vec<String>,
     },
 
+    /// Reading or writing a file (export, report) failed.
+    #[error("{file}: {op} failed: {source}")]
+    Io {
+        file: String,
+        op: &'static str,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// Building, querying or writing a table (polars) failed.
+    #[error("{file}: {detail}")]
+    Table { file: String, detail: String },
+
     /// Serializing to JSON failed.
     #[error("writing JSON: {0}")]
     Json(#[from] serde_json::Error),

@@ -141,6 +141,10 @@ pub struct EnergyAudit {
     pub resistive_loss_j: f64,
     /// `∫ Σ (D + D_m) q'^2 dt`.
     pub friction_loss_j: f64,
+    /// Its gear part `∫ Σ D_m q'^2 dt` (the joints' own part `∫ Σ D q'^2 dt` is the rest);
+    /// `None` for recordings of format version < 2, which have only the sum.
+    #[serde(default)]
+    pub gear_friction_loss_j: Option<f64>,
     /// Recorded balance residual at the end.
     pub residual_j: f64,
     /// `max_k |residual(t_k)|`.
@@ -188,9 +192,13 @@ pub struct RunMetrics {
     pub energy: EnergyAudit,
 }
 
+/// The topics [`run_metrics`] reads; [`read_run_metrics`] decodes only these (the transforms
+/// and joint states, most of a recording, are skipped).
+pub const METRIC_TOPICS: [&str; 4] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, topics::ENERGY];
+
 /// Reads the recording at `path` and computes its metrics; errors name the file.
 pub fn read_run_metrics(path: &Path) -> Result<RunMetrics, Error> {
-    run_metrics(&schemas::read_recording(path)?)
+    run_metrics(&schemas::read_recording_topics(path, Some(&METRIC_TOPICS))?)
 }
 
 /// Reads the intact part of a possibly damaged recording at `path`
@@ -351,6 +359,10 @@ fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Er
         magnetic_change_j: change("magnetic")?,
         resistive_loss_j: end("resistive_loss")?.1,
         friction_loss_j: end("friction_loss")?.1,
+        gear_friction_loss_j: match rec.messages.get(topics::ENERGY).and_then(|m| m.first()) {
+            Some((_, msg)) if msg.get("gear_friction_loss").is_some() => Some(end("gear_friction_loss")?.1),
+            _ => None,
+        },
         residual_j: residual[residual.len() - 1],
         max_abs_residual_j,
         t_max_abs_residual_s,

@@ -74,7 +74,7 @@ impl FromStr for Format {
 pub fn render_comparison(cmp: &Comparison, format: Format) -> Result<String, Error> {
     let runs: Vec<&RunMetrics> = cmp.runs.iter().map(|r| &r.metrics).collect();
     Ok(match format {
-        Format::Table => table::render(&runs, Some(cmp)),
+        Format::Table => table::render(&runs, Some(cmp), false),
         Format::Json => serde_json::to_string_pretty(cmp)? + "\n",
         Format::Csv => {
             let ratios: Vec<&Ratios> = cmp.runs.iter().map(|r| &r.to_baseline).collect();
@@ -83,14 +83,37 @@ pub fn render_comparison(cmp: &Comparison, format: Format) -> Result<String, Err
     })
 }
 
+/// A comparison's tables as Markdown (headings `###`, pipe tables; without the findings,
+/// which the report puts first), for the report document.
+pub fn render_comparison_markdown(cmp: &Comparison) -> String {
+    let runs: Vec<&RunMetrics> = cmp.runs.iter().map(|r| &r.metrics).collect();
+    table::render(&runs, Some(cmp), true)
+}
+
 /// Renders per-run metrics (JSON: an array of [`RunMetrics`]); text ends with a newline.
 pub fn render_metrics(runs: &[RunMetrics], format: Format) -> Result<String, Error> {
     let refs: Vec<&RunMetrics> = runs.iter().collect();
     Ok(match format {
-        Format::Table => table::render(&refs, None),
+        Format::Table => table::render(&refs, None, false),
         Format::Json => serde_json::to_string_pretty(runs)? + "\n",
         Format::Csv => csv::render(&refs, None),
     })
+}
+
+/// The name of each run in tables: its run name, followed by its file stem when another run
+/// has the same name (the same run from two versions: `two-elbow (old)`, `two-elbow (new)`).
+pub(crate) fn run_labels(runs: &[&RunMetrics]) -> Vec<String> {
+    runs.iter()
+        .map(|r| {
+            if runs.iter().filter(|o| o.run == r.run).count() < 2 {
+                return r.run.clone();
+            }
+            let stem = std::path::Path::new(&r.file)
+                .file_stem()
+                .map_or_else(|| r.file.clone(), |s| s.to_string_lossy().into_owned());
+            format!("{} ({stem})", r.run)
+        })
+        .collect()
 }
 
 /// Joints in order of first appearance over the runs.
@@ -119,7 +142,7 @@ fn union<'a>(names: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
     out
 }
 
-fn status(s: Status) -> &'static str {
+pub(crate) fn status(s: Status) -> &'static str {
     match s {
         Status::Complete => "complete",
         Status::Failed => "failed",

@@ -134,6 +134,7 @@ fn write_run(path: &Path, r: &Run) -> PathBuf {
             resistive_loss: 2.0 * t,
             friction_loss: 0.1 * t,
             balance_residual: 1e-13 * t.sin(),
+            gear_friction_loss: 0.04 * t,
         };
         w.write(topics::ENERGY, ns, &e).unwrap();
         if !r.format_v0 {
@@ -167,7 +168,7 @@ fn crc32(bytes: &[u8]) -> u32 {
 }
 
 /// `RecordingWriter` always writes the current format version, so the version-0 fixture is
-/// written by it and then patched: `recording.format_version` "1" -> "0" in the (uncompressed)
+/// written by it and then patched: `recording.format_version` (one digit) -> "0" in the (uncompressed)
 /// metadata record, and the data section CRC in the DataEnd record recomputed. Nothing else
 /// changes length, so the summary and its CRC stay valid.
 fn with_format_version_0(bytes: &[u8]) -> Vec<u8> {
@@ -182,7 +183,11 @@ fn with_format_version_0(bytes: &[u8]) -> Vec<u8> {
         crc32(&bytes[..data_end]),
         "CRC as written"
     );
-    let key = b"\x0e\x00\x00\x00format_version\x01\x00\x00\x001";
+    let mut key = b"\x0e\x00\x00\x00format_version\x01\x00\x00\x00".to_vec();
+    let version = schemas::FORMAT_VERSION.to_string();
+    assert_eq!(version.len(), 1, "the patch keeps lengths: a one-digit version");
+    key.extend_from_slice(version.as_bytes());
+    let key = key.as_slice();
     let at: Vec<usize> = (0..bytes.len() - key.len())
         .filter(|&i| &bytes[i..i + key.len()] == key)
         .collect();

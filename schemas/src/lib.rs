@@ -39,6 +39,7 @@ pub use messages::{
     Message, MotorState, RosString, Vec3,
 };
 pub use reader::{
+    read_recording_bytes_topics, read_recording_topics, NOT_SELECTED,
     read_recording, read_recording_bytes, read_recording_recover, read_recording_recover_bytes,
     ChannelInfo, Recording, RecoverReport,
 };
@@ -54,7 +55,10 @@ pub use foxglove::messages::{
 
 /// Version of the recording layout (topics, message fields). Stored in the metadata record
 /// [`RECORDING_METADATA`] under [`FORMAT_VERSION_KEY`].
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// History: 0 had no `run.joint_names`; 1 added them; 2 added `/energy`
+/// `gear_friction_loss` (the D_m part of the friction loss).
+pub const FORMAT_VERSION: u32 = 2;
 /// Name of the metadata record that describes the run.
 pub const RECORDING_METADATA: &str = "recording";
 /// Key of [`FORMAT_VERSION`] in [`RECORDING_METADATA`].

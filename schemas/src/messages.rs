@@ -115,6 +115,9 @@ pub struct EnergyState {
     pub friction_loss: f64,
     /// Energy balance residual: input − stored − dissipated (should stay ≈ 0).
     pub balance_residual: f64,
+    /// The gears' part of `friction_loss`, ∫ Σ D_m q̇² dt (since format version 2; the joints'
+    /// own part, ∫ Σ D q̇² dt, is `friction_loss − gear_friction_loss`).
+    pub gear_friction_loss: f64,
 }
 
 /// `std_msgs/msg/String` (ROS 2, CDR). Carries the URDF on [`crate::topics::ROBOT_DESCRIPTION`].

@@ -57,13 +57,24 @@ pub struct Recording {
 
 /// Reads and decodes the MCAP file at `path`; errors name the file.
 pub fn read_recording(path: &Path) -> Result<Recording, Error> {
+    read_recording_topics(path, None)
+}
+
+/// Like [`read_recording`], but decodes only the messages of `topics` (all when `None`).
+///
+/// The whole file is still read and checked (CRCs, statistics); messages of other channels are
+/// counted and dropped undecoded, which is most of the cost of a recording with many
+/// transforms. Those channels are listed in [`Recording::channels`] with
+/// [`ChannelInfo::undecoded`] = "not selected", so asking for them is an error, never an empty
+/// series.
+pub fn read_recording_topics(path: &Path, topics: Option<&[&str]>) -> Result<Recording, Error> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|source| Error::Io {
         file: file.clone(),
         op: "reading",
         source,
     })?;
-    read_recording_bytes(&bytes, &file)
+    read_recording_bytes_topics(&bytes, &file, topics)
 }
 
 struct SchemaRec {
@@ -116,6 +127,9 @@ fn decoder_for(
     }
 }
 
+/// [`ChannelInfo::undecoded`] of a channel left out by [`read_recording_topics`].
+pub const NOT_SELECTED: &str = "not selected: the file was read for other topics only";
+
 /// Smallest record-length limit: no record (inside a chunk or not) may be longer than the
 /// larger of this and the file itself, so a corrupt length cannot make us allocate wildly.
 const MIN_RECORD_LENGTH_LIMIT: usize = 64 << 20;
@@ -128,8 +142,19 @@ const MIN_RECORD_LENGTH_LIMIT: usize = 64 << 20;
 /// bounds while describing an error in a corrupt descriptor set). Such a panic is caught and
 /// returned as [`Error::Malformed`]; the panic hook still prints it to stderr.
 pub fn read_recording_bytes(bytes: &[u8], source: &str) -> Result<Recording, Error> {
-    let parsed =
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| read_mcap(bytes, source)));
+    read_recording_bytes_topics(bytes, source, None)
+}
+
+/// [`read_recording_bytes`] decoding only the messages of `topics` (see
+/// [`read_recording_topics`]).
+pub fn read_recording_bytes_topics(
+    bytes: &[u8],
+    source: &str,
+    topics: Option<&[&str]>,
+) -> Result<Recording, Error> {
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        read_mcap(bytes, source, topics)
+    }));
     parsed.unwrap_or_else(|panic| {
         let why = panic
             .downcast_ref::<&str>()
@@ -190,7 +215,7 @@ fn feed(
     Ok(())
 }
 
-fn read_mcap(bytes: &[u8], source: &str) -> Result<Recording, Error> {
+fn read_mcap(bytes: &[u8], source: &str, topics: Option<&[&str]>) -> Result<Recording, Error> {
     let file = source.to_string();
     if !bytes.starts_with(mcap::MAGIC) {
         return Err(Error::NotMcap {
@@ -200,6 +225,7 @@ fn read_mcap(bytes: &[u8], source: &str) -> Result<Recording, Error> {
     }
     let mut state = State {
         file,
+        only: topics.map(|t| t.iter().map(|s| s.to_string()).collect()),
         ..State::default()
     };
     feed(bytes, reader_options(bytes.len()), &mut state)?;
@@ -210,6 +236,8 @@ fn read_mcap(bytes: &[u8], source: &str) -> Result<Recording, Error> {
 #[derive(Default)]
 struct State {
     file: String,
+    /// Topics whose messages are decoded (`None`: all).
+    only: Option<std::collections::BTreeSet<String>>,
     schemas: BTreeMap<u16, SchemaRec>,
     channels: BTreeMap<u16, ChannelInfo>,
     decoders: BTreeMap<u16, Decoder>,
@@ -291,7 +319,12 @@ impl State {
             }
             return Ok(()); // the summary section repeats channels
         }
-        let decoder = decoder_for(&self.file, &info, schema)?;
+        let selected = self.only.as_ref().is_none_or(|only| only.contains(&info.topic));
+        let decoder = if selected {
+            decoder_for(&self.file, &info, schema)?
+        } else {
+            Decoder::Skip(NOT_SELECTED.to_string())
+        };
         if let Decoder::Skip(why) = &decoder {
             info.undecoded = Some(why.clone());
         }

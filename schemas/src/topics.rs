@@ -35,3 +35,33 @@ pub const ALL: [&str; 8] = [
     ENERGY,
     HAND_POINTS,
 ];
+
+/// What the entries of an array field of our topics stand for (readers label columns with it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArrayIndex {
+    /// One entry per actuated joint, names in metadata `run.joint_names` (a JSON list).
+    Joint,
+    /// One entry per contact, names in metadata `run.contacts` (a JSON list).
+    Contact,
+}
+
+impl ArrayIndex {
+    /// The metadata record and key holding the names, as a JSON list of strings.
+    pub fn names_key(self) -> (&'static str, &'static str) {
+        match self {
+            ArrayIndex::Joint => ("run", "joint_names"),
+            ArrayIndex::Contact => ("run", "contacts"),
+        }
+    }
+}
+
+/// The index of the array `field` of messages on `topic`, for the arrays of [`MOTORS`],
+/// [`ENERGY`] and [`CONSTRAINTS`]; `None` for anything else.
+pub fn array_index(topic: &str, field: &str) -> Option<ArrayIndex> {
+    match (topic, field) {
+        (MOTORS, "current" | "voltage" | "back_emf" | "electric_power" | "torque")
+        | (ENERGY, "link_work" | "electric_energy") => Some(ArrayIndex::Joint),
+        (CONSTRAINTS, "normal_force" | "position" | "velocity") => Some(ArrayIndex::Contact),
+        _ => None,
+    }
+}

@@ -27,7 +27,8 @@ fn identical_runs_give_identical_bytes() {
         .all(|c| c.compression == "zstd"));
     assert!(a == b, "recordings differ");
     // and the header names our library, not the mcap crate version
-    assert!(a.windows(19).any(|w| w == b"elbow-sim schemas 1"));
+    let library = format!("elbow-sim schemas {}", schemas::FORMAT_VERSION);
+    assert!(a.windows(library.len()).any(|w| w == library.as_bytes()));
 }
 
 #[test]
@@ -126,6 +127,6 @@ fn format_version_is_written_even_without_a_recording_record() {
     w.write(topics::ENERGY, 0, &EnergyState::default()).unwrap();
     w.finish().unwrap();
     let r = read_recording(&path).unwrap();
-    assert_eq!(r.metadata_value("recording", "format_version"), Some("1"));
+    assert_eq!(r.metadata_value("recording", "format_version"), Some(schemas::FORMAT_VERSION.to_string().as_str()));
     assert_eq!(r.metadata.len(), 1);
 }

@@ -205,6 +205,7 @@ impl<'a> Recorder<'a> {
         en.magnetic = o.magnetic;
         en.resistive_loss = o.loss_resistance;
         en.friction_loss = o.loss_friction;
+        en.gear_friction_loss = o.loss_gear_friction;
         en.balance_residual = o.balance_residual;
         self.writer.write(topics::ENERGY, t_ns, &self.energy).map_err(&err)?;
         Ok(())

@@ -2,14 +2,15 @@
 //! and the IK targets of eqs 28–29), and the derived outputs recorded at each sample.
 //!
 //! State `y` (all that is integrated, nothing else), with n = nv:
-//! `[ q (n) | q̇ (n) | i (n) | W (n) | E (n) | E_R | E_D ]` where the currents i are present
-//! only when the motors have inductance (L = 0: quasi-static current, no electrical state), and
-//! `W_j = ∫ τ_j q̇_j dt` (work of motor j on link j, τ of eq 12), `E_j = ∫ i_j v_j dt` (electric
-//! energy into motor j), `E_R = ∫ Σ R i² dt` and `E_D = ∫ Σ (D + D_m) q̇² dt` (losses). The
-//! quadratures ride along with the dynamics so that they are integrated to the same accuracy.
+//! `[ q (n) | q̇ (n) | i (n) | W (n) | E (n) | E_R | E_D | E_Dm ]` where the currents i are
+//! present only when the motors have inductance (L = 0: quasi-static current, no electrical
+//! state), and `W_j = ∫ τ_j q̇_j dt` (work of motor j on link j, τ of eq 12), `E_j = ∫ i_j v_j dt`
+//! (electric energy into motor j), `E_R = ∫ Σ R i² dt`, `E_D = ∫ Σ D q̇² dt` (the joints' viscous
+//! friction) and `E_Dm = ∫ Σ D_m q̇² dt` (the gears', eq 12's d_m term) (losses). The quadratures
+//! ride along with the dynamics so that they are integrated to the same accuracy.
 //!
 //! Energy balance (SCENE.md; ideal constraints do no work):
-//! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D`, T including the rotors' `½ Σ J_m q̇²`.
+//! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm`, T including the rotors' `½ Σ J_m q̇²`.
 //! Its residual measures the integration error (and constraint drift, which lets f_n work).
 
 use nalgebra::Vector3;
@@ -33,7 +34,7 @@ pub struct Layout {
 
 impl Layout {
     pub fn dim(&self) -> usize {
-        4 * self.nv + self.ni + 2
+        4 * self.nv + self.ni + 3
     }
     pub fn q(&self) -> std::ops::Range<usize> {
         0..self.nv
@@ -56,8 +57,13 @@ impl Layout {
     pub fn loss_r(&self) -> usize {
         4 * self.nv + self.ni
     }
+    /// `∫ Σ D_j q̇_j² dt`: the joints' own viscous friction.
     pub fn loss_d(&self) -> usize {
         4 * self.nv + self.ni + 1
+    }
+    /// `∫ Σ D_m,j q̇_j² dt`: the gears' viscous friction, seen at the joint.
+    pub fn loss_dm(&self) -> usize {
+        4 * self.nv + self.ni + 2
     }
     /// A readable name of state component `k`, for error messages.
     pub fn name(&self, k: usize, joints: &[String]) -> String {
@@ -74,8 +80,10 @@ impl Layout {
             format!("electric energy of {j}")
         } else if k == self.loss_r() {
             "resistive loss".into()
+        } else if k == self.loss_d() {
+            "joint friction loss".into()
         } else {
-            "friction loss".into()
+            "gear friction loss".into()
         }
     }
 }
@@ -103,8 +111,11 @@ pub struct Outputs {
     pub potential: f64,
     pub magnetic: f64,
     pub loss_resistance: f64,
+    /// `∫ Σ (D + D_m) q̇² dt`, J.
     pub loss_friction: f64,
-    /// `Σ E_j − (ΔT + ΔV + ΔE_L + E_R + E_D)`, J.
+    /// Its gear part `∫ Σ D_m q̇² dt`, J.
+    pub loss_gear_friction: f64,
+    /// `Σ E_j − (ΔT + ΔV + ΔE_L + E_R + E_D + E_Dm)`, J.
     pub balance_residual: f64,
 }
 
@@ -133,17 +144,18 @@ impl<'a> ArmSystem<'a> {
         let nv = scene.model.nv;
         let contacts = scene.run_contacts(run);
         let nc = contacts.len();
+        let layout = Layout { nv, ni: if scene.drives.quasi_static { 0 } else { nv } };
         let mut sys = Self {
             scene,
             contacts,
-            layout: Layout { nv, ni: if scene.drives.quasi_static { 0 } else { nv } },
+            layout,
             data: Data::new(&scene.model),
             fd: ForwardData::new(nv, nc),
             q_des: vec![0.0; nv],
             qd_des: vec![0.0; nv],
             voltage: vec![0.0; nv],
             current_qs: vec![0.0; nv],
-            jac: crate::stiff::JacobianScratch::new(nv, nc, 4 * nv + if scene.drives.quasi_static { 0 } else { nv } + 2),
+            jac: crate::stiff::JacobianScratch::new(nv, nc, layout.dim()),
             projection: crate::projection::ProjectionScratch::new(nv, nc),
             stored0: 0.0,
         };
@@ -229,7 +241,8 @@ impl<'a> ArmSystem<'a> {
         set(&mut out.link_work, &y[l.work()]);
         set(&mut out.electric_energy, &y[l.electric()]);
         out.loss_resistance = y[l.loss_r()];
-        out.loss_friction = y[l.loss_d()];
+        out.loss_friction = y[l.loss_d()] + y[l.loss_dm()];
+        out.loss_gear_friction = y[l.loss_dm()];
         // kinematics at this state (the dynamics left body velocities of RNEA in `data`)
         // ½ q̇ᵀ M q̇ from the mass matrix of this evaluation (valid for CRBA and Walker–Orin)
         let m_qd: f64 = (0..l.nv).map(|r| qd[r] * (0..l.nv).map(|c| self.data.m[(r, c)] * qd[c]).sum::<f64>()).sum();
@@ -274,7 +287,7 @@ impl OdeSystem for ArmSystem<'_> {
         if l.ni > 0 {
             dydt[l.current()].copy_from_slice(self.fd.di.as_slice());
         }
-        let (mut p_r, mut p_d) = (0.0, 0.0);
+        let (mut p_r, mut p_d, mut p_dm) = (0.0, 0.0, 0.0);
         for j in 0..l.nv {
             dydt[l.work().start + j] = self.fd.tau_motor[j] * qd[j];
             dydt[l.electric().start + j] = cur[j] * self.voltage[j];
@@ -282,11 +295,13 @@ impl OdeSystem for ArmSystem<'_> {
         }
         if d.has_friction {
             for j in 0..l.nv {
-                p_d += (d.d[j] + d.dm[j]) * qd[j] * qd[j];
+                p_d += d.d[j] * qd[j] * qd[j];
+                p_dm += d.dm[j] * qd[j] * qd[j];
             }
         }
         dydt[l.loss_r()] = p_r;
         dydt[l.loss_d()] = p_d;
+        dydt[l.loss_dm()] = p_dm;
         Ok(())
     }
 

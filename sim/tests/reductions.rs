@@ -29,7 +29,8 @@ fn quasi_static_motors_are_the_small_inductance_limit() {
     let qs = paper_with(|v| v["motor"]["inductance"] = 0.0.into());
     assert!(qs.drives.quasi_static);
     let run = qs.run("no-elbow").unwrap().clone();
-    assert_eq!(sim::system::ArmSystem::new(&qs, &run).layout.dim(), 4 * 10 + 2);
+    // q, q', W_j, E_j and the R, D and D_m losses: no current states
+    assert_eq!(sim::system::ArmSystem::new(&qs, &run).layout.dim(), 4 * 10 + 3);
     let (q0, res, e) = final_q(&qs, "no-elbow");
     assert!(res <= 1e-6 * e, "residual {res} of {e}");
     let diff = |l: f64| {

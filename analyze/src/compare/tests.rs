@@ -65,6 +65,7 @@ pub(crate) fn run(name: &str, contacts: &[&str], e: &[f64], w: &[f64], z_rms: f6
             magnetic_change_j: 0.0,
             resistive_loss_j: 0.0,
             friction_loss_j: 0.0,
+            gear_friction_loss_j: Some(0.0),
             residual_j: 0.0,
             max_abs_residual_j: 1e-6,
             t_max_abs_residual_s: 5.0,

@@ -79,6 +79,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
             "dMagnetic_J",
             "resistive_loss_J",
             "friction_loss_J",
+            "gear_friction_loss_J",
             "residual_J",
             "residual_max_abs_J",
             "residual_max_rel",
@@ -143,9 +144,11 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
             a.magnetic_change_j,
             a.resistive_loss_j,
             a.friction_loss_j,
-            a.residual_j,
-            a.max_abs_residual_j,
         ] {
+            row.num(x);
+        }
+        row.opt(a.gear_friction_loss_j);
+        for x in [a.residual_j, a.max_abs_residual_j] {
             row.num(x);
         }
         row.opt(a.max_abs_residual_rel);

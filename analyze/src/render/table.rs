@@ -24,7 +24,11 @@ impl Table {
         }
     }
 
-    fn write(&self, out: &mut String) {
+    /// As aligned text, or (`markdown`) as a heading and a GitHub pipe table.
+    fn write(&self, out: &mut String, markdown: bool) {
+        if markdown {
+            return self.write_markdown(out);
+        }
         let width = |s: &str| s.chars().count();
         let mut w: Vec<usize> = self.head.iter().map(|h| width(h)).collect();
         for row in &self.rows {
@@ -59,6 +63,26 @@ impl Table {
     }
 }
 
+impl Table {
+    fn write_markdown(&self, out: &mut String) {
+        let cell = |s: &str| s.replace('|', "\\|");
+        let row = |cells: &[String]| {
+            let parts: Vec<String> = cells.iter().map(|c| cell(c)).collect();
+            format!("| {} |\n", parts.join(" | "))
+        };
+        out.push_str(&format!("### {}\n\n", self.title));
+        out.push_str(&row(&self.head));
+        let rule: Vec<String> = (0..self.head.len())
+            .map(|c| if c < self.left { ":--".to_string() } else { "--:".to_string() })
+            .collect();
+        out.push_str(&row(&rule));
+        for r in &self.rows {
+            out.push_str(&row(r));
+        }
+        out.push('\n');
+    }
+}
+
 /// `x` with `d` decimals.
 fn f(x: f64, d: usize) -> String {
     format!("{x:.d$}")
@@ -79,11 +103,13 @@ fn q(x: Option<f64>) -> String {
     x.map_or("-".into(), |x| f(x, 3))
 }
 
-pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>) -> String {
+/// The sections as aligned text, or (`markdown`) as Markdown headings and pipe tables.
+pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: bool) -> String {
     let ratios: Option<Vec<&Ratios>> = cmp.map(|c| c.runs.iter().map(|r| &r.to_baseline).collect());
     let base = cmp.map(|c| c.baseline_index);
+    let labels = super::run_labels(runs);
     let name = |k: usize| {
-        let r = &runs[k].run;
+        let r = &labels[k];
         if Some(k) == base {
             format!("{r} *")
         } else {
@@ -139,7 +165,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>) -> String {
             joint,
         ]);
     }
-    t.write(&mut out);
+    t.write(&mut out, markdown);
 
     // hand error
     let mut head = vec![
@@ -167,7 +193,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>) -> String {
         }
         t.rows.push(row);
     }
-    t.write(&mut out);
+    t.write(&mut out, markdown);
 
     // energy totals
     let mut head = vec!["run", "E = Σ ∫ i v dt [J]", "W = Σ ∫ τ q' dt [J]"];
@@ -186,18 +212,19 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>) -> String {
         }
         t.rows.push(row);
     }
-    t.write(&mut out);
+    t.write(&mut out, markdown);
 
     // per-link energy
     let mut head: Vec<String> = vec!["joint".into()];
-    head.extend(runs.iter().map(|r| format!("W {} [J]", r.run)));
-    head.extend(runs.iter().map(|r| format!("E {} [J]", r.run)));
+    head.extend(labels.iter().map(|r| format!("W {r} [J]")));
+    head.extend(labels.iter().map(|r| format!("E {r} [J]")));
     if cmp.is_some() {
         head.extend(
-            runs.iter()
+            labels
+                .iter()
                 .enumerate()
                 .filter(|&(k, _)| Some(k) != base)
-                .map(|(_, r)| format!("E/E_base {}", r.run)),
+                .map(|(_, r)| format!("E/E_base {r}")),
         );
     }
     let head: Vec<&str> = head.iter().map(String::as_str).collect();
@@ -230,7 +257,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>) -> String {
         }
         t.rows.push(row);
     }
-    t.write(&mut out);
+    t.write(&mut out, markdown);
 
     // contacts
     if !contacts(runs).is_empty() {
@@ -263,45 +290,53 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>) -> String {
                 ]);
             }
         }
-        t.write(&mut out);
+        t.write(&mut out, markdown);
     }
 
     // energy balance
-    let mut t = Table::new(
-        "Energy balance at t_end [J]: E = ΔT + ΔV + Δ(L i²/2) + R loss + friction loss + residual",
-        &[
-            "run",
-            "E",
-            "ΔT",
-            "ΔV",
-            "Δ(L i²/2)",
-            "R loss",
-            "friction loss",
-            "residual",
-            "max |residual|",
-            "max |res| / E",
-        ],
-    );
-    for (k, r) in runs.iter().enumerate() {
-        let a = &r.energy;
-        let rel = a.max_abs_residual_rel.map_or("-".into(), e);
-        t.rows.push(vec![
-            name(k),
-            f(a.electric_j, 4),
-            f(a.kinetic_change_j, 4),
-            f(a.potential_change_j, 4),
-            f(a.magnetic_change_j, 4),
-            f(a.resistive_loss_j, 4),
-            f(a.friction_loss_j, 4),
-            e(a.residual_j),
-            e(a.max_abs_residual_j),
-            rel,
-        ]);
+    // the report explains the balance in its own section (report.rs)
+    if !markdown {
+        let mut t = Table::new(
+            "Energy balance at t_end [J]: E = ΔT + ΔV + Δ(L i²/2) + R loss + D loss + D_m loss + residual \
+             (R: windings, D: joints, D_m: gears; - where a recording has only D + D_m)",
+            &[
+                "run",
+                "E",
+                "ΔT",
+                "ΔV",
+                "Δ(L i²/2)",
+                "R loss",
+                "D loss",
+                "D_m loss",
+                "D + D_m",
+                "residual",
+                "max |residual|",
+                "max |res| / E",
+            ],
+        );
+        for (k, r) in runs.iter().enumerate() {
+            let a = &r.energy;
+            let rel = a.max_abs_residual_rel.map_or("-".into(), e);
+            t.rows.push(vec![
+                name(k),
+                f(a.electric_j, 4),
+                f(a.kinetic_change_j, 4),
+                f(a.potential_change_j, 4),
+                f(a.magnetic_change_j, 4),
+                f(a.resistive_loss_j, 4),
+                a.gear_friction_loss_j.map_or("-".into(), |g| f(a.friction_loss_j - g, 4)),
+                a.gear_friction_loss_j.map_or("-".into(), |g| f(g, 4)),
+                f(a.friction_loss_j, 4),
+                e(a.residual_j),
+                e(a.max_abs_residual_j),
+                rel,
+            ]);
+        }
+        t.write(&mut out, markdown);
     }
-    t.write(&mut out);
 
     // findings
-    if let Some(c) = cmp {
+    if let Some(c) = cmp.filter(|_| !markdown) {
         out.push_str("Findings\n");
         for s in &c.findings {
             out.push_str(&format!("- {s}\n"));

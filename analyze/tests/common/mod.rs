@@ -102,6 +102,8 @@ pub fn write(path: &Path, spec: &Spec) -> PathBuf {
             link_work_total: 3.0 * t,
             electric_energy_total: 7.0 * t,
             kinetic: t * t,
+            friction_loss: 0.5 * t,
+            gear_friction_loss: 0.2 * t,
             balance_residual: 1e-13 * t,
             ..Default::default()
         };

@@ -93,6 +93,7 @@ pub fn content(n: usize) -> Content {
                 resistive_loss: val(k, 7),
                 friction_loss: val(k, 8),
                 balance_residual: val(k, 9),
+                gear_friction_loss: val(k, 10),
             })
             .collect(),
         joints: (0..n)
