@@ -47,10 +47,21 @@ pub enum Command {
     /// W_j and E_j, contact forces, energy balance, and findings in plain sentences.
     #[command(after_help = COMPARE_EXAMPLES)]
     Compare(CompareArgs),
-    /// Per-run metrics only (no baseline, no findings): one row per recording, so it also merges
-    /// the shards of a sweep (`analyze summary results/`).
-    #[command(after_help = METRICS_EXAMPLES, visible_alias = "summary")]
+    /// Per-run metrics only (no baseline, no findings), every number of each run; for many runs
+    /// as one filterable table use `summary`.
+    #[command(after_help = METRICS_EXAMPLES)]
     Metrics(MetricsArgs),
+    /// One table of many runs (hundreds of recordings, read in parallel): one row per
+    /// recording with its hand error, energy totals, per-link E_j and W_j, peak current, contact
+    /// forces, energy residual and chosen scene parameters; filter, sort and pick columns
+    /// (polars). Merges the shards of a sweep.
+    #[command(after_help = SUMMARY_EXAMPLES)]
+    Summary(SummaryArgs),
+    /// Every topic of recordings as tables for Python and spreadsheets: one Parquet or CSV file
+    /// per topic (time column `t` in s, one column per field, arrays expanded per joint or
+    /// contact name) and metadata.json, in OUT/<recording name>/.
+    #[command(after_help = EXPORT_EXAMPLES)]
+    Export(ExportArgs),
     /// Compare two recordings or exported tables run by run (matched by run name): hand error,
     /// E and W totals, per-link W_j and E_j, currents, contact forces, energy residual, with
     /// absolute and relative differences. Exit status 0: nothing moved beyond the tolerances;
@@ -62,11 +73,41 @@ pub enum Command {
   analyze diff a.mcap b.mcap --rtol 1e-6 --all    looser, and list every quantity
   analyze diff a.csv b.csv --format json")]
     Diff(DiffArgs),
+    /// The comparison report as one Markdown document: what stands out, the tables (hand
+    /// error, energy totals and per link with ratios to the baseline, contacts), the energy
+    /// audit (electric energy in; kinetic, potential, magnetic stored; R, D and D_m losses;
+    /// residual; the integrals rechecked from the samples) and the figures.
+    #[command(after_help = "Examples:
+  analyze report out/                           -> out/report/report.md and out/report/figures/
+  analyze report out/ --baseline one-elbow -o review
+  analyze report a.mcap b.mcap --no-figures -o r")]
+    Report(ReportArgs),
     /// The paper's figures (hand paths Fig. 1-3, total and per-link work and electric energy
     /// Fig. 4-25) and more (currents, voltages, elbow normal forces, hand error), every run in
     /// each, as SVG and PNG, with index.md and index.html listing them in order.
     #[command(after_help = FIGURES_EXAMPLES)]
     Figures(FiguresArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
+    #[arg(required = true, value_name = "FILES_OR_DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// The baseline run, by run name, file path or file stem [default: the first run without
+    /// contacts, else the first run].
+    #[arg(long, value_name = "RUN")]
+    pub baseline: Option<String>,
+    /// Directory for report.md and its figures/ (created if needed).
+    #[arg(long, short = 'o', value_name = "DIR", default_value = "out/report")]
+    pub output: PathBuf,
+    /// Leave out the figures (faster; the report then has tables only).
+    #[arg(long)]
+    pub no_figures: bool,
+    /// The energy integrals are rechecked from the samples over the whole run and from this
+    /// time on, s (after the start-up transient, which is faster than the output step).
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.05)]
+    pub check_from: f64,
 }
 
 #[derive(Debug, Args)]
@@ -132,6 +173,93 @@ pub struct MetricsArgs {
     pub output: Output,
 }
 
+const SUMMARY_EXAMPLES: &str = "\
+Examples:
+  analyze summary results/                            every results/*.mcap
+  analyze summary 'results/**/*.mcap' -j 8            a quoted glob, 8 reader threads
+  analyze summary results/ --param controller.kp --param controller.kd --sort E_j
+  analyze summary results/ --filter 'z_rms_m<0.02' --filter run=two-elbow --sort E_j --desc
+  analyze summary results/ --columns file,run,E_j,z_rms_m --limit 10
+  analyze summary results/ --format csv -o runs.csv   every column (per link too)
+
+Columns (SI units, suffix = unit): file scene run status contacts n_contacts integrator t_end_s
+samples hand_rms_m hand_max_m z_rms_m z_max_m E_j W_j peak_current_a peak_current_joint
+min_normal_force_n pull_time_s residual_rel error bytes, E.<joint>_j and W.<joint>_j per link,
+p.<path> per --param. The text table shows a readable subset unless --columns is given.";
+
+const EXPORT_EXAMPLES: &str = "\
+Examples:
+  analyze export out/paper-two-elbow.mcap -o tables/       -> tables/paper-two-elbow/*.parquet
+  analyze export out/ --format csv -o tables/              every recording, CSV
+  analyze export run.mcap --topics /motors,/energy -o t/   only these topics
+
+In Python: pandas.read_parquet('tables/paper-two-elbow/motors.parquet')";
+
+#[derive(Debug, Args)]
+pub struct SummaryArgs {
+    /// Recordings (.mcap), directories (every *.mcap directly in them) or glob patterns
+    /// (quote them: 'results/**/*.mcap'); sorted by path, duplicates removed.
+    #[arg(required = true, value_name = "FILES_DIRS_OR_GLOBS")]
+    pub inputs: Vec<String>,
+    /// Add the scene parameter at this dot path of the scene JSON stored in each recording as
+    /// a column `p.<PATH>` (e.g. controller.kp, motors.0.R); repeatable.
+    #[arg(long = "param", value_name = "PATH")]
+    pub params: Vec<String>,
+    /// Keep rows where COLUMN OP VALUE holds, OP one of = != < <= > >= (numbers compare as
+    /// numbers); repeatable, all must hold. E.g. 'z_rms_m<0.02', run=two-elbow.
+    #[arg(long = "filter", value_name = "COND", value_parser = parse_filter)]
+    pub filters: Vec<analyze::filter::Filter>,
+    /// Sort by these columns (comma-separated), ascending unless --desc [default: by file].
+    #[arg(long, value_name = "COLUMNS", value_delimiter = ',')]
+    pub sort: Vec<String>,
+    /// Sort descending.
+    #[arg(long)]
+    pub desc: bool,
+    /// Show only these columns, in this order (comma-separated) [default: all for json and
+    /// csv; a readable subset for the table].
+    #[arg(long, value_name = "COLUMNS", value_delimiter = ',')]
+    pub columns: Vec<String>,
+    /// Show at most N rows (after filtering and sorting).
+    #[arg(long, value_name = "N")]
+    pub limit: Option<usize>,
+    /// Reader threads [default: one per core].
+    #[arg(long, short = 'j', value_name = "N", default_value_t = 0)]
+    pub jobs: usize,
+    /// Leave out recordings that cannot be read (each is named on stderr) instead of stopping
+    /// at the first; the exit status is still 1 if any was left out.
+    #[arg(long)]
+    pub skip_bad: bool,
+    #[command(flatten)]
+    pub output: Output,
+}
+
+fn parse_filter(s: &str) -> Result<analyze::filter::Filter, String> {
+    s.parse()
+}
+
+/// Table file format of `analyze export`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExportFormat {
+    Parquet,
+    Csv,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
+    #[arg(required = true, value_name = "FILES_OR_DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// Output directory; each recording goes to OUT/<its file stem>/.
+    #[arg(long, short = 'o', value_name = "OUT", default_value = "out/tables")]
+    pub output: PathBuf,
+    /// File format of the tables.
+    #[arg(long, short = 'f', value_name = "FORMAT", default_value = "parquet")]
+    pub format: ExportFormat,
+    /// Only these topics (comma-separated, e.g. /motors,/energy) [default: every decoded topic].
+    #[arg(long, value_name = "TOPICS", value_delimiter = ',')]
+    pub topics: Vec<String>,
+}
+
 #[derive(Debug, Args)]
 pub struct Output {
     /// table: aligned text for people; json: every number, stable keys; csv: one row per run.
@@ -187,7 +315,7 @@ mod tests {
             (a.output.format, a.output.output, a.baseline),
             (Format::Table, None, None)
         );
-        assert!(matches!(parse(&["summary", "dir/"]).unwrap().command, Command::Metrics(_)));
+        assert!(matches!(parse(&["summary", "dir/"]).unwrap().command, Command::Summary(_)));
         let Command::Metrics(m) = parse(&["metrics", "a.mcap", "-f", "csv"]).unwrap().command
         else {
             panic!()

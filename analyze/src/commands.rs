@@ -11,6 +11,27 @@ use anyhow::{bail, Context, Result};
 
 use crate::cli::{Cli, Command, Output};
 
+mod report;
+#[cfg(feature = "tables")]
+mod tables;
+
+#[cfg(not(feature = "tables"))]
+mod tables {
+    //! Without the feature `tables` (polars) the commands say how to get them.
+    fn missing() -> anyhow::Result<()> {
+        anyhow::bail!(
+            "this analyze was built without the feature `tables` (polars); build it with \
+             `cargo build --release -p analyze`"
+        )
+    }
+    pub fn summary(_: &crate::cli::SummaryArgs) -> anyhow::Result<()> {
+        missing()
+    }
+    pub fn export(_: &crate::cli::ExportArgs) -> anyhow::Result<()> {
+        missing()
+    }
+}
+
 /// Runs one command line.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
@@ -23,6 +44,9 @@ pub fn run(cli: Cli) -> Result<()> {
             let runs = load(&a.inputs, a.recover)?;
             emit(&a.output, &render_metrics(&runs, a.output.format)?)
         }
+        Command::Summary(a) => tables::summary(&a),
+        Command::Report(a) => report::report(&a),
+        Command::Export(a) => tables::export(&a),
         Command::Figures(a) => figures(&a),
         // exit status: 0 nothing moved, 1 something moved, 2 bad input (not main's 1)
         Command::Diff(a) => match diff(&a) {

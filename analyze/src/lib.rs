@@ -29,9 +29,16 @@
 
 pub mod compare;
 pub mod diff;
+pub mod filter;
+pub mod integrals;
+pub mod report;
 mod error;
 #[cfg(feature = "figures")]
 pub mod figures;
+#[cfg(feature = "tables")]
+pub mod frames;
+#[cfg(feature = "tables")]
+pub mod summary;
 pub mod metrics;
 pub mod render;
 #[cfg(test)]

@@ -25,7 +25,7 @@ use crate::cli::Format;
     sim sweep sim/scenes/sweeps/paper-gains.json                 the whole grid on this machine\n  \
     sim sweep sweep.json --shard 3/16 -o results/                 grid points k with k % 16 == 3\n  \
     sim sweep sweep.json --shard ${SLURM_ARRAY_TASK_ID}/16 -o results/\n  \
-    analyze metrics results/ --format csv                          merge the shards: one row per recording")]
+    analyze summary results/ --param controller.kp --format csv    merge the shards: one row per recording")]
 pub struct SweepArgs {
     /// Sweep JSON file: a base scene, optional runs and duration, and the axes of the grid.
     pub sweep: PathBuf,
