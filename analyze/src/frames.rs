@@ -188,26 +188,20 @@ fn file_names(frames: &RecordingFrames, format: ExportFormat) -> Vec<String> {
 /// Each file is written to a temporary name and renamed, so a killed export never leaves a
 /// half-written table under the final name.
 pub fn export(frames: &mut RecordingFrames, dir: &Path, format: ExportFormat) -> Result<Vec<PathBuf>, Error> {
-    let io = |file: &Path, op: &'static str| {
-        let file = file.display().to_string();
-        move |source| Error::Io { file, op, source }
-    };
-    std::fs::create_dir_all(dir).map_err(io(dir, "creating"))?;
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        file: dir.display().to_string(),
+        op: "creating",
+        source,
+    })?;
     let mut written = Vec::new();
     let files = file_names(frames, format);
-    for ((topic, df), name) in frames.topics.iter_mut().zip(&files) {
+    for ((_, df), name) in frames.topics.iter_mut().zip(&files) {
         let path = dir.join(name);
         write_atomic(&path, |f| match format {
             ExportFormat::Parquet => ParquetWriter::new(f).finish(df).map(drop),
             ExportFormat::Csv => CsvWriter::new(f).include_header(true).finish(df),
         })
-        .map_err(|e| match e {
-            WriteError::Io(source) => io(&path, "writing")(source),
-            WriteError::Polars(e) => Error::Table {
-                file: path.display().to_string(),
-                detail: format!("writing {topic}: {e}"),
-            },
-        })?;
+        .map_err(|e| e.into_error(&path))?;
         written.push(path);
     }
     let meta = serde_json::json!({
@@ -227,13 +221,7 @@ pub fn export(frames: &mut RecordingFrames, dir: &Path, format: ExportFormat) ->
         use std::io::Write;
         f.write_all(text.as_bytes()).map_err(PolarsError::from)
     })
-    .map_err(|e| match e {
-        WriteError::Io(source) => io(&path, "writing")(source),
-        WriteError::Polars(e) => Error::Table {
-            file: path.display().to_string(),
-            detail: e.to_string(),
-        },
-    })?;
+    .map_err(|e| e.into_error(&path))?;
     written.push(path);
     Ok(written)
 }
@@ -241,6 +229,17 @@ pub fn export(frames: &mut RecordingFrames, dir: &Path, format: ExportFormat) ->
 enum WriteError {
     Io(std::io::Error),
     Polars(PolarsError),
+}
+
+impl WriteError {
+    /// The library's error, naming the file being written.
+    fn into_error(self, path: &Path) -> Error {
+        let file = path.display().to_string();
+        match self {
+            WriteError::Io(source) => Error::Io { file, op: "writing", source },
+            WriteError::Polars(e) => Error::Table { file, detail: format!("writing the table: {e}") },
+        }
+    }
 }
 
 /// Writes through `.NAME.partial` in the same directory, then renames over `path`.

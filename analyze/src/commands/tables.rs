@@ -1,7 +1,6 @@
 //! `analyze summary` and `analyze export`: the commands built on polars.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use analyze::frames::{self, ExportFormat};
 use analyze::summary::{self, Query};
@@ -56,12 +55,7 @@ fn progress(len: usize, what: &str) -> indicatif::ProgressBar {
 pub fn summary(a: &SummaryArgs) -> Result<()> {
     let paths = expand_patterns(&a.inputs)?;
     let bar = progress(paths.len(), "reading");
-    let done = AtomicUsize::new(0);
-    let tick = || {
-        done.fetch_add(1, Ordering::Relaxed);
-        bar.inc(1);
-    };
-    let results = summary::read_rows(&paths, &a.params, a.jobs, &tick);
+    let results = summary::read_rows(&paths, &a.params, a.jobs, &|| bar.inc(1));
     bar.finish_and_clear();
     let mut rows = Vec::with_capacity(results.len());
     let mut bad = 0;
