@@ -11,7 +11,11 @@ Examples:
   analyze compare out/                      every out/*.mcap against the run without elbows
   analyze compare out/ --baseline one-elbow --format csv -o table.csv
   analyze compare a.mcap b.mcap --format json
-  analyze metrics out/two-elbow.mcap        one run's numbers, no comparison";
+  analyze metrics out/two-elbow.mcap        one run's numbers, no comparison
+  analyze report out/ -o out/report         the comparison as a document, with the figures
+  analyze summary 'results/*.mcap' --sort E_j  hundreds of runs as one table
+  analyze export out/ -o tables/            every topic as Parquet, for Python
+  analyze diff old/ new/                    what moved between two versions";
 
 const COMPARE_EXAMPLES: &str = "\
 Examples:
