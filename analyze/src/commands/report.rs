@@ -1,8 +1,6 @@
 //! `analyze report`: each recording read once, for the metrics, the sampled-integral check and
 //! the figures; then the comparison, the figures and `report.md`.
 
-use std::path::Path;
-
 use analyze::report::{render_report, FigureLink, RunInfo};
 use analyze::{run_metrics, Comparison};
 use anyhow::{Context, Result};
@@ -63,10 +61,6 @@ pub fn report(a: &ReportArgs) -> Result<()> {
     let text = render_report(&cmp, &info, &links, index);
     let path = a.output.join("report.md");
     write_file(&path, &text)?;
-    eprintln!("analyze: report of {} runs in {}", metrics.len(), display(&path));
+    eprintln!("analyze: report of {} runs in {}", metrics.len(), path.display());
     Ok(())
-}
-
-fn display(p: &Path) -> String {
-    p.display().to_string()
 }
