@@ -4,8 +4,7 @@
 
 use crate::error::RunError;
 use crate::integrate::{
-    integrate_sampled, ArkImex, ArkImexSettings, Dopri5Settings, DormandPrince45, IntegrateError, Rk4, Rosenbrock,
-    RosenbrockSettings, Stats, Stepper,
+    integrate_sampled, ArkImex, DormandPrince45, IntegrateError, Rk4, Rosenbrock, Stats, StepControl, Stepper,
 };
 use crate::scene::{IntegratorSettings, Run, Scene};
 use crate::system::{ArmSystem, Outputs};
@@ -25,7 +24,9 @@ fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String) -> RunE
         IntegrateError::StepSizeTooSmall { t, h } => RunError::StepSizeTooSmall { t, h },
         IntegrateError::SingularMatrix { t, h } => RunError::SingularIterationMatrix { t, h },
         IntegrateError::NonFiniteState { t, index } => RunError::NonFiniteState { t, index, name: names(index) },
-        IntegrateError::TooManySteps { t, max_steps } => RunError::TooManySteps { t, max_steps },
+        IntegrateError::TooManySteps { t, max_steps } => {
+            RunError::TooManySteps { t, max_steps: usize::try_from(max_steps).unwrap_or(usize::MAX) }
+        }
         IntegrateError::InvalidOutputGrid { t0, t_end, dt_out } => RunError::Dynamics(crate::error::DynamicsError::NonFinite {
             t: t0,
             what: format!("the output grid (t_end = {t_end}, dt = {dt_out})"),
@@ -61,23 +62,28 @@ pub fn simulate(
             drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
         }
         IntegratorSettings::Dopri45 { rtol, atol, h_max, max_steps } => {
-            let settings = Dopri5Settings { rtol, atol, h_max, max_steps, ..Dopri5Settings::default() };
-            let mut st = DormandPrince45::new(dim, settings);
+            let mut st = DormandPrince45::new(dim, step_control(rtol, atol, h_max, max_steps));
             drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
         }
         IntegratorSettings::Rosenbrock { rtol, atol, h_max, max_steps, jacobian_reuse } => {
-            let settings = RosenbrockSettings { rtol, atol, h_max, max_steps, jacobian_reuse, ..RosenbrockSettings::default() };
-            let mut st = Rosenbrock::new(dim, settings);
+            let control = step_control(rtol, atol, h_max, max_steps);
+            let mut st = Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse);
             drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
         }
         IntegratorSettings::Imex { rtol, atol, h_max, max_steps } => {
-            let settings = ArkImexSettings { rtol, atol, h_max, max_steps, ..ArkImexSettings::default() };
-            let mut st = ArkImex::new(dim, settings);
+            let mut st = ArkImex::new(dim, step_control(rtol, atol, h_max, max_steps));
             drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
         }
     }
     .map_err(|e| map_err(e, &names))?;
     Ok(RunReport { stats, samples, last: out })
+}
+
+/// The scene's step control (the scene holds the user-facing defaults): Hairer's starting step,
+/// no smallest step, `max_steps` attempts.
+fn step_control(rtol: f64, atol: f64, h_max: f64, max_steps: usize) -> StepControl {
+    let max_steps = u64::try_from(max_steps).unwrap_or(u64::MAX);
+    StepControl { rtol, atol, h_init: None, h_max, h_min: 0.0, max_steps }
 }
 
 fn drive<'s, St: Stepper<ArmSystem<'s>>>(

@@ -1,6 +1,6 @@
-//! Pieces shared by the adaptive steppers: the settings error, validation of the common
-//! step-control fields, the tolerance-weighted error norm, Hairer's starting step and the
-//! elementary step-size controller.
+//! Pieces shared by the adaptive steppers: the tolerance-weighted error norm, Hairer's starting
+//! step, the state kept between attempts and the step loop. The settings ([`StepControl`]) and
+//! the elementary controller ([`Controller`]) are in `control.rs`.
 //!
 //! References (HNW I = Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*,
 //! 2nd ed., 1993): error norm and controller HNW I §II.4 (4.11)–(4.13); starting step HNW I
@@ -8,127 +8,8 @@
 //! [`super::ArkImex`] share these, the state they carry between attempts ([`Core`]) and the
 //! step loop ([`step`]); [`super::DormandPrince45`] keeps its own (PI) controller.
 
-use std::fmt;
-
+use super::control::{Controller, StepControl};
 use super::{IntegrateError, OdeSystem, Stats};
-
-/// An out-of-range field of a settings struct ([`super::Dopri5Settings`],
-/// [`super::RosenbrockSettings`], [`super::ArkImexSettings`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SettingsError {
-    /// Name of the settings struct, e.g. `"RosenbrockSettings"`.
-    pub settings: &'static str,
-    /// Field name.
-    pub field: &'static str,
-    /// Offending value (integers converted to f64).
-    pub value: f64,
-    /// What the value must satisfy.
-    pub requirement: &'static str,
-}
-
-impl fmt::Display for SettingsError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "invalid {}.{} = {}: must be {}",
-            self.settings, self.field, self.value, self.requirement
-        )
-    }
-}
-
-impl std::error::Error for SettingsError {}
-
-/// The step-control fields common to [`super::Dopri5Settings`],
-/// [`super::RosenbrockSettings`] and [`super::ArkImexSettings`] (same meaning in all three).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Control {
-    pub rtol: f64,
-    pub atol: f64,
-    pub h_init: Option<f64>,
-    pub h_max: f64,
-    pub h_min: f64,
-    pub max_steps: usize,
-    pub safety: f64,
-    pub fac_min: f64,
-    pub fac_max: f64,
-}
-
-/// The [`Control`] part of a settings struct with the same field names (all three have them).
-macro_rules! control_of {
-    ($settings:expr) => {{
-        let s = &$settings;
-        $crate::integrate::adaptive::Control {
-            rtol: s.rtol,
-            atol: s.atol,
-            h_init: s.h_init,
-            h_max: s.h_max,
-            h_min: s.h_min,
-            max_steps: s.max_steps,
-            safety: s.safety,
-            fac_min: s.fac_min,
-            fac_max: s.fac_max,
-        }
-    }};
-}
-pub(super) use control_of;
-
-impl Control {
-    /// Range checks of the common fields (the settings' `validate` add their own fields).
-    pub fn validate(&self, settings: &'static str) -> Result<(), SettingsError> {
-        let bad = |field, value, requirement| {
-            Err(SettingsError {
-                settings,
-                field,
-                value,
-                requirement,
-            })
-        };
-        if !(self.rtol.is_finite() && self.rtol >= 0.0) {
-            return bad("rtol", self.rtol, "finite and >= 0");
-        }
-        if !(self.atol.is_finite() && self.atol > 0.0) {
-            return bad("atol", self.atol, "finite and > 0");
-        }
-        if let Some(h) = self.h_init {
-            if !(h.is_finite() && h > 0.0 && h >= self.h_min) {
-                return bad("h_init", h, "finite, > 0 and >= h_min");
-            }
-        }
-        if self.h_max.is_nan() || self.h_max <= 0.0 {
-            return bad("h_max", self.h_max, "> 0 (may be infinite)");
-        }
-        if !(self.h_min.is_finite() && self.h_min >= 0.0 && self.h_min <= self.h_max) {
-            return bad("h_min", self.h_min, "finite, >= 0 and <= h_max");
-        }
-        if self.max_steps == 0 {
-            return bad("max_steps", 0.0, "> 0");
-        }
-        if !(self.safety > 0.0 && self.safety <= 1.0) {
-            return bad("safety", self.safety, "in (0, 1]");
-        }
-        if !(self.fac_min > 0.0 && self.fac_min <= 1.0) {
-            return bad("fac_min", self.fac_min, "in (0, 1]");
-        }
-        if !(self.fac_max.is_finite() && self.fac_max >= 1.0) {
-            return bad("fac_max", self.fac_max, "finite and >= 1");
-        }
-        Ok(())
-    }
-
-    /// Step-size factor `h_new / h` for the scaled error `err` of a method whose error
-    /// estimate is `O(h^(1/expo))` (HNW I (4.13)): `safety err^(-expo)` bounded to
-    /// `[fac_min, fac_max]`; a NaN or infinite `err` gives `fac_min`.
-    pub fn factor(&self, err: f64, expo: f64) -> f64 {
-        let finite = err < f64::INFINITY; // false for inf and NaN
-        if !finite {
-            return self.fac_min;
-        }
-        if err == 0.0 {
-            return self.fac_max;
-        }
-        (self.safety * err.powf(-expo)).clamp(self.fac_min, self.fac_max)
-    }
-}
 
 /// `sqrt(1/n sum (e_i / sc_i)^2)`, `sc_i = atol + rtol max(|y_i|, |y_new_i|)` (HNW I (4.11));
 /// 0 for `n = 0`. NaN/inf propagate.
@@ -176,7 +57,10 @@ pub(super) enum Attempt {
 /// What every adaptive stepper keeps between attempts besides its vectors.
 #[derive(Clone, Debug)]
 pub(super) struct Core {
-    pub control: Control,
+    /// The user's tolerances and limits.
+    pub control: StepControl,
+    /// The method's controller constants.
+    pub controller: Controller,
     /// Current time.
     pub t: f64,
     /// Start and size of the last accepted step (`h_last = 0` before the first step).
@@ -193,9 +77,10 @@ pub(super) struct Core {
 }
 
 impl Core {
-    pub fn new(control: Control) -> Self {
+    pub fn new(control: StepControl, controller: Controller) -> Self {
         Self {
             control,
+            controller,
             t: 0.0,
             t_prev: 0.0,
             h_last: 0.0,
@@ -246,7 +131,7 @@ impl Core {
     /// `index` of an attempt with step `h`: the next attempt uses `fac_min h`.
     pub fn reject_non_finite(&mut self, h: f64, t_bad: f64, index: usize) -> Attempt {
         self.reject(
-            h * self.control.fac_min,
+            h * self.controller.fac_min,
             Failure::NonFinite { t: t_bad, index },
         )
     }
@@ -321,7 +206,7 @@ pub(super) fn step<S: OdeSystem, A: Adaptive<S>>(
     loop {
         let core = st.core();
         let max_steps = core.control.max_steps;
-        if core.stats.steps + core.stats.rejected >= max_steps as u64 {
+        if core.stats.steps + core.stats.rejected >= max_steps {
             return Err(IntegrateError::TooManySteps {
                 t: core.t,
                 max_steps,
@@ -355,7 +240,7 @@ pub(super) fn initial_step<S: OdeSystem>(
     f0: &[f64],
     y1: &mut [f64],
     f1: &mut [f64],
-    c: &Control,
+    c: &StepControl,
     order: i32,
 ) -> Result<f64, IntegrateError<S::Error>> {
     let n = y.len();
@@ -408,31 +293,6 @@ pub(super) fn land(t: f64, h: f64, t_stop: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn controller_factor_is_bounded() {
-        let c = Control {
-            rtol: 1e-6,
-            atol: 1e-6,
-            h_init: None,
-            h_max: 1.0,
-            h_min: 0.0,
-            max_steps: 10,
-            safety: 0.9,
-            fac_min: 0.2,
-            fac_max: 6.0,
-        };
-        assert_eq!(c.factor(0.0, 1.0 / 3.0), 6.0);
-        assert_eq!(c.factor(f64::NAN, 1.0 / 3.0), 0.2);
-        assert_eq!(c.factor(f64::INFINITY, 1.0 / 3.0), 0.2);
-        assert!((c.factor(1.0, 1.0 / 3.0) - 0.9).abs() < 1e-15);
-        assert!((c.factor(8.0, 1.0 / 3.0) - 0.45).abs() < 1e-15);
-        assert!(c.validate("X").is_ok());
-        let e = Control { fac_max: 0.5, ..c }.validate("RosenbrockSettings");
-        let e = e.expect_err("fac_max < 1");
-        assert_eq!((e.settings, e.field), ("RosenbrockSettings", "fac_max"));
-        assert!(e.to_string().contains("RosenbrockSettings.fac_max = 0.5"));
-    }
 
     #[test]
     fn error_norm_is_weighted_rms() {

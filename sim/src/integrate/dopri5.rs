@@ -27,12 +27,11 @@
 //! - `max_steps` counts attempts (accepted + rejected) since `init`; every rejection is counted in
 //!   [`Stats::rejected`], including those before the first accepted step.
 
-use super::adaptive::{
-    self, control_of, error_norm, initial_step, Adaptive, Attempt, Core, Failure,
-};
+use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::control::Controller;
 use super::{
     dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeSystem, SettingsError,
-    Stats, Stepper,
+    Stats, StepControl, Stepper,
 };
 
 // Dormand & Prince (1980) tableau, HNW I §II.5 (c6 = c7 = 1).
@@ -76,77 +75,22 @@ const D5: f64 = 701980252875.0 / 199316789632.0;
 const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
 
-/// Tolerances and step-size controller settings for [`DormandPrince45`].
-///
-/// The defaults are those of [`Default`] (the only place they are written down); the
-/// controller constants match `dopri5.f`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Dopri5Settings {
-    /// Relative tolerance, >= 0.
-    pub rtol: f64,
-    /// Absolute tolerance (same unit as y), > 0.
-    pub atol: f64,
-    /// First step to try; `None` uses Hairer's starting-step algorithm (one extra evaluation).
-    pub h_init: Option<f64>,
-    /// Largest step, > 0 (may be infinite).
-    pub h_max: f64,
-    /// Smallest step before giving up with `StepSizeTooSmall`, >= 0 (a final step shortened
-    /// to land on `t_stop` may be smaller).
-    pub h_min: f64,
-    /// Most step attempts (accepted + rejected) between `init` and `TooManySteps`, > 0.
-    pub max_steps: usize,
-    /// Safety factor on the predicted optimal step, in (0, 1].
-    pub safety: f64,
-    /// Lower bound on `h_new / h`, in (0, 1] (`dopri5.f` FAC1).
-    pub fac_min: f64,
-    /// Upper bound on `h_new / h`, >= 1 (`dopri5.f` FAC2).
-    pub fac_max: f64,
-    /// PI stabilisation exponent, in [0, 0.2]; 0 gives the plain controller (`dopri5.f` BETA).
-    pub beta: f64,
-}
+/// The step-size controller of `dopri5.f` (SAFE = 0.9, FAC1 = 0.2, FAC2 = 10): `h_new / h`
+/// in `[0.2, 10]`.
+const CONTROLLER: Controller = Controller {
+    safety: 0.9,
+    fac_min: 0.2,
+    fac_max: 10.0,
+};
 
-impl Default for Dopri5Settings {
-    fn default() -> Self {
-        Self {
-            rtol: 1e-6,
-            atol: 1e-9,
-            h_init: None,
-            h_max: f64::INFINITY,
-            h_min: 0.0,
-            max_steps: 100_000,
-            safety: 0.9,
-            fac_min: 0.2,
-            fac_max: 10.0,
-            beta: 0.04,
-        }
-    }
-}
-
-impl Dopri5Settings {
-    /// Checks every field's range (see the field docs); use on user-supplied settings.
-    ///
-    /// # Errors
-    /// The first field out of range, with its value and the requirement.
-    pub fn validate(&self) -> Result<(), SettingsError> {
-        control_of!(self).validate("Dopri5Settings")?;
-        if !(self.beta >= 0.0 && self.beta <= 0.2) {
-            return Err(SettingsError {
-                settings: "Dopri5Settings",
-                field: "beta",
-                value: self.beta,
-                requirement: "in [0, 0.2]",
-            });
-        }
-        Ok(())
-    }
-}
+/// PI stabilisation exponent of `dopri5.f` (BETA = 0.04; 0 would give the plain controller).
+const BETA: f64 = 0.04;
 
 /// Adaptive Dormand–Prince 5(4) stepper (`dopri5.f`) with dense output.
 #[derive(Clone, Debug)]
 pub struct DormandPrince45 {
     /// State dimension.
     dim: usize,
-    settings: Dopri5Settings,
     /// Time, last step, step-size control and statistics.
     core: Core,
     /// Exponent of err in the controller, `1/5 - 0.75 beta`.
@@ -174,9 +118,9 @@ impl DormandPrince45 {
     /// A stepper for systems of dimension `dim`; all buffers are allocated here.
     ///
     /// # Panics
-    /// If `settings.validate()` fails; use [`DormandPrince45::try_new`] for user input.
-    pub fn new(dim: usize, settings: Dopri5Settings) -> Self {
-        match Self::try_new(dim, settings) {
+    /// If `control.validate()` fails; use [`DormandPrince45::try_new`] for user input.
+    pub fn new(dim: usize, control: StepControl) -> Self {
+        match Self::try_new(dim, control) {
             Ok(s) => s,
             Err(e) => panic!("DormandPrince45::new: {e}"),
         }
@@ -185,15 +129,14 @@ impl DormandPrince45 {
     /// Like [`DormandPrince45::new`], returning the settings error instead of panicking.
     ///
     /// # Errors
-    /// The first out-of-range field of `settings` (see [`Dopri5Settings::validate`]).
-    pub fn try_new(dim: usize, settings: Dopri5Settings) -> Result<Self, SettingsError> {
-        settings.validate()?;
+    /// The first out-of-range field of `control` (see [`StepControl::validate`]).
+    pub fn try_new(dim: usize, control: StepControl) -> Result<Self, SettingsError> {
+        control.validate()?;
         let z = || vec![0.0; dim];
         Ok(Self {
             dim,
-            settings,
-            core: Core::new(control_of!(settings)),
-            expo1: 0.2 - 0.75 * settings.beta,
+            core: Core::new(control, CONTROLLER),
+            expo1: 0.2 - 0.75 * BETA,
             y: z(),
             k1: z(),
             err_old: 1e-4,
@@ -207,11 +150,6 @@ impl DormandPrince45 {
             y_new: z(),
             dense: [z(), z(), z(), z(), z()],
         })
-    }
-
-    /// The settings this stepper was built with.
-    pub fn settings(&self) -> &Dopri5Settings {
-        &self.settings
     }
 
     adaptive_accessors!();
@@ -364,15 +302,12 @@ impl DormandPrince45 {
         }
 
         // error estimate (into y_stage) in the tolerance-weighted RMS norm, HNW I §II.4
-        let Dopri5Settings {
-            atol,
-            rtol,
+        let StepControl { atol, rtol, .. } = self.core.control;
+        let Controller {
             safety,
             fac_min,
             fac_max,
-            beta,
-            ..
-        } = self.settings;
+        } = CONTROLLER;
         let (y, k1, k3, k4, k5, k6, k7) = (
             &self.y, &self.k1, &self.k3, &self.k4, &self.k5, &self.k6, &self.k7,
         );
@@ -390,7 +325,7 @@ impl DormandPrince45 {
             let fac = (fac11 / safety).min(1.0 / fac_min);
             return Ok(self.core.reject(h / fac, Failure::None));
         }
-        let fac = (fac11 / self.err_old.powf(beta) / safety)
+        let fac = (fac11 / self.err_old.powf(BETA) / safety)
             .min(1.0 / fac_min)
             .max(1.0 / fac_max);
         let h_new = self.core.limit_growth(h / fac, h, h_proposed);

@@ -53,65 +53,22 @@
 //! stages shrink the step; `max_steps` counts attempts; stop times are hit exactly).
 
 use self::tableau::{AE, AI, B, B_DENSE, B_HAT, C, GAMMA};
-use super::adaptive::{
-    self, control_of, error_norm, initial_step, Adaptive, Attempt, Core, Failure,
-};
+use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::control::Controller;
 use super::{
     dense_output, first_non_finite, hermite, IntegrateError, SettingsError, SplitSystem, Stats,
-    Stepper,
+    StepControl, Stepper,
 };
 
 mod tableau;
 
-/// Tolerances and step-size controller for [`ArkImex`] (fields as in
-/// [`super::RosenbrockSettings`], without a Jacobian).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ArkImexSettings {
-    /// Relative tolerance, >= 0.
-    pub rtol: f64,
-    /// Absolute tolerance (same unit as y), > 0.
-    pub atol: f64,
-    /// First step to try; `None` uses Hairer's starting-step algorithm (one extra evaluation).
-    pub h_init: Option<f64>,
-    /// Largest step, > 0 (may be infinite).
-    pub h_max: f64,
-    /// Smallest step before giving up with `StepSizeTooSmall`, >= 0.
-    pub h_min: f64,
-    /// Most step attempts (accepted + rejected) between `init` and `TooManySteps`, > 0.
-    pub max_steps: usize,
-    /// Safety factor on the predicted optimal step, in (0, 1].
-    pub safety: f64,
-    /// Lower bound on `h_new / h`, in (0, 1].
-    pub fac_min: f64,
-    /// Upper bound on `h_new / h`, >= 1.
-    pub fac_max: f64,
-}
-
-impl Default for ArkImexSettings {
-    fn default() -> Self {
-        Self {
-            rtol: 1e-6,
-            atol: 1e-9,
-            h_init: None,
-            h_max: f64::INFINITY,
-            h_min: 0.0,
-            max_steps: 100_000,
-            safety: 0.9,
-            fac_min: 0.2,
-            fac_max: 6.0,
-        }
-    }
-}
-
-impl ArkImexSettings {
-    /// Checks every field's range (see the field docs).
-    ///
-    /// # Errors
-    /// The first field out of range, with its value and the requirement.
-    pub fn validate(&self) -> Result<(), SettingsError> {
-        control_of!(self).validate("ArkImexSettings")
-    }
-}
+/// The step-size controller, as for [`super::Rosenbrock`] (Hairer's `ros4.f`: SAFE = 0.9,
+/// FAC1 = 0.2, FAC2 = 6): `h_new / h` in `[0.2, 6]`.
+const CONTROLLER: Controller = Controller {
+    safety: 0.9,
+    fac_min: 0.2,
+    fac_max: 6.0,
+};
 
 /// The interpolation check accepts a step when the Hermite and the paper's interpolants agree
 /// at the midpoint to within `DENSE_SLACK` times the tolerance.
@@ -121,7 +78,6 @@ const DENSE_SLACK: f64 = 10.0;
 #[derive(Clone, Debug)]
 pub struct ArkImex {
     dim: usize,
-    settings: ArkImexSettings,
     /// Time, last step, step-size control and statistics.
     core: Core,
     y: Vec<f64>,
@@ -145,9 +101,9 @@ impl ArkImex {
     /// A stepper for systems of dimension `dim`; all buffers are allocated here.
     ///
     /// # Panics
-    /// If `settings.validate()` fails; use [`ArkImex::try_new`] for user input.
-    pub fn new(dim: usize, settings: ArkImexSettings) -> Self {
-        match Self::try_new(dim, settings) {
+    /// If `control.validate()` fails; use [`ArkImex::try_new`] for user input.
+    pub fn new(dim: usize, control: StepControl) -> Self {
+        match Self::try_new(dim, control) {
             Ok(s) => s,
             Err(e) => panic!("ArkImex::new: {e}"),
         }
@@ -156,15 +112,14 @@ impl ArkImex {
     /// Like [`ArkImex::new`], returning the settings error instead of panicking.
     ///
     /// # Errors
-    /// The first out-of-range field of `settings`.
-    pub fn try_new(dim: usize, settings: ArkImexSettings) -> Result<Self, SettingsError> {
-        settings.validate()?;
+    /// The first out-of-range field of `control` (see [`StepControl::validate`]).
+    pub fn try_new(dim: usize, control: StepControl) -> Result<Self, SettingsError> {
+        control.validate()?;
         let z = || vec![0.0; dim];
         let six = || [z(), z(), z(), z(), z(), z()];
         Ok(Self {
             dim,
-            settings,
-            core: Core::new(control_of!(settings)),
+            core: Core::new(control, CONTROLLER),
             y: z(),
             y_prev: z(),
             f_prev: z(),
@@ -177,11 +132,6 @@ impl ArkImex {
             fi_new: z(),
             scratch: z(),
         })
-    }
-
-    /// The settings this stepper was built with.
-    pub fn settings(&self) -> &ArkImexSettings {
-        &self.settings
     }
 
     adaptive_accessors!();
@@ -312,7 +262,7 @@ impl<S: SplitSystem> Adaptive<S> for ArkImex {
         }
         let c = self.core.control;
         let err = error_norm(&self.r, &self.y, &self.y_new, c.atol, c.rtol);
-        let fac = c.factor(err, 0.25);
+        let fac = CONTROLLER.factor(err, 0.25);
         let passed = err <= 1.0;
         if !passed {
             return Ok(self.core.reject(h * fac.min(1.0), Failure::None));
@@ -342,10 +292,10 @@ impl<S: SplitSystem> Adaptive<S> for ArkImex {
         let err_dense = error_norm(&self.r, &self.y, &self.y_new, c.atol, c.rtol) / DENSE_SLACK;
         let interpolation_ok = err_dense <= 1.0;
         if !interpolation_ok {
-            let h_next = h * c.factor(err_dense, 0.25).min(1.0);
+            let h_next = h * CONTROLLER.factor(err_dense, 0.25).min(1.0);
             return Ok(self.core.reject(h_next, Failure::None));
         }
-        let fac = fac.min(c.factor(err_dense, 0.25));
+        let fac = fac.min(CONTROLLER.factor(err_dense, 0.25));
 
         let h_new = self.core.limit_growth(h * fac, h, h_proposed);
         for i in 0..n {

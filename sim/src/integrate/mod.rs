@@ -8,6 +8,11 @@
 //! [`integrate_sampled`] drives a stepper over an interval and reports the solution on a fixed
 //! output grid via dense output, so recorded times never depend on the solver's step sizes.
 //!
+//! The adaptive methods take one [`StepControl`] (tolerances and step limits, the same for
+//! all three; [`StepControl::new`] sets no limit beyond the tolerances: user-facing defaults
+//! belong to the caller). Each method's controller constants (safety factor, bounds on the
+//! step-size ratio) are fixed to those of Hairer's reference codes (`dopri5.f`, `ros4.f`).
+//!
 //! Methods and their references (Hairer, Nørsett & Wanner, *Solving Ordinary Differential
 //! Equations I*, 2nd ed., Springer 1993, "HNW I" below):
 //! - [`Rk4`]: the classical 4th-order Runge–Kutta method (Kutta 1901, HNW I §II.1),
@@ -60,6 +65,11 @@ macro_rules! forward_stepper_accessors {
 /// `y`.
 macro_rules! adaptive_accessors {
     () => {
+        /// The tolerances and limits this stepper was built with.
+        pub fn control(&self) -> &StepControl {
+            &self.core.control
+        }
+
         /// Start of the last accepted step (equals `t()` before the first step).
         pub fn t_prev(&self) -> f64 {
             self.core.t_prev
@@ -89,6 +99,7 @@ macro_rules! adaptive_accessors {
 }
 
 mod adaptive;
+mod control;
 mod dopri5;
 mod imex;
 mod jacobian;
@@ -100,12 +111,12 @@ pub mod test_problems;
 #[cfg(test)]
 mod testutil;
 
-pub use self::adaptive::SettingsError;
-pub use self::dopri5::{Dopri5Settings, DormandPrince45};
-pub use self::imex::{ArkImex, ArkImexSettings};
+pub use self::control::{SettingsError, StepControl};
+pub use self::dopri5::DormandPrince45;
+pub use self::imex::ArkImex;
 pub use self::jacobian::{fd_jacobian, FdJacobian};
 pub use self::rk4::Rk4;
-pub use self::rosenbrock::{Rosenbrock, RosenbrockSettings};
+pub use self::rosenbrock::Rosenbrock;
 pub use self::sampled::integrate_sampled;
 
 /// What gets integrated: y' = f(t, y). Must be a pure function of (t, y) apart from scratch.
@@ -202,7 +213,7 @@ pub enum IntegrateError<E> {
     NonFiniteState { t: f64, index: usize },
     /// More than `max_steps` step attempts (accepted + rejected) since `init`; `t` is where
     /// the stepper stands.
-    TooManySteps { t: f64, max_steps: usize },
+    TooManySteps { t: f64, max_steps: u64 },
     /// The `sample` callback of [`integrate_sampled`] returned an error at output time `t`.
     /// (Added to the interface so a recorder failure is not mistaken for a dynamics failure.)
     Sample { t: f64, source: E },

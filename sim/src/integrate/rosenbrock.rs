@@ -52,25 +52,31 @@
 //! `fac_min` and is reported only if the step size collapses; steps shortened to land on
 //! `t_stop` do not reduce the next step; `max_steps` counts attempts.
 
-pub use self::settings::RosenbrockSettings;
 use self::tableau::{Tableau, GAMMA};
-use super::adaptive::{
-    self, control_of, error_norm, initial_step, Adaptive, Attempt, Core, Failure,
-};
+use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::control::Controller;
 use super::lu::{lu_factor, lu_solve};
 use super::{
     dense_output, eval, eval_finite, first_non_finite, hermite, IntegrateError, OdeJacobian,
-    SettingsError, Stats, Stepper,
+    SettingsError, Stats, StepControl, Stepper,
 };
 
-mod settings;
 mod tableau;
+
+/// The step-size controller of Hairer's `ros4.f` (SAFE = 0.9, FAC1 = 0.2, FAC2 = 6):
+/// `h_new / h` in `[0.2, 6]`.
+const CONTROLLER: Controller = Controller {
+    safety: 0.9,
+    fac_min: 0.2,
+    fac_max: 6.0,
+};
 
 /// Adaptive ROS34PW2 Rosenbrock-W stepper (see the module docs).
 #[derive(Clone, Debug)]
 pub struct Rosenbrock {
     dim: usize,
-    settings: RosenbrockSettings,
+    /// Accepted steps between Jacobian evaluations, >= 1.
+    jacobian_reuse: usize,
     /// Time, last step, step-size control and statistics.
     core: Core,
     tab: Tableau,
@@ -104,13 +110,14 @@ pub struct Rosenbrock {
 }
 
 impl Rosenbrock {
-    /// A stepper for systems of dimension `dim`; all buffers (two `dim x dim` matrices) are
+    /// A stepper for systems of dimension `dim`, with a fresh Jacobian every step (see
+    /// [`Rosenbrock::with_jacobian_reuse`]); all buffers (two `dim x dim` matrices) are
     /// allocated here.
     ///
     /// # Panics
-    /// If `settings.validate()` fails; use [`Rosenbrock::try_new`] for user input.
-    pub fn new(dim: usize, settings: RosenbrockSettings) -> Self {
-        match Self::try_new(dim, settings) {
+    /// If `control.validate()` fails; use [`Rosenbrock::try_new`] for user input.
+    pub fn new(dim: usize, control: StepControl) -> Self {
+        match Self::try_new(dim, control) {
             Ok(s) => s,
             Err(e) => panic!("Rosenbrock::new: {e}"),
         }
@@ -119,14 +126,14 @@ impl Rosenbrock {
     /// Like [`Rosenbrock::new`], returning the settings error instead of panicking.
     ///
     /// # Errors
-    /// The first out-of-range field of `settings`.
-    pub fn try_new(dim: usize, settings: RosenbrockSettings) -> Result<Self, SettingsError> {
-        settings.validate()?;
+    /// The first out-of-range field of `control` (see [`StepControl::validate`]).
+    pub fn try_new(dim: usize, control: StepControl) -> Result<Self, SettingsError> {
+        control.validate()?;
         let z = || vec![0.0; dim];
         Ok(Self {
             dim,
-            settings,
-            core: Core::new(control_of!(settings)),
+            jacobian_reuse: 1,
+            core: Core::new(control, CONTROLLER),
             tab: Tableau::new(),
             y: z(),
             f0: z(),
@@ -151,9 +158,41 @@ impl Rosenbrock {
         })
     }
 
-    /// The settings this stepper was built with.
-    pub fn settings(&self) -> &RosenbrockSettings {
-        &self.settings
+    /// Keeps each Jacobian for `k` accepted steps (`k >= 1`; the default, 1, evaluates a
+    /// fresh `J` every step). The Jacobian is also refreshed after a rejection if it was not
+    /// evaluated at the current point. Fewer Jacobians cost stability margin, not order (the
+    /// W property, module docs).
+    ///
+    /// # Panics
+    /// If `k == 0`; use [`Rosenbrock::try_with_jacobian_reuse`] for user input.
+    pub fn with_jacobian_reuse(self, k: usize) -> Self {
+        match self.try_with_jacobian_reuse(k) {
+            Ok(s) => s,
+            Err(e) => panic!("Rosenbrock::with_jacobian_reuse: {e}"),
+        }
+    }
+
+    /// Like [`Rosenbrock::with_jacobian_reuse`], returning the settings error instead of
+    /// panicking.
+    ///
+    /// # Errors
+    /// `k == 0` (`settings = "Rosenbrock"`, `field = "jacobian_reuse"`).
+    pub fn try_with_jacobian_reuse(mut self, k: usize) -> Result<Self, SettingsError> {
+        if k == 0 {
+            return Err(SettingsError {
+                settings: "Rosenbrock",
+                field: "jacobian_reuse",
+                value: 0.0,
+                requirement: ">= 1",
+            });
+        }
+        self.jacobian_reuse = k;
+        Ok(self)
+    }
+
+    /// Accepted steps between Jacobian evaluations (see [`Rosenbrock::with_jacobian_reuse`]).
+    pub fn jacobian_reuse(&self) -> usize {
+        self.jacobian_reuse
     }
 
     adaptive_accessors!();
@@ -297,7 +336,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
         h_proposed: f64,
     ) -> Result<Attempt, IntegrateError<S::Error>> {
         let need_jac = !self.jac_valid
-            || self.steps_since_jac >= self.settings.jacobian_reuse
+            || self.steps_since_jac >= self.jacobian_reuse
             || (self.core.rejected_last && !self.jac_fresh);
         if need_jac {
             self.evaluate_jacobian(sys)?;
@@ -362,7 +401,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
         }
         let c = self.core.control;
         let err = error_norm(&self.y_stage, &self.y, &self.y_new, c.atol, c.rtol);
-        let fac = c.factor(err, 1.0 / 3.0);
+        let fac = CONTROLLER.factor(err, 1.0 / 3.0);
         let passed = err <= 1.0;
         if !passed {
             return Ok(self.core.reject(h * fac.min(1.0), Failure::None));

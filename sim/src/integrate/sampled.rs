@@ -116,7 +116,7 @@ mod tests {
     use super::super::test_problems::{
         ExactSolution, FailingRhs, HarmonicOscillator, Kepler, RhsFailure,
     };
-    use super::super::{Dopri5Settings, DormandPrince45, Rk4};
+    use super::super::{DormandPrince45, Rk4, StepControl};
     use super::*;
 
     /// Collects all samples of one run.
@@ -179,7 +179,7 @@ mod tests {
                         &mut sample,
                     )
                 } else {
-                    let mut st = DormandPrince45::new(2, Dopri5Settings::default());
+                    let mut st = DormandPrince45::new(2, StepControl::new(1e-6, 1e-9));
                     integrate_sampled(&mut st, &mut p, t0, &y0, t_end, dt_out, &mut sample)
                 };
                 res.expect("run");
@@ -231,11 +231,7 @@ mod tests {
     fn sampled_dopri5_is_independent_of_dt_out() {
         let tau = std::f64::consts::TAU;
         let tol = 1e-8;
-        let s = Dopri5Settings {
-            rtol: tol,
-            atol: tol,
-            ..Dopri5Settings::default()
-        };
+        let s = StepControl::new(tol, tol);
         let mut reference: Option<(Stats, Vec<f64>)> = None;
         for dt_out in [tau, tau / 7.0, tau / 1000.0, tau / 20000.0] {
             let mut p = Kepler { e: 0.5 };
@@ -289,7 +285,7 @@ mod tests {
     #[test]
     fn sampled_rhs_error_passes_through() {
         let mut p = FailingRhs { t_fail: 0.42 };
-        let mut st = DormandPrince45::new(1, Dopri5Settings::default());
+        let mut st = DormandPrince45::new(1, StepControl::new(1e-6, 1e-9));
         let mut last = 0.0;
         let res = integrate_sampled(&mut st, &mut p, 0.0, &[1.0], 1.0, 0.1, |t, _| {
             last = t;

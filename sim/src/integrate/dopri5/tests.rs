@@ -5,15 +5,11 @@ use super::super::test_problems::{
 use super::super::testutil::{run_exact, scaled_err, Run};
 use super::*;
 
-fn tol_settings(tol: f64) -> Dopri5Settings {
-    Dopri5Settings {
-        rtol: tol,
-        atol: tol,
-        ..Dopri5Settings::default()
-    }
+fn tol_settings(tol: f64) -> StepControl {
+    StepControl::new(tol, tol)
 }
 
-fn run<P: ExactSolution>(p: P, settings: Dopri5Settings, t_end: f64) -> Run {
+fn run<P: ExactSolution>(p: P, settings: StepControl, t_end: f64) -> Run {
     let st = DormandPrince45::new(p.dim(), settings);
     run_exact(p, st, t_end)
 }
@@ -30,7 +26,7 @@ const TOLS: [f64; 3] = [1e-6, 1e-8, 1e-10];
 /// that grows along the orbit (about 10x per revolution at e = 0, much more at e = 0.9,
 /// where the pericentre passage is fast). Tolerance proportionality still holds: the ratio
 /// err/tol stays roughly constant as tol shrinks.
-fn for_each_problem(mut f: impl FnMut(&str, f64, &dyn Fn(Dopri5Settings) -> Run)) {
+fn for_each_problem(mut f: impl FnMut(&str, f64, &dyn Fn(StepControl) -> Run)) {
     let tau = std::f64::consts::TAU;
     f("decay", 10.0, &|s| {
         run(ExponentialDecay { k: 1.0, y0: 1.0 }, s, 5.0)
@@ -85,12 +81,12 @@ fn dopri5_global_and_dense_error_within_c_tol() {
 #[test]
 fn dopri5_fixed_step_order_five() {
     fn fixed<P: ExactSolution>(p: P, h: f64, t_end: f64) -> f64 {
-        let s = Dopri5Settings {
+        let s = StepControl {
             rtol: 1e3,
             atol: 1e3,
             h_init: Some(h),
             h_max: h,
-            ..Dopri5Settings::default()
+            ..StepControl::new(1e-6, 1e-9)
         };
         let r = run(p, s, t_end);
         assert_eq!(r.stats.rejected, 0);
@@ -133,11 +129,11 @@ fn dopri5_dense_output_local_order_five() {
         let mut y0 = [0.0; 4];
         p.exact(t0, &mut y0);
         // loose tolerance so the step of size h is accepted as is
-        let s = Dopri5Settings {
+        let s = StepControl {
             rtol: 1e3,
             atol: 1e3,
             h_init: Some(h),
-            ..Dopri5Settings::default()
+            ..StepControl::new(1e-6, 1e-9)
         };
         let mut st = DormandPrince45::new(4, s);
         st.init(&mut p, t0, &y0).expect("init");
@@ -185,7 +181,7 @@ fn dopri5_stats_count_rhs_evals() {
     // a too-large first step forces rejections; with h_init given there is no guess
     let mut p = Kepler { e: 0.9 };
     let y0 = p.y0();
-    let s = Dopri5Settings {
+    let s = StepControl {
         h_init: Some(1.0),
         ..tol_settings(1e-8)
     };
@@ -273,7 +269,7 @@ fn dopri5_step_size_too_small_at_singularity() {
     // the same with a user h_min stops earlier
     let mut st = DormandPrince45::new(
         1,
-        Dopri5Settings {
+        StepControl {
             h_min: 1e-6,
             ..tol_settings(1e-8)
         },
@@ -344,7 +340,7 @@ fn dopri5_too_many_steps() {
     let mut p = HarmonicOscillator::default();
     let mut st = DormandPrince45::new(
         2,
-        Dopri5Settings {
+        StepControl {
             max_steps: 10,
             ..tol_settings(1e-10)
         },
@@ -369,7 +365,7 @@ fn dopri5_too_many_steps() {
 #[test]
 fn dopri5_respects_h_max_h_init_and_stop_times() {
     let mut p = ExponentialDecay::default();
-    let s = Dopri5Settings {
+    let s = StepControl {
         h_max: 0.01,
         ..tol_settings(1e-6)
     };
@@ -383,7 +379,7 @@ fn dopri5_respects_h_max_h_init_and_stop_times() {
     assert!(st.stats().steps >= 100);
 
     // h_init is the first step when it passes the error test
-    let s = Dopri5Settings {
+    let s = StepControl {
         h_init: Some(1e-3),
         ..tol_settings(1e-6)
     };
@@ -419,87 +415,36 @@ fn dopri5_respects_h_max_h_init_and_stop_times() {
 
 #[test]
 fn dopri5_settings_validation() {
-    assert!(Dopri5Settings::default().validate().is_ok());
+    let ok = StepControl::new(1e-6, 1e-9);
+    assert!(ok.validate().is_ok());
     let cases = [
-        (
-            "rtol",
-            Dopri5Settings {
-                rtol: -1.0,
-                ..Default::default()
-            },
-        ),
-        (
-            "atol",
-            Dopri5Settings {
-                atol: 0.0,
-                ..Default::default()
-            },
-        ),
+        ("rtol", StepControl { rtol: -1.0, ..ok }),
+        ("atol", StepControl { atol: 0.0, ..ok }),
         (
             "h_init",
-            Dopri5Settings {
+            StepControl {
                 h_init: Some(f64::NAN),
-                ..Default::default()
+                ..ok
             },
         ),
-        (
-            "h_max",
-            Dopri5Settings {
-                h_max: 0.0,
-                ..Default::default()
-            },
-        ),
+        ("h_max", StepControl { h_max: 0.0, ..ok }),
         (
             "h_min",
-            Dopri5Settings {
+            StepControl {
                 h_min: 1.0,
                 h_max: 0.5,
-                ..Default::default()
+                ..ok
             },
         ),
         (
             "h_init",
-            Dopri5Settings {
+            StepControl {
                 h_init: Some(1e-9),
                 h_min: 1e-6,
-                ..Default::default()
+                ..ok
             },
         ),
-        (
-            "max_steps",
-            Dopri5Settings {
-                max_steps: 0,
-                ..Default::default()
-            },
-        ),
-        (
-            "safety",
-            Dopri5Settings {
-                safety: 1.5,
-                ..Default::default()
-            },
-        ),
-        (
-            "fac_min",
-            Dopri5Settings {
-                fac_min: 0.0,
-                ..Default::default()
-            },
-        ),
-        (
-            "fac_max",
-            Dopri5Settings {
-                fac_max: 0.5,
-                ..Default::default()
-            },
-        ),
-        (
-            "beta",
-            Dopri5Settings {
-                beta: 0.3,
-                ..Default::default()
-            },
-        ),
+        ("max_steps", StepControl { max_steps: 0, ..ok }),
     ];
     for (field, s) in cases {
         match DormandPrince45::try_new(1, s) {

@@ -2,29 +2,25 @@ use super::super::test_problems::{
     ExactSolution, NanAfter, OscillatorSplit, RhsFailure, StiffKepler, StiffLinear, StiffOscillator,
 };
 use super::super::testutil::{run_exact, scaled_err, Run};
-use super::super::{integrate_sampled, Dopri5Settings, DormandPrince45, OdeSystem};
+use super::super::{integrate_sampled, DormandPrince45, OdeSystem};
 use super::*;
 use std::convert::Infallible;
 
-fn tol_settings(tol: f64) -> ArkImexSettings {
-    ArkImexSettings {
-        rtol: tol,
-        atol: tol,
-        ..ArkImexSettings::default()
-    }
+fn tol_settings(tol: f64) -> StepControl {
+    StepControl::new(tol, tol)
 }
 
-fn fixed_settings(h: f64) -> ArkImexSettings {
-    ArkImexSettings {
+fn fixed_settings(h: f64) -> StepControl {
+    StepControl {
         rtol: 1e3,
         atol: 1e3,
         h_init: Some(h),
         h_max: h,
-        ..ArkImexSettings::default()
+        ..StepControl::new(1e-6, 1e-9)
     }
 }
 
-fn run<P: ExactSolution + SplitSystem>(p: P, settings: ArkImexSettings, t_end: f64) -> Run {
+fn run<P: ExactSolution + SplitSystem>(p: P, settings: StepControl, t_end: f64) -> Run {
     let st = ArkImex::new(p.dim(), settings);
     run_exact(p, st, t_end)
 }
@@ -202,11 +198,7 @@ fn ark436_fixed_step_order_four_on_split_problem() {
 /// Steps of DOPRI5 on the same problem and tolerance (for contrast).
 fn dopri5_stats<P: ExactSolution>(mut p: P, tol: f64, t_end: f64) -> Stats {
     let y0 = p.y0();
-    let s = Dopri5Settings {
-        rtol: tol,
-        atol: tol,
-        ..Dopri5Settings::default()
-    };
+    let s = StepControl::new(tol, tol);
     let mut st = DormandPrince45::new(p.dim(), s);
     let t0 = p.t0();
     st.init(&mut p, t0, &y0).expect("init");
@@ -315,7 +307,7 @@ fn ark436_splits_on_motor_oscillator() {
 #[test]
 fn ark436_global_and_dense_error_within_c_tol() {
     let tau = std::f64::consts::TAU;
-    type Solve<'a> = &'a dyn Fn(ArkImexSettings) -> Run;
+    type Solve<'a> = &'a dyn Fn(StepControl) -> Run;
     let problems: [(&str, f64, Solve); 4] = [
         ("PR -1e4", 10.0, &|s| {
             run(

@@ -3,31 +3,27 @@ use super::super::test_problems::{
     RationalDecay, RhsFailure, StiffKepler, StiffLinear, StiffOscillator,
 };
 use super::super::testutil::{run_exact, scaled_err, Run};
-use super::super::{integrate_sampled, Dopri5Settings, DormandPrince45, FdJacobian, OdeSystem};
+use super::super::{integrate_sampled, DormandPrince45, FdJacobian, OdeSystem};
 use super::tableau::{ALPHA, B, B_HAT, GAMMA_IJ};
 use super::*;
 use std::convert::Infallible;
 
-fn tol_settings(tol: f64) -> RosenbrockSettings {
-    RosenbrockSettings {
-        rtol: tol,
-        atol: tol,
-        ..RosenbrockSettings::default()
-    }
+fn tol_settings(tol: f64) -> StepControl {
+    StepControl::new(tol, tol)
 }
 
 /// Fixed step `h`: tolerances so loose that every step passes, `h_init = h_max = h`.
-fn fixed_settings(h: f64) -> RosenbrockSettings {
-    RosenbrockSettings {
+fn fixed_settings(h: f64) -> StepControl {
+    StepControl {
         rtol: 1e3,
         atol: 1e3,
         h_init: Some(h),
         h_max: h,
-        ..RosenbrockSettings::default()
+        ..StepControl::new(1e-6, 1e-9)
     }
 }
 
-fn run<P: ExactSolution + OdeJacobian>(p: P, settings: RosenbrockSettings, t_end: f64) -> Run {
+fn run<P: ExactSolution + OdeJacobian>(p: P, settings: StepControl, t_end: f64) -> Run {
     let st = Rosenbrock::new(p.dim(), settings);
     run_exact(p, st, t_end)
 }
@@ -213,7 +209,7 @@ fn ros34pw2_fixed_step_order_three_exact_and_wrong_jacobian() {
 /// Kepler 213, decay 0.5, harmonic 10.3, rational 0.7, Kepler e=0.5 108; C has a margin of 2-4x.
 /// Kepler's are large for the physical reason given in the DOPRI5 tests (energy errors become
 /// phase errors), the harmonic oscillator's because 10 s is 3 periods of undamped error growth.
-fn for_each_problem(mut f: impl FnMut(&str, f64, &dyn Fn(RosenbrockSettings) -> Run)) {
+fn for_each_problem(mut f: impl FnMut(&str, f64, &dyn Fn(StepControl) -> Run)) {
     let tau = std::f64::consts::TAU;
     f("PR -1e4", 7.0, &|s| {
         run(
@@ -291,11 +287,7 @@ fn rosenbrock_global_and_dense_error_within_c_tol() {
 fn dopri5_steps<P: ExactSolution>(mut p: P, tol: f64, t_end: f64) -> (Stats, f64) {
     let y0 = p.y0();
     let n = p.dim();
-    let s = Dopri5Settings {
-        rtol: tol,
-        atol: tol,
-        ..Dopri5Settings::default()
-    };
+    let s = StepControl::new(tol, tol);
     let mut st = DormandPrince45::new(n, s);
     let t0 = p.t0();
     st.init(&mut p, t0, &y0).expect("init");
@@ -384,13 +376,7 @@ fn rosenbrock_vs_dopri5_on_motor_oscillator() {
         for reuse in [1, 5] {
             let mut p = FdJacobian::new(StiffOscillator::default());
             let y0 = p.inner().y0();
-            let mut st = Rosenbrock::new(
-                3,
-                RosenbrockSettings {
-                    jacobian_reuse: reuse,
-                    ..tol_settings(tol)
-                },
-            );
+            let mut st = Rosenbrock::new(3, tol_settings(tol)).with_jacobian_reuse(reuse);
             st.init(&mut p, 0.0, &y0).expect("init");
             while st.t() < 5.0 {
                 st.step(&mut p, 5.0).expect("step");
@@ -424,13 +410,7 @@ fn rosenbrock_jacobian_reuse_cuts_jacobian_evals_and_keeps_tolerance() {
         let mut base: Option<Stats> = None;
         for reuse in [1, 5, 20] {
             let mut sys = FdJacobian::new(p.clone());
-            let mut st = Rosenbrock::new(
-                n,
-                RosenbrockSettings {
-                    jacobian_reuse: reuse,
-                    ..tol_settings(tol)
-                },
-            );
+            let mut st = Rosenbrock::new(n, tol_settings(tol)).with_jacobian_reuse(reuse);
             st.init(&mut sys, 0.0, &y0).expect("init");
             while st.t() < t_end {
                 st.step(&mut sys, t_end).expect("step");

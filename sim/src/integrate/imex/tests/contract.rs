@@ -16,7 +16,7 @@ fn ark436_stats_count_evaluations_exactly() {
         let mut q = p;
         let mut st = ArkImex::new(
             5,
-            ArkImexSettings {
+            StepControl {
                 h_init,
                 ..tol_settings(1e-8)
             },
@@ -187,7 +187,7 @@ fn ark436_too_many_steps_stop_times_and_settings() {
     let y0 = p.y0();
     let mut st = ArkImex::new(
         5,
-        ArkImexSettings {
+        StepControl {
             max_steps: 10,
             ..tol_settings(1e-10)
         },
@@ -215,32 +215,14 @@ fn ark436_too_many_steps_stop_times_and_settings() {
     }
     assert_eq!(st.step(&mut p, 3.0).expect("no-op"), 3.0);
 
-    assert!(ArkImexSettings::default().validate().is_ok());
+    assert!(StepControl::new(1e-6, 1e-9).validate().is_ok());
+    let ok = StepControl::new(1e-6, 1e-9);
     for (field, s) in [
-        (
-            "atol",
-            ArkImexSettings {
-                atol: 0.0,
-                ..Default::default()
-            },
-        ),
-        (
-            "safety",
-            ArkImexSettings {
-                safety: 1.5,
-                ..Default::default()
-            },
-        ),
-        (
-            "max_steps",
-            ArkImexSettings {
-                max_steps: 0,
-                ..Default::default()
-            },
-        ),
+        ("atol", StepControl { atol: 0.0, ..ok }),
+        ("max_steps", StepControl { max_steps: 0, ..ok }),
     ] {
         match ArkImex::try_new(1, s) {
-            Err(e) => assert_eq!((e.settings, e.field), ("ArkImexSettings", field)),
+            Err(e) => assert_eq!((e.settings, e.field), ("StepControl", field)),
             Ok(_) => panic!("{field}: accepted invalid settings"),
         }
     }

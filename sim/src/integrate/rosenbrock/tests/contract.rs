@@ -10,7 +10,7 @@ use super::*;
 #[test]
 fn rosenbrock_dense_output_local_order_four_and_exact_ends() {
     fn local_dense_err(h: f64) -> f64 {
-        let s = RosenbrockSettings {
+        let s = StepControl {
             h_init: Some(h),
             ..fixed_settings(h)
         };
@@ -41,7 +41,7 @@ fn rosenbrock_stats_count_evaluations_exactly() {
     let tau = std::f64::consts::TAU;
     let mut p = Kepler { e: 0.9 };
     let y0 = p.y0();
-    let s = RosenbrockSettings {
+    let s = StepControl {
         h_init: Some(1.0),
         ..tol_settings(1e-7)
     };
@@ -70,13 +70,7 @@ fn rosenbrock_stats_count_evaluations_exactly() {
     assert_eq!(s.implicit_solves, 0);
 
     let mut p = FdJacobian::new(Kepler { e: 0.9 });
-    let mut st = Rosenbrock::new(
-        4,
-        RosenbrockSettings {
-            jacobian_reuse: 3,
-            ..tol_settings(1e-7)
-        },
-    );
+    let mut st = Rosenbrock::new(4, tol_settings(1e-7)).with_jacobian_reuse(3);
     st.init(&mut p, 0.0, &y0).expect("init");
     while st.t() < tau {
         st.step(&mut p, tau).expect("step");
@@ -147,7 +141,7 @@ fn rosenbrock_singular_matrix_reported_with_its_time() {
         t_sing: 0.45,
         h_sing: h,
     };
-    let s = RosenbrockSettings {
+    let s = StepControl {
         h_min: h,
         ..fixed_settings(h)
     };
@@ -172,7 +166,7 @@ fn rosenbrock_singular_matrix_reported_with_its_time() {
     assert!(err.to_string().contains("t = 0.5"));
 
     let tol = 1e-6;
-    let s = RosenbrockSettings {
+    let s = StepControl {
         h_init: Some(h),
         h_max: h,
         ..tol_settings(tol)
@@ -294,7 +288,7 @@ fn rosenbrock_too_many_steps_and_stop_times() {
     let mut p = HarmonicOscillator::default();
     let mut st = Rosenbrock::new(
         2,
-        RosenbrockSettings {
+        StepControl {
             max_steps: 10,
             ..tol_settings(1e-10)
         },
@@ -329,44 +323,28 @@ fn rosenbrock_too_many_steps_and_stop_times() {
 
 #[test]
 fn rosenbrock_settings_validation() {
-    assert!(RosenbrockSettings::default().validate().is_ok());
+    let ok = StepControl::new(1e-6, 1e-9);
+    let e = Rosenbrock::new(1, ok)
+        .try_with_jacobian_reuse(0)
+        .expect_err("reuse 0");
+    assert_eq!((e.settings, e.field), ("Rosenbrock", "jacobian_reuse"));
+    assert!(e.to_string().contains("Rosenbrock.jacobian_reuse"), "{e}");
     for (field, s) in [
-        (
-            "jacobian_reuse",
-            RosenbrockSettings {
-                jacobian_reuse: 0,
-                ..Default::default()
-            },
-        ),
-        (
-            "rtol",
-            RosenbrockSettings {
-                rtol: -1.0,
-                ..Default::default()
-            },
-        ),
+        ("rtol", StepControl { rtol: -1.0, ..ok }),
         (
             "h_min",
-            RosenbrockSettings {
+            StepControl {
                 h_min: 1.0,
                 h_max: 0.5,
-                ..Default::default()
-            },
-        ),
-        (
-            "fac_max",
-            RosenbrockSettings {
-                fac_max: 0.5,
-                ..Default::default()
+                ..ok
             },
         ),
     ] {
         match Rosenbrock::try_new(1, s) {
             Err(e) => {
-                assert_eq!((e.settings, e.field), ("RosenbrockSettings", field));
+                assert_eq!((e.settings, e.field), ("StepControl", field));
                 assert!(
-                    e.to_string()
-                        .contains(&format!("RosenbrockSettings.{field}")),
+                    e.to_string().contains(&format!("StepControl.{field}")),
                     "{e}"
                 );
             }
@@ -387,13 +365,7 @@ fn rosenbrock_with_integrate_sampled_is_independent_of_dt_out() {
         let mut p = FdJacobian::new(StiffOscillator::default());
         let exact = *p.inner();
         let y0 = exact.y0();
-        let mut st = Rosenbrock::new(
-            3,
-            RosenbrockSettings {
-                jacobian_reuse: 5,
-                ..tol_settings(tol)
-            },
-        );
+        let mut st = Rosenbrock::new(3, tol_settings(tol)).with_jacobian_reuse(5);
         let (mut worst, mut count, mut ex) = (0.0f64, 0usize, [0.0; 3]);
         let stats = integrate_sampled(&mut st, &mut p, 0.0, &y0, 5.0, dt_out, |t, y| {
             exact.exact(t, &mut ex);
