@@ -375,6 +375,3 @@ impl<S: OdeSystem> Stepper<S> for DormandPrince45 {
         eval_finite(&mut self.core.stats, sys, self.core.t, y, &mut self.k1)
     }
 }
-
-#[cfg(test)]
-mod tests;

@@ -99,6 +99,8 @@ macro_rules! adaptive_accessors {
 }
 
 mod adaptive;
+#[cfg(test)]
+mod contract;
 mod control;
 mod dopri5;
 mod imex;

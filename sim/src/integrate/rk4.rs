@@ -236,114 +236,15 @@ impl<S: OdeSystem> Stepper<S> for Rk4 {
 
 #[cfg(test)]
 mod tests {
+    //! Rk4-specific: the grid, landing on stop times, the step count, the stage at which a
+    //! failure is met. The stepper contract (orders, dense output, counts, errors) is
+    //! `contract.rs`.
+
     use super::super::test_problems::{
-        ExactSolution, FailingRhs, HarmonicOscillator, Kepler, NanAfter, RationalDecay, RhsFailure,
-        RiccatiBlowup,
+        FailingRhs, HarmonicOscillator, NanAfter, RationalDecay, RhsFailure,
     };
+    use super::super::testutil::run_to_failure;
     use super::*;
-
-    fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-        a.iter()
-            .zip(b)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0, f64::max)
-    }
-
-    /// Integrates `p` from its t0 to `t_end` with step `h`; returns the max-norm error at
-    /// `t_end` and the max-norm error of the dense output at theta = 1/4, 1/2, 3/4 of every step.
-    fn rk4_errors<P: ExactSolution>(mut p: P, h: f64, t_end: f64) -> (f64, f64) {
-        let n = p.dim();
-        let y0 = p.y0();
-        let mut st = Rk4::new(n, h);
-        let (mut ex, mut yi) = (vec![0.0; n], vec![0.0; n]);
-        let t0 = p.t0();
-        st.init(&mut p, t0, &y0).expect("init");
-        let mut dense_err: f64 = 0.0;
-        while st.t() < t_end {
-            let t_old = st.t();
-            let t_new = st.step(&mut p, t_end).expect("step");
-            for th in [0.25, 0.5, 0.75] {
-                let tq = t_old + th * (t_new - t_old);
-                st.interpolate(tq, &mut yi);
-                p.exact(tq, &mut ex);
-                dense_err = dense_err.max(max_abs_diff(&yi, &ex));
-            }
-        }
-        assert_eq!(st.t(), t_end);
-        p.exact(t_end, &mut ex);
-        (max_abs_diff(st.y(), &ex), dense_err)
-    }
-
-    /// Observed order p = log2(e(h) / e(h/2)) of the end-point and dense-output errors.
-    fn observed_orders<P: ExactSolution + Copy + std::fmt::Debug>(
-        p: P,
-        h: f64,
-        t_end: f64,
-    ) -> (f64, f64) {
-        let (e1, d1) = rk4_errors(p, h, t_end);
-        let (e2, d2) = rk4_errors(p, 0.5 * h, t_end);
-        eprintln!(
-            "{p:?} h = {h}: end err {e1:.3e} -> {e2:.3e} (order {:.3}), dense err {d1:.3e} -> {d2:.3e} (order {:.3})",
-            (e1 / e2).log2(),
-            (d1 / d2).log2()
-        );
-        ((e1 / e2).log2(), (d1 / d2).log2())
-    }
-
-    // Global error at t_end must fall 16x per halving of h: observed order in [3.8, 4.2].
-    #[test]
-    fn rk4_observed_order_nonlinear() {
-        let (p, _) = observed_orders(RationalDecay, 0.1, 3.0);
-        assert!((3.8..=4.2).contains(&p), "observed order {p}");
-    }
-
-    #[test]
-    fn rk4_observed_order_oscillator() {
-        let (p, _) = observed_orders(HarmonicOscillator { omega: 2.0 }, 0.05, 10.0);
-        assert!((3.8..=4.2).contains(&p), "observed order {p}");
-    }
-
-    #[test]
-    fn rk4_observed_order_kepler() {
-        let period = std::f64::consts::TAU;
-        let (p, _) = observed_orders(Kepler { e: 0.3 }, period / 400.0, period);
-        assert!((3.8..=4.2).contains(&p), "observed order {p}");
-    }
-
-    // Hermite dense output at interior points: error O(h^4), observed order in [3.8, 4.2].
-    #[test]
-    fn rk4_hermite_dense_output_order() {
-        for (name, d) in [
-            ("rational", observed_orders(RationalDecay, 0.1, 3.0).1),
-            (
-                "oscillator",
-                observed_orders(HarmonicOscillator { omega: 2.0 }, 0.05, 10.0).1,
-            ),
-        ] {
-            assert!(
-                (3.8..=4.2).contains(&d),
-                "{name}: dense-output observed order {d}"
-            );
-        }
-    }
-
-    #[test]
-    fn rk4_dense_output_endpoints_are_exact() {
-        let mut p = HarmonicOscillator::default();
-        let mut st = Rk4::new(2, 0.1);
-        st.init(&mut p, 0.0, &[1.0, 0.0]).expect("init");
-        // before any step: the state itself
-        let mut out = [0.0; 2];
-        st.interpolate(0.0, &mut out);
-        assert_eq!(out, [1.0, 0.0]);
-        st.step(&mut p, 1.0).expect("step");
-        let y1 = [st.y()[0], st.y()[1]];
-        st.step(&mut p, 1.0).expect("step");
-        st.interpolate(st.t(), &mut out);
-        assert_eq!(out.as_slice(), st.y());
-        st.interpolate(st.t_prev(), &mut out);
-        assert_eq!(out, y1);
-    }
 
     #[test]
     fn rk4_step_times_are_multiples_of_h() {
@@ -368,10 +269,7 @@ mod tests {
         }
         assert_eq!(last, 0.25);
         assert_eq!(st.stats().steps, 3); // 0.1, 0.2, 0.25 (shortened)
-                                         // at t_stop: a no-op
-        assert_eq!(st.step(&mut p, 0.25).expect("no-op"), 0.25);
-        assert_eq!(st.stats().steps, 3);
-        // the grid resumes at 0.3 = 3 * 0.1, not 0.35
+                                         // the grid resumes at 0.3 = 3 * 0.1, not 0.35
         assert_eq!(st.step(&mut p, 1.0).expect("step"), 3.0 * 0.1);
         // a stop time within rounding of a grid point is hit without a sliver step
         let mut st = Rk4::new(2, 0.1);
@@ -382,110 +280,43 @@ mod tests {
         }
         assert_eq!(st.stats().steps, 3);
         assert_eq!(st.t(), t_stop);
-    }
-
-    // Exactly 4 evaluations per step plus 1 in init (FSAL-style reuse of f at the step end).
-    #[test]
-    fn rk4_stats_count_rhs_evals_exactly() {
-        let mut p = Kepler { e: 0.2 };
-        let y0 = p.y0();
-        let mut st = Rk4::new(4, 0.01);
-        st.init(&mut p, 0.0, &y0).expect("init");
-        assert_eq!(
-            st.stats(),
-            Stats {
-                rhs_evals: 1,
-                steps: 0,
-                rejected: 0,
-                ..Stats::default()
-            }
-        );
+        // 123 full steps + 1 shortened to reach 1.234 with h = 0.01
+        let mut st = Rk4::new(2, 0.01);
+        st.init(&mut p, 0.0, &[1.0, 0.0]).expect("init");
         while st.t() < 1.234 {
             st.step(&mut p, 1.234).expect("step");
         }
-        let s = st.stats();
-        assert_eq!(s.steps, 124); // 123 full steps + 1 shortened
-        assert_eq!(s.rhs_evals, 4 * s.steps + 1);
-        assert_eq!(s.rejected, 0);
+        assert_eq!(st.stats().steps, 124);
     }
 
+    // A failure is met by the first stage evaluated at or after its onset: with h = 0.1, a
+    // failing rhs from 0.33 and a NaN from 0.43 at k2 of the steps from 0.3 and 0.4 (0.35,
+    // 0.45); the state stays at the step's start (t = 0.3 after 3 steps; t = 0.4).
     #[test]
-    fn rk4_rhs_error_passes_through_and_state_is_kept() {
+    fn rk4_failures_are_met_at_the_stage_time() {
         let mut p = FailingRhs { t_fail: 0.33 };
         let mut st = Rk4::new(1, 0.1);
         st.init(&mut p, 0.0, &[1.0]).expect("init");
-        let mut err = None;
-        while st.t() < 1.0 {
-            match st.step(&mut p, 1.0) {
-                Ok(_) => {}
-                Err(e) => {
-                    err = Some(e);
-                    break;
-                }
-            }
-        }
-        // the first evaluation at t >= 0.33 is k2 of the step from 0.3, at 0.35
-        match err {
-            Some(IntegrateError::Rhs(RhsFailure { t })) => assert!((t - 0.35).abs() < 1e-15, "{t}"),
+        match run_to_failure(&mut st, &mut p, 1.0) {
+            IntegrateError::Rhs(RhsFailure { t }) => assert!((t - 0.35).abs() < 1e-15, "{t}"),
             other => panic!("expected Rhs error, got {other:?}"),
         }
-        // the failed step left the last good state untouched
-        assert!((st.t() - 0.3).abs() < 1e-15);
-        assert_eq!(st.stats().steps, 3);
-    }
-
-    // A stage derivative turning NaN is reported at the time it was evaluated.
-    #[test]
-    fn rk4_nan_reports_stage_time_and_index() {
+        assert!((st.t() - 0.3).abs() < 1e-15 && st.stats().steps == 3);
         let mut p = NanAfter {
             t_nan: 0.43,
             index: 1,
         };
         let mut st = Rk4::new(2, 0.1);
         st.init(&mut p, 0.0, &[1.0, 1.0]).expect("init");
-        let err = loop {
-            if let Err(e) = st.step(&mut p, 1.0) {
-                break e;
-            }
-        };
-        match err {
+        match run_to_failure(&mut st, &mut p, 1.0) {
             IntegrateError::NonFiniteState { t, index } => {
-                // the first evaluation at t >= 0.43 is k2 of the step [0.4, 0.5], at 0.45
-                assert!((t - 0.45).abs() < 1e-12, "t = {t}");
-                assert_eq!(index, 1);
+                assert!(
+                    (t - 0.45).abs() < 1e-12 && index == 1,
+                    "t = {t}, index {index}"
+                );
             }
             other => panic!("expected NonFiniteState, got {other:?}"),
         }
-    }
-
-    // y' = y^2 with a fixed step overflows past the singularity at t = 1.
-    #[test]
-    fn rk4_overflow_after_blowup_is_non_finite_state() {
-        let mut p = RiccatiBlowup;
-        let mut st = Rk4::new(1, 0.05);
-        st.init(&mut p, 0.0, &[1.0]).expect("init");
-        let err = loop {
-            match st.step(&mut p, 10.0) {
-                Ok(t) => assert!(t < 10.0, "integrated through the singularity"),
-                Err(e) => break e,
-            }
-        };
-        match err {
-            IntegrateError::NonFiniteState { t, index } => {
-                assert_eq!(index, 0);
-                assert!(t > 1.0 && t < 2.0, "t = {t}");
-            }
-            other => panic!("expected NonFiniteState, got {other:?}"),
-        }
-    }
-
-    #[test]
-    fn rk4_non_finite_initial_state_is_rejected() {
-        let mut p = HarmonicOscillator::default();
-        let mut st = Rk4::new(2, 0.1);
-        match st.init(&mut p, 0.5, &[1.0, f64::INFINITY]) {
-            Err(IntegrateError::NonFiniteState { t, index }) => assert_eq!((t, index), (0.5, 1)),
-            other => panic!("expected NonFiniteState, got {other:?}"),
-        }
+        assert!((st.t() - 0.4).abs() < 1e-15);
     }
 }

@@ -1,29 +1,11 @@
-use super::super::test_problems::{
-    ExactSolution, NanAfter, OscillatorSplit, RhsFailure, StiffKepler, StiffLinear, StiffOscillator,
-};
-use super::super::testutil::{run_exact, scaled_err, Run};
-use super::super::{integrate_sampled, DormandPrince45, OdeSystem};
+//! ArkImex-specific tests: the tableau's order conditions and stability, and the choice of the
+//! split on the motor oscillator. The stepper contract (orders, tolerance, dense output,
+//! counts, errors, settings, stiff problems) is `contract.rs`.
+
+use super::super::test_problems::{OscillatorSplit, StiffOscillator};
+use super::super::testutil::run_exact;
+use super::super::DormandPrince45;
 use super::*;
-use std::convert::Infallible;
-
-fn tol_settings(tol: f64) -> StepControl {
-    StepControl::new(tol, tol)
-}
-
-fn fixed_settings(h: f64) -> StepControl {
-    StepControl {
-        rtol: 1e3,
-        atol: 1e3,
-        h_init: Some(h),
-        h_max: h,
-        ..StepControl::new(1e-6, 1e-9)
-    }
-}
-
-fn run<P: ExactSolution + SplitSystem>(p: P, settings: StepControl, t_end: f64) -> Run {
-    let st = ArkImex::new(p.dim(), settings);
-    run_exact(p, st, t_end)
-}
 
 /// `sum_i w_i (A c^k)_i`-style sums: `phi(b, v) = sum_i b_i v_i`, `mv(A, v) = A v`.
 fn dot(b: &[f64; 6], v: &[f64; 6]) -> f64 {
@@ -162,92 +144,6 @@ fn ark436_satisfies_its_order_conditions() {
     }
 }
 
-/// Fixed-step global scaled error at t_end.
-fn fixed<P: ExactSolution + SplitSystem>(p: P, h: f64, t_end: f64) -> f64 {
-    let r = run(p, fixed_settings(h), t_end);
-    assert_eq!(r.stats.rejected, 0);
-    r.err_end
-}
-
-// Fixed step: the error falls 16x per halving of h on the split problem of the brief: a stiff
-// Prothero-Robinson component w' = -k (w - cos t) - sin t (implicit, k = 1e4 and 1e6) coupled
-// nonlinearly to the Kepler problem (explicit). Observed order in [3.8, 4.3] over
-// h = tau/200 -> tau/400 -> tau/800 (measured 4.2, 4.1 for both k); h k = 79 .. 3e4, far
-// outside any explicit method's stability region.
-#[test]
-fn ark436_fixed_step_order_four_on_split_problem() {
-    let tau = std::f64::consts::TAU;
-    for k in [1e4, 1e6] {
-        let p = StiffKepler { e: 0.3, k };
-        let (e1, e2, e3) = (
-            fixed(p, tau / 200.0, tau),
-            fixed(p, tau / 400.0, tau),
-            fixed(p, tau / 800.0, tau),
-        );
-        let (o1, o2) = ((e1 / e2).log2(), (e2 / e3).log2());
-        eprintln!(
-            "stiff kepler k = {k:e}: err {e1:.3e} -> {e2:.3e} -> {e3:.3e}, orders {o1:.3}, {o2:.3}"
-        );
-        assert!(
-            (3.8..=4.3).contains(&o1) && (3.8..=4.3).contains(&o2),
-            "k {k}: orders {o1} {o2}"
-        );
-    }
-}
-
-/// Steps of DOPRI5 on the same problem and tolerance (for contrast).
-fn dopri5_stats<P: ExactSolution>(mut p: P, tol: f64, t_end: f64) -> Stats {
-    let y0 = p.y0();
-    let s = StepControl::new(tol, tol);
-    let mut st = DormandPrince45::new(p.dim(), s);
-    let t0 = p.t0();
-    st.init(&mut p, t0, &y0).expect("init");
-    while st.t() < t_end {
-        st.step(&mut p, t_end).expect("step");
-    }
-    st.stats()
-}
-
-// Stability: on Prothero-Robinson with lambda = -1e4 (all implicit) the IMEX steps are set by
-// accuracy, not stability: measured 11 steps on [0, 1] at tol 1e-6 (bound 40; |h lambda| up to
-// ~3e3) against DOPRI5's 3030 (bound >= 1e4 / 3.31); the same 11 for lambda = -1e6 (bound 1.5x).
-#[test]
-fn ark436_steps_far_beyond_the_explicit_limit() {
-    let tol = 1e-6;
-    let mut counts = Vec::new();
-    for lambda in [-1e4, -1e6] {
-        let r = run(StiffLinear { lambda, y0: 1.0 }, tol_settings(tol), 1.0);
-        eprintln!(
-            "PR lambda {lambda:.0e}: ARK {} steps ({} rejected), {} rhs, {} solves, err {:.2e}",
-            r.stats.steps, r.stats.rejected, r.stats.rhs_evals, r.stats.implicit_solves, r.err_end
-        );
-        assert!(
-            r.err_end <= 5.0 * tol && r.err_dense <= 5.0 * tol,
-            "err {} {}",
-            r.err_end,
-            r.err_dense
-        );
-        counts.push(r.stats.steps as f64);
-    }
-    let d = dopri5_stats(
-        StiffLinear {
-            lambda: -1e4,
-            y0: 1.0,
-        },
-        tol,
-        1.0,
-    );
-    eprintln!(
-        "PR lambda -1e4: DOPRI5 {} steps, {} rhs",
-        d.steps, d.rhs_evals
-    );
-    assert!(
-        counts[0] <= 40.0 && counts[1] <= 1.5 * counts[0],
-        "{counts:?}"
-    );
-    assert!(d.steps as f64 >= 1e4 / 3.31);
-}
-
 // The brief's comparison on the motor oscillator (eigenvalues -450 +- 1900i, -20; 5 s) at tol
 // 1e-6 and 1e-9, for the three splits (numbers in the output). Only the current equation
 // implicit (the robot's diagonal split) leaves the velocity-current loop explicit: the step
@@ -256,11 +152,17 @@ fn ark436_steps_far_beyond_the_explicit_limit() {
 // position loop (gain p) still limits the step. Only with everything implicit are the steps
 // accuracy-limited. Asserts: current-only >= 1000 steps; all-implicit <= 1/3 of DOPRI5's
 // steps; errors within 50 tol (current-only; measured 19 end, 26 dense) or 80 tol (the others,
-// measured <= 1.8 end, 40 dense; see `ark436_global_and_dense_error_within_c_tol`).
+// measured <= 1.8 end, 40 dense; see the contract's `tolerance_cases`).
 #[test]
 fn ark436_splits_on_motor_oscillator() {
     for tol in [1e-6, 1e-9] {
-        let d = dopri5_stats(StiffOscillator::default(), tol, 5.0);
+        let p = StiffOscillator::default();
+        let d = run_exact(
+            p,
+            &mut DormandPrince45::new(3, StepControl::new(tol, tol)),
+            5.0,
+        )
+        .stats;
         eprintln!(
             "tol {tol:.0e}: DOPRI5 {} steps ({} rejected), {} rhs",
             d.steps, d.rejected, d.rhs_evals
@@ -270,14 +172,8 @@ fn ark436_splits_on_motor_oscillator() {
             OscillatorSplit::VelocityCurrent,
             OscillatorSplit::Full,
         ] {
-            let r = run(
-                StiffOscillator {
-                    split,
-                    ..Default::default()
-                },
-                tol_settings(tol),
-                5.0,
-            );
+            let mut st = ArkImex::new(3, StepControl::new(tol, tol));
+            let r = run_exact(StiffOscillator { split, ..p }, &mut st, 5.0);
             let s = r.stats;
             eprintln!(
                 "tol {tol:.0e}: ARK {split:?}: {} steps ({} rejected), {} rhs, {} solves, err end {:.2} tol, dense {:.2} tol",
@@ -297,69 +193,3 @@ fn ark436_splits_on_motor_oscillator() {
         }
     }
 }
-
-// Global error at t_end and dense output at 7 interior points of every step within C tol for
-// tol in {1e-5, 1e-7, 1e-9} and decreasing with tol. Measured worst err/tol (end point; dense):
-// PR 0.11; 4.8 -> C 10; PR with initial transient 0.04; 11 -> C 25; motor oscillator
-// (velocity-current split) 1.1; 38 -> C 80; stiff Kepler 233; 229 -> C 500 (Kepler's
-// phase-error growth, as for DOPRI5). The dense output (cubic) is one order below the method,
-// so its error relative to tol grows as tol shrinks where the steps resolve a fast transient.
-#[test]
-fn ark436_global_and_dense_error_within_c_tol() {
-    let tau = std::f64::consts::TAU;
-    type Solve<'a> = &'a dyn Fn(StepControl) -> Run;
-    let problems: [(&str, f64, Solve); 4] = [
-        ("PR -1e4", 10.0, &|s| {
-            run(
-                StiffLinear {
-                    lambda: -1e4,
-                    y0: 1.0,
-                },
-                s,
-                3.0,
-            )
-        }),
-        ("PR -1e4 y0=2", 25.0, &|s| {
-            run(
-                StiffLinear {
-                    lambda: -1e4,
-                    y0: 2.0,
-                },
-                s,
-                3.0,
-            )
-        }),
-        ("motor oscillator", 80.0, &|s| {
-            run(
-                StiffOscillator {
-                    split: OscillatorSplit::VelocityCurrent,
-                    ..Default::default()
-                },
-                s,
-                5.0,
-            )
-        }),
-        ("stiff kepler", 500.0, &|s| {
-            run(StiffKepler::default(), s, tau)
-        }),
-    ];
-    for (name, c, solve) in problems {
-        let mut prev = f64::INFINITY;
-        for tol in [1e-5, 1e-7, 1e-9] {
-            let r = solve(tol_settings(tol));
-            eprintln!(
-                "{name:16} tol {tol:.0e}: end {:.3} tol, dense {:.3} tol, steps {}, rejected {}, rhs {}",
-                r.err_end / tol, r.err_dense / tol, r.stats.steps, r.stats.rejected, r.stats.rhs_evals
-            );
-            assert!(
-                r.err_end <= c * tol && r.err_dense <= c * tol,
-                "{name} tol {tol}"
-            );
-            let worst = r.err_end.max(r.err_dense);
-            assert!(worst < prev, "{name}: error did not decrease at tol {tol}");
-            prev = worst;
-        }
-    }
-}
-
-mod contract;

@@ -1,64 +1,162 @@
-use super::super::SplitSystem;
+//! Checks of the test problems themselves: exact solutions against their ODEs, the splits,
+//! implicit solves, analytic Jacobians and time derivatives against differences; Kepler's
+//! orbit, the failure systems, the oscillator's spectrum.
+
+use super::super::testutil::Problem;
+use super::super::{OdeJacobian, SplitSystem};
 use super::*;
 
-/// Central difference of the exact solution against `rhs`: catches typos in either.
-/// Tolerance: 1e-6 relative to max(1, |f|) with h = 1e-5 (truncation ~h^2 |y'''|).
-fn check_exact_matches_rhs<P: ExactSolution>(mut p: P, times: &[f64]) {
-    let n = p.dim();
-    let (mut yp, mut ym, mut y, mut f) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let h = 1e-5;
-    for &t in times {
-        p.exact(t + h, &mut yp);
-        p.exact(t - h, &mut ym);
-        p.exact(t, &mut y);
-        if p.rhs(t, &y, &mut f).is_err() {
-            panic!("rhs failed at t = {t}");
+/// Every problem the way the steppers see it ([`Problem`]), with times inside its domain.
+fn problems() -> Vec<(Problem, &'static [f64])> {
+    let times: &[f64] = &[0.1, 0.7, 1.3, 2.9, 5.0];
+    let mut v = vec![
+        (Problem::Decay(ExponentialDecay { k: 0.7, y0: 2.0 }), times),
+        (
+            Problem::Oscillator(HarmonicOscillator { omega: 2.0 }),
+            times,
+        ),
+        (Problem::Rational(RationalDecay), times),
+        (Problem::Kepler(Kepler { e: 0.5 }), times),
+        (Problem::Kepler(Kepler { e: 0.9 }), times),
+        (
+            Problem::Pr(StiffLinear {
+                lambda: -1e4,
+                y0: 1.0,
+            }),
+            times,
+        ),
+        (Problem::Blowup(RiccatiBlowup), &[0.1, 0.5, 0.9]),
+        (Problem::StiffKepler(StiffKepler::default()), times),
+        (Problem::Failing(FailingRhs { t_fail: 10.0 }), times),
+        (
+            Problem::Nan(NanAfter {
+                t_nan: 10.0,
+                index: 1,
+            }),
+            times,
+        ),
+    ];
+    for split in [
+        OscillatorSplit::Current,
+        OscillatorSplit::VelocityCurrent,
+        OscillatorSplit::Full,
+    ] {
+        for gain in [1.0, 1e3] {
+            v.push((
+                Problem::Motor(StiffOscillator {
+                    split,
+                    gain,
+                    ..Default::default()
+                }),
+                times,
+            ));
         }
-        for i in 0..n {
-            let fd = (yp[i] - ym[i]) / (2.0 * h);
-            assert!(
-                (fd - f[i]).abs() <= 1e-6 * f[i].abs().max(1.0),
-                "component {i} at t = {t}: finite difference {fd} vs rhs {}",
-                f[i]
-            );
-        }
+    }
+    v
+}
+
+/// Column `j` of `df/dy` by central differences, `(f(t, y + d e_j) - f(t, y - d e_j)) / 2d`
+/// with `d = 1e-6 max(1, |y_j|)`, into `col`.
+fn central_column(p: &mut Problem, t: f64, y: &[f64], j: usize, col: &mut [f64]) {
+    let n = y.len();
+    let d = 1e-6 * y[j].abs().max(1.0);
+    let (mut yp, mut fp, mut fm) = (y.to_vec(), vec![0.0; n], vec![0.0; n]);
+    yp[j] = y[j] + d;
+    p.rhs(t, &yp, &mut fp).expect("rhs");
+    yp[j] = y[j] - d;
+    p.rhs(t, &yp, &mut fm).expect("rhs");
+    for i in 0..n {
+        col[i] = (fp[i] - fm[i]) / (2.0 * d);
     }
 }
 
+// For every problem:
+// - the exact solution satisfies the ODE: central difference (h = 1e-5, truncation ~h^2 |y'''|)
+//   against rhs within 1e-6 relative to max(1, |f|) (the motor oscillator after its fast
+//   transient, e^(-450 t) < 1e-19 at t >= 0.1);
+// - at points off the solution (y + 0.01 (i + 1) at t = 0.05, 0.7, 2.3, so the stiff terms
+//   do not vanish): the split parts add up to rhs (1e-15 relative); solve_implicit solves
+//   z - gamma f_I(t, z) = r (residual <= 1e-14 times the size of the terms that cancel,
+//   1 + |r| + gamma sum_j |J_ij z_j| + gamma |f|; the oscillator's coefficients reach 7.6e7);
+//   and where the problem has them (analytic) f_t matches a central difference in t (1e-6
+//   relative to max(1, |f_t|)) and J central differences in y (1e-8 relative to
+//   1 + max_j |J_ij|; measured <= 7e-11).
 #[test]
-fn exact_solutions_satisfy_their_odes() {
-    let times = [0.1, 0.7, 1.3, 2.9, 5.0];
-    check_exact_matches_rhs(ExponentialDecay { k: 0.7, y0: 2.0 }, &times);
-    check_exact_matches_rhs(HarmonicOscillator { omega: 2.0 }, &times);
-    check_exact_matches_rhs(RationalDecay, &times);
-    check_exact_matches_rhs(Kepler { e: 0.5 }, &times);
-    check_exact_matches_rhs(Kepler { e: 0.9 }, &times);
-    check_exact_matches_rhs(
-        StiffLinear {
-            lambda: -1e4,
-            y0: 1.0,
-        },
-        &times,
-    );
-    check_exact_matches_rhs(RiccatiBlowup, &[0.1, 0.5, 0.9]);
-    // after the fast transient (e^(-450 t) < 1e-19 at t >= 0.1): y''' is O(1), as above
-    check_exact_matches_rhs(StiffOscillator::default(), &times);
-    check_exact_matches_rhs(
-        StiffOscillator {
-            gain: 1e3,
-            ..Default::default()
-        },
-        &times,
-    );
-    check_exact_matches_rhs(StiffKepler::default(), &times);
-    check_exact_matches_rhs(FailingRhs { t_fail: 10.0 }, &times);
-    check_exact_matches_rhs(
-        NanAfter {
-            t_nan: 10.0,
-            index: 1,
-        },
-        &times,
-    );
+fn problems_are_consistent() {
+    for (mut p, times) in problems() {
+        let n = p.dim();
+        let v = |len| vec![0.0; len];
+        let (mut yp, mut ym, mut y, mut f) = (v(n), v(n), v(n), v(n));
+        for &t in times {
+            let h = 1e-5;
+            p.exact(t + h, &mut yp);
+            p.exact(t - h, &mut ym);
+            p.exact(t, &mut y);
+            p.rhs(t, &y, &mut f).expect("rhs");
+            for i in 0..n {
+                let fd = (yp[i] - ym[i]) / (2.0 * h);
+                let ok = (fd - f[i]).abs() <= 1e-6 * f[i].abs().max(1.0);
+                assert!(ok, "{p:?} [{i}] at t = {t}: {fd} vs {}", f[i]);
+            }
+        }
+        let (mut fe, mut fi, mut z, mut fz_e, mut fz_i) = (v(n), v(n), v(n), v(n), v(n));
+        let (mut ft, mut fp, mut fm, mut jac, mut col) = (v(n), v(n), v(n), v(n * n), v(n));
+        for t in [0.05, 0.7, 2.3] {
+            p.exact(t, &mut y);
+            for (i, v) in y.iter_mut().enumerate() {
+                *v += 0.01 * (i as f64 + 1.0);
+            }
+            p.rhs(t, &y, &mut f).expect("rhs");
+            p.rhs_split(t, &y, &mut fe, &mut fi).expect("rhs_split");
+            for i in 0..n {
+                let ok = (fe[i] + fi[i] - f[i]).abs() <= 1e-15 * f[i].abs().max(1.0);
+                assert!(ok, "{p:?} split sum {i}");
+            }
+            for gamma in [1e-6, 1e-3, 0.1] {
+                p.solve_implicit(t, gamma, &y, &mut z).expect("solve");
+                p.rhs_split(t, &z, &mut fz_e, &mut fz_i).expect("rhs_split");
+                p.jacobian(t, &z, &f, &mut jac).expect("jacobian");
+                for i in 0..n {
+                    let res = z[i] - gamma * fz_i[i] - y[i];
+                    let scale = y[i].abs()
+                        + gamma * (0..n).map(|j| (jac[i * n + j] * z[j]).abs()).sum::<f64>()
+                        + gamma * f[i].abs()
+                        + 1.0;
+                    let ok = res.abs() <= 1e-14 * scale;
+                    assert!(
+                        ok,
+                        "{p:?} t {t} gamma {gamma} [{i}]: {res} (scale {scale:e})"
+                    );
+                }
+            }
+            if !p.time_derivative(t, &y, &f, &mut ft).expect("f_t") {
+                continue; // finite-difference Jacobian and f_t
+            }
+            let dt = 1e-5;
+            p.rhs(t + dt, &y, &mut fp).expect("rhs");
+            p.rhs(t - dt, &y, &mut fm).expect("rhs");
+            for i in 0..n {
+                let fd = (fp[i] - fm[i]) / (2.0 * dt);
+                let ok = (fd - ft[i]).abs() <= 1e-6 * ft[i].abs().max(1.0);
+                assert!(ok, "{p:?} f_t[{i}]: {fd} vs {}", ft[i]);
+            }
+            p.jacobian(t, &y, &f, &mut jac).expect("jacobian");
+            for j in 0..n {
+                central_column(&mut p, t, &y, j, &mut col);
+                for i in 0..n {
+                    let row = &jac[i * n..(i + 1) * n];
+                    let e = (col[i] - row[j]).abs()
+                        / (1.0 + row.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+                    assert!(
+                        e <= 1e-8,
+                        "{p:?} t {t} J[{i}][{j}]: {} vs {} ({e:e})",
+                        col[i],
+                        row[j]
+                    );
+                }
+            }
+        }
+    }
 }
 
 #[test]
@@ -100,83 +198,6 @@ fn failure_systems_fail_where_documented() {
     }
     .rhs(0.5, &[1.0, 1.0], &mut f2);
     assert!(f2[0].is_finite() && f2[1].is_nan());
-}
-
-/// At a few points: the split parts add up to `rhs` (to 1e-15 relative), `solve_implicit`
-/// solves `z - gamma f_I(t, z) = r` (residual <= 1e-14 times the size of the terms that
-/// cancel, `1 + |r| + gamma sum_j |J_ij z_j| + gamma |f|`; the oscillator's coefficients reach
-/// 7.6e7), the analytic `∂f/∂t` matches a central difference in `t` (1e-6 relative to
-/// max(1, |f_t|)).
-fn check_split_and_time_derivative<P: SplitSystem + OdeJacobian + ExactSolution>(mut p: P) {
-    let n = p.dim();
-    let (mut y, mut f, mut fe, mut fi) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let (mut z, mut fz_e, mut fz_i, mut ft) =
-        (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-    for &t in &[0.05, 0.7, 2.3] {
-        p.exact(t, &mut y);
-        // a point off the solution, so the stiff terms do not vanish
-        for (i, v) in y.iter_mut().enumerate() {
-            *v += 0.01 * (i as f64 + 1.0);
-        }
-        let _ = p.rhs(t, &y, &mut f);
-        let _ = p.rhs_split(t, &y, &mut fe, &mut fi);
-        for i in 0..n {
-            assert!(
-                (fe[i] + fi[i] - f[i]).abs() <= 1e-15 * f[i].abs().max(1.0),
-                "split sum {i}"
-            );
-        }
-        let mut jac = vec![0.0; n * n];
-        for gamma in [1e-6, 1e-3, 0.1] {
-            let _ = p.solve_implicit(t, gamma, &y, &mut z);
-            let _ = p.rhs_split(t, &z, &mut fz_e, &mut fz_i);
-            let _ = p.jacobian(t, &z, &f, &mut jac);
-            for i in 0..n {
-                let res = z[i] - gamma * fz_i[i] - y[i];
-                // size of the terms that cancel: |r| + gamma sum_j |J_ij z_j| + gamma |f_i|
-                let scale = y[i].abs()
-                    + gamma * (0..n).map(|j| (jac[i * n + j] * z[j]).abs()).sum::<f64>()
-                    + gamma * f[i].abs()
-                    + 1.0;
-                assert!(
-                    res.abs() <= 1e-14 * scale,
-                    "t {t} gamma {gamma} [{i}]: {res} (scale {scale:e})"
-                );
-            }
-        }
-        assert!(matches!(p.time_derivative(t, &y, &f, &mut ft), Ok(true)));
-        let dt = 1e-5;
-        let _ = p.rhs(t + dt, &y, &mut fp);
-        let _ = p.rhs(t - dt, &y, &mut fm);
-        for i in 0..n {
-            let fd = (fp[i] - fm[i]) / (2.0 * dt);
-            assert!(
-                (fd - ft[i]).abs() <= 1e-6 * ft[i].abs().max(1.0),
-                "f_t[{i}]: {fd} vs {}",
-                ft[i]
-            );
-        }
-    }
-}
-
-#[test]
-fn splits_solves_and_time_derivatives_are_consistent() {
-    check_split_and_time_derivative(StiffLinear::default());
-    for split in [
-        OscillatorSplit::Current,
-        OscillatorSplit::VelocityCurrent,
-        OscillatorSplit::Full,
-    ] {
-        for gain in [1.0, 1e3] {
-            check_split_and_time_derivative(StiffOscillator {
-                split,
-                gain,
-                ..Default::default()
-            });
-        }
-    }
-    check_split_and_time_derivative(StiffKepler::default());
 }
 
 // The oscillator's eigenvalues are the documented ones: the characteristic polynomial
