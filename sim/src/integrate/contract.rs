@@ -366,6 +366,9 @@ fn dense_output_local_order_and_exact_ends() {
     }
 }
 
+/// A tolerance test case: name, problem, end time, stiff, C per method.
+type TolCase = (&'static str, Problem, f64, bool, [Option<f64>; 4]);
+
 /// Tolerance test cases: problem, end time, stiff, and per method the error constant C
 /// (global and dense error <= C tol), `None` for Rk4 (fixed step) and the stiff problems on
 /// the explicit methods (see `stiff_problem_steps_set_by_accuracy_or_stability`). C is the
@@ -378,7 +381,7 @@ fn dense_output_local_order_and_exact_ends() {
 /// e = 0.9, where the pericentre passage is fast; ArkImex's explicit part, built for its
 /// pairing, is the weakest there); the oscillator's because 10 s is 3 periods of undamped
 /// error growth.
-pub(super) fn tolerance_cases() -> [(&'static str, Problem, f64, bool, [Option<f64>; 4]); 9] {
+pub(super) fn tolerance_cases() -> [TolCase; 9] {
     [
         (
             "decay",
