@@ -4,18 +4,18 @@
 #   recordings/refresh.sh --check   re-make into a temporary directory and compare with the archive
 #                                   (byte for byte, and the energy table line by line); exit 1 if
 #                                   anything differs. CI runs this.
-# Needs the release binary: `cargo build --release -p sim -p analyze` (CARGO_TARGET_DIR honoured).
+# Needs the release binaries: `cargo build --release --bins` (CARGO_TARGET_DIR honoured).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 target="${CARGO_TARGET_DIR:-target}"
 sim="$(realpath -m "$target")/release/sim"
 analyze="$(realpath -m "$target")/release/analyze"
-[ -x "$sim" ] && [ -x "$analyze" ] || cargo build --release -p sim -p analyze --quiet
+[ -x "$sim" ] && [ -x "$analyze" ] || cargo build --release --bins --quiet
 
 make_archive() {  # $1 = output directory
   local dir="$1"
   mkdir -p "$dir"
-  "$sim" recordings/paper-archive.json -o "$dir" -j 1 --quiet --format csv > /dev/null
+  "$sim" run recordings/paper-archive.json -o "$dir" -j 1 --quiet --format csv > /dev/null
   # from inside the directory, so the table names the files without a directory
   (cd "$dir" && "$analyze" compare paper-archive-*.mcap --format csv > paper-archive-energy.csv)
   {
@@ -23,8 +23,9 @@ make_archive() {  # $1 = output directory
     echo "  \"scene\": \"recordings/paper-archive.json\","
     echo "  \"scene_sha256\": \"$(sha256sum recordings/paper-archive.json | cut -d' ' -f1)\","
     echo "  \"urdf_sha256\": \"$(sha256sum sim/scenes/paper_arm.urdf | cut -d' ' -f1)\","
-    echo "  \"tool\": \"$("$sim" --version)\","
-    echo "  \"command\": \"sim recordings/paper-archive.json -o recordings -j 1\","
+    # the tool's name and version as recordings store them (not the build's commit)
+    echo "  \"tool\": \"$("$sim" --version | cut -d' ' -f1,2)\","
+    echo "  \"command\": \"sim run recordings/paper-archive.json -o recordings -j 1\","
     echo "  \"files\": ["
     local first=1
     for f in "$dir"/paper-archive-*.mcap "$dir/paper-archive-energy.csv"; do
@@ -43,7 +44,7 @@ if [ "${1:-}" = "--check" ]; then
   trap 'rm -rf "$tmp"' EXIT
   # the archived recordings reproduce themselves from their own metadata ...
   for f in recordings/paper-archive-*.mcap; do
-    "$sim" replay "$f" -o "$tmp/replay" --quiet
+    "$sim" replay "$f" -o "$tmp/replay" --quiet > /dev/null
     cmp "$f" "$tmp/replay/$(basename "$f")"
   done
   # ... and the current code re-makes them from the scene

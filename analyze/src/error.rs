@@ -74,6 +74,15 @@ pub enum Error {
     #[error("{file}: {detail}")]
     Table { file: String, detail: String },
 
+    /// The summary's query or table failed (an unknown column, a value that is not a number).
+    #[error("summary: {0}")]
+    Summary(String),
+
+    /// Tables (`analyze summary`, `analyze export`) need polars: a build with the feature
+    /// `tables`.
+    #[error("tables need polars: this build has no feature `tables`; build with `cargo build --release --features tables` (or `cargo install --path . --features tables`)")]
+    TablesUnavailable,
+
     /// Serializing to JSON failed.
     #[error("writing JSON: {0}")]
     Json(#[from] serde_json::Error),

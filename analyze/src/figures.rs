@@ -20,17 +20,20 @@
 use std::path::{Path, PathBuf};
 
 use plotters::style::FontStyle;
-use schemas::{topics, Recording};
+use schemas::{ConstraintState, EnergyState, HandState, MotorState, Recording, TopicMessage, Vec3};
 
 use crate::Error;
 
 mod catalogue;
 mod draw;
 mod index;
+mod work_precision;
 
 pub use index::write_index;
+pub use work_precision::{work_precision, WorkPrecisionSeries};
 
-static FONT: &[u8] = include_bytes!("../../sim/assets/DejaVuSans.ttf");
+/// DejaVu Sans (licence beside it in `analyze/assets`): every figure of the project uses it.
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// Registers DejaVu Sans as plotters' "sans-serif" (once), so PNGs look the same everywhere.
 fn register_font() {
@@ -64,7 +67,7 @@ pub struct Series {
 }
 
 impl Series {
-    /// From [`Recording::series`] rows; a short row leaves NaN (not drawn) in its columns.
+    /// From rows of values; a short row leaves NaN (not drawn) in its columns.
     fn from_rows(t: Vec<f64>, rows: &[Vec<f64>]) -> Self {
         let width = rows.iter().map(Vec::len).max().unwrap_or(0);
         let cols = (0..width)
@@ -108,58 +111,42 @@ pub struct RunSeries {
     pub normal_force: Series,
 }
 
-/// `rec.series(topic, field)`, or an empty series if the recording has no such topic.
-fn series(rec: &Recording, topic: &str, field: &str) -> Result<Series, Error> {
-    match rec.series(topic, field) {
-        Ok((t, rows)) => Ok(Series::from_rows(t, &rows)),
-        Err(schemas::Error::UnknownTopic { .. }) => Ok(Series::default()),
+/// Every message of `M`'s topic, none if the recording has no such topic.
+fn read_or_none<M: TopicMessage>(rec: &Recording) -> Result<Vec<(f64, M)>, Error> {
+    match rec.read::<M>() {
+        Ok(v) => Ok(v),
+        Err(schemas::Error::UnknownTopic { .. }) => Ok(Vec::new()),
         Err(e) => Err(e.into()),
     }
 }
 
-/// Three scalar fields `prefix.x`, `.y`, `.z` of `topic` as one series with three columns.
-fn vec3(rec: &Recording, topic: &str, prefix: &str) -> Result<Series, Error> {
-    let mut out = Series::default();
-    for axis in ["x", "y", "z"] {
-        let s = series(rec, topic, &format!("{prefix}.{axis}"))?;
-        out.t = s.t;
-        out.cols.push(s.cols.into_iter().next().unwrap_or_default());
-    }
-    if out.t.is_empty() {
-        out.cols.clear();
-    }
-    Ok(out)
+/// One row per message, `row(message)` its values.
+fn series<M>(messages: &[(f64, M)], row: impl Fn(&M) -> Vec<f64>) -> Series {
+    let rows: Vec<Vec<f64>> = messages.iter().map(|(_, m)| row(m)).collect();
+    Series::from_rows(messages.iter().map(|(t, _)| *t).collect(), &rows)
 }
 
-/// The series of one recording; `fallback_name` names it if metadata `run.run` is absent.
+/// The series of one recording; `fallback_name` names it if it has no `run` record.
 pub fn load_run(rec: &Recording, fallback_name: &str) -> Result<RunSeries, Error> {
-    let name = rec
-        .metadata_value("run", "run")
-        .unwrap_or(fallback_name)
-        .to_string();
-    let contacts = match rec.metadata_value("run", "contacts") {
-        None => Vec::new(),
-        Some(v) => serde_json::from_str(v).map_err(|e| Error::BadMetadata {
-            file: rec.source.clone(),
-            record: "run".into(),
-            key: "contacts".into(),
-            value: v.into(),
-            detail: format!("not a JSON array of strings: {e}"),
-        })?,
-    };
+    let run = rec.run_opt()?;
+    let hand = read_or_none::<HandState>(rec)?;
+    let energy = read_or_none::<EnergyState>(rec)?;
+    let motors = read_or_none::<MotorState>(rec)?;
+    let constraints = read_or_none::<ConstraintState>(rec)?;
+    let xyz = |v: &Vec3| vec![v.x, v.y, v.z];
     Ok(RunSeries {
-        name,
-        contacts,
-        actual: vec3(rec, topics::HAND, "actual")?,
-        desired: vec3(rec, topics::HAND, "desired")?,
-        error_norm: series(rec, topics::HAND, "error_norm")?,
-        work: series(rec, topics::ENERGY, "link_work")?,
-        work_total: series(rec, topics::ENERGY, "link_work_total")?,
-        electric: series(rec, topics::ENERGY, "electric_energy")?,
-        electric_total: series(rec, topics::ENERGY, "electric_energy_total")?,
-        current: series(rec, topics::MOTORS, "current")?,
-        voltage: series(rec, topics::MOTORS, "voltage")?,
-        normal_force: series(rec, topics::CONSTRAINTS, "normal_force")?,
+        name: run.as_ref().map_or_else(|| fallback_name.to_string(), |r| r.run.clone()),
+        contacts: run.map(|r| r.contacts).unwrap_or_default(),
+        actual: series(&hand, |h| xyz(&h.actual)),
+        desired: series(&hand, |h| xyz(&h.desired)),
+        error_norm: series(&hand, |h| vec![h.error_norm]),
+        work: series(&energy, |e| e.link_work.clone()),
+        work_total: series(&energy, |e| vec![e.link_work_total]),
+        electric: series(&energy, |e| e.electric_energy.clone()),
+        electric_total: series(&energy, |e| vec![e.electric_energy_total]),
+        current: series(&motors, |m| m.current.clone()),
+        voltage: series(&motors, |m| m.voltage.clone()),
+        normal_force: series(&constraints, |c| c.normal_force.clone()),
     })
 }
 

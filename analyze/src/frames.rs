@@ -57,26 +57,13 @@ pub fn read_frames(path: &Path, topics: Option<&[&str]>) -> Result<RecordingFram
 
 /// The frames of a decoded recording.
 pub fn recording_frames(rec: &Recording) -> Result<RecordingFrames, Error> {
-    let names = |kind: ArrayIndex| -> Option<Vec<String>> {
-        let (record, key) = kind.names_key();
-        serde_json::from_str(rec.metadata_value(record, key)?).ok()
-    };
-    let (mut joints, contacts) = (names(ArrayIndex::Joint), names(ArrayIndex::Contact));
-    if joints.is_none() && rec.format_version() == Some(0) {
-        // format 0 had no `run.joint_names`; its joints are joint1..N, as the metrics name them
-        // (from whichever joint-indexed array was decoded, so the names do not depend on the
-        // topics selected)
-        use schemas::topics::{ENERGY, MOTORS};
-        let fields = [(MOTORS, "current"), (MOTORS, "voltage"), (ENERGY, "link_work"), (ENERGY, "electric_energy")];
-        let n = fields.iter().find_map(|(topic, field)| {
-            let (_, first) = rec.messages.get(*topic)?.first()?;
-            first.get(field)?.as_list().map(<[_]>::len)
-        });
-        joints = n.map(|n| (1..=n).map(|k| format!("joint{k}")).collect());
-    }
+    // the names of per-joint and per-contact entries (format 0: `joint1..N`, by the reader);
+    // none for a file without a `run` record (another producer's), whose arrays keep indices
+    let run = rec.run().ok();
+    let (joints, contacts) = (run.as_ref().map(|r| r.joint_names.clone()), run.as_ref().map(|r| r.contacts.clone()));
     let mut out = RecordingFrames {
         source: rec.source.clone(),
-        metadata: rec.metadata.clone(),
+        metadata: rec.metadata_records().clone(),
         topics: Vec::new(),
         skipped: Vec::new(),
     };
@@ -89,7 +76,7 @@ pub fn recording_frames(rec: &Recording) -> Result<RecordingFrames, Error> {
             out.skipped.push((ch.topic.clone(), why.clone()));
             continue;
         }
-        let Some(messages) = rec.messages.get(&ch.topic) else {
+        let Some(messages) = rec.messages(&ch.topic) else {
             continue;
         };
         let topic = ch.topic.as_str();
@@ -135,21 +122,7 @@ fn frame(t: Vec<f64>, cols: Columns) -> PolarsResult<DataFrame> {
     DataFrame::new(height, columns)
 }
 
-/// File format of [`export`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExportFormat {
-    Parquet,
-    Csv,
-}
-
-impl ExportFormat {
-    pub fn extension(self) -> &'static str {
-        match self {
-            ExportFormat::Parquet => "parquet",
-            ExportFormat::Csv => "csv",
-        }
-    }
-}
+pub use crate::export::ExportFormat;
 
 /// The file name of a topic's table: `/joint_states` -> `joint_states.parquet`.
 pub fn topic_file_name(topic: &str, format: ExportFormat) -> String {

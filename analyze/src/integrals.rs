@@ -21,7 +21,7 @@
 //! at 8 kHz) miss joules of E_9 and E_10; [`sampled_integrals_from`] checks the run after such a
 //! transient, where the samples converge as h².
 
-use schemas::{topics, Recording};
+use schemas::{topics, ArraySizes, EnergyState, JointState, MotorState, Recording};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
@@ -132,54 +132,44 @@ pub fn sampled_integrals(rec: &Recording) -> Result<SampledIntegrals, Error> {
 /// step (the paper arm's light wrist links ring for the first milliseconds) makes the samples
 /// unable to reproduce the integral over the whole run, while after it they converge as h².
 pub fn sampled_integrals_from(rec: &Recording, from_s: f64) -> Result<SampledIntegrals, Error> {
-    let (t, current) = rec.series(topics::MOTORS, "current")?;
-    let (_, voltage) = rec.series(topics::MOTORS, "voltage")?;
-    let (_, torque) = rec.series(topics::MOTORS, "torque")?;
-    let (tq, velocity) = rec.series(topics::JOINT_STATES, "velocity")?;
-    let (te, e_rec) = rec.series(topics::ENERGY, "electric_energy")?;
-    let (_, w_rec) = rec.series(topics::ENERGY, "link_work")?;
     let file = || rec.source.clone();
-    if t.len() < 3 {
+    let motors = rec.read::<MotorState>()?;
+    if motors.len() < 3 {
         // the error estimate needs every second sample of at least two intervals
         return Err(Error::Table {
             file: file(),
-            detail: format!("{} has {} samples: at least 3 are needed to check the integrals", topics::MOTORS, t.len()),
+            detail: format!("{} has {} samples: at least 3 are needed to check the integrals", topics::MOTORS, motors.len()),
         });
     }
-    let (times_equal, which) = if tq != t { (false, topics::JOINT_STATES) } else { (te == t, topics::ENERGY) };
-    if !times_equal {
+    let n = motors[0].1.current.len();
+    let sizes = ArraySizes { joints: n, contacts: rec.run().map_or(0, |r| r.contacts.len()) };
+    let motors = rec.read_sized::<MotorState>(sizes)?;
+    let joint_states = rec.read_sized::<JointState>(sizes)?;
+    let energy = rec.read_sized::<EnergyState>(sizes)?;
+    let t: Vec<f64> = motors.iter().map(|m| m.0).collect();
+    let same_times = |times: &mut dyn Iterator<Item = f64>| times.eq(t.iter().copied());
+    let which = if !same_times(&mut joint_states.iter().map(|m| m.0)) {
+        Some(topics::JOINT_STATES)
+    } else if !same_times(&mut energy.iter().map(|m| m.0)) {
+        Some(topics::ENERGY)
+    } else {
+        None
+    };
+    if let Some(which) = which {
         return Err(Error::Table {
             file: file(),
             detail: format!("{which} is not sampled at the times of {}: cannot integrate their product", topics::MOTORS),
         });
     }
-    let n = current[0].len();
-    let joints: Vec<String> = rec
-        .metadata_value("run", "joint_names")
-        .and_then(|s| serde_json::from_str(s).ok())
-        .filter(|j: &Vec<String>| j.len() == n)
-        .unwrap_or_else(|| (1..=n).map(|k| format!("joint{k}")).collect());
-    let row_len = |rows: &[Vec<f64>], topic: &str, field: &str| -> Result<(), Error> {
-        match rows.iter().enumerate().find(|(_, r)| r.len() != n) {
-            None => Ok(()),
-            Some((index, r)) => Err(Error::WrongLength {
-                file: file(),
-                topic: topic.into(),
-                field: field.into(),
-                index,
-                t_s: t[index],
-                found: r.len(),
-                expected: n,
-                per: "joint",
-            }),
-        }
-    };
-    row_len(&current, topics::MOTORS, "current")?;
-    row_len(&voltage, topics::MOTORS, "voltage")?;
-    row_len(&torque, topics::MOTORS, "torque")?;
-    row_len(&velocity, topics::JOINT_STATES, "velocity")?;
-    row_len(&e_rec, topics::ENERGY, "electric_energy")?;
-    row_len(&w_rec, topics::ENERGY, "link_work")?;
+    let unrecorded = [
+        (topics::MOTORS, "voltage", motors.iter().any(|(_, m)| m.voltage.len() != n)),
+        (topics::MOTORS, "torque", motors.iter().any(|(_, m)| m.torque.len() != n)),
+        (topics::JOINT_STATES, "velocity", joint_states.iter().any(|(_, q)| q.velocity.len() != n)),
+    ];
+    if let Some((topic, what, _)) = unrecorded.iter().find(|u| u.2) {
+        return Err(Error::Table { file: file(), detail: format!("{topic} does not record every {what}: cannot check the integrals") });
+    }
+    let joints = rec.run().ok().map(|r| r.joint_names).filter(|j| j.len() == n).unwrap_or_else(|| (1..=n).map(|k| format!("joint{k}")).collect());
     let first = t.iter().position(|&x| x >= from_s).unwrap_or(t.len());
     if t.len() - first < 3 {
         return Err(Error::Table {
@@ -189,18 +179,14 @@ pub fn sampled_integrals_from(rec: &Recording, from_s: f64) -> Result<SampledInt
     }
     let last = t.len() - 1;
     let ts = &t[first..];
-    let mut p = vec![0.0; ts.len()];
+    let (e_first, e_last) = (&energy[first].1, &energy[last].1);
     let mut electric = Vec::with_capacity(n);
     let mut work = Vec::with_capacity(n);
     for j in 0..n {
-        for (k, pk) in p.iter_mut().enumerate() {
-            *pk = current[first + k][j] * voltage[first + k][j];
-        }
-        electric.push(integral(ts, &p, e_rec[last][j] - e_rec[first][j]));
-        for (k, pk) in p.iter_mut().enumerate() {
-            *pk = torque[first + k][j] * velocity[first + k][j];
-        }
-        work.push(integral(ts, &p, w_rec[last][j] - w_rec[first][j]));
+        let p: Vec<f64> = motors[first..].iter().map(|(_, m)| m.current[j] * m.voltage[j]).collect();
+        electric.push(integral(ts, &p, e_last.electric_energy[j] - e_first.electric_energy[j]));
+        let p: Vec<f64> = motors[first..].iter().zip(&joint_states[first..]).map(|((_, m), (_, q))| m.torque[j] * q.velocity[j]).collect();
+        work.push(integral(ts, &p, e_last.link_work[j] - e_first.link_work[j]));
     }
     Ok(SampledIntegrals { from_s: ts[0], dt_s: t[1] - t[0], joints, electric, work })
 }

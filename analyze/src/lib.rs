@@ -29,6 +29,7 @@
 
 pub mod compare;
 pub mod diff;
+pub mod export;
 pub mod filter;
 pub mod integrals;
 pub mod report;
@@ -37,12 +38,9 @@ mod error;
 pub mod figures;
 #[cfg(feature = "tables")]
 pub mod frames;
-#[cfg(feature = "tables")]
 pub mod summary;
 pub mod metrics;
 pub mod render;
-#[cfg(test)]
-mod testutil;
 
 pub use compare::Comparison;
 pub use diff::{read_input, render_diff, Diff, DiffError, Tolerance};

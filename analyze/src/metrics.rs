@@ -1,8 +1,9 @@
 //! Per-run metrics of one recording: [`run_metrics`] -> [`RunMetrics`].
 //!
-//! Everything is read through the generic, schema-driven reader ([`schemas::read_recording`],
-//! [`Recording::series`], [`Recording::metadata_value`]); nothing assumes which program wrote
-//! the file, only the recording format (topics and metadata keys of the `schemas` crate).
+//! Everything is read through the schema-driven reader of `schemas`, typed: the metadata
+//! ([`Recording::run`], [`Recording::result`]) and the messages of each topic as the format's
+//! structs ([`Recording::read_sized`]); nothing assumes which program wrote the file, only the
+//! recording format that `schemas` owns.
 //! What is computed, following SCENE.md "What to report per run" (the paper's Fig. 1-25):
 //!
 //! - **Hand error** `e(t) = r(t) - r_d(t)` (`/hand` `error.{x,y,z}` and `error_norm`), per axis
@@ -27,18 +28,15 @@
 
 use std::path::Path;
 
-use schemas::{topics, Recording, RecoverReport};
+use schemas::{
+    topics, ArraySizes, ConstraintState, EnergyState, HandState, MotorState, Recording, RecoverReport, RunResult, RunStatus,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
 
 mod signal;
-use signal::{argmin, column, last, min_with_time, negative_time, peak_abs, Source};
-
-/// Metadata record with the run's description (`scene`, `run`, `contacts`, `joint_names`).
-const RUN_RECORD: &str = "run";
-/// Metadata record with the run's outcome (`status`, `error`, `error_time`).
-const RESULT_RECORD: &str = "result";
+use signal::{argmin, min_with_time, negative_time, peak_abs};
 
 /// How the run ended (metadata `result.status`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -215,22 +213,21 @@ pub fn read_run_metrics_recover(path: &Path) -> Result<(RunMetrics, RecoverRepor
 /// `error` stating where the recording stops and why. The metrics cover the messages
 /// recovered (`t_end_s` is the last recovered `/hand` sample).
 pub fn run_metrics_recovered(rec: &Recording, report: &RecoverReport) -> Result<RunMetrics, Error> {
-    let incomplete = (!report.complete && rec.metadata_value(RESULT_RECORD, "status").is_none())
-        .then(|| {
-            format!(
-                "recording damaged, stops at byte {} of {}: {}",
-                report.stopped_at,
-                report.file_len,
-                report.reason.as_deref().unwrap_or("unknown")
-            )
-        });
+    let incomplete = (!report.complete && rec.result()?.is_none()).then(|| {
+        format!(
+            "recording damaged, stops at byte {} of {}: {}",
+            report.stopped_at,
+            report.file_len,
+            report.reason.as_deref().unwrap_or("unknown")
+        )
+    });
     metrics(rec, incomplete)
 }
 
 /// Computes the metrics of one decoded recording (see the module docs for the formulas).
 ///
-/// Needs the metadata `run.{scene,run,contacts,joint_names}` (`joint_names` may be absent from a
-/// file of format version 0: joints are then `joint1..jointN`) and `result.status`, and at least
+/// Needs the metadata records `run` (names of the run, contacts and joints; format 0 names its
+/// joints `joint1..jointN`) and `result` (the status), and at least
 /// one message on each of `/hand`, `/motors`, `/constraints` and `/energy`, with one array
 /// entry per joint (motors, energy) or per contact (constraints).
 pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
@@ -239,69 +236,51 @@ pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
 
 /// `incomplete`: the recording was recovered without its `result` record; the reason.
 fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Error> {
-    let src = Source(rec);
-    // Format version 0 had no `run.joint_names` (analyze/tests/fixtures/README.md): its arrays
-    // are in joint order, named joint1..jointN here. Any other version must have the key.
-    let joint_names = match rec.metadata_value(RUN_RECORD, "joint_names") {
-        None if rec.format_version() == Some(0) => {
-            let (_, current) = rec.series(topics::MOTORS, "current")?;
-            let n = current.first().map_or(0, Vec::len);
-            (1..=n).map(|k| format!("joint{k}")).collect()
-        }
-        _ => src.json_names(RUN_RECORD, "joint_names")?,
-    };
-    let contacts = src.json_names(RUN_RECORD, "contacts")?;
-    let result_status = match &incomplete {
-        Some(_) => "incomplete",
-        None => src.meta(RESULT_RECORD, "status")?,
-    };
-    let status = match result_status {
-        "incomplete" if incomplete.is_some() => Status::Incomplete,
-        "complete" => Status::Complete,
-        "failed" => Status::Failed,
-        other => {
-            return Err(src.bad_meta(
-                RESULT_RECORD,
-                "status",
-                other,
-                "expected complete or failed",
-            ))
+    let file = || rec.source.clone();
+    let run = rec.run()?;
+    let (status, error, error_time_s) = match &incomplete {
+        Some(why) => (Status::Incomplete, Some(why.clone()), None),
+        None => {
+            let r = rec.record::<RunResult>()?;
+            let status = match r.status {
+                RunStatus::Complete => Status::Complete,
+                RunStatus::Failed => Status::Failed,
+            };
+            (status, r.error, r.error_time_s)
         }
     };
-    let error_time_s = match rec.metadata_value(RESULT_RECORD, "error_time") {
-        None => None,
-        Some(v) => Some(
-            v.parse::<f64>()
-                .map_err(|e| src.bad_meta(RESULT_RECORD, "error_time", v, &e.to_string()))?,
-        ),
-    };
+    let sizes = ArraySizes { joints: run.joint_names.len(), contacts: run.contacts.len() };
+    let non_empty = |topic: &str, n: usize| if n == 0 { Err(Error::NoSamples { file: file(), topic: topic.into() }) } else { Ok(()) };
+    let hand = rec.read::<HandState>()?;
+    let motors = rec.read_sized::<MotorState>(sizes)?;
+    let constraints = rec.read_sized::<ConstraintState>(sizes)?;
+    let energy = rec.read_sized::<EnergyState>(sizes)?;
+    non_empty(topics::HAND, hand.len())?;
+    non_empty(topics::MOTORS, motors.len())?;
+    non_empty(topics::CONSTRAINTS, constraints.len())?;
+    non_empty(topics::ENERGY, energy.len())?;
+    let joint_names = run.joint_names;
+    let contacts = run.contacts;
 
     // hand error, per axis and in norm
-    let axis = |field: &str| -> Result<(Vec<f64>, AxisError), Error> {
-        let (t, e) = src.scalars(topics::HAND, field)?;
-        let (max_abs_m, t_max_s) = peak_abs(&t, &e);
+    let hand_t: Vec<f64> = hand.iter().map(|(t, _)| *t).collect();
+    let axis = |e: &dyn Fn(&HandState) -> f64| -> AxisError {
+        let e: Vec<f64> = hand.iter().map(|(_, h)| e(h)).collect();
+        let (max_abs_m, t_max_s) = peak_abs(&hand_t, &e);
         let rms_m = (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt();
-        Ok((
-            t,
-            AxisError {
-                rms_m,
-                max_abs_m,
-                t_max_s,
-            },
-        ))
+        AxisError { rms_m, max_abs_m, t_max_s }
     };
-    let (hand_t, x) = axis("error.x")?;
     let hand_error = HandError {
-        x,
-        y: axis("error.y")?.1,
-        z: axis("error.z")?.1,
-        norm: axis("error_norm")?.1,
+        x: axis(&|h| h.error.x),
+        y: axis(&|h| h.error.y),
+        z: axis(&|h| h.error.z),
+        norm: axis(&|h| h.error_norm),
     };
 
     // motor currents
     let n = joint_names.len();
-    let (cur_t, cur) = src.arrays(topics::MOTORS, "current", n, "joint")?;
-    let peaks: Vec<(f64, f64)> = (0..n).map(|j| peak_abs(&cur_t, &column(&cur, j))).collect();
+    let cur_t: Vec<f64> = motors.iter().map(|(t, _)| *t).collect();
+    let peaks: Vec<(f64, f64)> = (0..n).map(|j| peak_abs(&cur_t, &motors.iter().map(|(_, m)| m.current[j]).collect::<Vec<_>>())).collect();
     let peak_current = argmin(peaks.iter().map(|p| -p.0)).map(|j| PeakCurrent {
         joint: joint_names[j].clone(),
         current_a: peaks[j].0,
@@ -309,27 +288,23 @@ fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Er
     });
 
     // per-link energy at the end
-    let (_, work) = src.arrays(topics::ENERGY, "link_work", n, "joint")?;
-    let (_, electric) = src.arrays(topics::ENERGY, "electric_energy", n, "joint")?;
-    let (work_end, electric_end) = (last(&work), last(&electric));
+    let (first, last) = (&energy[0].1, &energy[energy.len() - 1].1);
     let links = (0..n)
         .map(|j| LinkMetrics {
             joint: joint_names[j].clone(),
-            work_j: work_end[j],
-            electric_energy_j: electric_end[j],
+            work_j: last.link_work[j],
+            electric_energy_j: last.electric_energy[j],
             peak_current_a: peaks[j].0,
             t_peak_current_s: peaks[j].1,
         })
         .collect();
 
     // contacts
-    let nc = contacts.len();
-    let (c_t, force) = src.arrays(topics::CONSTRAINTS, "normal_force", nc, "contact")?;
-    let (_, pos) = src.arrays(topics::CONSTRAINTS, "position", nc, "contact")?;
-    let (_, vel) = src.arrays(topics::CONSTRAINTS, "velocity", nc, "contact")?;
-    let contact_forces = (0..nc)
+    let c_t: Vec<f64> = constraints.iter().map(|(t, _)| *t).collect();
+    let contact_forces = (0..contacts.len())
         .map(|c| {
-            let f = column(&force, c);
+            let column = |f: &dyn Fn(&ConstraintState) -> f64| -> Vec<f64> { constraints.iter().map(|(_, m)| f(m)).collect() };
+            let f = column(&|m| m.normal_force[c]);
             let (min_normal_force_n, t_min_normal_force_s) = min_with_time(&c_t, &f);
             ContactMetrics {
                 contact: contacts[c].clone(),
@@ -337,59 +312,49 @@ fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Er
                 t_min_normal_force_s,
                 pull_time_s: negative_time(&c_t, &f),
                 first_pull_s: c_t.iter().zip(&f).find(|(_, &f)| f < 0.0).map(|(&t, _)| t),
-                max_abs_position_m: peak_abs(&c_t, &column(&pos, c)).0,
-                max_abs_velocity_m_s: peak_abs(&c_t, &column(&vel, c)).0,
+                max_abs_position_m: peak_abs(&c_t, &column(&|m| m.position[c])).0,
+                max_abs_velocity_m_s: peak_abs(&c_t, &column(&|m| m.velocity[c])).0,
             }
         })
         .collect();
 
     // energy audit
-    let end = |field: &str| -> Result<(f64, f64), Error> {
-        let (_, v) = src.scalars(topics::ENERGY, field)?;
-        Ok((v[0], v[v.len() - 1]))
-    };
-    let change = |field: &str| end(field).map(|(first, last)| last - first);
-    let electric_j = end("electric_energy_total")?.1;
-    let (res_t, residual) = src.scalars(topics::ENERGY, "balance_residual")?;
-    let (max_abs_residual_j, t_max_abs_residual_s) = peak_abs(&res_t, &residual);
-    let energy = EnergyAudit {
+    let e_t: Vec<f64> = energy.iter().map(|(t, _)| *t).collect();
+    let residual: Vec<f64> = energy.iter().map(|(_, e)| e.balance_residual).collect();
+    let (max_abs_residual_j, t_max_abs_residual_s) = peak_abs(&e_t, &residual);
+    let electric_j = last.electric_energy_total;
+    let energy_audit = EnergyAudit {
         electric_j,
-        kinetic_change_j: change("kinetic")?,
-        potential_change_j: change("potential")?,
-        magnetic_change_j: change("magnetic")?,
-        resistive_loss_j: end("resistive_loss")?.1,
-        friction_loss_j: end("friction_loss")?.1,
-        gear_friction_loss_j: match rec.messages.get(topics::ENERGY).and_then(|m| m.first()) {
-            Some((_, msg)) if msg.get("gear_friction_loss").is_some() => Some(end("gear_friction_loss")?.1),
-            _ => None,
-        },
-        residual_j: residual[residual.len() - 1],
+        kinetic_change_j: last.kinetic - first.kinetic,
+        potential_change_j: last.potential - first.potential,
+        magnetic_change_j: last.magnetic - first.magnetic,
+        resistive_loss_j: last.resistive_loss,
+        friction_loss_j: last.friction_loss,
+        gear_friction_loss_j: rec.has_gear_friction_loss().then_some(last.gear_friction_loss),
+        residual_j: last.balance_residual,
         max_abs_residual_j,
         t_max_abs_residual_s,
         max_abs_residual_rel: (electric_j != 0.0).then(|| max_abs_residual_j / electric_j.abs()),
     };
 
     Ok(RunMetrics {
-        file: rec.source.clone(),
-        scene: src.meta(RUN_RECORD, "scene")?.to_string(),
-        run: src.meta(RUN_RECORD, "run")?.to_string(),
+        file: file(),
+        scene: run.scene,
+        run: run.run,
         contacts,
         joint_names,
         samples: hand_t.len(),
         t_end_s: hand_t[hand_t.len() - 1],
         status,
-        error: incomplete.or_else(|| {
-            rec.metadata_value(RESULT_RECORD, "error")
-                .map(str::to_string)
-        }),
+        error,
         error_time_s,
         hand_error,
         links,
-        link_work_total_j: end("link_work_total")?.1,
+        link_work_total_j: last.link_work_total,
         electric_energy_total_j: electric_j,
         peak_current,
         contact_forces,
-        energy,
+        energy: energy_audit,
     })
 }
 

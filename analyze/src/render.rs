@@ -6,11 +6,13 @@
 //! - [`Format::Json`]: the serde form of the structs, pretty-printed; keys are the field names
 //!   and stable. Non-finite numbers come out as `null` (serde_json's rule), so only finite
 //!   values round-trip.
-//! - [`Format::Csv`]: one header row, one row per run (RFC 4180 quoting). Per-link columns are
-//!   `W_<joint>_J`, `E_<joint>_J` (and `E_<joint>_ratio` in a comparison), per-contact columns
-//!   `fn_min_<contact>_N`, `pull_<contact>_s`, `first_pull_<contact>_s`; empty cells where a run
-//!   lacks the joint or contact or the value does not exist. Numbers use Rust's shortest
-//!   round-trip form.
+//! - [`Format::Csv`]: one header row, one row per run (RFC 4180 quoting, the `csv` crate). Column
+//!   names follow one scheme in every table of both tools: `<quantity>[.<joint or contact>]_<unit>`
+//!   with the SI unit in lower case (`_m`, `_s`, `_j`, `_a`, `_n`) or `_ratio`/`_rel`: run-level
+//!   `err_z_rms_m`, `E_total_j`, `E_total_ratio`, `peak_current_a`; per link `W.joint4_j`,
+//!   `E.joint4_j`, `E.joint4_ratio`; per contact `fn_min.elbow4_n`, `pull.elbow4_s`,
+//!   `first_pull.elbow4_s`. Empty cells where a run lacks the joint or contact or the value does
+//!   not exist. Numbers use Rust's shortest round-trip form.
 
 use std::fmt;
 use std::str::FromStr;
@@ -21,6 +23,9 @@ use crate::Error;
 
 mod csv;
 mod table;
+mod text;
+
+pub use text::TextTable;
 
 /// Output format. `FromStr` accepts `table`, `json`, `csv` (any case); `Display` writes them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

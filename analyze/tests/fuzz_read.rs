@@ -10,8 +10,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-mod common;
-use common::{write, Spec};
+use schemas::synth::Synth;
 
 const FUZZ_CASES: usize = 10_000;
 const SEED: u64 = 0xF022_0000_2EAD_0001;
@@ -106,14 +105,9 @@ fn mutate(r: &mut Rng, base: &[u8], recs: &[(usize, usize)]) -> Vec<u8> {
 #[test]
 fn reading_path_never_panics() {
     let dir = tempfile::tempdir().unwrap();
-    let path = write(
-        &dir.path().join("small.mcap"),
-        &Spec {
-            samples: 40,
-            chunk_size: Some(1024),
-            ..Spec::default()
-        },
-    );
+    let mut s = Synth::new("one-elbow", &["elbow4"], 2);
+    (s.dt, s.n, s.chunk_size) = (1e-3, 39, Some(1024));
+    let path = s.write(&dir.path().join("small.mcap"));
     let base = std::fs::read(path).unwrap();
     let recs = records(&base);
     assert!(

@@ -78,7 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     rec.insert("joints".to_string(), "shoulder,elbow".to_string());
     rec.insert("output_rate_hz".to_string(), "100".to_string());
-    w.write_metadata(schemas::RECORDING_METADATA, &rec)?;
+    w.write_metadata_raw("recording", &rec)?;
     w.write(
         topics::ROBOT_DESCRIPTION,
         0,

@@ -116,25 +116,38 @@ pub enum Error {
         reason: String,
     },
 
-    /// A message of the topic lacks the requested field.
-    #[error(
-        "{file}: topic {topic}: message #{index} (log_time {log_time_ns} ns) has no field {field}"
-    )]
-    MissingField {
+    /// A metadata record is missing, lacks a key its format version must have, or holds a value
+    /// that does not parse.
+    #[error("{file}: metadata record `{record}`: {detail}")]
+    Metadata {
         file: String,
-        topic: String,
-        field: String,
-        index: usize,
-        log_time_ns: u64,
+        record: String,
+        detail: String,
     },
 
-    /// The field exists but is neither a number nor a list of numbers.
-    #[error("{file}: topic {topic}: field {field} of message #{index} is not numeric: {found}")]
-    NotNumeric {
+    /// A message does not have the fields (and types) its topic's struct needs.
+    #[error("{file}: topic {topic}: message #{index} (log_time {log_time_ns} ns): {detail}")]
+    Field {
+        file: String,
+        topic: String,
+        index: usize,
+        log_time_ns: u64,
+        detail: String,
+    },
+
+    /// A per-joint or per-contact array has the wrong length.
+    #[error(
+        "{file}: topic {topic}, field {field}, message #{index} (t = {t_s} s): \
+         {found} entries, expected {expected} (one per {per})"
+    )]
+    WrongLength {
         file: String,
         topic: String,
         field: String,
         index: usize,
-        found: String,
+        t_s: f64,
+        found: usize,
+        expected: usize,
+        per: &'static str,
     },
 }

@@ -15,8 +15,8 @@
 //! - Which encoding for which topic follows `/work/shared/VIEWERS.md` so that recordings open
 //!   in both Foxglove and Rerun: URDF and joint states as ROS 2 CDR, transforms and point
 //!   clouds as Foxglove protobuf schemas, our own signals as derived protobuf.
-//! - The metadata record [`RECORDING_METADATA`] carries [`FORMAT_VERSION_KEY`] =
-//!   [`FORMAT_VERSION`]; bump the version whenever a message struct changes its fields.
+//! - Metadata records are typed ([`meta`]): [`RecordingInfo`] carries [`FORMAT_VERSION`]; bump the
+//!   version whenever a message struct or a metadata record changes its fields.
 //!
 //! # References
 //! - MCAP format and well-known encodings: <https://mcap.dev/spec>, <https://mcap.dev/spec/registry>.
@@ -27,8 +27,11 @@
 pub mod cdr;
 pub mod error;
 pub mod messages;
+pub mod meta;
 pub mod reader;
 mod ros2msg;
+#[cfg(feature = "synth")]
+pub mod synth;
 pub mod topics;
 pub mod value;
 pub mod writer;
@@ -36,12 +39,16 @@ pub mod writer;
 pub use error::Error;
 pub use messages::{
     frame_transform, hand_points, timestamp, ConstraintState, EnergyState, HandState, JointState,
-    Message, MotorState, RosString, Vec3,
+    Message, MotorState, RosString, TopicMessage, Vec3,
+};
+pub use meta::{
+    IntegratorInfo, MetadataRecord, ModelInfo, RecordingInfo, RunDescription, RunInfo, RunNames,
+    RunResult, RunStatus, SceneRecord, Setup, UrdfRecord,
 };
 pub use reader::{
-    read_recording_bytes_topics, read_recording_topics, NOT_SELECTED,
-    read_recording, read_recording_bytes, read_recording_recover, read_recording_recover_bytes,
-    ChannelInfo, Recording, RecoverReport,
+    read_recording, read_recording_bytes, read_recording_bytes_topics, read_recording_recover,
+    read_recording_recover_bytes, read_recording_topics, ArraySizes, ChannelInfo, Recording,
+    RecoverReport, NOT_SELECTED,
 };
 pub use value::Value;
 pub use writer::RecordingWriter;
@@ -53,16 +60,12 @@ pub use foxglove::messages::{
     Vector3,
 };
 
-/// Version of the recording layout (topics, message fields). Stored in the metadata record
-/// [`RECORDING_METADATA`] under [`FORMAT_VERSION_KEY`].
+/// Version of the recording layout (topics, message fields, metadata keys). Stored in the
+/// metadata record `recording` ([`RecordingInfo`]); [`meta`] lists what each version holds.
 ///
 /// History: 0 had no `run.joint_names`; 1 added them; 2 added `/energy`
 /// `gear_friction_loss` (the D_m part of the friction loss).
 pub const FORMAT_VERSION: u32 = 2;
-/// Name of the metadata record that describes the run.
-pub const RECORDING_METADATA: &str = "recording";
-/// Key of [`FORMAT_VERSION`] in [`RECORDING_METADATA`].
-pub const FORMAT_VERSION_KEY: &str = "format_version";
 
 /// Simulated seconds -> log time in ns, rounded to nearest. Negative times and NaN give 0,
 /// times beyond ~584 years saturate at `u64::MAX`.

@@ -11,6 +11,9 @@
 //! [`frame_transform`] and [`hand_points`]. The two ROS 2 messages, [`RosString`] and
 //! [`JointState`], are hand-encoded as CDR in [`crate::cdr`].
 
+use serde::Deserialize;
+
+use crate::topics;
 use foxglove::messages::{
     packed_element_field::NumericType, FrameTransform, PackedElementField, PointCloud, Pose,
     Quaternion, Timestamp, Vector3,
@@ -38,7 +41,7 @@ pub trait Message {
 
 /// Electrical and mechanical state of every motor (topic [`crate::topics::MOTORS`]).
 /// Arrays have one entry per actuated joint.
-#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
 pub struct MotorState {
     /// Simulated time, s.
     pub time: f64,
@@ -55,7 +58,7 @@ pub struct MotorState {
 }
 
 /// State of every constraint (topic [`crate::topics::CONSTRAINTS`]), one entry per constraint.
-#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
 pub struct ConstraintState {
     /// Simulated time, s.
     pub time: f64,
@@ -68,7 +71,7 @@ pub struct ConstraintState {
 }
 
 /// A 3-vector (m unless stated otherwise).
-#[derive(Debug, Clone, Copy, PartialEq, Default, foxglove::Encode)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, foxglove::Encode, Deserialize)]
 pub struct Vec3 {
     pub x: f64,
     pub y: f64,
@@ -76,7 +79,7 @@ pub struct Vec3 {
 }
 
 /// Hand position, world frame, m (topic [`crate::topics::HAND`]).
-#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
 pub struct HandState {
     /// Simulated time, s.
     pub time: f64,
@@ -91,7 +94,7 @@ pub struct HandState {
 }
 
 /// Energy bookkeeping, J, cumulative from t = 0 (topic [`crate::topics::ENERGY`]).
-#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode)]
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
 pub struct EnergyState {
     /// Simulated time, s.
     pub time: f64,
@@ -116,8 +119,32 @@ pub struct EnergyState {
     /// Energy balance residual: input − stored − dissipated (should stay ≈ 0).
     pub balance_residual: f64,
     /// The gears' part of `friction_loss`, ∫ Σ D_m q̇² dt (since format version 2; the joints'
-    /// own part, ∫ Σ D q̇² dt, is `friction_loss − gear_friction_loss`).
+    /// own part, ∫ Σ D q̇² dt, is `friction_loss − gear_friction_loss`). Read as 0 from older
+    /// files: ask [`crate::Recording::has_gear_friction_loss`].
+    #[serde(default)]
     pub gear_friction_loss: f64,
+}
+
+/// A message type bound to the one topic that carries it, for typed reading
+/// ([`crate::Recording::read`]).
+pub trait TopicMessage: serde::de::DeserializeOwned {
+    const TOPIC: &'static str;
+}
+
+impl TopicMessage for MotorState {
+    const TOPIC: &'static str = topics::MOTORS;
+}
+impl TopicMessage for ConstraintState {
+    const TOPIC: &'static str = topics::CONSTRAINTS;
+}
+impl TopicMessage for HandState {
+    const TOPIC: &'static str = topics::HAND;
+}
+impl TopicMessage for EnergyState {
+    const TOPIC: &'static str = topics::ENERGY;
+}
+impl TopicMessage for JointState {
+    const TOPIC: &'static str = topics::JOINT_STATES;
 }
 
 /// `std_msgs/msg/String` (ROS 2, CDR). Carries the URDF on [`crate::topics::ROBOT_DESCRIPTION`].
@@ -128,7 +155,8 @@ pub struct RosString {
 
 /// `sensor_msgs/msg/JointState` (ROS 2, CDR), for [`crate::topics::JOINT_STATES`].
 /// The header stamp is `stamp_ns` (ns since t = 0, normally equal to the log time).
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(from = "JointStateWire")]
 pub struct JointState {
     /// Header stamp, ns (split into `sec`/`nanosec` on the wire; saturates at i32::MAX s).
     pub stamp_ns: u64,
@@ -142,6 +170,35 @@ pub struct JointState {
     pub velocity: Vec<f64>,
     /// N·m.
     pub effort: Vec<f64>,
+}
+
+/// `sensor_msgs/msg/JointState` as decoded from CDR (`.msg` field names).
+#[derive(Deserialize)]
+struct JointStateWire {
+    header: HeaderWire,
+    name: Vec<String>,
+    position: Vec<f64>,
+    velocity: Vec<f64>,
+    effort: Vec<f64>,
+}
+
+#[derive(Deserialize)]
+struct HeaderWire {
+    stamp: TimeWire,
+    frame_id: String,
+}
+
+#[derive(Deserialize)]
+struct TimeWire {
+    sec: i64,
+    nanosec: u64,
+}
+
+impl From<JointStateWire> for JointState {
+    fn from(w: JointStateWire) -> Self {
+        let ns = u64::try_from(w.header.stamp.sec).unwrap_or(0).saturating_mul(1_000_000_000).saturating_add(w.header.stamp.nanosec);
+        JointState { stamp_ns: ns, frame_id: w.header.frame_id, name: w.name, position: w.position, velocity: w.velocity, effort: w.effort }
+    }
 }
 
 /// Encodes a protobuf [`foxglove::Encode`] message into a growable buffer.

@@ -25,7 +25,9 @@ use prost_reflect::{DescriptorPool, DynamicMessage, MessageDescriptor, ReflectMe
 use crate::value::Value;
 
 mod recover;
-use crate::{from_log_time, ros2msg, Error, FORMAT_VERSION_KEY, RECORDING_METADATA};
+mod typed;
+use crate::{ros2msg, Error};
+pub use typed::ArraySizes;
 pub use recover::{read_recording_recover, read_recording_recover_bytes, RecoverReport};
 
 /// One channel of the file.
@@ -47,12 +49,14 @@ pub struct ChannelInfo {
 pub struct Recording {
     /// The label errors use: the path, or the `source` given to [`read_recording_bytes`].
     pub source: String,
-    /// Metadata records by name (records with the same name are merged, later keys win).
-    pub metadata: BTreeMap<String, BTreeMap<String, String>>,
+    /// Metadata records by name (records with the same name are merged, later keys win); read
+    /// them typed ([`Recording::record`], [`Recording::run`], …).
+    pub(crate) metadata: BTreeMap<String, BTreeMap<String, String>>,
     /// Channels in channel-id order.
     pub channels: Vec<ChannelInfo>,
-    /// Decoded messages by topic, sorted by log time (stable: file order among equal times).
-    pub messages: BTreeMap<String, Vec<(u64, Value)>>,
+    /// Decoded messages by topic, sorted by log time (stable: file order among equal times);
+    /// read them typed ([`Recording::read`]) or generically ([`Recording::messages`]).
+    pub(crate) messages: BTreeMap<String, Vec<(u64, Value)>>,
 }
 
 /// Reads and decodes the MCAP file at `path`; errors name the file.
@@ -454,71 +458,20 @@ fn proto_to_value(v: &prost_reflect::Value) -> Value {
 }
 
 impl Recording {
-    /// A numeric field of every message on `topic`: times in s (from the log times, see
-    /// [`crate::from_log_time`]) and one row per message: a scalar field gives a 1-element row,
-    /// an array field its elements. `field` is a [`Value::get`] path (`"current"`, `"actual.x"`).
-    pub fn series(&self, topic: &str, field: &str) -> Result<(Vec<f64>, Vec<Vec<f64>>), Error> {
-        let file = || self.source.clone();
-        let Some(list) = self.messages.get(topic) else {
-            let chans: Vec<&ChannelInfo> =
-                self.channels.iter().filter(|c| c.topic == topic).collect();
-            if chans.is_empty() {
-                let available = self.channels.iter().map(|c| c.topic.clone()).collect();
-                return Err(Error::UnknownTopic {
-                    file: file(),
-                    topic: topic.into(),
-                    available,
-                });
-            }
-            if let Some(reason) = chans.iter().find_map(|c| c.undecoded.clone()) {
-                return Err(Error::UndecodedTopic {
-                    file: file(),
-                    topic: topic.into(),
-                    reason,
-                });
-            }
-            return Ok((Vec::new(), Vec::new())); // a channel without messages
-        };
-        let mut times = Vec::with_capacity(list.len());
-        let mut rows = Vec::with_capacity(list.len());
-        for (index, (t, msg)) in list.iter().enumerate() {
-            let v = msg.get(field).ok_or_else(|| Error::MissingField {
-                file: file(),
-                topic: topic.into(),
-                field: field.into(),
-                index,
-                log_time_ns: *t,
-            })?;
-            let row = match v.as_f64() {
-                Some(x) => vec![x],
-                None => v.as_f64_vec().ok_or_else(|| Error::NotNumeric {
-                    file: file(),
-                    topic: topic.into(),
-                    field: field.into(),
-                    index,
-                    found: v.kind().to_string(),
-                })?,
-            };
-            times.push(from_log_time(*t));
-            rows.push(row);
-        }
-        Ok((times, rows))
-    }
-
-    /// The value of `key` in the metadata record `record`.
-    pub fn metadata_value(&self, record: &str, key: &str) -> Option<&str> {
-        self.metadata.get(record)?.get(key).map(String::as_str)
-    }
-
-    /// `recording.format_version`, if present and a number.
-    pub fn format_version(&self) -> Option<u32> {
-        self.metadata_value(RECORDING_METADATA, FORMAT_VERSION_KEY)?
-            .parse()
-            .ok()
-    }
-
     /// The channel of `topic` (the first one, if several share the topic).
     pub fn channel(&self, topic: &str) -> Option<&ChannelInfo> {
         self.channels.iter().find(|c| c.topic == topic)
+    }
+
+    /// Every decoded message by topic, sorted by log time: for tools that handle any topic
+    /// generically (tables, export, checks).
+    pub fn message_map(&self) -> &BTreeMap<String, Vec<(u64, Value)>> {
+        &self.messages
+    }
+
+    /// Every decoded message of `topic` (log time in ns, decoded value), for tools that handle
+    /// any topic generically (tables, export); `None` when the file has none decoded.
+    pub fn messages(&self, topic: &str) -> Option<&[(u64, Value)]> {
+        self.messages.get(topic).map(Vec::as_slice)
     }
 }

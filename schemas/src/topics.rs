@@ -39,29 +39,50 @@ pub const ALL: [&str; 8] = [
 /// What the entries of an array field of our topics stand for (readers label columns with it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ArrayIndex {
-    /// One entry per actuated joint, names in metadata `run.joint_names` (a JSON list).
+    /// One entry per actuated joint ([`crate::RunDescription::joint_names`]).
     Joint,
-    /// One entry per contact, names in metadata `run.contacts` (a JSON list).
+    /// One entry per contact ([`crate::RunDescription::contacts`]).
     Contact,
 }
 
 impl ArrayIndex {
-    /// The metadata record and key holding the names, as a JSON list of strings.
-    pub fn names_key(self) -> (&'static str, &'static str) {
+    /// The names of the entries, in array order.
+    pub fn names(self, run: &crate::RunDescription) -> &[String] {
         match self {
-            ArrayIndex::Joint => ("run", "joint_names"),
-            ArrayIndex::Contact => ("run", "contacts"),
+            ArrayIndex::Joint => &run.joint_names,
+            ArrayIndex::Contact => &run.contacts,
         }
     }
 }
 
+/// Whether the array `field` of `topic` must always be recorded. The others may be empty in a
+/// message (not recorded by a producer, e.g. the voltages of an older test file); when present
+/// they have one entry per joint or contact like the rest.
+pub fn array_required(topic: &str, field: &str) -> bool {
+    matches!(
+        (topic, field),
+        (MOTORS, "current") | (ENERGY, "link_work" | "electric_energy") | (CONSTRAINTS, "normal_force" | "position" | "velocity")
+    )
+}
+
+/// The field of a message that names the entries of its sibling arrays
+/// (`sensor_msgs/JointState`'s `name`: `position[k]` is joint `name[k]`).
+pub const LABEL_LIST_FIELD: &str = "name";
+
+/// The label an entry of a list gives itself, for tools that expand lists into named columns:
+/// a `foxglove.FrameTransform` is named by its child frame (`/tf`: `transforms.link3.…`).
+pub fn entry_label(item: &crate::Value) -> Option<&str> {
+    item.get("child_frame_id").and_then(crate::Value::as_str).filter(|s| !s.is_empty())
+}
+
 /// The index of the array `field` of messages on `topic`, for the arrays of [`MOTORS`],
-/// [`ENERGY`] and [`CONSTRAINTS`]; `None` for anything else.
+/// [`ENERGY`], [`JOINT_STATES`] and [`CONSTRAINTS`]; `None` for anything else.
 pub fn array_index(topic: &str, field: &str) -> Option<ArrayIndex> {
     match (topic, field) {
         (MOTORS, "current" | "voltage" | "back_emf" | "electric_power" | "torque")
         | (ENERGY, "link_work" | "electric_energy") => Some(ArrayIndex::Joint),
         (CONSTRAINTS, "normal_force" | "position" | "velocity") => Some(ArrayIndex::Contact),
+        (JOINT_STATES, "position" | "velocity" | "effort") => Some(ArrayIndex::Joint),
         _ => None,
     }
 }

@@ -10,9 +10,9 @@
 //!   its worker count, which the `mcap` crate defaults to the host's core count), schema and
 //!   channel ids in order of first use, metadata in `BTreeMap` order, per-channel sequence
 //!   numbers counting from 0, `publish_time = log_time`.
-//! - **Format version.** The `recording` metadata record always carries
-//!   `format_version = FORMAT_VERSION`: added to the caller's `recording` record, or written
-//!   alone by `finish` if the caller wrote none.
+//! - **Format version.** The `recording` metadata record ([`RecordingInfo`]) always carries
+//!   `format_version = FORMAT_VERSION`: the caller's, checked, or written alone by `finish` if
+//!   the caller wrote none.
 
 use std::collections::{BTreeMap, HashMap};
 use std::fs::File;
@@ -22,7 +22,8 @@ use std::path::{Path, PathBuf};
 use mcap::records::{MessageHeader, Metadata};
 
 use crate::messages::Message;
-use crate::{Error, FORMAT_VERSION, FORMAT_VERSION_KEY, RECORDING_METADATA};
+use crate::meta::{to_entries, MetadataRecord, RecordingInfo};
+use crate::{Error, FORMAT_VERSION};
 
 /// The MCAP header's library string (fixed, so files do not depend on the build).
 pub fn library_string() -> String {
@@ -142,37 +143,41 @@ impl RecordingWriter {
             .expect("RecordingWriter used after finish")
     }
 
-    /// Writes an MCAP metadata record `name` with `entries` (in key order). For the record
-    /// [`RECORDING_METADATA`] the writer adds `format_version`; passing a different
-    /// `format_version` is an error.
-    pub fn write_metadata(
-        &mut self,
-        name: &str,
-        entries: &BTreeMap<String, String>,
-    ) -> Result<(), Error> {
+    /// Writes the metadata record `record` ([`crate::meta`]). The [`RecordingInfo`] record must
+    /// carry this writer's [`FORMAT_VERSION`] (use [`RecordingInfo::new`]).
+    pub fn write_record<R: MetadataRecord>(&mut self, record: &R) -> Result<(), Error> {
+        let entries = to_entries(record).map_err(|detail| Error::BadMetadata {
+            file: self.file.clone(),
+            record: R::NAME.into(),
+            key: String::new(),
+            detail,
+        })?;
+        self.write_metadata_raw(R::NAME, &entries)
+    }
+
+    /// Writes an MCAP metadata record `name` with any `entries` (in key order), bypassing the
+    /// typed records: for tests of readers (malformed or foreign metadata). For the record
+    /// `recording` the writer adds `format_version`; a different `format_version` is an error.
+    pub fn write_metadata_raw(&mut self, name: &str, entries: &BTreeMap<String, String>) -> Result<(), Error> {
         let mut metadata = entries.clone();
-        if name == RECORDING_METADATA {
+        if name == RecordingInfo::NAME {
             let version = FORMAT_VERSION.to_string();
-            match metadata.get(FORMAT_VERSION_KEY) {
+            let key = "format_version";
+            match metadata.get(key) {
                 Some(v) if *v != version => {
                     return Err(Error::BadMetadata {
                         file: self.file.clone(),
                         record: name.into(),
-                        key: FORMAT_VERSION_KEY.into(),
+                        key: key.into(),
                         detail: format!("caller gave {v}, this writer writes format {version}"),
                     })
                 }
-                _ => metadata.insert(FORMAT_VERSION_KEY.to_string(), version),
+                _ => metadata.insert(key.to_string(), version),
             };
             self.wrote_recording_metadata = true;
         }
-        let record = Metadata {
-            name: name.to_string(),
-            metadata,
-        };
-        self.mcap()
-            .write_metadata(&record)
-            .map_err(|e| self.mcap_err(e))
+        let record = Metadata { name: name.to_string(), metadata };
+        self.mcap().write_metadata(&record).map_err(|e| self.mcap_err(e))
     }
 
     /// Writes `msg` on `topic` at `log_time_ns` (also its publish time). The first message on
@@ -248,7 +253,7 @@ impl RecordingWriter {
     /// `path`. Returns `path`. On error the temporary file is removed and `path` is untouched.
     pub fn finish(mut self) -> Result<PathBuf, Error> {
         if !self.wrote_recording_metadata {
-            self.write_metadata(RECORDING_METADATA, &BTreeMap::new())?;
+            self.write_metadata_raw(RecordingInfo::NAME, &BTreeMap::new())?;
         }
         let tmp_file = self.tmp_path.display().to_string();
         let io = |op, source| Error::Io {

@@ -17,7 +17,7 @@ fn recording() -> Vec<u8> {
     let mut w = RecordingWriter::create_with_chunk_size(&dir.path().join("r.mcap"), 4096).unwrap();
     let mut run = BTreeMap::new();
     run.insert("run".to_string(), "two-elbow".to_string());
-    w.write_metadata("run", &run).unwrap();
+    w.write_metadata_raw("run", &run).unwrap();
     for k in 0..SAMPLES {
         let t = f64::from(k) * 1e-3;
         let ns = schemas::to_log_time(t);
@@ -42,13 +42,13 @@ fn recording() -> Vec<u8> {
     }
     let mut result = BTreeMap::new();
     result.insert("status".to_string(), "complete".to_string());
-    w.write_metadata("result", &result).unwrap();
+    w.write_metadata_raw("result", &result).unwrap();
     std::fs::read(w.finish().unwrap()).unwrap()
 }
 
 fn assert_prefix(part: &Recording, full: &Recording, what: &str) {
-    for (topic, list) in &part.messages {
-        let all = &full.messages[topic];
+    for (topic, list) in part.message_map() {
+        let all = &full.messages(topic).unwrap();
         assert!(list.len() <= all.len(), "{what}: {topic}");
         assert_eq!(
             list[..],
@@ -59,7 +59,7 @@ fn assert_prefix(part: &Recording, full: &Recording, what: &str) {
 }
 
 fn count(rec: &Recording) -> u64 {
-    rec.messages.values().map(|l| l.len() as u64).sum()
+    rec.message_map().values().map(|l| l.len() as u64).sum()
 }
 
 /// An intact file: the recovered recording is the normal reader's, and the report says complete.
@@ -69,8 +69,8 @@ fn an_intact_file_reads_as_with_the_normal_reader() {
     let normal = read_recording_bytes(&full, "r.mcap").unwrap();
     let (rec, report) = read_recording_recover_bytes(&full, "r.mcap").unwrap();
     assert!(report.complete && report.reason.is_none(), "{report}");
-    assert_eq!(rec.messages, normal.messages);
-    assert_eq!(rec.metadata, normal.metadata);
+    assert_eq!(rec.message_map(), normal.message_map());
+    assert_eq!(rec.metadata_records(), normal.metadata_records());
     assert_eq!(rec.channels, normal.channels);
     assert_eq!(report.messages, u64::from(SAMPLES) * 2);
     assert_eq!(
@@ -115,10 +115,10 @@ fn truncated_files_give_a_prefix_of_the_messages() {
             "{text}"
         );
         if n > 0 {
-            assert_eq!(rec.metadata_value("run", "run"), Some("two-elbow"));
+            assert_eq!(rec.metadata_records().get("run").and_then(|m| m.get("run")).map(String::as_str), Some("two-elbow"));
             assert_eq!(
                 report.t_end_ns,
-                rec.messages
+                rec.message_map()
                     .values()
                     .flat_map(|l| l.last())
                     .map(|(t, _)| *t)
@@ -166,7 +166,7 @@ fn a_corrupt_chunk_stops_recovery_before_it() {
     // the prefix ends where the damage starts: recovery of the file cut there gives the same
     let (rec2, _) =
         read_recording_recover_bytes(&full[..report.stopped_at as usize], "cut").unwrap();
-    assert_eq!(rec2.messages, rec.messages);
+    assert_eq!(rec2.message_map(), rec.message_map());
 }
 
 #[test]
@@ -179,7 +179,7 @@ fn nothing_to_recover_is_an_error_or_empty() {
     let e = read_recording_recover(std::path::Path::new("/nonexistent/y.mcap")).unwrap_err();
     assert!(e.to_string().contains("/nonexistent/y.mcap"), "{e}");
     let (rec, report) = read_recording_recover_bytes(mcap::MAGIC, "m.mcap").unwrap();
-    assert!(rec.messages.is_empty() && rec.metadata.is_empty() && report.messages == 0);
+    assert!(rec.message_map().is_empty() && rec.metadata_records().is_empty() && report.messages == 0);
     assert_eq!(report.stopped_at, 8);
     assert!(report.to_string().contains("no messages"), "{report}");
 }
@@ -208,8 +208,8 @@ fn chunk_size_option_reads_the_same() {
     let (ra, pa) = read_recording_recover_bytes(&a, "a").unwrap();
     let (rb, pb) = read_recording_recover_bytes(&b, "b").unwrap();
     assert_eq!((pa.chunks, pb.chunks > 3), (1, true), "{pa} / {pb}");
-    assert_eq!(ra.messages, rb.messages);
-    let v: &Value = &ra.messages[topics::MOTORS][7].1;
+    assert_eq!(ra.message_map(), rb.message_map());
+    let v: &Value = &ra.message_map()[topics::MOTORS][7].1;
     assert_eq!(
         v.get("current").and_then(Value::as_f64_vec),
         Some(vec![7.0; 4])

@@ -157,22 +157,30 @@ fn foreign_json_big_endian_cdr_and_unknown_encodings() {
         put(w, c, 0, &[1, 2, 3]);
     });
     let r = read_recording_bytes(&bytes, "foreign.mcap").unwrap();
-    let json = &r.messages["/json"][0].1;
+    let json = &r.messages("/json").unwrap()[0].1;
     assert_eq!(json.get("x"), Some(&Value::F64(1.5)));
     assert_eq!(
         json.get("v").and_then(Value::as_f64_vec),
         Some(vec![1.0, -2.0, 3.25])
     );
-    let be = &r.messages["/be"][0].1;
+    let be = &r.messages("/be").unwrap()[0].1;
     assert_eq!(be.get("y"), Some(&Value::F64(-2.0)));
-    assert_eq!(r.series("/be", "z").unwrap().1, vec![vec![0.5]]);
+    assert_eq!(be.get("z"), Some(&Value::F64(0.5)));
 
     // the ros1 channel is listed with a reason and its messages are counted but not decoded
     let ros1 = r.channels.iter().find(|c| c.topic == "/ros1").unwrap();
     assert_eq!(ros1.message_count, 1);
     assert!(ros1.undecoded.as_deref().unwrap().contains("ros1"));
-    assert!(!r.messages.contains_key("/ros1"));
-    let e = r.series("/ros1", "x").unwrap_err();
+    assert!(r.messages("/ros1").is_none());
+    #[derive(serde::Deserialize)]
+    struct Ros1Thing {
+        #[allow(dead_code)]
+        x: f64,
+    }
+    impl schemas::TopicMessage for Ros1Thing {
+        const TOPIC: &'static str = "/ros1";
+    }
+    let e = r.read::<Ros1Thing>().err().unwrap();
     assert!(matches!(e, Error::UndecodedTopic { .. }), "{e}");
 }
 

@@ -6,7 +6,10 @@
 mod common;
 
 use common::{bits, content, f, fv, tf, val, write_all, URDF};
-use schemas::{from_log_time, read_recording, topics, Value};
+use schemas::{
+    from_log_time, read_recording, topics, ArraySizes, ConstraintState, EnergyState, HandState, JointState,
+    MotorState, RecordingWriter, Value,
+};
 
 #[test]
 fn every_message_type_round_trips_through_the_generic_reader() {
@@ -16,9 +19,9 @@ fn every_message_type_round_trips_through_the_generic_reader() {
     let r = read_recording(&path).unwrap();
 
     // metadata: caller's entries plus the format version
-    assert_eq!(r.metadata_value("recording", "scene"), Some("two_link"));
-    assert_eq!(r.metadata_value("recording", "integrator"), Some("rk4"));
-    assert_eq!(r.metadata_value("solver", "dt"), Some("0.001"));
+    assert_eq!(r.metadata_records().get("recording").and_then(|m| m.get("scene")).map(String::as_str), Some("two_link"));
+    assert_eq!(r.metadata_records().get("recording").and_then(|m| m.get("integrator")).map(String::as_str), Some("rk4"));
+    assert_eq!(r.metadata_records().get("solver").and_then(|m| m.get("dt")).map(String::as_str), Some("0.001"));
     assert_eq!(r.format_version(), Some(schemas::FORMAT_VERSION));
 
     // channels in order of first use, with the encodings VIEWERS.md asks for
@@ -86,7 +89,7 @@ fn every_message_type_round_trips_through_the_generic_reader() {
     );
     assert!(r.channels.iter().all(|c| c.undecoded.is_none()));
 
-    let urdf = &r.messages["/robot_description"];
+    let urdf = &r.messages("/robot_description").unwrap();
     assert_eq!(urdf.len(), 1);
     assert_eq!(
         (urdf[0].0, urdf[0].1.get("data").and_then(Value::as_str)),
@@ -94,7 +97,7 @@ fn every_message_type_round_trips_through_the_generic_reader() {
     );
 
     for (k, &t) in c.times.iter().enumerate() {
-        let m = &r.messages["/motors"][k];
+        let m = &r.messages("/motors").unwrap()[k];
         assert_eq!(m.0, t);
         let want = &c.motors[k];
         assert_eq!(f(&m.1, "time"), want.time.to_bits());
@@ -104,14 +107,14 @@ fn every_message_type_round_trips_through_the_generic_reader() {
         assert_eq!(fv(&m.1, "electric_power"), bits(&want.electric_power));
         assert_eq!(fv(&m.1, "torque"), bits(&want.torque));
 
-        let m = &r.messages["/constraints"][k].1;
+        let m = &r.messages("/constraints").unwrap()[k].1;
         let want = &c.constraints[k];
         assert_eq!(f(m, "time"), want.time.to_bits());
         assert_eq!(fv(m, "normal_force"), bits(&want.normal_force));
         assert_eq!(fv(m, "position"), bits(&want.position));
         assert_eq!(fv(m, "velocity"), bits(&want.velocity));
 
-        let m = &r.messages["/hand"][k].1;
+        let m = &r.messages("/hand").unwrap()[k].1;
         let want = &c.hands[k];
         for (name, v) in [
             ("actual", want.actual),
@@ -124,7 +127,7 @@ fn every_message_type_round_trips_through_the_generic_reader() {
         }
         assert_eq!(f(m, "error_norm"), want.error_norm.to_bits());
 
-        let m = &r.messages["/energy"][k].1;
+        let m = &r.messages("/energy").unwrap()[k].1;
         let want = &c.energies[k];
         assert_eq!(fv(m, "link_work"), bits(&want.link_work));
         assert_eq!(fv(m, "electric_energy"), bits(&want.electric_energy));
@@ -142,7 +145,7 @@ fn every_message_type_round_trips_through_the_generic_reader() {
             assert_eq!(f(m, name), x.to_bits(), "energy.{name}");
         }
 
-        let m = &r.messages["/joint_states"][k].1;
+        let m = &r.messages("/joint_states").unwrap()[k].1;
         let want = &c.joints[k];
         let sec = m.get("header.stamp.sec").and_then(Value::as_f64).unwrap() as u64;
         let nsec = m
@@ -166,7 +169,7 @@ fn every_message_type_round_trips_through_the_generic_reader() {
         assert_eq!(fv(m, "velocity"), bits(&want.velocity));
         assert_eq!(fv(m, "effort"), bits(&want.effort));
 
-        let m = &r.messages["/tf"][k].1;
+        let m = &r.messages("/tf").unwrap()[k].1;
         let want = tf(t, k);
         let list = m.get("transforms").and_then(Value::as_list).unwrap();
         assert_eq!(list.len(), want.transforms.len());
@@ -219,7 +222,7 @@ fn every_message_type_round_trips_through_the_generic_reader() {
             assert_eq!(secs * 1_000_000_000 + nanos, t);
         }
 
-        let m = &r.messages["/hand_points"][k].1;
+        let m = &r.messages("/hand_points").unwrap()[k].1;
         assert_eq!(m.get("frame_id").and_then(Value::as_str), Some("world"));
         assert_eq!(m.get("point_stride").and_then(Value::as_f64), Some(24.0));
         let names: Vec<&str> = (0..3)
@@ -240,53 +243,45 @@ fn every_message_type_round_trips_through_the_generic_reader() {
         assert_eq!(pts, bits(&[1.0, 2.0, 3.0, val(k, 0), -0.0, 9.5]));
     }
 
-    // series: times from the log times, scalar fields as 1-element rows, arrays as rows
-    let (t, rows) = r.series(topics::MOTORS, "current").unwrap();
-    assert_eq!(
-        t,
-        c.times
-            .iter()
-            .map(|&n| from_log_time(n))
-            .collect::<Vec<_>>()
-    );
-    assert_eq!(
-        rows.iter().map(|r| bits(r)).collect::<Vec<_>>(),
-        c.motors
-            .iter()
-            .map(|m| bits(&m.current))
-            .collect::<Vec<_>>()
-    );
-    let (_, rows) = r.series(topics::HAND, "actual.y").unwrap();
-    assert_eq!(
-        rows.iter().map(|r| bits(r)).collect::<Vec<_>>(),
-        c.hands
-            .iter()
-            .map(|h| vec![h.actual.y.to_bits()])
-            .collect::<Vec<_>>()
-    );
+    // typed reading: times from the log times, every field bit for bit
+    let motors = r.read::<MotorState>().unwrap();
+    assert_eq!(motors.iter().map(|m| m.0).collect::<Vec<_>>(), c.times.iter().map(|&n| from_log_time(n)).collect::<Vec<_>>());
+    assert_eq!(motors.iter().map(|m| bits(&m.1.current)).collect::<Vec<_>>(), c.motors.iter().map(|m| bits(&m.current)).collect::<Vec<_>>());
+    // (Debug text: NaN equals itself there, and -0.0 differs from 0.0)
+    let same = |a: &dyn std::fmt::Debug, b: &dyn std::fmt::Debug| assert_eq!(format!("{a:?}"), format!("{b:?}"));
+    same(&motors.into_iter().map(|m| m.1).collect::<Vec<_>>(), &c.motors);
+    let hands = r.read::<HandState>().unwrap();
+    same(&hands.into_iter().map(|h| h.1).collect::<Vec<_>>(), &c.hands);
+    let energies = r.read::<EnergyState>().unwrap();
+    same(&energies.into_iter().map(|e| e.1).collect::<Vec<_>>(), &c.energies);
+    let constraints = r.read::<ConstraintState>().unwrap();
+    same(&constraints.into_iter().map(|e| e.1).collect::<Vec<_>>(), &c.constraints);
+    // the ROS 2 message through its CDR schema, header stamp included
+    let joints = r.read::<JointState>().unwrap();
+    same(&joints.into_iter().map(|j| j.1).collect::<Vec<_>>(), &c.joints);
 }
 
+/// Typed reading of a topic the file lacks, of a message without a field the type needs, and
+/// of arrays of the wrong length: errors that name the file, the topic and the field.
 #[test]
-fn series_errors_name_file_topic_and_field() {
+fn typed_reading_errors_name_file_topic_and_field() {
     let dir = tempfile::tempdir().unwrap();
     let path = write_all(&dir.path().join("s.mcap"), &content(2));
     let r = read_recording(&path).unwrap();
-    let e = r.series("/nope", "x").unwrap_err().to_string();
-    assert!(
-        e.contains("s.mcap") && e.contains("/nope") && e.contains("/motors"),
-        "{e}"
-    );
-    let e = r
-        .series(topics::MOTORS, "nonexistent")
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("s.mcap") && e.contains("/motors") && e.contains("nonexistent"),
-        "{e}"
-    );
-    let e = r
-        .series(topics::ROBOT_DESCRIPTION, "data")
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("not numeric") && e.contains("string"), "{e}");
+    #[derive(Debug, serde::Deserialize)]
+    struct Nope {}
+    impl schemas::TopicMessage for Nope {
+        const TOPIC: &'static str = "/nope";
+    }
+    let e = r.read::<Nope>().unwrap_err().to_string();
+    assert!(e.contains("s.mcap") && e.contains("/nope") && e.contains("/motors"), "{e}");
+    let e = r.read_sized::<MotorState>(ArraySizes { joints: 7, contacts: 0 }).unwrap_err().to_string();
+    assert!(e.contains("s.mcap") && e.contains("/motors") && e.contains("current") && e.contains("expected 7"), "{e}");
+    // a HandState written on /motors: the typed reader names the missing field
+    let bad = dir.path().join("bad.mcap");
+    let mut w = RecordingWriter::create(&bad).unwrap();
+    w.write(topics::MOTORS, 0, &HandState::default()).unwrap();
+    w.finish().unwrap();
+    let e = read_recording(&bad).unwrap().read::<MotorState>().unwrap_err().to_string();
+    assert!(e.contains("bad.mcap") && e.contains("/motors") && e.contains("missing field `current`"), "{e}");
 }

@@ -73,7 +73,7 @@ fn dropped_writer_leaves_nothing_and_finish_leaves_only_path() {
     w.write(topics::MOTORS, 0, &MotorState::default()).unwrap();
     assert_eq!(w.finish().unwrap(), path);
     assert_eq!(listing(), ["run.mcap"]);
-    assert_eq!(read_recording(&path).unwrap().messages["/motors"].len(), 1);
+    assert_eq!(read_recording(&path).unwrap().messages("/motors").unwrap().len(), 1);
 
     // an abandoned second run never touches the finished recording
     let before = std::fs::read(&path).unwrap();
@@ -109,7 +109,7 @@ fn writer_rejects_misuse_with_errors_naming_the_file() {
     );
     let mut bad = BTreeMap::new();
     bad.insert("format_version".to_string(), "99".to_string());
-    let e = w.write_metadata("recording", &bad).unwrap_err().to_string();
+    let e = w.write_metadata_raw("recording", &bad).unwrap_err().to_string();
     assert!(e.contains("format_version") && e.contains("99"), "{e}");
     drop(w);
     let e = RecordingWriter::create(&dir.path().join("no_such_dir/x.mcap"))
@@ -127,6 +127,6 @@ fn format_version_is_written_even_without_a_recording_record() {
     w.write(topics::ENERGY, 0, &EnergyState::default()).unwrap();
     w.finish().unwrap();
     let r = read_recording(&path).unwrap();
-    assert_eq!(r.metadata_value("recording", "format_version"), Some(schemas::FORMAT_VERSION.to_string().as_str()));
-    assert_eq!(r.metadata.len(), 1);
+    assert_eq!(r.metadata_records().get("recording").and_then(|m| m.get("format_version")).map(String::as_str), Some(schemas::FORMAT_VERSION.to_string().as_str()));
+    assert_eq!(r.metadata_records().len(), 1);
 }

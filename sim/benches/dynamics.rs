@@ -19,7 +19,7 @@ use sim::dynamics::samples::SplitMix64;
 use sim::dynamics::{crba, rnea, walker_orin, Data};
 use sim::integrate::OdeSystem;
 use sim::scene::Scene;
-use sim::system::ArmSystem;
+use sim::ode::ArmSystem;
 
 const PLANTS: [(&str, MassMatrixMethod, ConstraintSolver); 4] = [
     ("crba-schur", MassMatrixMethod::Crba, ConstraintSolver::Schur),
@@ -30,10 +30,10 @@ const PLANTS: [(&str, MassMatrixMethod, ConstraintSolver); 4] = [
 
 fn kernels(c: &mut Criterion) {
     let scene = Scene::paper().expect("the built-in scene is valid");
-    let model = &scene.model;
+    let model = scene.model();
     let nv = model.nv;
     let mut rng = SplitMix64(2024);
-    let q = scene.q0.clone();
+    let q = scene.q0().to_vec();
     let qd = rng.vector(nv, -1.0, 1.0);
     let qdd = rng.vector(nv, -1.0, 1.0);
     let current = rng.vector(nv, -3.0, 3.0);
@@ -62,13 +62,13 @@ fn kernels(c: &mut Criterion) {
     for (name, mass_matrix, solver) in PLANTS {
         let plant = Plant {
             model,
-            drives: &scene.drives,
-            contacts: &scene.contacts,
+            drives: &scene.drives(),
+            contacts: &scene.contacts(),
             mass_matrix,
             solver,
-            stabilization: scene.stabilization,
+            stabilization: scene.stabilization(),
         };
-        let mut fd = ForwardData::new(nv, scene.contacts.len());
+        let mut fd = ForwardData::new(nv, scene.contacts().len());
         g.bench_function(BenchmarkId::new("forward", name), |b| {
             b.iter(|| {
                 forward_dynamics(&plant, &mut data, &mut fd, 0.0, black_box(&q), black_box(&qd), &current, &voltage)
@@ -82,22 +82,25 @@ fn kernels(c: &mut Criterion) {
 
 fn rhs(c: &mut Criterion) {
     let scene = Scene::paper().expect("the built-in scene is valid");
-    let nv = scene.model.nv;
+    let nv = scene.model().nv;
     let mut g = c.benchmark_group("paper_rhs");
     // the scene's plant on each run, then the two-elbow run with every other plant
     let mut cases: Vec<(String, Scene, usize)> =
-        (0..scene.runs.len()).map(|k| (scene.runs[k].name.clone(), scene.clone(), k)).collect();
-    let two = scene.runs.iter().position(|r| r.contacts.len() == 2).expect("a two-elbow run");
+        (0..scene.runs().len()).map(|k| (scene.runs()[k].name.clone(), scene.clone(), k)).collect();
+    let two = scene.runs().iter().position(|r| r.contacts.len() == 2).expect("a two-elbow run");
     for (name, mass_matrix, solver) in &PLANTS[1..] {
-        let mut s = scene.clone();
-        s.mass_matrix = *mass_matrix;
-        s.solver = *solver;
-        cases.push((format!("{}-{name}", scene.runs[two].name), s, two));
+        let s = scene
+            .vary(|sp| {
+                sp.dynamics.mass_matrix = *mass_matrix;
+                sp.dynamics.constraint_solver = *solver;
+            })
+            .expect("a valid variation");
+        cases.push((format!("{}-{name}", scene.runs()[two].name), s, two));
     }
     for (name, s, k) in &cases {
-        let mut sys = ArmSystem::new(s, &s.runs[*k]);
+        let mut sys = ArmSystem::new(s, &s.runs()[*k]);
         let mut y = sys.initial_state();
-        let l = sys.layout;
+        let l = sys.layout();
         let mut rng = SplitMix64(7);
         y[l.qd()].copy_from_slice(&rng.vector(nv, -1.0, 1.0));
         y[l.current()].copy_from_slice(&rng.vector(nv, -3.0, 3.0));

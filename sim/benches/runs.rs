@@ -21,28 +21,31 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 use sim::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
 use sim::run::simulate;
-use sim::scene::{IntegratorSettings, Scene};
+use sim::scene::spec::IntegratorSpec;
+use sim::scene::Scene;
 
 fn runs(c: &mut Criterion) {
     let paper = Scene::paper().expect("the built-in scene is valid");
-    let two = paper.runs.iter().position(|r| r.contacts.len() == 2).expect("a two-elbow run");
+    let two = paper.runs().iter().position(|r| r.contacts.len() == 2).expect("a two-elbow run");
 
-    let mut rk4 = paper.clone();
-    rk4.integrator = IntegratorSettings::Rk4 { step: 1e-4 };
-    let mut baseline = rk4.clone();
-    baseline.mass_matrix = MassMatrixMethod::WalkerOrin;
-    baseline.solver = ConstraintSolver::Kkt;
+    let rk4 = paper.vary(|s| s.integrator = IntegratorSpec::rk4(1e-4)).expect("a valid variation");
+    let baseline = rk4
+        .vary(|s| {
+            s.dynamics.mass_matrix = MassMatrixMethod::WalkerOrin;
+            s.dynamics.constraint_solver = ConstraintSolver::Kkt;
+        })
+        .expect("a valid variation");
     let cases = [("two-elbow-dopri45", paper), ("two-elbow-rk4", rk4), ("two-elbow-paper-baseline", baseline)];
 
     let mut g = c.benchmark_group("paper_run");
     // a run takes 0.1–3 s: the same iteration count in every sample (10 runs, not 55)
     g.sampling_mode(SamplingMode::Flat);
     for (name, scene) in &cases {
-        let run = &scene.runs[two];
+        let run = &scene.runs()[two];
         let report = simulate(scene, run, |_| Ok(())).expect("the run completes");
         eprintln!(
             "{name}: {} s simulated, {} steps ({} rejected), {} rhs evaluations, {} samples",
-            scene.duration, report.stats.steps, report.stats.rejected, report.stats.rhs_evals, report.samples
+            scene.duration(), report.stats.steps, report.stats.rejected, report.stats.rhs_evals, report.samples
         );
         g.bench_function(*name, |b| {
             b.iter(|| {

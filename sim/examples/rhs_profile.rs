@@ -4,7 +4,7 @@ use sim::integrate::OdeSystem;
 fn main() {
     let scene = sim::scene::Scene::paper().expect("built-in scene");
     let run = scene.run("two-elbow").expect("run").clone();
-    let mut sys = sim::system::ArmSystem::new(&scene, &run);
+    let mut sys = sim::ode::ArmSystem::new(&scene, &run);
     let y = sys.initial_state();
     let mut f = vec![0.0; y.len()];
     let n: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(20_000);

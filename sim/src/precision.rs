@@ -13,21 +13,20 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
-use crate::error::RunError;
-use crate::scene::{IntegratorSettings, Run, Scene};
+use crate::dynamics::motor::Electrical;
+use crate::error::{RunError, SceneError};
+use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, PerJoint, SceneSpec};
+use crate::scene::{Run, Scene};
 
-/// One configuration to measure.
+/// One configuration to measure: a variation of the scene, validated like any scene.
 #[derive(Clone, Debug)]
 pub struct Variant {
     /// Series name in the table and the plot (method + model).
     pub series: String,
     /// The rung on the ladder: a tolerance or a step, as text.
     pub setting: String,
-    pub integrator: IntegratorSettings,
-    pub mass_matrix: MassMatrixMethod,
-    pub solver: ConstraintSolver,
-    /// A modified scene (a model reduction) instead of the scene itself.
-    pub reduced: Option<Box<Scene>>,
+    /// The scene with this integrator, mass-matrix method, constraint solver and model.
+    pub scene: Scene,
 }
 
 /// The measurement of one variant.
@@ -71,21 +70,47 @@ fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Sta
     Ok((r, rep.stats, drift))
 }
 
-/// The tight reference: Dormand–Prince at rtol 1e-12, atol 1e-14, CRBA + Schur.
-pub fn reference(scene: &Scene, run: &Run) -> Result<Reference, RunError> {
-    let mut s = scene.clone();
-    s.integrator = IntegratorSettings::Dopri45 { rtol: 1e-12, atol: 1e-14, h_max: 1.0 / scene.output_rate, max_steps: usize::MAX };
-    s.mass_matrix = MassMatrixMethod::Crba;
-    s.solver = ConstraintSolver::Schur;
+/// An adaptive `method` at `rtol` (atol = rtol / 100), steps of at most `h_max`.
+fn adaptive(method: &str, rtol: f64, h_max: Option<f64>) -> IntegratorSpec {
+    IntegratorSpec::adaptive(method, rtol, h_max).expect("a method of the ladder")
+}
+
+/// `scene` with `integrator`, `mass_matrix`, `solver` and `reduce` applied to its spec.
+fn variation(
+    scene: &Scene,
+    integrator: IntegratorSpec,
+    mass_matrix: MassMatrixMethod,
+    solver: ConstraintSolver,
+    reduce: impl FnOnce(&mut SceneSpec),
+) -> Result<Scene, SceneError> {
+    scene.vary(|s| {
+        s.integrator = integrator;
+        s.dynamics.mass_matrix = mass_matrix;
+        s.dynamics.constraint_solver = solver;
+        reduce(s);
+    })
+}
+
+/// Why the reference run could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum ReferenceError {
+    #[error("the reference scene (dopri45, rtol 1e-12): {0}")]
+    Scene(#[from] SceneError),
+    #[error("the reference run (dopri45, rtol 1e-12): {0}")]
+    Run(#[from] RunError),
+}
+
+/// The tight reference: Dormand–Prince at rtol 1e-12, atol 1e-14, steps of at most the output
+/// interval, CRBA + Schur.
+pub fn reference(scene: &Scene, run: &Run) -> Result<Reference, ReferenceError> {
+    let spec = IntegratorSpec::Dopri45(AdaptiveSpec { rtol: 1e-12, atol: 1e-14, h_max: Some(1.0 / scene.output_rate), max_steps: None });
+    let s = variation(scene, spec, MassMatrixMethod::Crba, ConstraintSolver::Schur, |_| {})?;
     Ok(collect(&s, run)?.0)
 }
 
 /// Measure one variant against the reference.
-pub fn measure(scene: &Scene, run: &Run, v: &Variant, reference: &Reference, repeats: usize) -> Row {
-    let mut s = v.reduced.as_deref().cloned().unwrap_or_else(|| scene.clone());
-    s.integrator = v.integrator;
-    s.mass_matrix = v.mass_matrix;
-    s.solver = v.solver;
+pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) -> Row {
+    let s = &v.scene;
     let mut row = Row {
         series: v.series.clone(),
         setting: v.setting.clone(),
@@ -102,7 +127,7 @@ pub fn measure(scene: &Scene, run: &Run, v: &Variant, reference: &Reference, rep
     // timing: the simulation alone, best of `repeats`
     for _ in 0..repeats.max(1) {
         let t0 = Instant::now();
-        match crate::run::simulate(&s, run, |_| Ok(())) {
+        match crate::run::simulate(s, run, |_| Ok(())) {
             Ok(rep) => {
                 row.wall_s = row.wall_s.min(t0.elapsed().as_secs_f64());
                 row.rhs_evals = rep.stats.rhs_evals;
@@ -117,7 +142,7 @@ pub fn measure(scene: &Scene, run: &Run, v: &Variant, reference: &Reference, rep
     }
     row.speed_vs_real_time = s.duration / row.wall_s;
     // errors: one more run that keeps the samples
-    match collect(&s, run) {
+    match collect(s, run) {
         Ok((r, _, drift)) => {
             row.max_drift_m = drift;
             row.max_hand_error_m = r.hand.iter().zip(&reference.hand).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
@@ -135,63 +160,51 @@ pub fn measure(scene: &Scene, run: &Run, v: &Variant, reference: &Reference, rep
 
 /// The default ladder for a scene: RK4 over steps, Dormand–Prince over tolerances, the
 /// paper-style baseline (Walker–Orin + the full block solve + RK4), and the model reductions
-/// that apply (quasi-static motors when the scene has inductance).
-pub fn default_ladder(scene: &Scene) -> Vec<Variant> {
-    let h_max = 1.0 / scene.output_rate;
-    let mut v = Vec::new();
-    let plain = |series: &str, setting: String, integrator| Variant {
-        series: series.into(),
-        setting,
-        integrator,
-        mass_matrix: MassMatrixMethod::Crba,
-        solver: ConstraintSolver::Schur,
-        reduced: None,
-    };
-    for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
-        v.push(plain("dopri45", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max, max_steps: 100_000_000 }));
-    }
+/// that apply (quasi-static motors when the scene has inductance). Every variant is the scene's
+/// spec changed and validated again.
+pub fn default_ladder(scene: &Scene) -> Result<Vec<Variant>, SceneError> {
+    use ConstraintSolver::{Kkt, Schur};
+    use MassMatrixMethod::{Crba, WalkerOrin};
+    let h_out = Some(1.0 / scene.output_rate);
     // the stiff methods may take steps far longer than the output interval; so may dopri45,
     // up to its stability limit
-    let h_long = scene.duration / 10.0;
+    let h_long = Some(scene.duration / 10.0);
+    let mut v = Vec::new();
+    let mut push = |series: &str, setting: String, spec: IntegratorSpec, mm, solver, reduce: &dyn Fn(&mut SceneSpec)| -> Result<(), SceneError> {
+        let scene = variation(scene, spec, mm, solver, reduce)?;
+        v.push(Variant { series: series.into(), setting, scene });
+        Ok(())
+    };
+    let none = &|_: &mut SceneSpec| {};
+    for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
+        push("dopri45", format!("rtol {tol:.0e}"), adaptive("dopri45", tol, h_out), Crba, Schur, none)?;
+    }
     for tol in [1e-4, 1e-6, 1e-8] {
-        v.push(plain("dopri45 (h_max free)", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max: h_long, max_steps: 100_000_000 }));
+        push("dopri45 (h_max free)", format!("rtol {tol:.0e}"), adaptive("dopri45", tol, h_long), Crba, Schur, none)?;
     }
     for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] {
-        v.push(plain(
-            "rosenbrock (structured J)",
-            format!("rtol {tol:.0e}"),
-            IntegratorSettings::Rosenbrock { rtol: tol, atol: tol * 1e-2, h_max: h_long, max_steps: 100_000_000, jacobian_reuse: 1 },
-        ));
+        push("rosenbrock (structured J)", format!("rtol {tol:.0e}"), adaptive("rosenbrock", tol, h_long), Crba, Schur, none)?;
     }
     for tol in [1e-4, 1e-6, 1e-8] {
-        v.push(plain("imex (circuits implicit)", format!("rtol {tol:.0e}"), IntegratorSettings::Imex { rtol: tol, atol: tol * 1e-2, h_max: h_long, max_steps: 100_000_000 }));
+        push("imex (circuits implicit)", format!("rtol {tol:.0e}"), adaptive("imex", tol, h_long), Crba, Schur, none)?;
     }
     for h in [5e-4, 2e-4, 1e-4, 5e-5, 2e-5] {
-        v.push(plain("rk4", format!("h {h:.0e} s"), IntegratorSettings::Rk4 { step: h }));
+        push("rk4", format!("h {h:.0e} s"), IntegratorSpec::rk4(h), Crba, Schur, none)?;
     }
     for h in [5e-4, 2e-4, 1e-4, 5e-5, 2e-5] {
-        v.push(Variant {
-            series: "paper baseline (walker-orin + kkt + rk4)".into(),
-            setting: format!("h {h:.0e} s"),
-            integrator: IntegratorSettings::Rk4 { step: h },
-            mass_matrix: MassMatrixMethod::WalkerOrin,
-            solver: ConstraintSolver::Kkt,
-            reduced: None,
-        });
+        push("paper baseline (walker-orin + kkt + rk4)", format!("h {h:.0e} s"), IntegratorSpec::rk4(h), WalkerOrin, Kkt, none)?;
     }
-    if !scene.drives.quasi_static {
-        let mut q = scene.clone();
-        let l = vec![0.0; scene.model.nv];
-        q.drives.l = nalgebra::DVector::from_vec(l);
-        q.drives.quasi_static = true;
-        q.current0 = vec![0.0; scene.model.nv];
+    if scene.drives.electrical == Electrical::Inductive {
+        // the quasi-static reduction: L = 0 on every motor, no current state
+        let quasi_static = &|s: &mut SceneSpec| {
+            s.motor.inductance = PerJoint::All(0.0);
+            s.initial.current = PerJoint::All(0.0);
+        };
         for tol in [1e-6, 1e-8, 1e-10] {
-            let mut r = plain("dopri45, L = 0 (quasi-static)", format!("rtol {tol:.0e}"), IntegratorSettings::Dopri45 { rtol: tol, atol: tol * 1e-2, h_max, max_steps: 100_000_000 });
-            r.reduced = Some(Box::new(q.clone()));
-            v.push(r);
+            push("dopri45, L = 0 (quasi-static)", format!("rtol {tol:.0e}"), adaptive("dopri45", tol, h_out), Crba, Schur, quasi_static)?;
         }
     }
-    v
+    Ok(v)
 }
 
 /// Per series, the cheapest run whose max hand error is at most `target_m`.

@@ -5,64 +5,27 @@
 //! `/hand_points`; and metadata with everything needed to reproduce the run (scene, URDF,
 //! tool version, integrator), nothing that differs between two identical runs.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use nalgebra::UnitQuaternion;
 use schemas::{
     frame_transform, hand_points, to_log_time, topics, ConstraintState, EnergyState, FrameTransforms, HandState,
-    JointState, MotorState, RecordingWriter, RosString, Vec3,
+    JointState, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
+    SceneRecord, Setup, UrdfRecord, Vec3,
 };
 
 use crate::error::RunError;
-use crate::scene::{IntegratorSettings, Run, Scene};
-use crate::system::Outputs;
+use crate::scene::{Run, Scene};
+use crate::ode::Outputs;
 
 /// The world frame's id in `/tf`.
 pub const WORLD_FRAME: &str = "world";
 /// Name and version of this tool, stored in every recording.
 pub const TOOL: &str = concat!("elbow-sim ", env!("CARGO_PKG_VERSION"));
 
-/// Metadata record names.
-pub mod records {
-    pub const RUN: &str = "run";
-    pub const SCENE: &str = "scene";
-    pub const URDF: &str = "urdf";
-    pub const RESULT: &str = "result";
-}
-
-/// The integrator and its settings as metadata text.
-pub fn integrator_description(s: &IntegratorSettings) -> BTreeMap<String, String> {
-    let mut m = BTreeMap::new();
-    match *s {
-        IntegratorSettings::Rk4 { step } => {
-            m.insert("integrator".into(), "rk4".into());
-            m.insert("integrator.step".into(), format!("{step:e}"));
-        }
-        IntegratorSettings::Dopri45 { rtol, atol, h_max, max_steps } => {
-            m.insert("integrator".into(), "dopri45".into());
-            m.insert("integrator.rtol".into(), format!("{rtol:e}"));
-            m.insert("integrator.atol".into(), format!("{atol:e}"));
-            m.insert("integrator.h_max".into(), format!("{h_max:e}"));
-            m.insert("integrator.max_steps".into(), max_steps.to_string());
-        }
-        IntegratorSettings::Rosenbrock { rtol, atol, h_max, max_steps, jacobian_reuse } => {
-            m.insert("integrator".into(), "rosenbrock (ROS34PW2, structured Jacobian)".into());
-            m.insert("integrator.rtol".into(), format!("{rtol:e}"));
-            m.insert("integrator.atol".into(), format!("{atol:e}"));
-            m.insert("integrator.h_max".into(), format!("{h_max:e}"));
-            m.insert("integrator.max_steps".into(), max_steps.to_string());
-            m.insert("integrator.jacobian_reuse".into(), jacobian_reuse.to_string());
-        }
-        IntegratorSettings::Imex { rtol, atol, h_max, max_steps } => {
-            m.insert("integrator".into(), "imex (ARK4(3)6L[2]SA, armature circuits implicit)".into());
-            m.insert("integrator.rtol".into(), format!("{rtol:e}"));
-            m.insert("integrator.atol".into(), format!("{atol:e}"));
-            m.insert("integrator.h_max".into(), format!("{h_max:e}"));
-            m.insert("integrator.max_steps".into(), max_steps.to_string());
-        }
-    }
-    m
+/// Compact JSON of a setting (its serde form).
+fn json<T: serde::Serialize>(v: &T) -> String {
+    serde_json::to_string(v).unwrap_or_default()
 }
 
 fn v3(v: &nalgebra::Vector3<f64>) -> Vec3 {
@@ -92,42 +55,35 @@ impl<'a> Recorder<'a> {
         let err = |source| RunError::Recording { path: path.to_path_buf(), source };
         let mut writer = RecordingWriter::create(path).map_err(err)?;
         let joint_names = scene.model.joint_names();
-        let contact_names: Vec<&str> = run.contacts.iter().map(|&k| scene.contacts[k].name.as_str()).collect();
-
-        let mut rec = BTreeMap::new();
-        rec.insert("tool".to_string(), TOOL.to_string());
-        writer.write_metadata(schemas::RECORDING_METADATA, &rec).map_err(err)?;
-
-        let mut m = integrator_description(&scene.integrator);
-        m.insert("scene".into(), scene.spec.name.clone());
-        m.insert("run".into(), run.name.clone());
-        m.insert("contacts".into(), serde_json::to_string(&contact_names).unwrap_or_default());
-        m.insert("joint_names".into(), serde_json::to_string(&joint_names).unwrap_or_default());
-        m.insert("duration".into(), format!("{:e}", scene.duration));
-        m.insert("output_rate".into(), format!("{:e}", scene.output_rate));
-        m.insert("mass_matrix".into(), serde_json::to_string(&scene.mass_matrix).unwrap_or_default().trim_matches('"').into());
-        m.insert("constraint_solver".into(), serde_json::to_string(&scene.solver).unwrap_or_default().trim_matches('"').into());
-        m.insert("stabilization".into(), serde_json::to_string(&scene.stabilization).unwrap_or_default());
-        // the model that ran: only the terms the scene has are assembled
-        m.insert(
-            "model.electrical".into(),
-            if scene.drives.quasi_static { "quasi-static current (L = 0)" } else { "L di/dt (one state per motor)" }.into(),
-        );
-        m.insert("model.contacts".into(), run.contacts.len().to_string());
-        m.insert("model.friction".into(), if scene.drives.has_friction { "on" } else { "off" }.into());
-        m.insert("model.gravity".into(), if scene.model.gravity == nalgebra::Vector3::zeros() { "off" } else { "on" }.into());
-        m.insert("hand_frame".into(), WORLD_FRAME.into());
-        m.insert("tool".into(), TOOL.into());
-        writer.write_metadata(records::RUN, &m).map_err(err)?;
-
-        let mut s = BTreeMap::new();
-        s.insert("json".into(), serde_json::to_string_pretty(&scene.spec).unwrap_or_default());
-        s.insert("source".into(), Path::new(&scene.source).file_name().map_or(scene.source.clone(), |f| f.to_string_lossy().into_owned()));
-        writer.write_metadata(records::SCENE, &s).map_err(err)?;
-        let mut u = BTreeMap::new();
-        u.insert("file".into(), scene.spec.urdf.clone());
-        u.insert("xml".into(), scene.urdf_xml.clone());
-        writer.write_metadata(records::URDF, &u).map_err(err)?;
+        let contact_names: Vec<String> = run.contacts.iter().map(|&k| scene.contacts[k].name.clone()).collect();
+        writer.write_record(&RecordingInfo::new(TOOL)).map_err(err)?;
+        let run_info = RunInfo {
+            scene: scene.spec.name.clone(),
+            run: run.name.clone(),
+            contacts: contact_names,
+            joint_names: joint_names.clone(),
+            setup: Setup {
+                integrator: scene.integrator.describe(),
+                duration_s: scene.duration,
+                output_rate_hz: scene.output_rate,
+                mass_matrix: json(&scene.mass_matrix).trim_matches('"').into(),
+                constraint_solver: json(&scene.solver).trim_matches('"').into(),
+                stabilization: json(&scene.stabilization),
+                // the model that ran: only the terms the scene has are assembled
+                model: ModelInfo {
+                    electrical: scene.drives.electrical.describe().into(),
+                    contacts: run.contacts.len(),
+                    friction: scene.drives.has_friction,
+                    gravity: scene.model.gravity != nalgebra::Vector3::zeros(),
+                },
+                hand_frame: WORLD_FRAME.into(),
+                tool: TOOL.into(),
+            },
+        };
+        writer.write_record(&run_info).map_err(err)?;
+        let source = Path::new(&scene.source).file_name().map_or(scene.source.clone(), |f| f.to_string_lossy().into_owned());
+        writer.write_record(&SceneRecord { json: serde_json::to_string_pretty(&scene.spec).unwrap_or_default(), source }).map_err(err)?;
+        writer.write_record(&UrdfRecord { file: scene.spec.urdf.clone(), xml: scene.urdf_xml.clone() }).map_err(err)?;
 
         writer
             .write(topics::ROBOT_DESCRIPTION, 0, &RosString { data: scene.urdf_xml.clone() })
@@ -215,25 +171,13 @@ impl<'a> Recorder<'a> {
     /// the solver statistics, or the error that stopped the run (the file then holds every
     /// sample up to the failure and says when and why).
     pub fn finish(mut self, outcome: Result<&crate::integrate::Stats, &RunError>) -> Result<PathBuf, RunError> {
-        let mut r = BTreeMap::new();
-        match outcome {
-            Ok(stats) => {
-                r.insert("status".into(), "complete".into());
-                r.insert("rhs_evals".into(), stats.rhs_evals.to_string());
-                r.insert("steps".into(), stats.steps.to_string());
-                r.insert("rejected".into(), stats.rejected.to_string());
-            }
-            Err(e) => {
-                r.insert("status".into(), "failed".into());
-                r.insert("error".into(), e.to_string());
-                if let Some(t) = e.time() {
-                    r.insert("error_time".into(), format!("{t:e}"));
-                }
-            }
-        }
+        let result = match outcome {
+            Ok(stats) => RunResult::complete(stats.rhs_evals, stats.steps, stats.rejected),
+            Err(e) => RunResult::failed(e.to_string(), e.time()),
+        };
         let path = self.path.clone();
         let err = |source| RunError::Recording { path: path.clone(), source };
-        self.writer.write_metadata(records::RESULT, &r).map_err(err)?;
+        self.writer.write_record(&result).map_err(err)?;
         self.writer.finish().map_err(err)
     }
 }

@@ -3,11 +3,9 @@
 //! sink (the recorder, or a test). Knows nothing about the recording format.
 
 use crate::error::RunError;
-use crate::integrate::{
-    integrate_sampled, ArkImex, DormandPrince45, IntegrateError, Rk4, Rosenbrock, Stats, StepControl, Stepper,
-};
-use crate::scene::{IntegratorSettings, Run, Scene};
-use crate::system::{ArmSystem, Outputs};
+use crate::integrate::{IntegrateError, Stats};
+use crate::scene::{Run, Scene};
+use crate::ode::{ArmSystem, Outputs};
 
 /// What a run reports besides its samples.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -42,10 +40,9 @@ pub fn simulate(
 ) -> Result<RunReport, RunError> {
     let mut sys = ArmSystem::new(scene, run);
     let y0 = sys.initial_state();
-    let dim = y0.len();
     let dt_out = 1.0 / scene.output_rate;
     let joints = scene.model.joint_names();
-    let layout = sys.layout;
+    let layout = sys.layout();
     let names = move |k: usize| layout.name(k, &joints);
     let mut out = Outputs::default();
     let mut samples = 0usize;
@@ -56,45 +53,9 @@ pub fn simulate(
         samples += 1;
         sink(&out)
     };
-    let stats = match scene.integrator {
-        IntegratorSettings::Rk4 { step } => {
-            let mut st = Rk4::new(dim, step);
-            drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
-        }
-        IntegratorSettings::Dopri45 { rtol, atol, h_max, max_steps } => {
-            let mut st = DormandPrince45::new(dim, step_control(rtol, atol, h_max, max_steps));
-            drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
-        }
-        IntegratorSettings::Rosenbrock { rtol, atol, h_max, max_steps, jacobian_reuse } => {
-            let control = step_control(rtol, atol, h_max, max_steps);
-            let mut st = Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse);
-            drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
-        }
-        IntegratorSettings::Imex { rtol, atol, h_max, max_steps } => {
-            let mut st = ArkImex::new(dim, step_control(rtol, atol, h_max, max_steps));
-            drive(&mut st, &mut sys, &y0, scene.duration, dt_out, &mut on_sample)
-        }
-    }
+    let stats = scene.integrator.integrate(&mut sys, &y0, scene.duration, dt_out, &mut on_sample)
     .map_err(|e| map_err(e, &names))?;
     Ok(RunReport { stats, samples, last: out })
-}
-
-/// The scene's step control (the scene holds the user-facing defaults): Hairer's starting step,
-/// no smallest step, `max_steps` attempts.
-fn step_control(rtol: f64, atol: f64, h_max: f64, max_steps: usize) -> StepControl {
-    let max_steps = u64::try_from(max_steps).unwrap_or(u64::MAX);
-    StepControl { rtol, atol, h_init: None, h_max, h_min: 0.0, max_steps }
-}
-
-fn drive<'s, St: Stepper<ArmSystem<'s>>>(
-    st: &mut St,
-    sys: &mut ArmSystem<'s>,
-    y0: &[f64],
-    t_end: f64,
-    dt_out: f64,
-    on_sample: &mut impl FnMut(f64, &[f64]) -> Result<(), RunError>,
-) -> Result<Stats, IntegrateError<RunError>> {
-    integrate_sampled(st, sys, 0.0, y0, t_end, dt_out, on_sample)
 }
 
 /// What `run_to_file` reports.

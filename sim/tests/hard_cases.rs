@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use sim::scene::{IntegratorSettings, Scene};
+use sim::scene::spec::IntegratorSpec;
+use sim::scene::Scene;
 
 fn hard(name: &str) -> Result<Scene, sim::error::SceneError> {
     Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/hard").join(format!("{name}.json")))
@@ -21,7 +22,7 @@ struct Result_ {
 fn run(scene: &Scene, run: &str) -> Result_ {
     let run = scene.run(run).unwrap().clone();
     let (mut res, mut drift, mut first, mut last, mut finite) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, true);
-    let t_end = scene.duration;
+    let t_end = scene.duration();
     let rep = sim::run::simulate(scene, &run, |o| {
         res = res.max(o.balance_residual.abs());
         let d = o.constraint_position.iter().fold(0.0f64, |m, c| m.max(c.abs()));
@@ -43,8 +44,7 @@ fn run(scene: &Scene, run: &str) -> Result_ {
 /// L 100x smaller: an electrical pole near −65000 1/s; balance to 1e-6.
 #[test]
 fn stiff_motor() {
-    let mut s = hard("stiff-motor").unwrap();
-    s.duration = 0.3;
+    let s = hard("stiff-motor").unwrap().vary(|sp| sp.duration = 0.3).unwrap();
     for r in ["two-elbow", "no-elbow"] {
         assert!(run(&s, r).residual_rel <= 1e-6);
     }
@@ -53,8 +53,7 @@ fn stiff_motor() {
 /// PD gains x10; balance to 1e-6.
 #[test]
 fn gains_x10() {
-    let mut s = hard("gains-x10").unwrap();
-    s.duration = 1.0;
+    let s = hard("gains-x10").unwrap().vary(|sp| sp.duration = 1.0).unwrap();
     assert!(run(&s, "two-elbow").residual_rel <= 1e-6);
 }
 
@@ -63,8 +62,7 @@ fn gains_x10() {
 /// larger in the last 10 s than 10x the first 10 s — and the balance closes to 1e-6.
 #[test]
 fn sixty_seconds_with_bounded_drift() {
-    let mut s = hard("long-60s").unwrap();
-    s.integrator = IntegratorSettings::Dopri45 { rtol: 1e-8, atol: 1e-10, h_max: 1e-3, max_steps: 100_000_000 };
+    let s = hard("long-60s").unwrap().vary(|sp| sp.integrator = IntegratorSpec::adaptive("dopri45", 1e-8, Some(1e-3)).unwrap()).unwrap();
     let r = run(&s, "two-elbow");
     assert!(r.residual_rel <= 1e-6, "{}", r.residual_rel);
     assert!(r.max_drift <= 1e-8, "drift {:e}", r.max_drift);
@@ -75,8 +73,7 @@ fn sixty_seconds_with_bounded_drift() {
 /// gives large but finite joint rates; the run completes and balances to 1e-6.
 #[test]
 fn near_the_reach_limit() {
-    let mut s = hard("reach-limit").unwrap();
-    s.duration = 0.5;
+    let s = hard("reach-limit").unwrap().vary(|sp| sp.duration = 0.5).unwrap();
     let r = run(&s, "two-elbow");
     assert!(r.finite && r.residual_rel <= 1e-6);
 }
@@ -84,8 +81,7 @@ fn near_the_reach_limit() {
 /// A 5 cm step of the target at t = 2.5 s: the adaptive integrator steps through the jump.
 #[test]
 fn target_step() {
-    let mut s = hard("target-step").unwrap();
-    s.duration = 3.0;
+    let s = hard("target-step").unwrap().vary(|sp| sp.duration = 3.0).unwrap();
     assert!(run(&s, "two-elbow").residual_rel <= 1e-6);
 }
 
@@ -94,8 +90,7 @@ fn target_step() {
 /// few nm), balance 1e-6.
 #[test]
 fn redundant_contacts() {
-    let mut s = hard("redundant-contacts").unwrap();
-    s.duration = 1.0;
+    let s = hard("redundant-contacts").unwrap().vary(|sp| sp.duration = 1.0).unwrap();
     for name in ["elbow4-twice", "three-rows"] {
         let r = run(&s, name);
         assert!(r.finite, "{name}");
@@ -118,8 +113,7 @@ fn inconsistent_start_is_rejected() {
 #[test]
 fn long_chains() {
     for (name, t) in [("chain30", 0.5), ("chain100", 0.1)] {
-        let mut s = hard(name).unwrap();
-        s.duration = t;
+        let s = hard(name).unwrap().vary(|sp| sp.duration = t).unwrap();
         let r = run(&s, "free");
         assert!(r.finite && r.residual_rel <= 1e-6, "{name}: {}", r.residual_rel);
     }

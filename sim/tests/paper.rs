@@ -1,8 +1,9 @@
 //! Physics of the paper scene end to end (SCENE.md "Physics checks that hold for any scene"
 //! and the paper's conclusions), through `sim::run::simulate`.
 
-use sim::scene::{IntegratorSettings, Scene};
-use sim::system::Outputs;
+use sim::scene::spec::IntegratorSpec;
+use sim::scene::Scene;
+use sim::ode::Outputs;
 
 struct Summary {
     samples: Vec<f64>,
@@ -71,10 +72,9 @@ fn more_elbows_use_less_energy_and_track_better() {
 /// 1e-8 rad (both are far below that error; RK4's is ~1e-11 here).
 #[test]
 fn rk4_and_dopri_agree() {
-    let mut scene = Scene::paper().unwrap();
-    scene.duration = 1.0;
+    let scene = Scene::paper().unwrap().vary(|s| s.duration = 1.0).unwrap();
     let a = run(&scene, "two-elbow");
-    scene.integrator = IntegratorSettings::Rk4 { step: 2e-5 };
+    let scene = scene.vary(|s| s.integrator = IntegratorSpec::rk4(2e-5)).unwrap();
     let b = run(&scene, "two-elbow");
     for j in 0..10 {
         assert!((a.last.q[j] - b.last.q[j]).abs() < 1e-8, "joint {j}: {} vs {}", a.last.q[j], b.last.q[j]);
@@ -86,11 +86,14 @@ fn rk4_and_dopri_agree() {
 #[test]
 fn paper_baseline_matches_the_default_dynamics() {
     use sim::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
-    let mut scene = Scene::paper().unwrap();
-    scene.duration = 1.0;
+    let scene = Scene::paper().unwrap().vary(|s| s.duration = 1.0).unwrap();
     let a = run(&scene, "two-elbow");
-    scene.mass_matrix = MassMatrixMethod::WalkerOrin;
-    scene.solver = ConstraintSolver::Kkt;
+    let scene = scene
+        .vary(|s| {
+            s.dynamics.mass_matrix = MassMatrixMethod::WalkerOrin;
+            s.dynamics.constraint_solver = ConstraintSolver::Kkt;
+        })
+        .unwrap();
     let b = run(&scene, "two-elbow");
     assert!(b.max_residual <= 1e-6 * b.electric, "{:e}", b.max_residual);
     for j in 0..10 {

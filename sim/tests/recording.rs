@@ -4,8 +4,7 @@
 
 use std::path::Path;
 
-use schemas::{read_recording, topics};
-use sim::record::records;
+use schemas::{read_recording, topics, ConstraintState, EnergyState, HandState, JointState, MotorState, RunStatus};
 use sim::scene::{Scene, SceneSpec};
 
 fn small() -> Scene {
@@ -38,35 +37,41 @@ fn every_channel_round_trips_through_the_generic_reader() {
         assert_eq!(ch.message_count, expected, "{topic}");
     }
     // exact values: encoding is lossless
-    let (t, current) = rec.series(topics::MOTORS, "current").unwrap();
-    let (_, fnorm) = rec.series(topics::CONSTRAINTS, "normal_force").unwrap();
-    let (_, hand_z) = rec.series(topics::HAND, "actual.z").unwrap();
-    let (_, residual) = rec.series(topics::ENERGY, "balance_residual").unwrap();
-    let (_, q) = rec.series(topics::JOINT_STATES, "position").unwrap();
+    let motors = rec.read::<MotorState>().unwrap();
+    let constraints = rec.read::<ConstraintState>().unwrap();
+    let hands = rec.read::<HandState>().unwrap();
+    let energy = rec.read::<EnergyState>().unwrap();
+    let joints = rec.read::<JointState>().unwrap();
     for (k, o) in outputs.iter().enumerate() {
-        assert_eq!(t[k], o.t);
-        assert_eq!(current[k], o.current);
-        assert_eq!(fnorm[k], o.normal_force);
-        assert_eq!(hand_z[k], vec![o.hand.z]);
-        assert_eq!(residual[k], vec![o.balance_residual]);
-        assert_eq!(q[k], o.q);
+        assert_eq!(motors[k].0, o.t);
+        assert_eq!(motors[k].1.current, o.current);
+        assert_eq!(constraints[k].1.normal_force, o.normal_force);
+        assert_eq!(hands[k].1.actual.z, o.hand.z);
+        assert_eq!(energy[k].1.balance_residual, o.balance_residual);
+        assert_eq!(joints[k].1.position, o.q);
+        assert_eq!(joints[k].1.name, scene.model().joint_names());
     }
-    // the transforms cover every URDF joint plus world -> root, each sample
-    let (_, tf) = (0, &rec.messages[topics::TF]);
+    // the transforms cover every URDF joint plus world -> root, each sample (the generic view)
+    let tf = rec.messages(topics::TF).unwrap();
     let first = tf[0].1.get("transforms").and_then(|v| v.as_list()).unwrap();
-    assert_eq!(first.len(), scene.model.urdf_joints.len() + 1);
+    assert_eq!(first.len(), scene.model().urdf_joints.len() + 1);
     // the URDF is published as text
-    let urdf = rec.messages[topics::ROBOT_DESCRIPTION][0].1.get("data").and_then(|v| v.as_str()).unwrap();
-    assert_eq!(urdf, scene.urdf_xml);
+    let urdf = rec.messages(topics::ROBOT_DESCRIPTION).unwrap()[0].1.get("data").and_then(|v| v.as_str()).unwrap();
+    assert_eq!(urdf, scene.urdf_xml());
 
-    // metadata: enough to rebuild the same scene
-    let json = rec.metadata_value(records::SCENE, "json").unwrap();
-    let spec: SceneSpec = serde_json::from_str(json).unwrap();
-    assert_eq!(spec, scene.spec);
-    assert_eq!(rec.metadata_value(records::URDF, "xml"), Some(scene.urdf_xml.as_str()));
-    assert_eq!(rec.metadata_value(records::RUN, "run"), Some("elbow"));
-    assert_eq!(rec.metadata_value(records::RUN, "integrator"), Some("dopri45"));
-    assert_eq!(rec.metadata_value(records::RESULT, "status"), Some("complete"));
+    // metadata: enough to rebuild the same scene, and what ran
+    let spec: SceneSpec = serde_json::from_str(&rec.scene().unwrap().json).unwrap();
+    assert_eq!(&spec, scene.spec());
+    assert_eq!(rec.urdf().unwrap().xml, scene.urdf_xml());
+    let info = rec.run().unwrap();
+    assert_eq!((info.run.as_str(), info.joint_names.clone()), ("elbow", scene.model().joint_names()));
+    let setup = info.setup.unwrap();
+    assert_eq!(setup.integrator.method, "dopri45");
+    assert_eq!((setup.duration_s, setup.output_rate_hz), (scene.duration(), scene.output_rate()));
+    assert_eq!(setup.model.contacts, run.contacts.len());
+    let result = rec.result().unwrap().unwrap();
+    assert_eq!(result.status, RunStatus::Complete);
+    assert_eq!(result.steps, Some(rep.report.stats.steps));
     assert_eq!(rec.format_version(), Some(schemas::FORMAT_VERSION));
     // nothing but the recording is left in the directory (no temporary file)
     let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
@@ -94,18 +99,19 @@ fn identical_runs_give_identical_files() {
 /// the failure and a result record saying when and why; the error names the time.
 #[test]
 fn a_failed_run_leaves_a_valid_recording_that_says_why() {
-    let mut scene = small();
     // an unbounded voltage gain with a tiny inductance and a coarse RK4 step blows up
-    scene.integrator = sim::scene::IntegratorSettings::Rk4 { step: 5e-3 };
+    let scene = small().vary(|s| s.integrator = sim::scene::spec::IntegratorSpec::rk4(5e-3)).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("bad.mcap");
     let run = scene.run("free").unwrap().clone();
     let err = sim::run::run_to_file(&scene, &run, &path, |_| {}).unwrap_err();
     let t = err.time().expect("a numerical failure has a time");
-    assert!(t > 0.0 && t < scene.duration, "{err}");
+    assert!(t > 0.0 && t < scene.duration(), "{err}");
     let rec = read_recording(&path).unwrap();
-    assert_eq!(rec.metadata_value(records::RESULT, "status"), Some("failed"));
-    assert!(rec.metadata_value(records::RESULT, "error").unwrap().contains("t = "));
-    let (times, _) = rec.series(topics::MOTORS, "current").unwrap();
-    assert!(times.last().copied().unwrap_or(0.0) <= t);
+    let result = rec.result().unwrap().unwrap();
+    assert_eq!(result.status, RunStatus::Failed);
+    assert!(result.error.unwrap().contains("t = "));
+    assert_eq!(result.error_time_s, Some(t));
+    let motors = rec.read::<MotorState>().unwrap();
+    assert!(motors.last().map_or(0.0, |m| m.0) <= t);
 }

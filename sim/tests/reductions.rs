@@ -27,10 +27,10 @@ fn final_q(scene: &Scene, run: &str) -> (Vec<f64>, f64, f64) {
 #[test]
 fn quasi_static_motors_are_the_small_inductance_limit() {
     let qs = paper_with(|v| v["motor"]["inductance"] = 0.0.into());
-    assert!(qs.drives.quasi_static);
+    assert_eq!(qs.drives().electrical, sim::dynamics::motor::Electrical::QuasiStatic);
     let run = qs.run("no-elbow").unwrap().clone();
     // q, q', W_j, E_j and the R, D and D_m losses: no current states
-    assert_eq!(sim::system::ArmSystem::new(&qs, &run).layout.dim(), 4 * 10 + 3);
+    assert_eq!(sim::ode::ArmSystem::new(&qs, &run).layout().dim(), 4 * 10 + 3);
     let (q0, res, e) = final_q(&qs, "no-elbow");
     assert!(res <= 1e-6 * e, "residual {res} of {e}");
     let diff = |l: f64| {
@@ -50,7 +50,7 @@ fn frictionless_weightless_scene_balances() {
         v["motor"]["gear_damping"] = 0.0.into();
         v["gravity"] = serde_json::json!([0.0, 0.0, 0.0]);
     });
-    assert!(!s.drives.has_friction);
+    assert!(!s.drives().has_friction);
     let (_, res, e) = final_q(&s, "two-elbow");
     assert!(res <= 1e-6 * e, "residual {res} of {e}");
 }

@@ -253,40 +253,37 @@ fn from_json_run(v: &Value) -> Result<RunValues, String> {
     })
 }
 
-/// Splits CSV text (RFC 4180: quoted fields, `""` for a quote, line breaks inside quotes).
+/// Splits CSV text into rows of cells (RFC 4180, the `csv` crate); rows may differ in length.
 pub(super) fn csv_rows(text: &str) -> Result<Vec<Vec<String>>, String> {
-    let mut rows = Vec::new();
-    let (mut row, mut cell) = (Vec::new(), String::new());
-    let (mut quoted, mut any) = (false, false);
-    let mut chars = text.chars().peekable();
-    while let Some(c) = chars.next() {
-        any = true;
-        match (quoted, c) {
-            (true, '"') if chars.peek() == Some(&'"') => {
-                chars.next();
-                cell.push('"');
+    let mut reader = csv::ReaderBuilder::new().has_headers(false).flexible(true).from_reader(text.as_bytes());
+    reader
+        .records()
+        .map(|r| r.map(|r| r.iter().map(str::to_string).collect()).map_err(|e| format!("CSV: {e}")))
+        .collect()
+}
+
+/// A column name of an older table in the current scheme (`render` module docs): units in
+/// lower case (`E_total_J` → `E_total_j`), per-item columns with a dot (`E_joint4_J` →
+/// `E.joint4_j`, `fn_min_elbow4_N` → `fn_min.elbow4_n`), `E_ratio` → `E_total_ratio`.
+fn current_name(h: &str) -> String {
+    let lower_unit = |h: &str| match h.rsplit_once('_') {
+        Some((stem, unit @ ("J" | "A" | "N"))) => format!("{stem}_{}", unit.to_lowercase()),
+        _ => h.to_string(),
+    };
+    let h = lower_unit(h);
+    match h.as_str() {
+        "E_ratio" | "W_ratio" => return h.replace("_ratio", "_total_ratio"),
+        _ if h.contains('.') || h.starts_with("E_total") || h.starts_with("W_total") => return h,
+        _ => {}
+    }
+    for prefix in ["first_pull_", "fn_min_", "pull_", "W_", "E_"] {
+        if let Some(rest) = h.strip_prefix(prefix) {
+            if let Some((item, unit)) = rest.rsplit_once('_').filter(|(item, _)| !item.is_empty()) {
+                return format!("{}.{item}_{unit}", prefix.trim_end_matches('_'));
             }
-            (true, '"') => quoted = false,
-            (true, c) => cell.push(c),
-            (false, '"') if cell.is_empty() => quoted = true,
-            (false, ',') => row.push(std::mem::take(&mut cell)),
-            (false, '\r') if chars.peek() == Some(&'\n') => {}
-            (false, '\n') => {
-                row.push(std::mem::take(&mut cell));
-                rows.push(std::mem::take(&mut row));
-                any = false;
-            }
-            (false, c) => cell.push(c),
         }
     }
-    if quoted {
-        return Err("CSV: a quoted field is not closed".into());
-    }
-    if any {
-        row.push(cell);
-        rows.push(row);
-    }
-    Ok(rows)
+    h
 }
 
 pub(super) fn from_csv(text: &str) -> Result<Vec<RunValues>, String> {
@@ -294,6 +291,7 @@ pub(super) fn from_csv(text: &str) -> Result<Vec<RunValues>, String> {
     let Some((head, body)) = rows.split_first() else {
         return Err("empty CSV".into());
     };
+    let head: Vec<String> = head.iter().map(|h| current_name(h)).collect();
     let run_col = head
         .iter()
         .position(|h| h == "run")
@@ -303,9 +301,7 @@ pub(super) fn from_csv(text: &str) -> Result<Vec<RunValues>, String> {
     let mut cols: Vec<(usize, usize, Option<String>)> = Vec::new();
     let mut carried = vec![false; KINDS.len()];
     for (c, h) in head.iter().enumerate() {
-        let exact = KINDS
-            .iter()
-            .position(|k| k.per == Per::Run && k.csv == Some(h.as_str()));
+        let exact = KINDS.iter().position(|k| k.per == Per::Run && k.csv == Some(h.as_str()));
         if let Some(k) = exact {
             cols.push((c, k, None));
             carried[k] = true;

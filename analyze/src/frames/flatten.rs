@@ -173,12 +173,12 @@ impl Columns {
                 // sensor_msgs/JointState: `name` labels its sibling arrays
                 let names: Option<Vec<String>> = fields
                     .iter()
-                    .find(|(k, _)| k == "name")
+                    .find(|(k, _)| k == schemas::topics::LABEL_LIST_FIELD)
                     .and_then(|(_, v)| v.as_list())
                     .and_then(|l| l.iter().map(|x| x.as_str().map(String::from)).collect());
                 let len = path.len();
                 for (key, field) in fields {
-                    if key == "name" && names.is_some() && field.as_list().is_some() {
+                    if key == schemas::topics::LABEL_LIST_FIELD && names.is_some() && field.as_list().is_some() {
                         continue;
                     }
                     join(path, key);
@@ -209,10 +209,9 @@ impl Columns {
         let names = names.filter(|n| n.len() == items.len());
         let len = path.len();
         for (k, item) in items.iter().enumerate() {
-            let frame = item.get("child_frame_id").and_then(Value::as_str);
-            match (names, frame) {
+            match (names, schemas::topics::entry_label(item)) {
                 (Some(n), _) => join(path, &n[k]),
-                (None, Some(child)) if !child.is_empty() => join(path, child),
+                (None, Some(label)) => join(path, label),
                 _ => join(path, &k.to_string()),
             }
             self.visit(item, path, labels);

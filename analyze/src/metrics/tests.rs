@@ -1,15 +1,15 @@
-//! Metrics of synthetic recordings with known answers (written by `crate::testutil`).
+//! Metrics of synthetic recordings with known answers (written by `schemas::synth`).
 
 use std::f64::consts::PI;
 
 use super::signal::negative_time;
 use super::*;
-use crate::testutil::{linear_energy, Synth};
+use schemas::synth::{contact_forces, currents, hand_error, linear_energy, Synth};
 use schemas::EnergyState;
 
 fn read(s: &Synth) -> (tempfile::TempDir, RunMetrics) {
     let dir = tempfile::tempdir().unwrap();
-    let m = read_run_metrics(&s.write(dir.path())).unwrap();
+    let m = read_run_metrics(&s.write_in(dir.path())).unwrap();
     (dir, m)
 }
 
@@ -25,10 +25,10 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
 fn hand_error_rms_and_max_of_whole_period_sines() {
     let (a, b, c, period) = (0.02, 0.01, -0.003, 0.2);
     let mut s = Synth::new("sines", &[], 2);
-    s.hand_error = Box::new(move |t| {
+    s.hand = Some(hand_error(move |t| {
         let w = 2.0 * PI * t / period;
         [a * w.sin(), b * w.cos(), c]
-    });
+    }));
     let (_d, m) = read(&s);
     let e = &m.hand_error;
     assert_eq!(m.samples, 101);
@@ -82,7 +82,7 @@ fn pull_time_counts_sample_intervals() {
 #[test]
 fn normal_force_negative_on_a_known_interval() {
     let mut s = Synth::new("pull", &["elbow4", "elbow7"], 3);
-    s.constraint = Box::new(|t| {
+    s.constraints = Some(contact_forces(|t| {
         let k = (t / 0.01).round() as i64;
         let f4 = if (20..=50).contains(&k) {
             -1.0 - 10.0 * (t - 0.2)
@@ -92,7 +92,7 @@ fn normal_force_negative_on_a_known_interval() {
         let c = if k == 60 { -2e-6 } else { 1e-6 * t };
         let cd = if k == 30 { 5e-5 } else { 0.0 };
         vec![[f4, c, cd], [3.0, 0.0, -1e-7]]
-    });
+    }));
     let (_d, m) = read(&s);
     let [e4, e7] = &m.contact_forces[..] else {
         panic!("{:?}", m.contact_forces)
@@ -116,11 +116,11 @@ fn normal_force_negative_on_a_known_interval() {
 #[test]
 fn current_peaks_per_motor_and_overall() {
     let mut s = Synth::new("currents", &[], 3);
-    s.current = Box::new(|t| {
+    s.motors = Some(currents(|t| {
         let k = (t / 0.01).round() as i64;
         let w = 2.0 * PI * t;
         vec![w.sin(), if k == 70 { -3.0 } else { 0.5 }, 2.0 * w.cos()]
-    });
+    }));
     let (_d, m) = read(&s);
     let p: Vec<(f64, f64)> = m
         .links
@@ -150,7 +150,7 @@ fn current_peaks_per_motor_and_overall() {
 #[test]
 fn energy_audit_at_the_end() {
     let mut s = Synth::new("energy", &[], 3);
-    s.energy = Box::new(|t| EnergyState {
+    s.energy = Some(Box::new(|t| EnergyState {
         kinetic: 5.0 + t * t,
         potential: -2.0 + 3.0 * t,
         magnetic: 0.5 * t,
@@ -158,7 +158,7 @@ fn energy_audit_at_the_end() {
         friction_loss: 2.0 * t,
         balance_residual: 1e-3 * (2.0 * PI * t).sin(),
         ..linear_energy(t, 3, 1.0, 2.0)
-    });
+    }));
     let (_d, m) = read(&s);
     let w: Vec<f64> = m.links.iter().map(|l| l.work_j).collect();
     let e: Vec<f64> = m.links.iter().map(|l| l.electric_energy_j).collect();
@@ -191,11 +191,7 @@ fn energy_audit_at_the_end() {
 #[test]
 fn metadata_is_read_and_a_failed_run_says_when_and_why() {
     let mut s = Synth::new("broken", &["elbow4"], 2);
-    s.result_meta.insert("status".into(), "failed".into());
-    s.result_meta
-        .insert("error".into(), "step size too small".into());
-    s.result_meta
-        .insert("error_time".into(), format!("{:e}", 0.42));
+    s.result = Some(schemas::RunResult::failed("step size too small".into(), Some(0.42)));
     let (_d, m) = read(&s);
     assert_eq!((m.scene.as_str(), m.run.as_str()), ("synthetic", "broken"));
     assert_eq!(m.contacts, ["elbow4"]);
@@ -205,33 +201,25 @@ fn metadata_is_read_and_a_failed_run_says_when_and_why() {
     assert_eq!(m.error_time_s, Some(0.42));
 }
 
-/// Each broken input gives an error whose message names the file and what is wrong.
+/// Each broken input gives an error whose message names the file and what is wrong (a
+/// malformed metadata record is the reader's error: `schemas` tests those).
 #[test]
 fn incomplete_recordings_give_errors_naming_file_and_cause() {
     type Breaker = fn(&mut Synth);
     let cases: [(Breaker, &str); 5] = [
-        (|s| drop(s.run_meta.remove("contacts")), "contacts"),
-        (
-            |s| drop(s.run_meta.insert("joint_names".into(), "joint1".into())),
-            "joint_names",
-        ),
-        (
-            |s| drop(s.result_meta.insert("status".into(), "maybe".into())),
-            "status",
-        ),
-        (|s| s.current = Box::new(|_| vec![0.0; 2]), "/motors"),
-        (|s| s.skip.push(schemas::topics::ENERGY), "/energy"),
+        (|s| s.names = None, "run"),
+        (|s| s.result = None, "result"),
+        (|s| s.motors = Some(currents(|_| vec![0.0; 2])), "/motors"),
+        (|s| s.energy = None, "/energy"),
+        (|s| s.hand = None, "/hand"),
     ];
     let dir = tempfile::tempdir().unwrap();
     for (k, (brk, what)) in cases.into_iter().enumerate() {
         let mut s = Synth::new(&format!("case{k}"), &["elbow4"], 3);
         brk(&mut s);
-        let path = s.write(dir.path());
+        let path = s.write(&dir.path().join(format!("case{k}.mcap")));
         let msg = read_run_metrics(&path).unwrap_err().to_string();
-        assert!(
-            msg.contains(&path.display().to_string()) && msg.contains(what),
-            "case {k}: {msg}"
-        );
+        assert!(msg.contains(&path.display().to_string()) && msg.contains(what), "case {k}: {msg}");
     }
 }
 
@@ -239,7 +227,7 @@ fn incomplete_recordings_give_errors_naming_file_and_cause() {
 #[test]
 fn bad_files_give_errors_naming_them() {
     let dir = tempfile::tempdir().unwrap();
-    let good = Synth::new("good", &[], 2).write(dir.path());
+    let good = Synth::new("good", &[], 2).write_in(dir.path());
     let bytes = std::fs::read(&good).unwrap();
     let cases: [(&str, &[u8]); 3] = [
         ("empty.mcap", b""),

@@ -19,18 +19,14 @@ impl Row {
     }
 }
 
-/// RFC 4180: quote a field holding a comma, quote or line break; double the quotes.
-fn field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
+/// The rows as CSV (RFC 4180 quoting by the `csv` crate).
+fn csv_text(head: &[String], rows: &[Vec<String>]) -> String {
+    let mut w = csv::WriterBuilder::new().flexible(true).from_writer(Vec::new());
+    for r in std::iter::once(head).chain(rows.iter().map(Vec::as_slice)) {
+        // writing into memory cannot fail
+        let _ = w.write_record(r);
     }
-}
-
-fn line(cells: impl IntoIterator<Item = String>) -> String {
-    let cells: Vec<String> = cells.into_iter().map(|c| field(&c)).collect();
-    cells.join(",") + "\n"
+    String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
 }
 
 pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])>) -> String {
@@ -54,16 +50,16 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
         "err_z_max_m",
         "err_norm_rms_m",
         "err_norm_max_m",
-        "E_total_J",
-        "W_total_J",
+        "E_total_j",
+        "W_total_j",
     ]
     .map(String::from)
     .to_vec();
     if cmp.is_some() {
         head.extend(
             [
-                "E_ratio",
-                "W_ratio",
+                "E_total_ratio",
+                "W_total_ratio",
                 "err_z_rms_ratio",
                 "err_norm_rms_ratio",
             ]
@@ -72,36 +68,36 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
     }
     head.extend(
         [
-            "peak_current_A",
+            "peak_current_a",
             "peak_current_joint",
-            "dT_J",
-            "dV_J",
-            "dMagnetic_J",
-            "resistive_loss_J",
-            "friction_loss_J",
-            "gear_friction_loss_J",
-            "residual_J",
-            "residual_max_abs_J",
+            "dT_j",
+            "dV_j",
+            "dMagnetic_j",
+            "resistive_loss_j",
+            "friction_loss_j",
+            "gear_friction_loss_j",
+            "residual_j",
+            "residual_max_abs_j",
             "residual_max_rel",
         ]
         .map(String::from),
     );
     for j in &joints {
-        head.push(format!("W_{j}_J"));
-        head.push(format!("E_{j}_J"));
+        head.push(format!("W.{j}_j"));
+        head.push(format!("E.{j}_j"));
         if cmp.is_some() {
-            head.push(format!("E_{j}_ratio"));
+            head.push(format!("E.{j}_ratio"));
         }
     }
     for c in &contacts {
         head.extend([
-            format!("fn_min_{c}_N"),
-            format!("pull_{c}_s"),
-            format!("first_pull_{c}_s"),
+            format!("fn_min.{c}_n"),
+            format!("pull.{c}_s"),
+            format!("first_pull.{c}_s"),
         ]);
     }
 
-    let mut out = line(head);
+    let mut lines = Vec::with_capacity(runs.len());
     for (k, r) in runs.iter().enumerate() {
         let mut row = Row(Vec::with_capacity(64));
         for s in [
@@ -171,7 +167,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
             row.opt(c.map(|c| c.pull_time_s));
             row.opt(c.and_then(|c| c.first_pull_s));
         }
-        out += &line(row.0.into_iter().map(Option::unwrap_or_default));
+        lines.push(row.0.into_iter().map(Option::unwrap_or_default).collect());
     }
-    out
+    csv_text(&head, &lines)
 }

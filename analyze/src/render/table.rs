@@ -1,85 +1,27 @@
 //! Aligned text tables in sections, for people.
 
-use super::{contacts, joints, status};
+use super::{contacts, joints, status, TextTable};
 use crate::compare::{Comparison, Ratios};
 use crate::metrics::RunMetrics;
 
-/// One section: a title, a header row and rows, columns two spaces apart. The first `left`
-/// columns (names) are left-aligned, the others (numbers) right-aligned.
+/// One section: a title over a [`TextTable`].
 struct Table {
     title: String,
-    head: Vec<String>,
-    rows: Vec<Vec<String>>,
-    left: usize,
+    table: TextTable,
 }
 
 impl Table {
     fn new(title: impl Into<String>, head: &[&str]) -> Self {
-        let head = head.iter().map(|h| h.to_string()).collect();
-        Self {
-            title: title.into(),
-            head,
-            rows: Vec::new(),
-            left: 1,
-        }
+        Self { title: title.into(), table: TextTable::new(head) }
     }
 
     /// As aligned text, or (`markdown`) as a heading and a GitHub pipe table.
     fn write(&self, out: &mut String, markdown: bool) {
         if markdown {
-            return self.write_markdown(out);
+            out.push_str(&format!("### {}\n\n{}\n", self.title, self.table.markdown()));
+        } else {
+            out.push_str(&format!("{}\n{}\n", self.title, self.table.aligned()));
         }
-        let width = |s: &str| s.chars().count();
-        let mut w: Vec<usize> = self.head.iter().map(|h| width(h)).collect();
-        for row in &self.rows {
-            for (c, cell) in row.iter().enumerate() {
-                w[c] = w[c].max(width(cell));
-            }
-        }
-        let fmt_row = |cells: &[String]| {
-            let parts: Vec<String> = cells
-                .iter()
-                .enumerate()
-                .map(|(c, s)| {
-                    let pad = " ".repeat(w[c] - width(s));
-                    if c < self.left {
-                        format!("{s}{pad}")
-                    } else {
-                        format!("{pad}{s}")
-                    }
-                })
-                .collect();
-            parts.join("  ").trim_end().to_string() + "\n"
-        };
-        out.push_str(&self.title);
-        out.push('\n');
-        out.push_str(&fmt_row(&self.head));
-        let rule: Vec<String> = w.iter().map(|&n| "-".repeat(n)).collect();
-        out.push_str(&fmt_row(&rule));
-        for row in &self.rows {
-            out.push_str(&fmt_row(row));
-        }
-        out.push('\n');
-    }
-}
-
-impl Table {
-    fn write_markdown(&self, out: &mut String) {
-        let cell = |s: &str| s.replace('|', "\\|");
-        let row = |cells: &[String]| {
-            let parts: Vec<String> = cells.iter().map(|c| cell(c)).collect();
-            format!("| {} |\n", parts.join(" | "))
-        };
-        out.push_str(&format!("### {}\n\n", self.title));
-        out.push_str(&row(&self.head));
-        let rule: Vec<String> = (0..self.head.len())
-            .map(|c| if c < self.left { ":--".to_string() } else { "--:".to_string() })
-            .collect();
-        out.push_str(&row(&rule));
-        for r in &self.rows {
-            out.push_str(&row(r));
-        }
-        out.push('\n');
     }
 }
 
@@ -137,7 +79,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
             "at joint",
         ],
     );
-    t.left = 4;
+    t.table.left = 4;
     for (k, r) in runs.iter().enumerate() {
         let contacts = if r.contacts.is_empty() {
             "-".to_string()
@@ -154,7 +96,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
                 (f(p.current_a, 3), p.joint.clone())
             });
         let st = format!("{}{at}", status(r.status));
-        t.rows.push(vec![
+        t.table.rows.push(vec![
             name(k),
             r.scene.clone(),
             contacts,
@@ -191,7 +133,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         if let Some(q_) = &ratios {
             row.extend([q(q_[k].error_z_rms), q(q_[k].error_norm_rms)]);
         }
-        t.rows.push(row);
+        t.table.rows.push(row);
     }
     t.write(&mut out, markdown);
 
@@ -210,7 +152,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         if let Some(q_) = &ratios {
             row.extend([q(q_[k].electric_energy), q(q_[k].link_work)]);
         }
-        t.rows.push(row);
+        t.table.rows.push(row);
     }
     t.write(&mut out, markdown);
 
@@ -255,7 +197,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
                 row.push(q(cell.and_then(|c| c.electric_energy_ratio)));
             }
         }
-        t.rows.push(row);
+        t.table.rows.push(row);
     }
     t.write(&mut out, markdown);
 
@@ -274,11 +216,11 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
                 "max |C'| [m/s]",
             ],
         );
-        t.left = 2;
+        t.table.left = 2;
         for (k, r) in runs.iter().enumerate() {
             for c in &r.contact_forces {
                 let first = c.first_pull_s.map_or("-".into(), |t| f(t, 3));
-                t.rows.push(vec![
+                t.table.rows.push(vec![
                     name(k),
                     c.contact.clone(),
                     f(c.min_normal_force_n, 3),
@@ -317,7 +259,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         for (k, r) in runs.iter().enumerate() {
             let a = &r.energy;
             let rel = a.max_abs_residual_rel.map_or("-".into(), e);
-            t.rows.push(vec![
+            t.table.rows.push(vec![
                 name(k),
                 f(a.electric_j, 4),
                 f(a.kinetic_change_j, 4),

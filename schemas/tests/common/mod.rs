@@ -147,10 +147,10 @@ pub fn write_all(path: &Path, c: &Content) -> std::path::PathBuf {
     let mut rec = BTreeMap::new();
     rec.insert("scene".to_string(), "two_link".to_string());
     rec.insert("integrator".to_string(), "rk4".to_string());
-    w.write_metadata("recording", &rec).unwrap();
+    w.write_metadata_raw("recording", &rec).unwrap();
     let mut extra = BTreeMap::new();
     extra.insert("dt".to_string(), "0.001".to_string());
-    w.write_metadata("solver", &extra).unwrap();
+    w.write_metadata_raw("solver", &extra).unwrap();
     w.write(
         topics::ROBOT_DESCRIPTION,
         0,

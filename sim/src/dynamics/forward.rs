@@ -192,7 +192,7 @@ pub fn forward_dynamics(
     }
     // electrical rows and the motor torque of eq 12
     for j in 0..nv {
-        fd.di[j] = if drives.quasi_static { 0.0 } else { drives.current_rate(j, voltage[j], current[j], qd[j]) };
+        fd.di[j] = drives.current_rate(j, voltage[j], current[j], qd[j]);
         fd.tau_motor[j] = drives.link_torque(j, current[j], qd[j], fd.qdd[j]);
     }
     if let Some(j) = fd.qdd.iter().position(|x| !x.is_finite()) {

@@ -41,6 +41,34 @@ impl MotorParams {
     }
 }
 
+/// The motors' electrical model: what the state holds and how the current is found. A scene's
+/// motors are all of one kind (validated).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Electrical {
+    /// `L di/dt = v − R i − K_m q̇` (eq 11): one current state per motor.
+    Inductive,
+    /// L = 0: `i = (v − K_m q̇) / R`, algebraic; no electrical state.
+    QuasiStatic,
+}
+
+impl Electrical {
+    /// Electrical states of `nv` motors: `nv` or 0.
+    pub fn states(self, nv: usize) -> usize {
+        match self {
+            Electrical::Inductive => nv,
+            Electrical::QuasiStatic => 0,
+        }
+    }
+
+    /// As recorded (`model.electrical`) and shown.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Electrical::Inductive => "L di/dt (one state per motor)",
+            Electrical::QuasiStatic => "quasi-static current (L = 0)",
+        }
+    }
+}
+
 /// The drive train of every joint, reflected to the link side, as vectors (nv) for the RHS.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Drives {
@@ -56,8 +84,8 @@ pub struct Drives {
     pub dm: DVector<f64>,
     /// D: the joint's own viscous friction, N m s/rad.
     pub d: DVector<f64>,
-    /// L = 0 on every joint: the current follows the voltage instantly.
-    pub quasi_static: bool,
+    /// Inductive, or quasi-static (L = 0 on every joint: the current follows the voltage).
+    pub electrical: Electrical,
     /// Some D + D_m is non-zero (else the friction terms are skipped).
     pub has_friction: bool,
 }
@@ -72,7 +100,7 @@ impl Drives {
             jm: DVector::from_iterator(motors.len(), motors.iter().map(MotorParams::jm)),
             dm: DVector::from_iterator(motors.len(), motors.iter().map(MotorParams::dm)),
             d: DVector::from_column_slice(joint_damping),
-            quasi_static: motors.iter().all(|m| m.inductance == 0.0),
+            electrical: if motors.iter().all(|m| m.inductance == 0.0) { Electrical::QuasiStatic } else { Electrical::Inductive },
             has_friction: motors.iter().zip(joint_damping).any(|(m, d)| m.dm() + d != 0.0),
         }
     }
@@ -87,10 +115,14 @@ impl Drives {
         self.km.len()
     }
 
-    /// Eq 11 solved for the current rate of joint j, A/s.
+    /// Eq 11 solved for the current rate of joint j, A/s (0 for quasi-static motors, which
+    /// have no current state).
     #[inline]
     pub fn current_rate(&self, j: usize, v: f64, i: f64, qd: f64) -> f64 {
-        (v - self.r[j] * i - self.km[j] * qd) / self.l[j]
+        match self.electrical {
+            Electrical::Inductive => (v - self.r[j] * i - self.km[j] * qd) / self.l[j],
+            Electrical::QuasiStatic => 0.0,
+        }
     }
 
     /// Eq 12: torque delivered to link j, N m.

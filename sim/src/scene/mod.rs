@@ -12,24 +12,17 @@ use crate::control::{Circle, PdGains, YawPlanarIk};
 use crate::dynamics::constraints::PointOnPlane;
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 use crate::dynamics::kinematics::{body_point, forward_kinematics, forward_velocities, BodyPoint};
-use crate::dynamics::motor::{Drives, MotorParams};
+use crate::dynamics::motor::{Drives, Electrical, MotorParams};
 use crate::dynamics::{Data, Model};
 use crate::error::SceneError;
 pub use spec::SceneSpec;
-use spec::{Branch, Direction, Method, PerJoint, PointSpec};
+use spec::{Branch, Direction, PerJoint, PointSpec};
+
+use crate::integrator::Integrator;
 
 /// The built-in paper scene and its URDF.
 pub const PAPER_SCENE_JSON: &str = include_str!("../../scenes/paper.json");
 pub const PAPER_URDF: &str = include_str!("../../scenes/paper_arm.urdf");
-
-/// Integrator choice with validated settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum IntegratorSettings {
-    Rk4 { step: f64 },
-    Dopri45 { rtol: f64, atol: f64, h_max: f64, max_steps: usize },
-    Rosenbrock { rtol: f64, atol: f64, h_max: f64, max_steps: usize, jacobian_reuse: usize },
-    Imex { rtol: f64, atol: f64, h_max: f64, max_steps: usize },
-}
 
 /// One run of a scene: which contacts are active.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,32 +32,118 @@ pub struct Run {
     pub contacts: Vec<usize>,
 }
 
-/// A validated scene, ready to run.
+/// A validated scene, ready to run, and immutable: a variation goes through its spec and is
+/// validated again ([`Scene::vary`]), so the scene a recording stores is always the one that ran.
+/// Read it through the accessors below.
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// The spec as read (with defaults filled in): recorded so that a run can be replayed.
-    pub spec: SceneSpec,
+    pub(crate) spec: SceneSpec,
     /// Where the scene came from (a path, or "built-in paper scene").
-    pub source: String,
+    pub(crate) source: String,
     /// URDF text, as read.
-    pub urdf_xml: String,
-    pub model: Model,
-    pub drives: Drives,
-    pub gains: PdGains,
-    pub hand: BodyPoint,
-    pub circle: Circle,
-    pub ik: YawPlanarIk,
-    pub q0: Vec<f64>,
-    pub qd0: Vec<f64>,
-    pub current0: Vec<f64>,
-    pub contacts: Vec<PointOnPlane>,
-    pub runs: Vec<Run>,
-    pub mass_matrix: MassMatrixMethod,
-    pub solver: ConstraintSolver,
-    pub stabilization: Stabilization,
-    pub integrator: IntegratorSettings,
-    pub duration: f64,
-    pub output_rate: f64,
+    pub(crate) urdf_xml: String,
+    pub(crate) model: Model,
+    pub(crate) drives: Drives,
+    pub(crate) gains: PdGains,
+    pub(crate) hand: BodyPoint,
+    pub(crate) circle: Circle,
+    pub(crate) ik: YawPlanarIk,
+    pub(crate) q0: Vec<f64>,
+    pub(crate) qd0: Vec<f64>,
+    pub(crate) current0: Vec<f64>,
+    pub(crate) contacts: Vec<PointOnPlane>,
+    pub(crate) runs: Vec<Run>,
+    pub(crate) mass_matrix: MassMatrixMethod,
+    pub(crate) solver: ConstraintSolver,
+    pub(crate) stabilization: Stabilization,
+    pub(crate) integrator: Integrator,
+    pub(crate) duration: f64,
+    pub(crate) output_rate: f64,
+}
+
+/// Read access (the fields are private to the crate: a scene never changes after validation).
+impl Scene {
+    /// The spec as read (with defaults filled in): recorded so that a run can be replayed.
+    pub fn spec(&self) -> &SceneSpec {
+        &self.spec
+    }
+    /// Where the scene came from (a path, or "built-in paper scene").
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+    /// The URDF text, as read.
+    pub fn urdf_xml(&self) -> &str {
+        &self.urdf_xml
+    }
+    /// The robot: the read-only dynamics model built from the URDF.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+    /// The motors and gears, reflected to the link side.
+    pub fn drives(&self) -> &Drives {
+        &self.drives
+    }
+    /// The PD voltage law (eq 27).
+    pub fn gains(&self) -> &PdGains {
+        &self.gains
+    }
+    /// The tracked hand point.
+    pub fn hand(&self) -> &BodyPoint {
+        &self.hand
+    }
+    /// The target path.
+    pub fn circle(&self) -> &Circle {
+        &self.circle
+    }
+    /// The inverse kinematics of the targets.
+    pub fn ik(&self) -> &YawPlanarIk {
+        &self.ik
+    }
+    /// Initial joint angles, rad.
+    pub fn q0(&self) -> &[f64] {
+        &self.q0
+    }
+    /// Initial joint speeds, rad/s.
+    pub fn qd0(&self) -> &[f64] {
+        &self.qd0
+    }
+    /// Initial currents, A (zero for quasi-static motors).
+    pub fn current0(&self) -> &[f64] {
+        &self.current0
+    }
+    /// Every named contact; a run picks some.
+    pub fn contacts(&self) -> &[PointOnPlane] {
+        &self.contacts
+    }
+    /// The runs, in the scene's order.
+    pub fn runs(&self) -> &[Run] {
+        &self.runs
+    }
+    /// How M(q) is computed.
+    pub fn mass_matrix(&self) -> MassMatrixMethod {
+        self.mass_matrix
+    }
+    /// How the constrained system is solved.
+    pub fn solver(&self) -> ConstraintSolver {
+        self.solver
+    }
+    /// Constraint stabilisation.
+    pub fn stabilization(&self) -> Stabilization {
+        self.stabilization
+    }
+    /// The validated integrator.
+    pub fn integrator(&self) -> Integrator {
+        self.integrator
+    }
+    /// Simulated time of each run, s.
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+    /// Rate of the recorded samples, Hz.
+    pub fn output_rate(&self) -> f64 {
+        self.output_rate
+    }
 }
 
 /// Tolerance on the initial constraint violation |C(q0)|, m, and |Ċ|, m/s.
@@ -104,11 +183,30 @@ impl Scene {
             // a syntax error's path ends in `?` (the position serde had not reached)
             let path = e.path().to_string();
             let path = path.trim_end_matches('?').trim_end_matches('.');
+            let why = e.inner().to_string();
+            // a tagged value (the integrator) is read whole: name the unknown key inside it
+            if let Some(key) = why.strip_prefix("unknown field `").and_then(|r| r.split('`').next()) {
+                let field = if path.is_empty() { key.to_string() } else { format!("{path}.{key}") };
+                let value = serde_json::from_str::<serde_json::Value>(text)
+                    .ok()
+                    .and_then(|doc| doc.pointer(&format!("/{}", field.replace('.', "/"))).map(|v| v.to_string()))
+                    .unwrap_or_default();
+                return SceneError::new(source, field, value, why);
+            }
             let field = if path.is_empty() { "(document)" } else { path };
-            SceneError::new(source, field, json_literal_at(text, e.inner()), e.inner().to_string())
+            SceneError::new(source, field, json_literal_at(text, e.inner()), why)
         })?;
         let urdf_xml = read_urdf(&spec.urdf).map_err(|why| SceneError::new(source, "urdf", &spec.urdf, why))?;
         build(spec, source, urdf_xml)
+    }
+
+    /// A variation of this scene: `edit` changes a copy of its spec, which is validated again
+    /// (the URDF text is kept), so that a scene is never changed after validation and a
+    /// recording's stored scene is always what ran. Errors name the field and the value.
+    pub fn vary(&self, edit: impl FnOnce(&mut SceneSpec)) -> Result<Scene, SceneError> {
+        let mut spec = self.spec.clone();
+        edit(&mut spec);
+        build(spec, &self.source, self.urdf_xml.clone())
     }
 
     /// The run called `name`.
@@ -257,7 +355,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
     let q0 = c.per_joint("initial.q", &spec.initial.q, nv, |_| true, "")?;
     let qd0 = c.per_joint("initial.qd", &spec.initial.qd, nv, |_| true, "")?;
     let current0 = c.per_joint("initial.current", &spec.initial.current, nv, |_| true, "")?;
-    if drives.quasi_static && current0.iter().any(|&i| i != 0.0) {
+    if drives.electrical == Electrical::QuasiStatic && current0.iter().any(|&i| i != 0.0) {
         return Err(c.err("initial.current", format!("{current0:?}"), "quasi-static motors (L = 0) have no current state: leave it 0"));
     }
 
@@ -360,53 +458,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
         c.number("dynamics.stabilization.beta", beta, non_negative, "must be >= 0 1/s")?;
     }
 
-    // integrator
-    let is = &spec.integrator;
-    let output_dt = 1.0 / output_rate;
-    let integrator = match is.method {
-        Method::Rk4 => {
-            if let Some(r) = is.jacobian_reuse {
-                return Err(c.err("integrator.jacobian_reuse", r, "applies to rosenbrock only"));
-            }
-            for (name, v) in [("rtol", is.rtol), ("atol", is.atol), ("h_max", is.h_max)] {
-                if v.is_some() {
-                    return Err(c.err(format!("integrator.{name}"), v.unwrap_or_default(), "applies to dopri45 only"));
-                }
-            }
-            let step = is.step.ok_or_else(|| c.err("integrator.step", "(missing)", "rk4 needs a fixed step, s"))?;
-            IntegratorSettings::Rk4 { step: c.number("integrator.step", step, |h| h > 0.0 && h <= duration, "must be > 0 s and <= duration")? }
-        }
-        Method::Dopri45 | Method::Rosenbrock | Method::Imex => {
-            let method = match is.method {
-                Method::Dopri45 => "dopri45",
-                Method::Rosenbrock => "rosenbrock",
-                _ => "imex",
-            };
-            if let Some(st) = is.step {
-                return Err(c.err("integrator.step", st, format!("applies to rk4 only ({method} chooses its steps; use h_max)")));
-            }
-            if is.jacobian_reuse.is_some() && is.method != Method::Rosenbrock {
-                return Err(c.err("integrator.jacobian_reuse", is.jacobian_reuse.unwrap_or(0), "applies to rosenbrock only"));
-            }
-            let rtol = is.rtol.ok_or_else(|| c.err("integrator.rtol", "(missing)", format!("{method} needs rtol")))?;
-            let atol = is.atol.ok_or_else(|| c.err("integrator.atol", "(missing)", format!("{method} needs atol")))?;
-            let rtol = c.number("integrator.rtol", rtol, |x| (1e-14..1.0).contains(&x), "must be in [1e-14, 1)")?;
-            let atol = c.number("integrator.atol", atol, |x| x > 0.0, "must be > 0")?;
-            let h_max = c.number("integrator.h_max", is.h_max.unwrap_or(output_dt), positive, "must be > 0 s")?;
-            let max_steps = is.max_steps.unwrap_or(100_000_000);
-            match is.method {
-                Method::Dopri45 => IntegratorSettings::Dopri45 { rtol, atol, h_max, max_steps },
-                Method::Rosenbrock => {
-                    let jacobian_reuse = is.jacobian_reuse.unwrap_or(1);
-                    if jacobian_reuse == 0 {
-                        return Err(c.err("integrator.jacobian_reuse", 0, "must be >= 1"));
-                    }
-                    IntegratorSettings::Rosenbrock { rtol, atol, h_max, max_steps, jacobian_reuse }
-                }
-                _ => IntegratorSettings::Imex { rtol, atol, h_max, max_steps },
-            }
-        }
-    };
+    let integrator = Integrator::from_spec(&spec.integrator, file, duration, 1.0 / output_rate)?;
     Ok(Scene {
         source: file.to_string(),
         urdf_xml,

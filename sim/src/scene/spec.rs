@@ -227,45 +227,81 @@ pub struct DynamicsSpec {
     pub stabilization: Stabilization,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Method {
-    /// Classical Runge–Kutta, fixed step.
-    Rk4,
+/// The integrator and its settings, tagged by `method`; each method accepts only its own
+/// settings (an unknown or misplaced one is rejected with its name). Defaults are filled in one
+/// place, [`crate::integrator::Integrator::from_spec`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "kebab-case")]
+pub enum IntegratorSpec {
+    /// Classical Runge–Kutta with the fixed `step`, s.
+    Rk4(FixedStepSpec),
     /// Dormand–Prince 5(4), adaptive, with dense output.
-    Dopri45,
+    Dopri45(AdaptiveSpec),
     /// Rosenbrock-W ROS34PW2 (order 3, L-stable), adaptive, with the structured motor-arm
-    /// Jacobian (`sim/src/stiff.rs`).
-    Rosenbrock,
+    /// Jacobian (`sim/src/ode/jacobian.rs`).
+    Rosenbrock(RosenbrockSpec),
     /// IMEX additive Runge–Kutta ARK4(3)6L[2]SA: the armature circuits implicit (closed form),
     /// the mechanics explicit.
-    Imex,
+    Imex(AdaptiveSpec),
 }
 
-/// The integrator and its settings. `rk4` needs `step`; the adaptive methods (`dopri45`,
-/// `rosenbrock`, `imex`) need `rtol` and `atol`.
+/// `rk4`'s settings.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct IntegratorSpec {
-    pub method: Method,
-    /// Fixed step, s (rk4).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub step: Option<f64>,
-    /// Relative tolerance (dopri45).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rtol: Option<f64>,
-    /// Absolute tolerance (dopri45).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub atol: Option<f64>,
-    /// Largest step, s (dopri45; default: the output interval).
+pub struct FixedStepSpec {
+    /// s.
+    pub step: f64,
+}
+
+/// The step control of an adaptive method (`dopri45`, `imex`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AdaptiveSpec {
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance (in each state component's unit).
+    pub atol: f64,
+    /// Largest step, s (default: the output interval).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub h_max: Option<f64>,
-    /// Most steps per run before giving up (default 10^8).
+    /// Most step attempts per run before giving up (default 10^8).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max_steps: Option<usize>,
-    /// Steps between Jacobian refreshes (rosenbrock; default 1).
+    pub max_steps: Option<u64>,
+}
+
+/// `rosenbrock`'s settings: the step control of [`AdaptiveSpec`] and the Jacobian's reuse.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RosenbrockSpec {
+    pub rtol: f64,
+    pub atol: f64,
+    /// Largest step, s (default: the output interval).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub jacobian_reuse: Option<usize>,
+    pub h_max: Option<f64>,
+    /// Most step attempts per run before giving up (default 10^8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_steps: Option<u64>,
+    /// Accepted steps between Jacobian refreshes (default 1: every step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jacobian_reuse: Option<u64>,
+}
+
+impl IntegratorSpec {
+    /// `method` at `rtol` (atol = rtol / 100), steps of at most `h_max` when given.
+    pub fn adaptive(method: &str, rtol: f64, h_max: Option<f64>) -> Option<Self> {
+        let a = AdaptiveSpec { rtol, atol: rtol * 1e-2, h_max, max_steps: None };
+        Some(match method {
+            "dopri45" => IntegratorSpec::Dopri45(a),
+            "imex" => IntegratorSpec::Imex(a),
+            "rosenbrock" => IntegratorSpec::Rosenbrock(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None }),
+            _ => return None,
+        })
+    }
+
+    /// `rk4` with the fixed `step`, s.
+    pub fn rk4(step: f64) -> Self {
+        IntegratorSpec::Rk4(FixedStepSpec { step })
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

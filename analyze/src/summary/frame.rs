@@ -1,0 +1,161 @@
+//! The summary as one polars DataFrame and the query on it (feature `tables`).
+
+use polars::prelude::*;
+
+use super::{Filter, Op, Query, SummaryRow};
+use crate::metrics::RunMetrics;
+
+/// One DataFrame, one row per entry of `rows`: [`BASE_COLUMNS`] (`min_normal_force_n`: the lowest
+/// over the contacts, `pull_time_s`: the longest; both null without contacts), then `error`, `bytes`,
+/// `E.<joint>_j` and `W.<joint>_j` for every joint of any run (null where a run has no such
+/// joint), then `p.<param>` for each of `params` (Float64 when every value is a number, else
+/// text).
+pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<DataFrame> {
+    let n = rows.len();
+    let m = |f: &dyn Fn(&RunMetrics) -> f64| -> Vec<f64> { rows.iter().map(|r| f(&r.metrics)).collect() };
+    let s = |f: &dyn Fn(&SummaryRow) -> Option<String>| -> Vec<Option<String>> { rows.iter().map(f).collect() };
+    let min_force = |r: &RunMetrics| -> Option<f64> {
+        r.contact_forces.iter().map(|c| c.min_normal_force_n).reduce(f64::min)
+    };
+    let mut cols = vec![
+        Column::new("file".into(), s(&|r| Some(r.metrics.file.clone()))),
+        Column::new("scene".into(), s(&|r| Some(r.metrics.scene.clone()))),
+        Column::new("run".into(), s(&|r| Some(r.metrics.run.clone()))),
+        Column::new("status".into(), s(&|r| Some(crate::render::status(r.metrics.status).to_string()))),
+        Column::new("contacts".into(), s(&|r| Some(r.metrics.contacts.join(",")))),
+        Column::new("n_contacts".into(), rows.iter().map(|r| r.metrics.contacts.len() as u32).collect::<Vec<_>>()),
+        Column::new("integrator".into(), s(&|r| r.integrator.clone())),
+        Column::new("t_end_s".into(), m(&|r| r.t_end_s)),
+        Column::new("samples".into(), rows.iter().map(|r| r.metrics.samples as u64).collect::<Vec<_>>()),
+        Column::new("err_norm_rms_m".into(), m(&|r| r.hand_error.norm.rms_m)),
+        Column::new("err_norm_max_m".into(), m(&|r| r.hand_error.norm.max_abs_m)),
+        Column::new("err_z_rms_m".into(), m(&|r| r.hand_error.z.rms_m)),
+        Column::new("err_z_max_m".into(), m(&|r| r.hand_error.z.max_abs_m)),
+        Column::new("E_total_j".into(), m(&|r| r.electric_energy_total_j)),
+        Column::new("W_total_j".into(), m(&|r| r.link_work_total_j)),
+        Column::new(
+            "peak_current_a".into(),
+            rows.iter().map(|r| r.metrics.peak_current.as_ref().map(|p| p.current_a)).collect::<Vec<_>>(),
+        ),
+        Column::new("peak_current_joint".into(), s(&|r| r.metrics.peak_current.as_ref().map(|p| p.joint.clone()))),
+        Column::new("fn_min_n".into(), rows.iter().map(|r| min_force(&r.metrics)).collect::<Vec<_>>()),
+        Column::new(
+            "pull_max_s".into(),
+            rows.iter()
+                .map(|r| r.metrics.contact_forces.iter().map(|c| c.pull_time_s).reduce(f64::max))
+                .collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "residual_max_rel".into(),
+            rows.iter().map(|r| r.metrics.energy.max_abs_residual_rel).collect::<Vec<_>>(),
+        ),
+        Column::new("error".into(), s(&|r| r.metrics.error.clone())),
+        Column::new("bytes".into(), rows.iter().map(|r| r.bytes).collect::<Vec<_>>()),
+    ];
+    // per-link columns over the union of joints, in first-seen order
+    let mut joints: Vec<&str> = Vec::new();
+    for r in rows {
+        for l in &r.metrics.links {
+            if !joints.contains(&l.joint.as_str()) {
+                joints.push(&l.joint);
+            }
+        }
+    }
+    let link = |joint: &str, f: fn(&crate::metrics::LinkMetrics) -> f64| -> Vec<Option<f64>> {
+        rows.iter()
+            .map(|r| r.metrics.links.iter().find(|l| l.joint == joint).map(f))
+            .collect()
+    };
+    for j in &joints {
+        cols.push(Column::new(format!("E.{j}_j").into(), link(j, |l| l.electric_energy_j)));
+    }
+    for j in &joints {
+        cols.push(Column::new(format!("W.{j}_j").into(), link(j, |l| l.work_j)));
+    }
+    for (k, p) in params.iter().enumerate() {
+        let values: Vec<Option<&serde_json::Value>> = rows.iter().map(|r| r.params[k].as_ref()).collect();
+        let name = format!("p.{p}");
+        let numeric = values.iter().all(|v| v.is_none_or(|v| v.is_number()));
+        cols.push(if numeric {
+            Column::new(name.into(), values.iter().map(|v| v.and_then(|v| v.as_f64())).collect::<Vec<_>>())
+        } else {
+            let text = |v: &serde_json::Value| v.as_str().map_or_else(|| v.to_string(), String::from);
+            Column::new(name.into(), values.iter().map(|v| v.map(text)).collect::<Vec<_>>())
+        });
+    }
+    DataFrame::new(n, cols)
+}
+
+impl Query {
+    /// Runs the query on `df` with polars' eager API (filter masks, a stable multi-column sort,
+    /// a projection and a head): on a table of one row per recording there is nothing for a
+    /// query planner to gain. Errors name the unknown column or the value that does not parse
+    /// as a number for a numeric column.
+    pub fn run(&self, mut df: DataFrame) -> Result<DataFrame, String> {
+        let known = |df: &DataFrame, c: &str| -> Result<(), String> {
+            match df.column(c) {
+                Ok(_) => Ok(()),
+                Err(_) => Err(format!("no column {c:?}; the columns are: {}", df.get_column_names().iter().map(|c| c.as_str()).collect::<Vec<_>>().join(", "))),
+            }
+        };
+        for f in &self.filters {
+            known(&df, &f.column)?;
+            let mask = filter_mask(df.column(&f.column).map_err(|e| e.to_string())?, f)?;
+            df = df.filter(&mask).map_err(|e| e.to_string())?;
+        }
+        if !self.sort.is_empty() {
+            for c in &self.sort {
+                known(&df, c)?;
+            }
+            let opts = SortMultipleOptions::default()
+                .with_order_descending(self.descending)
+                .with_nulls_last(true)
+                .with_maintain_order(true);
+            df = df.sort(self.sort.iter().map(String::as_str).collect::<Vec<_>>(), opts).map_err(|e| e.to_string())?;
+        }
+        if !self.columns.is_empty() {
+            for c in &self.columns {
+                known(&df, c)?;
+            }
+            df = df.select(self.columns.iter().map(String::as_str)).map_err(|e| e.to_string())?;
+        }
+        if let Some(n) = self.limit {
+            df = df.head(Some(n));
+        }
+        Ok(df)
+    }
+}
+
+/// The rows of `column` where `f` holds (a null never does): numbers compare as numbers, text
+/// as text.
+fn filter_mask(column: &Column, f: &Filter) -> Result<BooleanChunked, String> {
+    let s = column.as_materialized_series();
+    let mask = if s.dtype().is_primitive_numeric() {
+        let x: f64 = f.value.parse().map_err(|_| format!("filter {:?}: {:?} is not a number (the column is numeric)", f.column, f.value))?;
+        let s = s.cast(&DataType::Float64).map_err(|e| e.to_string())?;
+        let v = s.f64().map_err(|e| e.to_string())?;
+        match f.op {
+            Op::Eq => v.equal(x),
+            Op::Ne => v.not_equal(x),
+            Op::Lt => v.lt(x),
+            Op::Le => v.lt_eq(x),
+            Op::Gt => v.gt(x),
+            Op::Ge => v.gt_eq(x),
+        }
+    } else {
+        let s = s.cast(&DataType::String).map_err(|e| e.to_string())?;
+        let v = s.str().map_err(|e| e.to_string())?;
+        let x = f.value.as_str();
+        match f.op {
+            Op::Eq => v.equal(x),
+            Op::Ne => v.not_equal(x),
+            Op::Lt => v.lt(x),
+            Op::Le => v.lt_eq(x),
+            Op::Gt => v.gt(x),
+            Op::Ge => v.gt_eq(x),
+        }
+    };
+    // a null compares as null: not kept
+    Ok(mask.fill_null_with_values(false).map_err(|e| e.to_string())?)
+}
+

@@ -1,0 +1,504 @@
+//! The metadata records of a recording as typed values: what `sim` writes and what every reader
+//! gets back, so no other crate spells a record name or a key.
+//!
+//! MCAP metadata is a map of strings per named record (<https://mcap.dev/spec#metadata-op0x0c>).
+//! Each record here is a serde struct ([`MetadataRecord`]) whose fields are the keys; values are
+//! text: numbers in Rust's `{:e}` form (`5e0`, `1e-3`, exact round trip), counts in decimal,
+//! name lists as JSON arrays of strings. The layout by format version (see
+//! [`crate::FORMAT_VERSION`]):
+//!
+//! | record | keys | since |
+//! |---|---|---|
+//! | `recording` | `format_version`, `tool` | 0 (`tool` since 1) |
+//! | `run` | `scene`, `run`, `contacts` | 0 |
+//! | `run` | `joint_names`, `integrator` and `integrator.*`, `duration`, `output_rate`, `mass_matrix`, `constraint_solver`, `stabilization`, `model.*`, `hand_frame`, `tool` | 1 |
+//! | `scene` | `json` (the scene as run), `source` | 1 |
+//! | `urdf` | `file`, `xml` | 1 |
+//! | `result` | `status` (`complete`/`failed`) | 0 |
+//! | `result` | `rhs_evals`, `steps`, `rejected` (complete), `error`, `error_time` (failed) | 1 |
+//!
+//! Readers ignore keys they do not know (a newer writer may add some) and reject a record that
+//! lacks a key its format version must have, naming the record and the key.
+
+use std::collections::BTreeMap;
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+/// A metadata record: its MCAP name and its keys (the struct's fields, every value text).
+pub trait MetadataRecord: Serialize + DeserializeOwned {
+    /// The MCAP metadata record name.
+    const NAME: &'static str;
+}
+
+/// Record `recording`: which format, written by which tool. [`crate::RecordingWriter::create`]
+/// writes it first, with this crate's [`crate::FORMAT_VERSION`].
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RecordingInfo {
+    #[serde(with = "text")]
+    pub format_version: u32,
+    /// Name and version of the writing tool, e.g. `elbow-sim 0.1.0` (absent in format 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool: Option<String>,
+}
+
+impl RecordingInfo {
+    /// This crate's format version, written by `tool` (e.g. `elbow-sim 0.1.0`).
+    pub fn new(tool: &str) -> Self {
+        Self { format_version: crate::FORMAT_VERSION, tool: Some(tool.to_string()) }
+    }
+}
+
+impl MetadataRecord for RecordingInfo {
+    const NAME: &'static str = "recording";
+}
+
+/// Record `run`: what ran. The names give the order of every per-joint and per-contact array of
+/// the messages ([`crate::topics::ArrayIndex`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunInfo {
+    /// The scene's name.
+    pub scene: String,
+    /// The run's name, e.g. `two-elbow`.
+    pub run: String,
+    /// The active contacts, in `/constraints` array order.
+    #[serde(with = "json_text")]
+    pub contacts: Vec<String>,
+    /// The actuated joints, in the order of `/motors`, `/energy` and `/joint_states`. Format 0
+    /// did not record them: the reader names them `joint1` … `jointN` from the arrays.
+    #[serde(with = "json_text")]
+    pub joint_names: Vec<String>,
+    /// How it ran (since format 1).
+    #[serde(flatten)]
+    pub setup: Setup,
+}
+
+/// The part of [`RunInfo`] that says how the run was computed (since format 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Setup {
+    #[serde(flatten)]
+    pub integrator: IntegratorInfo,
+    /// Simulated time, s.
+    #[serde(rename = "duration", with = "sci")]
+    pub duration_s: f64,
+    /// Rate of the recorded samples, Hz.
+    #[serde(rename = "output_rate", with = "sci")]
+    pub output_rate_hz: f64,
+    /// How M(q) was computed, e.g. `crba`.
+    pub mass_matrix: String,
+    /// How the constrained system was solved, e.g. `schur`.
+    pub constraint_solver: String,
+    /// The constraint stabilisation as JSON, e.g. `{"method":"none"}`.
+    pub stabilization: String,
+    #[serde(flatten)]
+    pub model: ModelInfo,
+    /// The frame of `/hand` positions.
+    pub hand_frame: String,
+    /// Name and version of the writing tool.
+    pub tool: String,
+}
+
+/// The integrator and its settings: keys `integrator` (the method, possibly with a phrase, e.g.
+/// `rosenbrock (ROS34PW2, structured Jacobian)`) and `integrator.<setting>` for each setting the
+/// method has.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IntegratorInfo {
+    #[serde(rename = "integrator")]
+    pub method: String,
+    /// Fixed step, s.
+    #[serde(rename = "integrator.step", default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub step: Option<f64>,
+    #[serde(rename = "integrator.rtol", default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub rtol: Option<f64>,
+    #[serde(rename = "integrator.atol", default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub atol: Option<f64>,
+    /// Largest step, s.
+    #[serde(rename = "integrator.h_max", default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub h_max: Option<f64>,
+    #[serde(rename = "integrator.max_steps", default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub max_steps: Option<u64>,
+    #[serde(rename = "integrator.jacobian_reuse", default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub jacobian_reuse: Option<u64>,
+}
+
+impl IntegratorInfo {
+    /// One phrase for people: `dopri45 rtol 1e-10 atol 1e-12 h_max 1e-3` (max_steps left out).
+    pub fn phrase(&self) -> String {
+        let mut s = self.method.clone();
+        let settings = [("step", self.step), ("rtol", self.rtol), ("atol", self.atol), ("h_max", self.h_max)];
+        for (name, v) in settings {
+            if let Some(v) = v {
+                s.push_str(&format!(" {name} {v:e}"));
+            }
+        }
+        if let Some(k) = self.jacobian_reuse {
+            s.push_str(&format!(" jacobian_reuse {k}"));
+        }
+        s
+    }
+}
+
+/// The terms of the model that ran (a scene assembles only what it has): keys `model.*`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ModelInfo {
+    /// The motors' electrical model, e.g. `L di/dt (one state per motor)`.
+    #[serde(rename = "model.electrical")]
+    pub electrical: String,
+    /// Number of active contacts.
+    #[serde(rename = "model.contacts", with = "text")]
+    pub contacts: usize,
+    /// Joint and gear friction terms assembled.
+    #[serde(rename = "model.friction", with = "on_off")]
+    pub friction: bool,
+    /// Gravity non-zero.
+    #[serde(rename = "model.gravity", with = "on_off")]
+    pub gravity: bool,
+}
+
+/// The names part of the `run` record, as every format version has it (`joint_names` since 1):
+/// what a producer that does not describe its integration writes (format 0, other tools).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunNames {
+    pub scene: String,
+    pub run: String,
+    #[serde(with = "json_text")]
+    pub contacts: Vec<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "json_text_opt")]
+    pub joint_names: Option<Vec<String>>,
+}
+
+impl MetadataRecord for RunNames {
+    const NAME: &'static str = "run";
+}
+
+/// The key whose presence says a `run` record has a [`Setup`].
+pub(crate) const SETUP_KEY: &str = "integrator";
+
+/// [`RunInfo`] as the reader finds it in a file of any format version.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunDescription {
+    pub scene: String,
+    pub run: String,
+    pub contacts: Vec<String>,
+    /// Recorded (format ≥ 1) or, for format 0, `joint1` … `jointN` from the arrays.
+    pub joint_names: Vec<String>,
+    /// `None` for format 0, and for files of other producers that do not say how they ran.
+    pub setup: Option<Setup>,
+}
+
+impl MetadataRecord for RunInfo {
+    const NAME: &'static str = "run";
+}
+
+/// Record `scene`: the scene exactly as it ran, so that the recording replays itself.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SceneRecord {
+    /// The scene JSON (with defaults filled in).
+    pub json: String,
+    /// Where it came from: a file name, or a label.
+    pub source: String,
+}
+
+impl MetadataRecord for SceneRecord {
+    const NAME: &'static str = "scene";
+}
+
+/// Record `urdf`: the robot description exactly as read.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct UrdfRecord {
+    /// The file name the scene gives.
+    pub file: String,
+    /// Its text.
+    pub xml: String,
+}
+
+impl MetadataRecord for UrdfRecord {
+    const NAME: &'static str = "urdf";
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunStatus {
+    Complete,
+    /// Stopped by a numerical failure; the file holds every sample up to it.
+    Failed,
+}
+
+/// Record `result`, written last: the status and the solver's work, or the error and its time.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    pub status: RunStatus,
+    /// Right-hand-side evaluations (complete runs, since format 1).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub rhs_evals: Option<u64>,
+    /// Accepted steps.
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub steps: Option<u64>,
+    /// Rejected step attempts.
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub rejected: Option<u64>,
+    /// Why a failed run stopped.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// Simulated time of the failure, s, when known.
+    #[serde(rename = "error_time", default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub error_time_s: Option<f64>,
+}
+
+impl RunResult {
+    /// A complete run and the solver's work.
+    pub fn complete(rhs_evals: u64, steps: u64, rejected: u64) -> Self {
+        Self { status: RunStatus::Complete, rhs_evals: Some(rhs_evals), steps: Some(steps), rejected: Some(rejected), error: None, error_time_s: None }
+    }
+
+    /// A run stopped by `error` at `time_s` (if known).
+    pub fn failed(error: String, time_s: Option<f64>) -> Self {
+        Self { status: RunStatus::Failed, rhs_evals: None, steps: None, rejected: None, error: Some(error), error_time_s: time_s }
+    }
+}
+
+impl MetadataRecord for RunResult {
+    const NAME: &'static str = "result";
+}
+
+/// The keys and text values of `record`, or why a field did not serialise to text.
+pub(crate) fn to_entries<R: MetadataRecord>(record: &R) -> Result<BTreeMap<String, String>, String> {
+    match serde_json::to_value(record).map_err(|e| e.to_string())? {
+        serde_json::Value::Object(map) => map
+            .into_iter()
+            .map(|(k, v)| match v {
+                serde_json::Value::String(s) => Ok((k, s)),
+                other => Err(format!("key `{k}` is not text: {other}")),
+            })
+            .collect(),
+        other => Err(format!("not a map of keys: {other}")),
+    }
+}
+
+/// The record from its keys and text values; the error names the missing or bad key.
+pub(crate) fn from_entries<R: DeserializeOwned>(entries: &BTreeMap<String, String>) -> Result<R, String> {
+    let map = entries.iter().map(|(k, v)| (k.clone(), serde_json::Value::String(v.clone()))).collect();
+    serde_json::from_value(serde_json::Value::Object(map)).map_err(|e| e.to_string())
+}
+
+/// A value as its `Display` text, parsed back with `FromStr` (counts, versions).
+mod text {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<T: std::fmt::Display, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(v)
+    }
+
+    pub fn deserialize<'de, T, D>(d: D) -> Result<T, D::Error>
+    where
+        T: std::str::FromStr,
+        T::Err: std::fmt::Display,
+        D: Deserializer<'de>,
+    {
+        let s = String::deserialize(d)?;
+        s.trim().parse().map_err(|e| serde::de::Error::custom(format!("{s:?}: {e}")))
+    }
+}
+
+/// [`text`] for optional values.
+mod text_opt {
+    use serde::{Deserializer, Serializer};
+
+    pub fn serialize<T: std::fmt::Display, S: Serializer>(v: &Option<T>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => super::text::serialize(v, s),
+            None => s.serialize_none(),
+        }
+    }
+
+    pub fn deserialize<'de, T, D>(d: D) -> Result<Option<T>, D::Error>
+    where
+        T: std::str::FromStr,
+        T::Err: std::fmt::Display,
+        D: Deserializer<'de>,
+    {
+        super::text::deserialize(d).map(Some)
+    }
+}
+
+/// An f64 in Rust's `{:e}` form (`5e0`, `1e-3`): shortest text that parses back to the same bits.
+mod sci {
+    use serde::{Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(&format_args!("{v:e}"))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        super::text::deserialize(d)
+    }
+}
+
+/// [`sci`] for optional values.
+mod sci_opt {
+    use serde::{Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => super::sci::serialize(v, s),
+            None => s.serialize_none(),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+        super::sci::deserialize(d).map(Some)
+    }
+}
+
+/// A list of names as a JSON array of strings.
+mod json_text {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &[String], s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&serde_json::to_string(v).map_err(serde::ser::Error::custom)?)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<String>, D::Error> {
+        let s = String::deserialize(d)?;
+        serde_json::from_str(&s).map_err(|e| serde::de::Error::custom(format!("{s:?} is not a JSON array of strings: {e}")))
+    }
+}
+
+/// [`json_text`] for an optional list.
+mod json_text_opt {
+    use serde::{Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &Option<Vec<String>>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(v) => super::json_text::serialize(v, s),
+            None => s.serialize_none(),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<String>>, D::Error> {
+        super::json_text::deserialize(d).map(Some)
+    }
+}
+
+/// A flag as `on`/`off`.
+mod on_off {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &bool, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(if *v { "on" } else { "off" })
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
+        match String::deserialize(d)?.as_str() {
+            "on" => Ok(true),
+            "off" => Ok(false),
+            other => Err(serde::de::Error::custom(format!("{other:?}: expected on or off"))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run_info() -> RunInfo {
+        RunInfo {
+            scene: "paper".into(),
+            run: "two-elbow".into(),
+            contacts: vec!["elbow4".into(), "elbow7".into()],
+            joint_names: vec!["joint1".into(), "joint2".into()],
+            setup: Setup {
+                integrator: IntegratorInfo {
+                    method: "dopri45".into(),
+                    step: None,
+                    rtol: Some(1e-10),
+                    atol: Some(1e-12),
+                    h_max: Some(1e-3),
+                    max_steps: Some(100_000_000),
+                    jacobian_reuse: None,
+                },
+                duration_s: 5.0,
+                output_rate_hz: 1000.0,
+                mass_matrix: "crba".into(),
+                constraint_solver: "schur".into(),
+                stabilization: r#"{"method":"none"}"#.into(),
+                model: ModelInfo { electrical: "L di/dt (one state per motor)".into(), contacts: 2, friction: true, gravity: true },
+                hand_frame: "world".into(),
+                tool: "elbow-sim 0.1.0".into(),
+            },
+        }
+    }
+
+    /// The keys and texts of format 2, exactly (the archived recordings hold these bytes).
+    #[test]
+    fn run_info_writes_the_format_2_keys() {
+        let e = to_entries(&run_info()).unwrap();
+        let want = [
+            ("constraint_solver", "schur"),
+            ("contacts", r#"["elbow4","elbow7"]"#),
+            ("duration", "5e0"),
+            ("hand_frame", "world"),
+            ("integrator", "dopri45"),
+            ("integrator.atol", "1e-12"),
+            ("integrator.h_max", "1e-3"),
+            ("integrator.max_steps", "100000000"),
+            ("integrator.rtol", "1e-10"),
+            ("joint_names", r#"["joint1","joint2"]"#),
+            ("mass_matrix", "crba"),
+            ("model.contacts", "2"),
+            ("model.electrical", "L di/dt (one state per motor)"),
+            ("model.friction", "on"),
+            ("model.gravity", "on"),
+            ("output_rate", "1e3"),
+            ("run", "two-elbow"),
+            ("scene", "paper"),
+            ("stabilization", r#"{"method":"none"}"#),
+            ("tool", "elbow-sim 0.1.0"),
+        ];
+        let got: Vec<(&str, &str)> = e.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
+        assert_eq!(got, want);
+        assert_eq!(from_entries::<RunInfo>(&e).unwrap(), run_info());
+    }
+
+    #[test]
+    fn results_round_trip_and_unknown_keys_are_ignored() {
+        for r in [RunResult::complete(148_640, 24_770, 3), RunResult::failed("t = 0.5 s: NaN".into(), Some(0.5)), RunResult::failed("?".into(), None)] {
+            let mut e = to_entries(&r).unwrap();
+            e.insert("added_by_a_newer_writer".into(), "x".into());
+            assert_eq!(from_entries::<RunResult>(&e).unwrap(), r);
+        }
+        let e = to_entries(&RunResult::failed("e".into(), Some(2.5e-3))).unwrap();
+        assert_eq!(e.get("error_time").map(String::as_str), Some("2.5e-3"));
+        assert_eq!(e.get("status").map(String::as_str), Some("failed"));
+    }
+
+    #[test]
+    fn a_missing_or_bad_key_is_named() {
+        let mut e = to_entries(&run_info()).unwrap();
+        e.remove("joint_names");
+        assert!(from_entries::<RunInfo>(&e).unwrap_err().contains("joint_names"));
+        let mut e = to_entries(&run_info()).unwrap();
+        e.insert("model.friction".into(), "maybe".into());
+        assert!(from_entries::<RunInfo>(&e).unwrap_err().contains("maybe"));
+        let mut e = to_entries(&run_info()).unwrap();
+        e.insert("duration".into(), "five".into());
+        assert!(from_entries::<RunInfo>(&e).unwrap_err().contains("five"));
+        let e = BTreeMap::from([("status".to_string(), "maybe".to_string())]);
+        assert!(from_entries::<RunResult>(&e).unwrap_err().contains("maybe"));
+    }
+
+    /// `{:e}` text parses back to the same f64, bit for bit.
+    #[test]
+    fn numbers_round_trip_exactly() {
+        for x in [0.1f64 + 0.2, 1e-300, 5.0, 1.0 / 3.0, 123456.789e10, -2.5e-7] {
+            let text = format!("{x:e}");
+            assert_eq!(text.parse::<f64>().unwrap().to_bits(), x.to_bits(), "{text}");
+        }
+    }
+
+    #[test]
+    fn the_integrator_phrase_names_its_settings() {
+        assert_eq!(run_info().setup.integrator.phrase(), "dopri45 rtol 1e-10 atol 1e-12 h_max 1e-3");
+    }
+}

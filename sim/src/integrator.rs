@@ -1,0 +1,171 @@
+//! The integrator of a scene, in one place: the validated [`Integrator`] made from the scene's
+//! [`IntegratorSpec`] (the only place user-facing defaults are filled in), its description in a
+//! recording ([`Integrator::describe`]), and the stepper it runs ([`Integrator::integrate`]).
+//! The methods themselves are robot-agnostic and live in [`crate::integrate`] (references
+//! there).
+
+use schemas::IntegratorInfo;
+
+use crate::error::SceneError;
+use crate::integrate::{
+    integrate_sampled, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rosenbrock, SplitSystem, Stats,
+    StepControl, Stepper,
+};
+use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, RosenbrockSpec};
+
+/// Most step attempts of a run when a scene does not say (`max_steps`).
+pub const DEFAULT_MAX_STEPS: u64 = 100_000_000;
+
+/// A validated integrator and its settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integrator {
+    /// Classical Runge–Kutta, fixed `step`, s.
+    Rk4 { step: f64 },
+    /// Dormand–Prince 5(4).
+    Dopri45(StepControl),
+    /// ROS34PW2 with the arm's structured Jacobian, refreshed every `jacobian_reuse` steps.
+    Rosenbrock { control: StepControl, jacobian_reuse: usize },
+    /// ARK4(3)6L[2]SA, the armature circuits implicit.
+    Imex(StepControl),
+}
+
+impl Integrator {
+    /// Validates `spec` of a scene read from `file` whose runs last `duration` s and are
+    /// recorded every `output_interval` s. Defaults: `h_max` = the output interval (no step
+    /// skips over a sample), `max_steps` = [`DEFAULT_MAX_STEPS`], `jacobian_reuse` = 1.
+    pub fn from_spec(spec: &IntegratorSpec, file: &str, duration: f64, output_interval: f64) -> Result<Self, SceneError> {
+        let err = |field: &str, value: &dyn std::fmt::Display, why: &str| SceneError::new(file, format!("integrator.{field}"), value, why);
+        let control = |rtol: f64, atol: f64, h_max: Option<f64>, max_steps: Option<u64>| -> Result<StepControl, SceneError> {
+            if !(rtol.is_finite() && (1e-14..1.0).contains(&rtol)) {
+                return Err(err("rtol", &rtol, "must be in [1e-14, 1)"));
+            }
+            if !(atol.is_finite() && atol > 0.0) {
+                return Err(err("atol", &atol, "must be > 0"));
+            }
+            let h_max = h_max.unwrap_or(output_interval);
+            if !(h_max.is_finite() && h_max > 0.0) {
+                return Err(err("h_max", &h_max, "must be > 0 s"));
+            }
+            let max_steps = max_steps.unwrap_or(DEFAULT_MAX_STEPS);
+            if max_steps == 0 {
+                return Err(err("max_steps", &max_steps, "must be >= 1"));
+            }
+            Ok(StepControl { rtol, atol, h_init: None, h_max, h_min: 0.0, max_steps })
+        };
+        Ok(match spec {
+            IntegratorSpec::Rk4(s) => {
+                if !(s.step.is_finite() && s.step > 0.0 && s.step <= duration) {
+                    return Err(err("step", &s.step, "must be > 0 s and <= duration"));
+                }
+                Integrator::Rk4 { step: s.step }
+            }
+            IntegratorSpec::Dopri45(AdaptiveSpec { rtol, atol, h_max, max_steps }) => {
+                Integrator::Dopri45(control(*rtol, *atol, *h_max, *max_steps)?)
+            }
+            IntegratorSpec::Imex(AdaptiveSpec { rtol, atol, h_max, max_steps }) => {
+                Integrator::Imex(control(*rtol, *atol, *h_max, *max_steps)?)
+            }
+            IntegratorSpec::Rosenbrock(RosenbrockSpec { rtol, atol, h_max, max_steps, jacobian_reuse }) => {
+                let reuse = jacobian_reuse.unwrap_or(1);
+                if reuse == 0 {
+                    return Err(err("jacobian_reuse", &reuse, "must be >= 1"));
+                }
+                let jacobian_reuse = usize::try_from(reuse).unwrap_or(usize::MAX);
+                Integrator::Rosenbrock { control: control(*rtol, *atol, *h_max, *max_steps)?, jacobian_reuse }
+            }
+        })
+    }
+
+    /// The method's name in scenes.
+    pub fn method(&self) -> &'static str {
+        match self {
+            Integrator::Rk4 { .. } => "rk4",
+            Integrator::Dopri45(_) => "dopri45",
+            Integrator::Rosenbrock { .. } => "rosenbrock",
+            Integrator::Imex(_) => "imex",
+        }
+    }
+
+    /// As recorded in a recording's `run` record.
+    pub fn describe(&self) -> IntegratorInfo {
+        let info = |method: &str, c: Option<&StepControl>| IntegratorInfo {
+            method: method.into(),
+            step: None,
+            rtol: c.map(|c| c.rtol),
+            atol: c.map(|c| c.atol),
+            h_max: c.map(|c| c.h_max),
+            max_steps: c.map(|c| c.max_steps),
+            jacobian_reuse: None,
+        };
+        match self {
+            Integrator::Rk4 { step } => IntegratorInfo { step: Some(*step), ..info("rk4", None) },
+            Integrator::Dopri45(c) => info("dopri45", Some(c)),
+            Integrator::Rosenbrock { control, jacobian_reuse } => IntegratorInfo {
+                jacobian_reuse: Some(*jacobian_reuse as u64),
+                ..info("rosenbrock (ROS34PW2, structured Jacobian)", Some(control))
+            },
+            Integrator::Imex(c) => info("imex (ARK4(3)6L[2]SA, armature circuits implicit)", Some(c)),
+        }
+    }
+
+    /// Integrates `sys` from `y0` at t = 0 to `t_end` with this method and hands the solution to
+    /// `on_sample` on the grid `k dt_out` (dense output, independent of the steps).
+    pub fn integrate<S: OdeJacobian + SplitSystem>(
+        &self,
+        sys: &mut S,
+        y0: &[f64],
+        t_end: f64,
+        dt_out: f64,
+        on_sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
+    ) -> Result<Stats, IntegrateError<S::Error>> {
+        let dim = y0.len();
+        let mut stepper: Box<dyn Stepper<S>> = match *self {
+            Integrator::Rk4 { step } => Box::new(Rk4::new(dim, step)),
+            Integrator::Dopri45(c) => Box::new(DormandPrince45::new(dim, c)),
+            Integrator::Rosenbrock { control, jacobian_reuse } => Box::new(Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse)),
+            Integrator::Imex(c) => Box::new(ArkImex::new(dim, c)),
+        };
+        integrate_sampled(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, on_sample)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(json: &str) -> IntegratorSpec {
+        serde_json::from_str(json).unwrap()
+    }
+
+    #[test]
+    fn defaults_are_filled_in_one_place() {
+        let i = Integrator::from_spec(&spec(r#"{"method":"dopri45","rtol":1e-10,"atol":1e-12}"#), "s.json", 5.0, 1e-3).unwrap();
+        assert_eq!(i, Integrator::Dopri45(StepControl { rtol: 1e-10, atol: 1e-12, h_init: None, h_max: 1e-3, h_min: 0.0, max_steps: DEFAULT_MAX_STEPS }));
+        let i = Integrator::from_spec(&spec(r#"{"method":"rosenbrock","rtol":1e-5,"atol":1e-7,"h_max":0.5}"#), "s.json", 5.0, 1e-3).unwrap();
+        assert!(matches!(i, Integrator::Rosenbrock { jacobian_reuse: 1, control } if control.h_max == 0.5));
+        assert_eq!(i.describe().phrase(), "rosenbrock (ROS34PW2, structured Jacobian) rtol 1e-5 atol 1e-7 h_max 5e-1 jacobian_reuse 1");
+    }
+
+    #[test]
+    fn each_method_accepts_only_its_own_settings() {
+        let bad = |json: &str| serde_json::from_str::<IntegratorSpec>(json).unwrap_err().to_string();
+        assert!(bad(r#"{"method":"dopri45","rtol":1e-6,"atol":1e-8,"step":1e-3}"#).contains("unknown field `step`"));
+        assert!(bad(r#"{"method":"imex","rtol":1e-6,"atol":1e-8,"jacobian_reuse":2}"#).contains("unknown field `jacobian_reuse`"));
+        assert!(bad(r#"{"method":"rk4","step":1e-3,"rtol":1e-6}"#).contains("unknown field `rtol`"));
+        assert!(bad(r#"{"method":"rk4"}"#).contains("missing field `step`"));
+        assert!(bad(r#"{"method":"euler","step":1e-3}"#).contains("unknown variant `euler`"));
+        // the serde form is the scene's: the tag first, unset settings left out
+        let text = serde_json::to_string(&spec(r#"{"atol":1e-12,"method":"dopri45","rtol":1e-10}"#)).unwrap();
+        assert_eq!(text, r#"{"method":"dopri45","rtol":1e-10,"atol":1e-12}"#);
+    }
+
+    #[test]
+    fn out_of_range_settings_name_field_and_value() {
+        let msg = |json: &str| Integrator::from_spec(&spec(json), "s.json", 5.0, 1e-3).unwrap_err().to_string();
+        assert!(msg(r#"{"method":"dopri45","rtol":0,"atol":1e-8}"#).contains("integrator.rtol` = 0"));
+        assert!(msg(r#"{"method":"dopri45","rtol":1e-6,"atol":-1}"#).contains("integrator.atol` = -1"));
+        assert!(msg(r#"{"method":"imex","rtol":1e-6,"atol":1e-8,"max_steps":0}"#).contains("integrator.max_steps` = 0"));
+        assert!(msg(r#"{"method":"rosenbrock","rtol":1e-6,"atol":1e-8,"jacobian_reuse":0}"#).contains("jacobian_reuse` = 0"));
+        assert!(msg(r#"{"method":"rk4","step":6}"#).contains("integrator.step` = 6"));
+    }
+}

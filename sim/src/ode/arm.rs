@@ -1,0 +1,155 @@
+//! [`ArmSystem`]: one run of a scene as an [`OdeSystem`] — the targets and PD voltages
+//! (eqs 27–29), the motors' currents, eq 21, and the quadratures of the energy balance.
+
+use crate::dynamics::constraints::PointOnPlane;
+use crate::dynamics::energy::{link_kinetic_energy, magnetic_energy, potential_energy, rotor_kinetic_energy};
+use crate::dynamics::forward::{forward_dynamics, Plant, Stabilization};
+use crate::dynamics::kinematics::forward_kinematics;
+use crate::dynamics::motor::Electrical;
+use crate::error::{DynamicsError, RunError};
+use crate::integrate::OdeSystem;
+use crate::scene::{Run, Scene};
+
+use super::layout::Layout;
+use super::workspace::Workspace;
+
+/// One run of a scene as an ODE. The scene is read-only; all scratch is in the workspace.
+pub struct ArmSystem<'a> {
+    pub(super) scene: &'a Scene,
+    pub(super) contacts: Vec<PointOnPlane>,
+    pub(super) layout: Layout,
+    pub(super) ws: Workspace,
+    /// T + V + ½ L i² at t = 0, J (for the balance residual).
+    pub(super) stored0: f64,
+}
+
+impl<'a> ArmSystem<'a> {
+    pub fn new(scene: &'a Scene, run: &Run) -> Self {
+        let nv = scene.model.nv;
+        let contacts = scene.run_contacts(run);
+        let layout = Layout { nv, electrical: scene.drives.electrical };
+        let ws = Workspace::new(&scene.model, contacts.len(), layout.dim());
+        let mut sys = Self { scene, contacts, layout, ws, stored0: 0.0 };
+        sys.stored0 = sys.stored_energy(&scene.q0, &scene.qd0, &scene.current0);
+        sys
+    }
+
+    /// Where each part of the state is.
+    pub fn layout(&self) -> Layout {
+        self.layout
+    }
+
+    /// The initial state vector.
+    pub fn initial_state(&self) -> Vec<f64> {
+        let l = self.layout;
+        let mut y = vec![0.0; l.dim()];
+        y[l.q()].copy_from_slice(&self.scene.q0);
+        y[l.qd()].copy_from_slice(&self.scene.qd0);
+        if l.ni() > 0 {
+            y[l.current()].copy_from_slice(&self.scene.current0);
+        }
+        y
+    }
+
+    /// T + V + ½ Σ L i², J. Clobbers the kinematics scratch.
+    pub(super) fn stored_energy(&mut self, q: &[f64], qd: &[f64], current: &[f64]) -> f64 {
+        let s = self.scene;
+        let data = &mut self.ws.data;
+        crate::dynamics::rnea::bias_forces(&s.model, data, q, qd);
+        let t = link_kinetic_energy(&s.model, data) + rotor_kinetic_energy(&s.drives, qd);
+        forward_kinematics(&s.model, data, q);
+        t + potential_energy(&s.model, data) + magnetic_energy(&s.drives, current)
+    }
+
+    /// The IK targets (eqs 28–29) and the PD voltages (eq 27) at (t, q, q̇), into the workspace.
+    pub(super) fn voltage_at(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), DynamicsError> {
+        let s = self.scene;
+        let ws = &mut self.ws;
+        s.ik.solve(&s.circle.position(t), &s.circle.velocity(t), &mut ws.q_des, &mut ws.qd_des)
+            .map_err(|why| DynamicsError::Unreachable { t, why })?;
+        s.gains.voltage(q, qd, &ws.q_des, &ws.qd_des, &mut ws.voltage);
+        Ok(())
+    }
+
+    /// The motor currents at `y`: the current states, or for quasi-static motors the currents
+    /// the last [`ArmSystem::evaluate`] computed.
+    pub(super) fn currents<'y>(&'y self, y: &'y [f64]) -> &'y [f64] {
+        match self.layout.electrical {
+            Electrical::Inductive => &y[self.layout.current()],
+            Electrical::QuasiStatic => &self.ws.current_qs,
+        }
+    }
+
+    /// Targets, voltages and currents at (t, y), then eq 21: everything the right-hand side,
+    /// the outputs and the Jacobian read, into the workspace.
+    pub(super) fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+        let l = self.layout;
+        let (q, qd) = (&y[l.q()], &y[l.qd()]);
+        let s = self.scene;
+        self.voltage_at(t, q, qd)?;
+        if l.electrical == Electrical::QuasiStatic {
+            for j in 0..l.nv {
+                self.ws.current_qs[j] = s.drives.quasi_static_current(j, self.ws.voltage[j], qd[j]);
+            }
+        }
+        let plant = Plant {
+            model: &s.model,
+            drives: &s.drives,
+            contacts: &self.contacts,
+            mass_matrix: s.mass_matrix,
+            solver: s.solver,
+            stabilization: s.stabilization,
+        };
+        let current = match l.electrical {
+            Electrical::Inductive => &y[l.current()],
+            Electrical::QuasiStatic => &self.ws.current_qs[..],
+        };
+        forward_dynamics(&plant, &mut self.ws.data, &mut self.ws.fd, t, q, qd, current, &self.ws.voltage)
+    }
+}
+
+impl OdeSystem for ArmSystem<'_> {
+    type Error = RunError;
+
+    fn dim(&self) -> usize {
+        self.layout.dim()
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RunError> {
+        self.evaluate(t, y)?;
+        let l = self.layout;
+        let d = &self.scene.drives;
+        let qd = &y[l.qd()];
+        let cur = self.currents(y);
+        let (fd, voltage) = (&self.ws.fd, &self.ws.voltage);
+        dydt[l.q()].copy_from_slice(qd);
+        dydt[l.qd()].copy_from_slice(fd.qdd.as_slice());
+        if l.ni() > 0 {
+            dydt[l.current()].copy_from_slice(fd.di.as_slice());
+        }
+        let (mut p_r, mut p_d, mut p_dm) = (0.0, 0.0, 0.0);
+        for j in 0..l.nv {
+            dydt[l.work().start + j] = fd.tau_motor[j] * qd[j];
+            dydt[l.electric().start + j] = cur[j] * voltage[j];
+            p_r += d.r[j] * cur[j] * cur[j];
+        }
+        if d.has_friction {
+            for j in 0..l.nv {
+                p_d += d.d[j] * qd[j] * qd[j];
+                p_dm += d.dm[j] * qd[j] * qd[j];
+            }
+        }
+        dydt[l.loss_r()] = p_r;
+        dydt[l.loss_d()] = p_d;
+        dydt[l.loss_dm()] = p_dm;
+        Ok(())
+    }
+
+    fn project(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
+        if self.scene.stabilization == Stabilization::Projection {
+            Ok(self.project_onto_constraints(t, y)?)
+        } else {
+            Ok(false)
+        }
+    }
+}

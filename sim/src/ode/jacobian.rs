@@ -1,0 +1,138 @@
+//! What the stiff integrators need from the arm's ODE ([`ArmSystem`]):
+//!
+//! - [`OdeJacobian`]: a cheap structured approximation of ∂f/∂y that keeps exactly the stiff
+//!   couplings — the PD voltage law into the armature circuit, the circuit's own `−R/L`, the
+//!   back-EMF, and the motor torque through the constrained inverse inertia
+//!   `M_c⁻¹ = M_J⁻¹ − M_J⁻¹ J_cᵀ (J_c M_J⁻¹ J_cᵀ)⁻¹ J_c M_J⁻¹` (frozen at the current q;
+//!   Featherstone, RBDA §8.1): `∂q̇/∂q̇ = I`; `∂q̈/∂i = M_c⁻¹ K_m`; `∂q̈/∂q̇ = −M_c⁻¹ (D + D_m)`;
+//!   `∂i̇/∂q = −k_p/L`, `∂i̇/∂q̇ = −(k_d + K_m)/L`, `∂i̇/∂i = −R/L`. With quasi-static motors
+//!   (L = 0) the current is eliminated: `∂q̈/∂q = −M_c⁻¹ K_m k_p/R`,
+//!   `∂q̈/∂q̇ = −M_c⁻¹ (K_m (k_d + K_m)/R + D + D_m)`. Coriolis, gravity stiffness and the
+//!   quadrature rows are left out: a Rosenbrock-W method keeps its order with any bounded
+//!   approximation (Hairer & Wanner, *Solving ODEs II*, §IV.7), and these terms are not stiff.
+//!   `M_c⁻¹` is computed here from M and J_c of the evaluation, whatever constraint solver the
+//!   scene uses (the Schur and the KKT solve leave different scratch behind).
+//! - [`SplitSystem`]: the armature circuit `L di/dt = v − R i − K_m q̇` is linear in i with a
+//!   diagonal matrix, so its implicit stage equation `z − γ f_I(z) = r` has the closed form
+//!   `z_i = (r_i + γ (v − K_m q̇)/L) / (1 + γ R/L)` (v and q̇ from the explicit components of r),
+//!   for an IMEX Runge–Kutta method (Ascher, Ruuth & Spiteri 1997; Kennedy & Carpenter 2003).
+
+use nalgebra::{Cholesky, DMatrix};
+
+use crate::dynamics::motor::Electrical;
+use crate::dynamics::spd::solve_regularized;
+use crate::error::{DynamicsError, RunError};
+use crate::integrate::{OdeJacobian, OdeSystem, SplitSystem};
+
+use super::arm::ArmSystem;
+
+impl ArmSystem<'_> {
+    /// `M_c⁻¹` at the state of the last evaluation (M in `data.m`, J_c in `fd.jac`), into the
+    /// Jacobian scratch.
+    fn constrained_inverse_inertia(&mut self, t: f64) -> Result<(), RunError> {
+        let nv = self.layout.nv;
+        let nc = self.contacts.len();
+        let d = &self.scene.drives;
+        let (data, fd, js) = (&self.ws.data, &self.ws.fd, &mut self.ws.jac);
+        js.m_j.copy_from(&data.m);
+        for j in 0..nv {
+            js.m_j[(j, j)] += d.jm[j];
+        }
+        // factor in place: the storage moves into the factor and back, no allocation
+        let m = std::mem::replace(&mut js.m_j, DMatrix::zeros(0, 0));
+        let Some(chol) = Cholesky::new(m) else {
+            js.m_j = DMatrix::zeros(nv, nv);
+            return Err(DynamicsError::SingularMassMatrix { t }.into());
+        };
+        js.minv.fill_with_identity();
+        chol.solve_mut(&mut js.minv);
+        if nc > 0 {
+            // Y = M_J⁻¹ J_cᵀ, A = J_c Y, then M_c⁻¹ = M_J⁻¹ − Y A⁻¹ Yᵀ (A regularised like the
+            // force solve, dynamics/spd.rs)
+            js.y.tr_copy_from(&fd.jac);
+            chol.solve_mut(&mut js.y);
+            js.a.gemm(1.0, &fd.jac, &js.y, 0.0);
+            js.ayt.tr_copy_from(&js.y);
+            if solve_regularized(&js.a, &mut js.a_factor, &mut js.ayt).is_some() {
+                js.minv.gemm(-1.0, &js.y, &js.ayt, 1.0);
+            }
+        }
+        js.m_j = chol.unpack_dirty();
+        Ok(())
+    }
+}
+
+impl OdeJacobian for ArmSystem<'_> {
+    fn jacobian(&mut self, t: f64, y: &[f64], _fy: &[f64], jac: &mut [f64]) -> Result<(), RunError> {
+        // the dynamics at (t, y): M and J_c are left in the workspace
+        let mut f = std::mem::take(&mut self.ws.jac.f);
+        let r = self.rhs(t, y, &mut f);
+        self.ws.jac.f = f;
+        r?;
+        self.constrained_inverse_inertia(t)?;
+        let l = self.layout;
+        let (nv, dim) = (l.nv, l.dim());
+        let scene = self.scene;
+        let (d, g) = (&scene.drives, &scene.gains);
+        jac.fill(0.0);
+        let mut set = |row: usize, col: usize, v: f64| jac[row * dim + col] = v;
+        for j in 0..nv {
+            set(l.q().start + j, l.qd().start + j, 1.0);
+        }
+        let minv = &self.ws.jac.minv;
+        for r in 0..nv {
+            for c in 0..nv {
+                let m = minv[(r, c)];
+                match l.electrical {
+                    Electrical::Inductive => {
+                        set(l.qd().start + r, l.current().start + c, m * d.km[c]);
+                        set(l.qd().start + r, l.qd().start + c, -m * (d.d[c] + d.dm[c]));
+                    }
+                    Electrical::QuasiStatic => {
+                        set(l.qd().start + r, l.q().start + c, -m * d.km[c] * g.kp[c] / d.r[c]);
+                        set(l.qd().start + r, l.qd().start + c, -m * (d.km[c] * (g.kd[c] + d.km[c]) / d.r[c] + d.d[c] + d.dm[c]));
+                    }
+                }
+            }
+        }
+        if l.electrical == Electrical::Inductive {
+            for j in 0..nv {
+                let row = l.current().start + j;
+                set(row, l.q().start + j, -g.kp[j] / d.l[j]);
+                set(row, l.qd().start + j, -(g.kd[j] + d.km[j]) / d.l[j]);
+                set(row, l.current().start + j, -d.r[j] / d.l[j]);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl SplitSystem for ArmSystem<'_> {
+    fn rhs_split(&mut self, t: f64, y: &[f64], f_e: &mut [f64], f_i: &mut [f64]) -> Result<(), RunError> {
+        self.rhs(t, y, f_e)?;
+        f_i.fill(0.0);
+        for k in self.layout.current() {
+            f_i[k] = f_e[k];
+            f_e[k] = 0.0;
+        }
+        Ok(())
+    }
+
+    fn solve_implicit(&mut self, t: f64, gamma: f64, r: &[f64], z: &mut [f64]) -> Result<(), RunError> {
+        z.copy_from_slice(r);
+        let l = self.layout;
+        if l.electrical == Electrical::QuasiStatic {
+            return Ok(());
+        }
+        // v(t, q, q̇) from the explicit components, then the closed form per motor
+        let scene = self.scene;
+        self.voltage_at(t, &r[l.q()], &r[l.qd()])?;
+        let (d, voltage) = (&scene.drives, &self.ws.voltage);
+        for j in 0..l.nv {
+            let k = l.current().start + j;
+            let qd = r[l.qd().start + j];
+            z[k] = (r[k] + gamma * (voltage[j] - d.km[j] * qd) / d.l[j]) / (1.0 + gamma * d.r[j] / d.l[j]);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,33 @@
+//! The ODE of one run, in one module: the state layout ([`Layout`]), the right-hand side (the
+//! paper's eq 21 with the PD law of eq 27 and the IK targets of eqs 28–29), the outputs recorded
+//! at each sample ([`Outputs`]), the structured Jacobian and the implicit circuit solve of the
+//! stiff methods, and the projection onto the constraints — all on one [`ArmSystem`] with one
+//! preallocated [`workspace::Workspace`] (private fields), so no part reads what another part
+//! happened to leave behind.
+//!
+//! State `y` (all that is integrated, nothing else), with n = nv:
+//! `[ q (n) | q̇ (n) | i (n) | W (n) | E (n) | E_R | E_D | E_Dm ]` where the currents i are
+//! present only for inductive motors ([`crate::dynamics::motor::Electrical`]), and
+//! `W_j = ∫ τ_j q̇_j dt` (work of motor j on link j, τ of eq 12), `E_j = ∫ i_j v_j dt` (electric
+//! energy into motor j), `E_R = ∫ Σ R i² dt`, `E_D = ∫ Σ D q̇² dt` (the joints' viscous friction)
+//! and `E_Dm = ∫ Σ D_m q̇² dt` (the gears', eq 12's d_m term). The quadratures ride along with
+//! the dynamics so that they are integrated to the same accuracy.
+//!
+//! Energy balance (SCENE.md; ideal constraints do no work):
+//! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm`, T including the rotors' `½ Σ J_m q̇²`.
+//! Its residual measures the integration error (and constraint drift, which lets f_n work).
+//!
+//! Files: `layout.rs` (state indices), `workspace.rs` (the scratch), `arm.rs` (the system and
+//! its right-hand side), `outputs.rs`, `jacobian.rs` (Rosenbrock's Jacobian, IMEX's split),
+//! `projection.rs`.
+
+mod arm;
+mod jacobian;
+mod layout;
+mod outputs;
+mod projection;
+mod workspace;
+
+pub use arm::ArmSystem;
+pub use layout::Layout;
+pub use outputs::Outputs;

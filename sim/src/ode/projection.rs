@@ -1,0 +1,85 @@
+//! Projection of the state back onto the constraint manifold after a step: positions onto
+//! C(q) = 0 by Gauss–Newton with the minimum-norm correction `Δq = −J_cᵀ (J_c J_cᵀ)⁻¹ C`
+//! (iterated to |C| ≤ 1e-13 m, at most 5 times), then velocities onto `J_c q̇ = 0` by
+//! `Δq̇ = −J_cᵀ (J_c J_cᵀ)⁻¹ J_c q̇` (Hairer, Lubich & Wanner, *Geometric Numerical
+//! Integration*, §IV.4; Ascher et al., "Stabilization of constrained mechanical systems with
+//! DAEs and invariant manifolds", 1995). Redundant rows are regularised as in the force solve (`dynamics/spd.rs`).
+
+use crate::dynamics::constraints::constraint_jacobian;
+use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
+use crate::dynamics::spd::solve_regularized;
+use crate::error::DynamicsError;
+
+use super::arm::ArmSystem;
+use super::workspace::ProjectionScratch;
+
+/// `J Jᵀ` into `p.jjt` (no temporary).
+fn form_jjt(p: &mut ProjectionScratch, nc: usize) {
+    for a in 0..nc {
+        for b in 0..nc {
+            p.jjt[(a, b)] = p.jac.row(a).dot(&p.jac.row(b));
+        }
+    }
+}
+
+/// Solve `J Jᵀ x = rhs` in place, regularised like the force solve when J Jᵀ is singular.
+fn solve_jjt(p: &mut ProjectionScratch, t: f64, nc: usize) -> Result<(), DynamicsError> {
+    form_jjt(p, nc);
+    match solve_regularized(&p.jjt, &mut p.work, &mut p.rhs) {
+        Some(_) => Ok(()),
+        None => Err(DynamicsError::SingularConstraints { t, constraints: "projection".into() }),
+    }
+}
+
+impl ArmSystem<'_> {
+    /// Project `y` onto C = 0, Ċ = 0. Returns whether it changed.
+    pub fn project_onto_constraints(&mut self, t: f64, y: &mut [f64]) -> Result<bool, DynamicsError> {
+        let nc = self.contacts.len();
+        if nc == 0 {
+            return Ok(false);
+        }
+        let l = self.layout;
+        let model = &self.scene.model;
+        let (p, data) = (&mut self.ws.projection, &mut self.ws.data);
+        let mut changed = false;
+        for _ in 0..5 {
+            let q = &y[l.q()];
+            forward_kinematics(model, data, q);
+            let mut worst = 0.0f64;
+            for (k, c) in self.contacts.iter().enumerate() {
+                p.rhs[k] = c.position(data);
+                worst = worst.max(p.rhs[k].abs());
+            }
+            if worst <= 1e-13 {
+                break;
+            }
+            forward_velocities(model, data, &y[l.qd()]);
+            constraint_jacobian(model, data, &self.contacts, &mut p.jac, &mut p.jdqd);
+            solve_jjt(p, t, nc)?;
+            // Δq = −Jᵀ x
+            for j in 0..l.nv {
+                let dq: f64 = (0..nc).map(|k| p.jac[(k, j)] * p.rhs[k]).sum();
+                y[l.q().start + j] -= dq;
+            }
+            changed = true;
+        }
+        // velocities at the projected positions
+        forward_kinematics(model, data, &y[l.q()]);
+        forward_velocities(model, data, &y[l.qd()]);
+        constraint_jacobian(model, data, &self.contacts, &mut p.jac, &mut p.jdqd);
+        let mut worst = 0.0f64;
+        for k in 0..nc {
+            p.rhs[k] = (0..l.nv).map(|j| p.jac[(k, j)] * y[l.qd().start + j]).sum();
+            worst = worst.max(p.rhs[k].abs());
+        }
+        if worst > 1e-13 {
+            solve_jjt(p, t, nc)?;
+            for j in 0..l.nv {
+                let dv: f64 = (0..nc).map(|k| p.jac[(k, j)] * p.rhs[k]).sum();
+                y[l.qd().start + j] -= dv;
+            }
+            changed = true;
+        }
+        Ok(changed)
+    }
+}

@@ -1,0 +1,93 @@
+//! The one workspace of an [`super::ArmSystem`], sized once (no allocation while integrating):
+//! the dynamics scratch ([`Data`], [`ForwardData`]), the controller's targets and voltages, the
+//! quasi-static currents, and the scratch of the Jacobian and of the projection. Fields are
+//! private to the `ode` module; each says which part writes it and which reads it.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::dynamics::forward::ForwardData;
+use crate::dynamics::{Data, Model};
+
+pub(super) struct Workspace {
+    /// Kinematics and dynamics scratch; written by every evaluation.
+    pub(super) data: Data,
+    /// Eq 21's scratch and outputs (q̈, f_n, di/dt, τ); written by `ArmSystem::evaluate`.
+    pub(super) fd: ForwardData,
+    /// IK targets q_d, q̇_d (nv); written by `ArmSystem::voltage_at`.
+    pub(super) q_des: Vec<f64>,
+    pub(super) qd_des: Vec<f64>,
+    /// Motor voltages of eq 27 (nv), V; written by `ArmSystem::voltage_at`.
+    pub(super) voltage: Vec<f64>,
+    /// Currents of quasi-static motors (computed, not integrated), A; `ArmSystem::evaluate`.
+    pub(super) current_qs: Vec<f64>,
+    /// The structured Jacobian's own matrices (`jacobian.rs`), computed there from `fd.jac`
+    /// (J_c) and `data.m` (M), whatever constraint solver ran.
+    pub(super) jac: JacobianScratch,
+    /// The projection's matrices (`projection.rs`).
+    pub(super) projection: ProjectionScratch,
+}
+
+impl Workspace {
+    pub(super) fn new(model: &Model, nc: usize, dim: usize) -> Self {
+        let nv = model.nv;
+        Self {
+            data: Data::new(model),
+            fd: ForwardData::new(nv, nc),
+            q_des: vec![0.0; nv],
+            qd_des: vec![0.0; nv],
+            voltage: vec![0.0; nv],
+            current_qs: vec![0.0; nv],
+            jac: JacobianScratch::new(nv, nc, dim),
+            projection: ProjectionScratch::new(nv, nc),
+        }
+    }
+}
+
+/// Scratch of the structured Jacobian.
+pub(super) struct JacobianScratch {
+    /// `M_J = M + J_m`, then its Cholesky factor (nv x nv).
+    pub(super) m_j: DMatrix<f64>,
+    /// `M_c⁻¹`, the constrained inverse inertia (nv x nv).
+    pub(super) minv: DMatrix<f64>,
+    /// `Y = M_J⁻¹ J_cᵀ` (nv x nc).
+    pub(super) y: DMatrix<f64>,
+    /// `A = J_c Y` (nc x nc), and its factor.
+    pub(super) a: DMatrix<f64>,
+    pub(super) a_factor: DMatrix<f64>,
+    /// `A⁻¹ Yᵀ` (nc x nv).
+    pub(super) ayt: DMatrix<f64>,
+    /// f(t, y) of the evaluation the Jacobian is taken at (dim).
+    pub(super) f: Vec<f64>,
+}
+
+impl JacobianScratch {
+    fn new(nv: usize, nc: usize, dim: usize) -> Self {
+        Self {
+            m_j: DMatrix::zeros(nv, nv),
+            minv: DMatrix::zeros(nv, nv),
+            y: DMatrix::zeros(nv, nc),
+            a: DMatrix::zeros(nc, nc),
+            a_factor: DMatrix::zeros(nc, nc),
+            ayt: DMatrix::zeros(nc, nv),
+            f: vec![0.0; dim],
+        }
+    }
+}
+
+/// Scratch of the projection onto the constraints.
+pub(super) struct ProjectionScratch {
+    /// `J_c` (nc x nv) and `J̇_c q̇` (nc).
+    pub(super) jac: DMatrix<f64>,
+    pub(super) jdqd: DVector<f64>,
+    /// `J_c J_cᵀ` (nc x nc) and its factor.
+    pub(super) jjt: DMatrix<f64>,
+    pub(super) work: DMatrix<f64>,
+    /// The right-hand side, then the solution (nc).
+    pub(super) rhs: DVector<f64>,
+}
+
+impl ProjectionScratch {
+    fn new(nv: usize, nc: usize) -> Self {
+        Self { jac: DMatrix::zeros(nc, nv), jdqd: DVector::zeros(nc), jjt: DMatrix::zeros(nc, nc), work: DMatrix::zeros(nc, nc), rhs: DVector::zeros(nc) }
+    }
+}

@@ -1,0 +1,73 @@
+//! `analyze compare` (runs against a baseline) and `analyze metrics` (per-run numbers only).
+
+use std::path::PathBuf;
+
+use analyze::{render_comparison, render_metrics, Comparison};
+use anyhow::Result;
+use cli::{exit, print_out, TableFormat, Verbosity};
+
+/// Compare runs against a baseline: hand error, E and W totals and their ratios, per-link W_j
+/// and E_j, contact forces, energy balance, and findings in plain sentences.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Output: sections (runs, hand error in mm, energy totals, per-link energy, contacts, energy
+balance, findings) for people; -f json is the comparison as stable keys, -f csv one row per run
+(columns such as err_z_rms_m, E_total_j, E.joint4_j, E.joint4_ratio, fn_min.elbow4_n).
+
+Examples:
+  analyze compare out/
+  analyze compare out/paper-no-elbow.mcap out/paper-two-elbow.mcap
+  analyze compare out/ --baseline two-elbow -f json > comparison.json
+  analyze compare --recover out/ out/.paper-no-elbow.mcap.partial")]
+pub struct CompareArgs {
+    /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
+    #[arg(required = true, value_name = "FILES_OR_DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// The baseline run, by run name, file path or file stem [default: the first run without
+    /// contacts, else the first run].
+    #[arg(long, value_name = "RUN")]
+    pub baseline: Option<String>,
+    /// Read what is intact of damaged (e.g. truncated) recordings; see `metrics --help`.
+    #[arg(long)]
+    pub recover: bool,
+    #[command(flatten)]
+    pub format: TableFormat,
+}
+
+/// Per-run metrics only (no baseline, no findings), every number of each run; for many runs as
+/// one filterable table use `summary`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Output: one section per quantity, one row per run; -f json is the list of runs with every
+number under stable keys (what `analyze diff` reads back), -f csv one row per run.
+
+Examples:
+  analyze metrics out/paper-two-elbow.mcap
+  analyze metrics out/ -f json > metrics.json
+  analyze metrics --recover out/.paper-two-elbow.mcap.partial   what a killed run left")]
+pub struct MetricsArgs {
+    /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
+    #[arg(required = true, value_name = "FILES_OR_DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// Read what is intact of damaged (e.g. truncated) recordings: the messages of every
+    /// complete chunk and the metadata before the damage. A warning on stderr names each
+    /// damaged file, the byte offset where reading stopped and what was recovered; a run cut
+    /// short before its result is reported as status `incomplete`.
+    #[arg(long)]
+    pub recover: bool,
+    #[command(flatten)]
+    pub format: TableFormat,
+}
+
+pub fn compare(a: &CompareArgs, v: Verbosity) -> Result<u8> {
+    let runs = crate::load::metrics(&a.inputs, a.recover, v)?;
+    let cmp = Comparison::new(&runs, a.baseline.as_deref())?;
+    print_out(&render_comparison(&cmp, a.format.format)?)?;
+    Ok(exit::SUCCESS)
+}
+
+pub fn metrics(a: &MetricsArgs, v: Verbosity) -> Result<u8> {
+    let runs = crate::load::metrics(&a.inputs, a.recover, v)?;
+    print_out(&render_metrics(&runs, a.format.format)?)?;
+    Ok(exit::SUCCESS)
+}

@@ -1,0 +1,45 @@
+//! `analyze figures`: the paper's figures and more, from recordings.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use cli::{exit, Verbosity};
+
+/// The paper's figures (hand paths Fig. 1-3, total and per-link work and electric energy
+/// Fig. 4-25) and more (currents, voltages, elbow normal forces, hand error), every run in
+/// each, as SVG and PNG, with index.md and index.html listing them in order.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Output: DIR/<figure>.svg and .png (1000x700 px), DIR/index.html and DIR/index.md.
+
+Examples:
+  analyze figures out/                      -> out/figures/
+  analyze figures out/ -o paper-figures     then open paper-figures/index.html
+  analyze figures out/paper-no-elbow.mcap out/paper-two-elbow.mcap -o two-runs")]
+pub struct FiguresArgs {
+    /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
+    #[arg(required = true, value_name = "FILES_OR_DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// Directory for the figures and index pages (created if needed).
+    #[arg(short = 'o', long = "out", value_name = "DIR", default_value = "out/figures")]
+    pub out: PathBuf,
+}
+
+pub fn run(a: &FiguresArgs, v: Verbosity) -> Result<u8> {
+    let paths = cli::inputs::expand(&a.inputs)?;
+    let runs = paths
+        .iter()
+        .map(|p| analyze::figures::read_run(p).with_context(|| format!("reading {}", p.display())))
+        .collect::<Result<Vec<_>>>()?;
+    let figures = analyze::figures::write_all(&runs, &paths, &a.out)?;
+    if !v.quiet {
+        eprintln!(
+            "analyze: {} figures (SVG and PNG) of {} runs in {}; open {}",
+            figures.len(),
+            runs.len(),
+            a.out.display(),
+            a.out.join("index.html").display()
+        );
+    }
+    Ok(exit::SUCCESS)
+}

@@ -1,0 +1,156 @@
+//! `sim check`: validate a scene and describe it, without running it.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use cli::{exit, print_out};
+use serde::Serialize;
+use sim::dynamics::forward::Stabilization;
+use sim::scene::Scene;
+
+/// Validate a scene file (every check a run makes before it starts) and describe what it
+/// holds: the robot, the contacts, the runs and the settings.
+#[derive(Debug, Clone, clap::Args)]
+#[command(after_help = "\
+Output: a description for people, or -f json (robot, contacts, runs, duration, output rate,
+integrator and its settings, model). Exit status 2 and the file, field and value when the scene
+is not valid.
+
+Examples:
+  sim check                            the built-in paper scene
+  sim check sim/scenes/hard/stiff-motor.json
+  sim check my_scene.json -f json")]
+pub struct CheckArgs {
+    /// Scene JSON file [default: the built-in paper scene].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+    /// table: a description for people; json: the same for machines.
+    #[arg(short = 'f', long = "format", value_enum, default_value = "table")]
+    pub format: DescribeFormat,
+}
+
+/// How `sim check` prints its description.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DescribeFormat {
+    Table,
+    Json,
+}
+
+/// What a valid scene describes.
+#[derive(Debug, Serialize)]
+struct Description {
+    scene: String,
+    source: String,
+    robot: String,
+    joints: Vec<String>,
+    moving_mass_kg: f64,
+    contacts: Vec<String>,
+    runs: Vec<RunDescription>,
+    duration_s: f64,
+    output_rate_hz: f64,
+    integrator: IntegratorDescription,
+    mass_matrix: String,
+    constraint_solver: String,
+    stabilization: String,
+    motors: &'static str,
+}
+
+/// The integrator with every setting that applies, defaults filled in.
+#[derive(Debug, Serialize)]
+struct IntegratorDescription {
+    method: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    step: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rtol: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    atol: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    h_max: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_steps: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    jacobian_reuse: Option<u64>,
+    /// The same in one phrase.
+    phrase: String,
+}
+
+#[derive(Debug, Serialize)]
+struct RunDescription {
+    name: String,
+    contacts: Vec<String>,
+}
+
+/// The compact JSON of a setting, without quotes for a plain name (`crba`).
+fn text<T: Serialize>(v: &T) -> String {
+    serde_json::to_string(v).unwrap_or_default().trim_matches('"').to_string()
+}
+
+fn describe(s: &Scene) -> Description {
+    Description {
+        scene: s.spec().name.clone(),
+        source: s.source().to_string(),
+        robot: s.model().name.clone(),
+        joints: s.model().joint_names(),
+        moving_mass_kg: s.model().total_mass(),
+        contacts: s.contacts().iter().map(|c| c.name.clone()).collect(),
+        runs: s
+            .runs()
+            .iter()
+            .map(|r| RunDescription { name: r.name.clone(), contacts: r.contacts.iter().map(|&k| s.contacts()[k].name.clone()).collect() })
+            .collect(),
+        duration_s: s.duration(),
+        output_rate_hz: s.output_rate(),
+        integrator: {
+            let i = s.integrator().describe();
+            IntegratorDescription {
+                method: s.integrator().method(),
+                step: i.step,
+                rtol: i.rtol,
+                atol: i.atol,
+                h_max: i.h_max,
+                max_steps: i.max_steps,
+                jacobian_reuse: i.jacobian_reuse,
+                phrase: i.phrase(),
+            }
+        },
+        mass_matrix: text(&s.mass_matrix()),
+        constraint_solver: text(&s.solver()),
+        stabilization: match s.stabilization() {
+            Stabilization::None => "none (eq 15 alone)".into(),
+            Stabilization::Baumgarte { alpha, beta } => format!("Baumgarte, alpha = {alpha} 1/s, beta = {beta} 1/s"),
+            Stabilization::Projection => "projection onto C = 0, C' = 0 after every step".into(),
+        },
+        motors: s.drives().electrical.describe(),
+    }
+}
+
+pub fn run(a: &CheckArgs) -> Result<u8> {
+    let s = crate::load_scene(a.scene.as_deref())?;
+    let d = describe(&s);
+    let text = match a.format {
+        DescribeFormat::Json => serde_json::to_string_pretty(&d)? + "\n",
+        DescribeFormat::Table => {
+            let mut o = String::new();
+            let joints = if d.joints.len() <= 12 {
+                d.joints.join(", ")
+            } else {
+                format!("{} … {}", d.joints[..3].join(", "), d.joints[d.joints.len() - 2..].join(", "))
+            };
+            writeln!(o, "scene `{}` ({}) is valid", d.scene, d.source)?;
+            writeln!(o, "  robot        {}: {} joints ({joints}), {:.3} kg moving", d.robot, d.joints.len(), d.moving_mass_kg)?;
+            writeln!(o, "  contacts     {}", if d.contacts.is_empty() { "none".into() } else { d.contacts.join(", ") })?;
+            for r in &d.runs {
+                writeln!(o, "  run          {}: contacts [{}]", r.name, r.contacts.join(", "))?;
+            }
+            writeln!(o, "  time         {} s, recorded at {} Hz", d.duration_s, d.output_rate_hz)?;
+            writeln!(o, "  integrator   {}", d.integrator.phrase)?;
+            writeln!(o, "  dynamics     mass matrix {}, constraint solver {}, stabilisation {}", d.mass_matrix, d.constraint_solver, d.stabilization)?;
+            writeln!(o, "  motors       {}", d.motors)?;
+            o
+        }
+    };
+    print_out(&text)?;
+    Ok(exit::SUCCESS)
+}

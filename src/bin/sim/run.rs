@@ -1,0 +1,181 @@
+//! `sim run` (and `sim` with no command): run the selected runs of a scene in parallel, each to
+//! its recording, then read the recordings back and print the comparison of the runs.
+//!
+//! The comparison is made by the `analyze` library from the files just written, so the numbers
+//! shown are those any reader of the recordings gets (the `sim` library never depends on
+//! `analyze`; this binary composes the two).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use cli::{exit, print_out, Jobs, TableFormat, Verbosity};
+use rayon::prelude::*;
+use sim::run::run_to_file;
+use sim::scene::{Run, Scene};
+
+/// The options of a run, with `sim` alone or `sim run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// Run only these runs of the scene (repeatable) [default: all].
+    #[arg(long = "run", value_name = "NAME")]
+    pub runs: Vec<String>,
+    /// Directory for the recordings, named <scene>-<run>.mcap.
+    #[arg(short = 'o', long = "out", value_name = "DIR", default_value = "out")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub jobs: Jobs,
+    #[command(flatten)]
+    pub format: TableFormat,
+    /// Baseline run for the ratios in the table [default: a run without contacts].
+    #[arg(long, value_name = "RUN")]
+    pub baseline: Option<String>,
+    /// Simulated time of every run, s [default: the scene's]. Changes the scene before it is
+    /// validated, so the recording stores the scene that ran.
+    #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
+    pub duration: Option<f64>,
+}
+
+/// Run a scene (the default command): every run to <out>/<scene>-<run>.mcap, then the table.
+#[derive(Debug, Clone, clap::Args)]
+#[command(after_help = "\
+Output: out/<scene>-<run>.mcap per run; on stdout the table comparing the runs (hand error,
+energy totals and ratios to the baseline, per-link energy, contacts, energy balance, findings),
+-f json|csv for machines; a progress bar per run on stderr.
+
+Examples:
+  sim run                                    the built-in paper scene (same as `sim`)
+  sim run sim/scenes/small/small.json -o /tmp/small
+  sim run --run two-elbow --duration 1 -f csv")]
+pub struct RunCommand {
+    /// Scene JSON file [default: the built-in paper scene].
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// A duration given on the command line: a positive number of seconds.
+pub fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
+        _ => Err(format!("{s:?} is not a positive number of seconds")),
+    }
+}
+
+/// `sim [run]`.
+pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
+    let scene = crate::load_scene(scene)?;
+    let scene = match a.duration {
+        Some(d) => scene.vary(|s| s.duration = d)?,
+        None => scene,
+    };
+    let runs = select_runs(&scene, &a.runs)?;
+    cli::create_dir(&a.out)?;
+    let done = run_all(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, v);
+    finish(&done, a.format, a.baseline.as_deref())
+}
+
+/// The runs called `names` (all when empty), in that order.
+pub fn select_runs(scene: &Scene, names: &[String]) -> Result<Vec<Run>> {
+    if names.is_empty() {
+        return Ok(scene.runs().to_vec());
+    }
+    names
+        .iter()
+        .map(|n| {
+            scene.run(n).cloned().with_context(|| {
+                let all: Vec<&str> = scene.runs().iter().map(|r| r.name.as_str()).collect();
+                format!("no run `{n}` in scene `{}` (runs: {})", scene.spec().name, all.join(", "))
+            })
+        })
+        .collect()
+}
+
+/// What became of one run.
+pub struct Done {
+    /// The recording, when it was written (complete, or failed numerically: it says why).
+    pub path: Option<PathBuf>,
+    /// The failure, if any.
+    pub error: Option<String>,
+}
+
+/// Runs `runs` of `scene` on `jobs` threads, run `r` to `path(r)`, with a progress bar each.
+pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Sync, jobs: &Jobs, v: Verbosity) -> Vec<Done> {
+    let bars = cli::progress::RunBars::new(v.quiet);
+    let bars: Vec<_> = runs.iter().map(|r| bars.add(&r.name, scene.duration())).collect();
+    let threads = jobs.threads(runs.len());
+    let started = Instant::now();
+    let work = || -> Vec<Done> {
+        runs.par_iter()
+            .zip(&bars)
+            .map(|(run, bar)| {
+                let target = path(run);
+                let t0 = Instant::now();
+                let mut count = 0u32;
+                let res = run_to_file(scene, run, &target, |t| {
+                    count += 1;
+                    if count % 64 == 0 {
+                        cli::progress::set_time(bar, t);
+                    }
+                });
+                let wall = t0.elapsed().as_secs_f64();
+                match res {
+                    Ok(r) => {
+                        bar.finish_with_message(format!("{:.3} s", scene.duration()));
+                        if v.verbose > 0 {
+                            let s = r.report.stats;
+                            bar.println(format!(
+                                "sim: {}: {} steps ({} rejected), {} right-hand sides, {:.2} s wall, {:.0}x real time",
+                                run.name, s.steps, s.rejected, s.rhs_evals, wall, scene.duration() / wall.max(1e-9)
+                            ));
+                        }
+                        Done { path: Some(r.path), error: None }
+                    }
+                    Err(e) => {
+                        bar.abandon_with_message(format!("failed at {}", e.time().map_or("?".into(), |t| format!("{t:.3} s"))));
+                        // a numerical failure still leaves a recording that says when and why
+                        let written = e.time().is_some() && target.is_file();
+                        Done { path: written.then_some(target), error: Some(format!("run `{}`: {e}", run.name)) }
+                    }
+                }
+            })
+            .collect()
+    };
+    let done = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+        Ok(pool) => pool.install(work),
+        Err(_) => work(),
+    };
+    if !v.quiet {
+        for d in done.iter().filter(|d| d.error.is_none()) {
+            if let Some(p) = &d.path {
+                eprintln!("wrote {}", p.display());
+            }
+        }
+        eprintln!("{} run(s) in {:.2} s wall time on {threads} thread(s)", runs.len(), started.elapsed().as_secs_f64());
+    }
+    done
+}
+
+/// Prints the comparison of the complete runs and the failures; the exit status.
+pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>) -> Result<u8> {
+    let complete: Vec<&Path> = done.iter().filter(|d| d.error.is_none()).filter_map(|d| d.path.as_deref()).collect();
+    if !complete.is_empty() {
+        print_comparison(&complete, format.format, baseline)?;
+    }
+    let failures: Vec<&str> = done.iter().filter_map(|d| d.error.as_deref()).collect();
+    for f in &failures {
+        eprintln!("sim: error: {f}");
+    }
+    Ok(if failures.is_empty() { exit::SUCCESS } else { exit::FAILED })
+}
+
+/// Reads the recordings back and prints the comparison of the runs.
+fn print_comparison(paths: &[&Path], format: analyze::Format, baseline: Option<&str>) -> Result<()> {
+    let metrics = paths
+        .iter()
+        .map(|p| analyze::read_run_metrics(p).with_context(|| format!("reading back {}", p.display())))
+        .collect::<Result<Vec<_>>>()?;
+    let cmp = analyze::Comparison::new(&metrics, baseline)?;
+    print_out(&analyze::render_comparison(&cmp, format)?)
+}
