@@ -78,6 +78,20 @@ fn split(line: &str) -> Vec<String> {
     words
 }
 
+/// The checks every tool's command line passes: clap's own consistency check, and every
+/// example of every `--help` parses (`parse` is the tool's `try_parse_from`). Panics naming the
+/// first failure (a test helper).
+pub fn check_command_line(cmd: clap::Command, parse: impl Fn(&[String]) -> Result<(), clap::Error>) {
+    cmd.clone().debug_assert();
+    let examples = help_examples(&cmd);
+    assert!(examples.len() >= 10, "too few examples: {examples:?}");
+    for args in examples {
+        if let Err(e) = parse(&args) {
+            panic!("{args:?}: {e}");
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,5 +1,5 @@
-//! Any recording -> polars DataFrames, one per topic, and their export to Parquet and CSV
-//! (feature `tables`).
+//! Any recording -> polars DataFrames, one per topic (feature `tables`); `export.rs` writes them
+//! as Parquet or CSV.
 //!
 //! The frames are built from the generic reader ([`schemas::read_recording`]), so every channel
 //! is decoded through the schema stored in the file, not through this program's message types:
@@ -14,7 +14,7 @@
 //! Units are the recording's (SI, radians; see the `schemas` crate's message docs).
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use polars::prelude::*;
 use schemas::topics::{array_index, ArrayIndex};
@@ -120,116 +120,4 @@ fn frame(t: Vec<f64>, cols: Columns) -> PolarsResult<DataFrame> {
         });
     }
     DataFrame::new(height, columns)
-}
-
-pub use crate::export::ExportFormat;
-
-/// The file name of a topic's table: `/joint_states` -> `joint_states.parquet`.
-pub fn topic_file_name(topic: &str, format: ExportFormat) -> String {
-    let stem: String = topic
-        .trim_start_matches('/')
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
-        .collect();
-    let stem = if stem.is_empty() { "topic".into() } else { stem };
-    format!("{stem}.{}", format.extension())
-}
-
-/// The file of each topic: [`topic_file_name`], with `_2`, `_3` ... before the extension when
-/// two topics map to one name (`/a/b` and `/a_b`).
-fn file_names(frames: &RecordingFrames, format: ExportFormat) -> Vec<String> {
-    let mut used = std::collections::BTreeSet::new();
-    frames
-        .topics
-        .iter()
-        .map(|(t, _)| {
-            let base = topic_file_name(t, format);
-            let mut name = base.clone();
-            let mut k = 2;
-            while !used.insert(name.clone()) {
-                let stem = base.trim_end_matches(&format!(".{}", format.extension()));
-                name = format!("{stem}_{k}.{}", format.extension());
-                k += 1;
-            }
-            name
-        })
-        .collect()
-}
-
-/// Writes one file per topic into `dir` (created if needed) plus `metadata.json` (the
-/// metadata records, and the topics skipped with the reason); returns the files written.
-/// Each file is written to a temporary name and renamed, so a killed export never leaves a
-/// half-written table under the final name.
-pub fn export(frames: &mut RecordingFrames, dir: &Path, format: ExportFormat) -> Result<Vec<PathBuf>, Error> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-        file: dir.display().to_string(),
-        op: "creating",
-        source,
-    })?;
-    let mut written = Vec::new();
-    let files = file_names(frames, format);
-    for ((_, df), name) in frames.topics.iter_mut().zip(&files) {
-        let path = dir.join(name);
-        write_atomic(&path, |f| match format {
-            ExportFormat::Parquet => ParquetWriter::new(f).finish(df).map(drop),
-            ExportFormat::Csv => CsvWriter::new(f).include_header(true).finish(df),
-        })
-        .map_err(|e| e.into_error(&path))?;
-        written.push(path);
-    }
-    let meta = serde_json::json!({
-        "source": frames.source,
-        "metadata": frames.metadata,
-        "topics": frames.topics.iter().zip(&files).map(|((t, df), file)| serde_json::json!({
-            "topic": t,
-            "file": file,
-            "rows": df.height(),
-            "columns": df.get_column_names().iter().map(|c| c.as_str()).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
-        "skipped": frames.skipped.iter().map(|(t, why)| serde_json::json!({"topic": t, "reason": why})).collect::<Vec<_>>(),
-    });
-    let path = dir.join("metadata.json");
-    let text = serde_json::to_string_pretty(&meta).unwrap_or_default() + "\n";
-    write_atomic(&path, |f| {
-        use std::io::Write;
-        f.write_all(text.as_bytes()).map_err(PolarsError::from)
-    })
-    .map_err(|e| e.into_error(&path))?;
-    written.push(path);
-    Ok(written)
-}
-
-enum WriteError {
-    Io(std::io::Error),
-    Polars(PolarsError),
-}
-
-impl WriteError {
-    /// The library's error, naming the file being written.
-    fn into_error(self, path: &Path) -> Error {
-        let file = path.display().to_string();
-        match self {
-            WriteError::Io(source) => Error::Io { file, op: "writing", source },
-            WriteError::Polars(e) => Error::Table { file, detail: format!("writing the table: {e}") },
-        }
-    }
-}
-
-/// Writes through `.NAME.partial` in the same directory, then renames over `path`.
-fn write_atomic(
-    path: &Path,
-    write: impl FnOnce(&mut std::fs::File) -> PolarsResult<()>,
-) -> Result<(), WriteError> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial"));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp).map_err(WriteError::Io)?;
-        write(&mut f).map_err(WriteError::Polars)?;
-        f.sync_all().map_err(WriteError::Io)?;
-        std::fs::rename(&tmp, path).map_err(WriteError::Io)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

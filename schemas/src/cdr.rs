@@ -15,6 +15,16 @@
 //! The schema texts are the `.msg` definitions (`ros2msg` schema encoding), with dependent
 //! types appended after lines of `=` and `MSG: pkg/Type` headers, as rosbag2's MCAP plugin
 //! writes them.
+//!
+//! Written by hand, on purpose (evaluated November 2026): serde-based CDR encoders exist
+//! (`cdr` 0.2, unmaintained since 2021; `cdr-encoding` 0.11, RustDDS's, +5 crates; `re_cdr`, one
+//! release) and would replace the ~100 lines of encoding, but the decoding that `analyze` needs —
+//! any message described by a `.msg` schema in a file, dynamically — exists only in a rerun
+//! internal crate (`re_ros_msg`, no API promise, pinned to an old version to avoid arrow, fields
+//! in alphabetical rather than declaration order) or crates that fail on real messages
+//! (`ros2_message`: 8-byte values aligned to 4) or need a ROS installation (`r2r`,
+//! `rosidl_runtime_rs`). One hand-written module does both directions with one alignment rule,
+//! tested against bytes of Fast-CDR's layout (`tests/round_trip.rs`, `tests/robustness.rs`).
 
 use crate::messages::{JointState, Message, RosString};
 use crate::ros2msg::{Array, Field, FieldType, MsgSchema, Prim};

@@ -159,10 +159,8 @@ pub fn contact_forces(f: impl Fn(f64) -> Vec<[f64; 3]> + 'static) -> Signal<Cons
     })
 }
 
-/// `W_j = w (j+1) t`, `E_j = e (j+1) t` and their totals; everything else zero.
-pub fn linear_energy(t: f64, n_joints: usize, w: f64, e: f64) -> EnergyState {
-    let link_work: Vec<f64> = (0..n_joints).map(|j| w * (j + 1) as f64 * t).collect();
-    let electric_energy: Vec<f64> = (0..n_joints).map(|j| e * (j + 1) as f64 * t).collect();
+/// `/energy` with these per-link `W_j` and `E_j` and their totals; everything else zero.
+pub fn energy(link_work: Vec<f64>, electric_energy: Vec<f64>) -> EnergyState {
     EnergyState {
         link_work_total: link_work.iter().sum(),
         electric_energy_total: electric_energy.iter().sum(),
@@ -170,6 +168,11 @@ pub fn linear_energy(t: f64, n_joints: usize, w: f64, e: f64) -> EnergyState {
         electric_energy,
         ..Default::default()
     }
+}
+
+/// `W_j = w (j+1) t`, `E_j = e (j+1) t` ([`energy`]).
+pub fn linear_energy(t: f64, n_joints: usize, w: f64, e: f64) -> EnergyState {
+    energy((0..n_joints).map(|j| w * (j + 1) as f64 * t).collect(), (0..n_joints).map(|j| e * (j + 1) as f64 * t).collect())
 }
 
 /// `full` cut to what `part` holds: every topic to `part`'s message count, and without the

@@ -109,7 +109,10 @@ pub fn grid_point(lens: &[usize], mut k: usize) -> Vec<usize> {
 
 /// Replace the node at the dot path `path` of `doc` by `value`. Object keys are names; inside
 /// arrays a segment is an index that must exist. A missing object key is created (objects on
-/// the way too); whether the scene knows it is for the scene's own validation to say.
+/// the way too); whether the scene knows it is for the scene's own validation to say. (Written
+/// out rather than with serde_json's JSON pointers, which `analyze summary --param` uses to
+/// read: `pointer_mut` cannot create a node, and an axis may set what the base scene leaves to
+/// its default, e.g. `integrator.h_max` or `dynamics.stabilization`.)
 pub fn set_path(doc: &mut Value, path: &str, value: Value) -> Result<(), String> {
     let segs: Vec<&str> = path.split('.').collect();
     if segs.iter().any(|s| s.is_empty()) {

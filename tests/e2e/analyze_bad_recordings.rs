@@ -1,17 +1,10 @@
 //! Damaged and foreign recordings through the `analyze` binary and library: a clear error
 //! naming the file and no panic; `--recover` reads the intact part of a truncated file.
 
+use crate::run_analyze;
 use std::path::Path;
-use std::process::Command;
 
 use schemas::synth::Synth;
-
-fn analyze(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_analyze"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -76,7 +69,7 @@ fn damaged_and_foreign_files_are_clear_errors() {
     ];
     for (path, want) in cases {
         for cmd in ["metrics", "compare"] {
-            let out = analyze(&[cmd, s(path)]);
+            let out = run_analyze(&[cmd, s(path)]);
             let stderr = String::from_utf8_lossy(&out.stderr);
             assert_eq!(out.status.code(), Some(2), "{cmd} {}: {stderr}", path.display());
             assert!(stderr.starts_with("analyze: error: "), "{stderr}");
@@ -95,7 +88,7 @@ fn damaged_and_foreign_files_are_clear_errors() {
     }
     // --recover does not make a foreign or empty file readable
     for path in [&empty, &text] {
-        let out = analyze(&["metrics", "--recover", s(path)]);
+        let out = run_analyze(&["metrics", "--recover", s(path)]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{stderr}");
         assert!(
@@ -104,7 +97,7 @@ fn damaged_and_foreign_files_are_clear_errors() {
         );
     }
     // ... nor one whose damage starts before the metadata
-    let out = analyze(&["metrics", "--recover", s(&magic_only)]);
+    let out = run_analyze(&["metrics", "--recover", s(&magic_only)]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
@@ -114,7 +107,7 @@ fn damaged_and_foreign_files_are_clear_errors() {
 }
 
 fn metrics_json(args: &[&str]) -> (serde_json::Value, String) {
-    let out = analyze(args);
+    let out = run_analyze(args);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
     (serde_json::from_slice(&out.stdout).unwrap(), stderr)
@@ -167,7 +160,7 @@ fn recover_reads_the_intact_part() {
         "{w1}"
     );
 
-    let out = analyze(&["compare", "--recover", s(&good), s(&cut)]);
+    let out = run_analyze(&["compare", "--recover", s(&good), s(&cut)]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(
         out.status.code(),
@@ -180,7 +173,7 @@ fn recover_reads_the_intact_part() {
         "{stdout}"
     );
     // without --recover the cut file is an error
-    let out = analyze(&["compare", s(&good), s(&cut)]);
+    let out = run_analyze(&["compare", s(&good), s(&cut)]);
     assert_eq!(out.status.code(), Some(2));
 }
 

@@ -1,13 +1,6 @@
 //! The `analyze` binary as a process: exit codes and messages on bad input, `--help`.
 
-use std::process::Command;
-
-fn analyze(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_analyze"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use crate::run_analyze;
 
 /// Empty, non-MCAP and missing files: bad input, exit status 2, the file named on stderr, no
 /// panic, nothing on stdout.
@@ -21,7 +14,7 @@ fn bad_files_exit_non_zero_naming_the_file() {
     let missing = dir.path().join("missing.mcap");
     for path in [&empty, &text, &missing] {
         for cmd in ["compare", "metrics"] {
-            let out = analyze(&[cmd, path.to_str().unwrap()]);
+            let out = run_analyze(&[cmd, path.to_str().unwrap()]);
             let stderr = String::from_utf8_lossy(&out.stderr);
             assert_eq!(out.status.code(), Some(2), "{cmd} {}: {stderr}", path.display());
             assert!(stderr.contains(&path.display().to_string()), "{stderr}");
@@ -31,7 +24,7 @@ fn bad_files_exit_non_zero_naming_the_file() {
             );
         }
     }
-    let out = analyze(&[
+    let out = run_analyze(&[
         "compare",
         dir.path().join("nothing-here").to_str().unwrap(),
         "-f",
@@ -42,7 +35,7 @@ fn bad_files_exit_non_zero_naming_the_file() {
 
 #[test]
 fn help_shows_commands_and_examples() {
-    let out = analyze(&["--help"]);
+    let out = run_analyze(&["--help"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success());
     for want in ["compare", "metrics", "Examples:", "analyze compare out/"] {

@@ -2,18 +2,11 @@
 //! parameter changed by 1 %, against the tables exported from it, across directories, with
 //! bad input, and with a recording of the previous format version (tests/fixtures/).
 
+use crate::run_analyze;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use schemas::synth::{contact_forces, currents, hand_error, Synth};
+use schemas::synth::{contact_forces, currents, energy, hand_error, Synth};
 use schemas::{topics, EnergyState};
-
-fn analyze(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_analyze"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -21,7 +14,7 @@ fn s(p: &Path) -> &str {
 
 /// Exit code, stdout, stderr.
 fn run(args: &[&str]) -> (i32, String, String) {
-    let out = analyze(args);
+    let out = run_analyze(args);
     let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
     let code = out.status.code().unwrap();
     (code, text(&out.stdout), text(&out.stderr))
@@ -70,13 +63,9 @@ fn write_run(path: &Path, r: &Run) -> PathBuf {
     s.motors = Some(currents(move |t| (0..JOINTS).map(|j| (j + 1) as f64 * (20.0 * t + j as f64).sin() * scale(j)).collect()));
     s.constraints = Some(contact_forces(|t| (0..2).map(|c| [(c + 1) as f64 * (7.0 * t).cos() - 0.3, 1e-15 * t, 1e-16]).collect()));
     s.energy = Some(Box::new(move |t| {
-        let link_work: Vec<f64> = (0..JOINTS).map(|j| (j + 1) as f64 * t * t).collect();
-        let electric_energy: Vec<f64> = (0..JOINTS).map(|j| 3.0 * (j + 1) as f64 * t * scale(j)).collect();
+        let link_work = (0..JOINTS).map(|j| (j + 1) as f64 * t * t).collect();
+        let electric_energy = (0..JOINTS).map(|j| 3.0 * (j + 1) as f64 * t * scale(j)).collect();
         EnergyState {
-            link_work_total: link_work.iter().sum(),
-            electric_energy_total: electric_energy.iter().sum(),
-            link_work,
-            electric_energy,
             kinetic: t * t,
             potential: -t,
             magnetic: 0.01 * t,
@@ -84,7 +73,7 @@ fn write_run(path: &Path, r: &Run) -> PathBuf {
             friction_loss: 0.1 * t,
             balance_residual: 1e-13 * t.sin(),
             gear_friction_loss: 0.04 * t,
-            ..Default::default()
+            ..energy(link_work, electric_energy)
         }
     }));
     if r.format_v0 {

@@ -5,8 +5,8 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use schemas::synth::{contact_forces, Synth};
-use schemas::{EnergyState, HandState, MotorState, Vec3};
+use schemas::synth::{contact_forces, energy, Synth};
+use schemas::{HandState, MotorState, Vec3};
 
 const JOINTS: usize = 10;
 
@@ -31,17 +31,7 @@ fn write_run(dir: &Path, run: &str, contacts: &[&str], sag: f64) -> PathBuf {
     }));
     let nc = contacts.len();
     s.constraints = Some(contact_forces(move |t| (0..nc).map(|c| [(-2.0 + 5.0 * (tau * t).sin()) * (c + 1) as f64, 0.0, 0.0]).collect()));
-    s.energy = Some(Box::new(move |t| {
-        let link_work = per(&|j| j * t * t);
-        let electric_energy = per(&|j| (1.0 + 10.0 * sag) * j * t);
-        EnergyState {
-            link_work_total: link_work.iter().sum(),
-            electric_energy_total: electric_energy.iter().sum(),
-            link_work,
-            electric_energy,
-            ..Default::default()
-        }
-    }));
+    s.energy = Some(Box::new(move |t| energy(per(&|j| j * t * t), per(&|j| (1.0 + 10.0 * sag) * j * t))));
     s.result = None;
     s.write(&dir.join(format!("paper-{run}.mcap")))
 }

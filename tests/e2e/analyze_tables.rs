@@ -3,16 +3,12 @@
 //! parameters, globs, bad files) and `analyze report`.
 
 
+use crate::run_analyze;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use analyze::frames::{read_frames, TIME_COLUMN};
 use polars::prelude::*;
 use schemas::topics;
-
-fn analyze(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_analyze")).args(args).output().unwrap()
-}
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("analyze/tests/fixtures").join(name)
@@ -68,7 +64,7 @@ fn export_round_trips_through_parquet_and_csv() {
     let out = dir.path().join("tables");
     let o = out.to_str().unwrap();
     for format in ["parquet", "csv"] {
-        let r = analyze(&["export", v1().to_str().unwrap(), "-o", o, "--format", format]);
+        let r = run_analyze(&["export", v1().to_str().unwrap(), "-o", o, "--format", format]);
         assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     }
     let run_dir = out.join("format-v1-small-elbow");
@@ -102,7 +98,7 @@ fn export_round_trips_through_parquet_and_csv() {
         .collect();
     assert!(leftovers.is_empty());
     // one topic only; an unknown topic is an error naming it
-    let r = analyze(&["export", v1().to_str().unwrap(), "-o", o, "--topics", "/motors,/nope"]);
+    let r = run_analyze(&["export", v1().to_str().unwrap(), "-o", o, "--topics", "/motors,/nope"]);
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("/nope"));
 }
@@ -116,12 +112,12 @@ fn older_formats_load_export_and_diff() {
     assert!(f.get(topics::MOTORS).unwrap().column("current.joint4").is_ok());
     assert!(f.get(topics::JOINT_STATES).is_none());
     let dir = tempfile::tempdir().unwrap();
-    let r = analyze(&["export", v0.to_str().unwrap(), "-o", dir.path().to_str().unwrap(), "-f", "csv"]);
+    let r = run_analyze(&["export", v0.to_str().unwrap(), "-o", dir.path().to_str().unwrap(), "-f", "csv"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     assert!(dir.path().join("format-v0-small/energy.csv").is_file());
-    let r = analyze(&["diff", v1().to_str().unwrap(), v1().to_str().unwrap()]);
+    let r = run_analyze(&["diff", v1().to_str().unwrap(), v1().to_str().unwrap()]);
     assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stdout));
-    let r = analyze(&["metrics", v1().to_str().unwrap(), "-f", "json"]);
+    let r = run_analyze(&["metrics", v1().to_str().unwrap(), "-f", "json"]);
     let m: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
     assert!(m[0]["energy"]["gear_friction_loss_j"].is_null(), "format 1 has only D + D_m");
 }
@@ -145,7 +141,7 @@ fn corpus() -> tempfile::TempDir {
 }
 
 fn summary_json(args: &[&str]) -> Vec<serde_json::Value> {
-    let r = analyze(&[&["summary"], args, &["-f", "json"]].concat());
+    let r = run_analyze(&[&["summary"], args, &["-f", "json"]].concat());
     assert!(r.status.success(), "{args:?}: {}", String::from_utf8_lossy(&r.stderr));
     serde_json::from_slice(&r.stdout).unwrap()
 }
@@ -158,7 +154,7 @@ fn summary_is_one_row_per_recording_filtered_sorted_and_projected() {
     let runs: Vec<&str> = all.iter().map(|r| r["run"].as_str().unwrap()).collect();
     assert_eq!(runs, ["elbow", "small", "one-elbow"], "sorted by file");
     // the numbers are the metrics' numbers
-    let m: serde_json::Value = serde_json::from_slice(&analyze(&["metrics", &v1().to_string_lossy(), "-f", "json"]).stdout).unwrap();
+    let m: serde_json::Value = serde_json::from_slice(&run_analyze(&["metrics", &v1().to_string_lossy(), "-f", "json"]).stdout).unwrap();
     assert_eq!(all[0]["E_total_j"], m[0]["electric_energy_total_j"]);
     assert_eq!(all[0]["err_z_rms_m"], m[0]["hand_error"]["z"]["rms_m"]);
     assert_eq!(all[0]["E.joint3_j"], m[0]["links"][2]["electric_energy_j"]);
@@ -177,7 +173,7 @@ fn summary_is_one_row_per_recording_filtered_sorted_and_projected() {
     assert_eq!(p.len(), 2);
     assert_eq!(p[0].as_object().unwrap().len(), 2);
     // the columns in the order asked (the JSON text keeps it; serde_json's map would sort)
-    let r = analyze(&["summary", d, "--columns", "run,E_total_j,file", "-f", "csv"]);
+    let r = run_analyze(&["summary", d, "--columns", "run,E_total_j,file", "-f", "csv"]);
     assert_eq!(String::from_utf8_lossy(&r.stdout).lines().next(), Some("run,E_total_j,file"));
     assert_eq!(p[0]["p.controller.kp"], 500.0);
     assert!(p[1]["p.controller.kp"].is_null(), "the synthetic files carry no scene");
@@ -185,11 +181,11 @@ fn summary_is_one_row_per_recording_filtered_sorted_and_projected() {
     let glob = format!("{d}/*.mcap");
     assert_eq!(summary_json(&[&glob]).len(), 3);
     // CSV has every column; the text table a readable subset with a row count
-    let csv = analyze(&["summary", d, "-f", "csv"]);
+    let csv = run_analyze(&["summary", d, "-f", "csv"]);
     let text = String::from_utf8_lossy(&csv.stdout);
     assert_eq!(text.lines().count(), 4);
     assert!(text.lines().next().unwrap().contains("W.joint1_j"));
-    let table = String::from_utf8_lossy(&analyze(&["summary", d]).stdout).to_string();
+    let table = String::from_utf8_lossy(&run_analyze(&["summary", d]).stdout).to_string();
     assert!(table.contains("err_norm_rms_m") && table.contains("(3 rows)") && !table.contains("W.joint1_j"), "{table}");
 }
 
@@ -198,7 +194,7 @@ fn summary_errors_name_the_column_value_or_file() {
     let dir = corpus();
     let d = dir.path().to_str().unwrap();
     let err = |args: &[&str]| {
-        let r = analyze(&[&["summary", d], args].concat());
+        let r = run_analyze(&[&["summary", d], args].concat());
         assert_eq!(r.status.code(), Some(2), "{args:?}");
         String::from_utf8_lossy(&r.stderr).to_string()
     };
@@ -206,15 +202,15 @@ fn summary_errors_name_the_column_value_or_file() {
     assert!(e.contains("\"nope\"") && e.contains("err_z_rms_m"), "{e}");
     assert!(err(&["--filter", "E_total_j<abc"]).contains("\"abc\" is not a number"));
     assert!(err(&["--sort", "zzz"]).contains("\"zzz\""));
-    let r = analyze(&["summary", d, "--filter", "E_total_j"]);
+    let r = run_analyze(&["summary", d, "--filter", "E_total_j"]);
     assert_eq!(r.status.code(), Some(2), "a filter without an operator is a usage error");
-    let r = analyze(&["summary", &format!("{d}/*.nothing")]);
+    let r = run_analyze(&["summary", &format!("{d}/*.nothing")]);
     assert!(String::from_utf8_lossy(&r.stderr).contains("matches no files"));
     // a damaged file: named, and with --skip-bad the others are still summarised (exit 1)
     std::fs::write(dir.path().join("d-bad.mcap"), "not a recording").unwrap();
     let e = err(&[]);
     assert!(e.contains("d-bad.mcap") && e.contains("--skip-bad"), "{e}");
-    let r = analyze(&["summary", d, "--skip-bad", "-f", "csv"]);
+    let r = run_analyze(&["summary", d, "--skip-bad", "-f", "csv"]);
     assert_eq!(r.status.code(), Some(1));
     assert_eq!(String::from_utf8_lossy(&r.stdout).lines().count(), 4);
     assert!(String::from_utf8_lossy(&r.stderr).contains("skipped"));
@@ -228,7 +224,7 @@ fn summary_errors_name_the_column_value_or_file() {
 fn report_is_a_document_with_the_audit_and_its_figures() {
     let dir = corpus();
     let out = dir.path().join("report");
-    let r = analyze(&["report", dir.path().to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let r = run_analyze(&["report", dir.path().to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     for want in [

@@ -3,11 +3,14 @@
 //! offered, shell completions and man pages, and the exit statuses (0 done, 1 a failure to see,
 //! 2 bad input).
 
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn tool(name: &str, args: &[&str]) -> Output {
-    let exe = if name == "sim" { env!("CARGO_BIN_EXE_sim") } else { env!("CARGO_BIN_EXE_analyze") };
-    Command::new(exe).args(args).output().unwrap()
+    if name == "sim" {
+        crate::run_sim(args)
+    } else {
+        crate::run_analyze(args)
+    }
 }
 
 fn stdout(o: &Output) -> String {

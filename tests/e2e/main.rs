@@ -13,3 +13,13 @@ mod pipeline;
 mod sampled_energy;
 mod sim_bad_input;
 mod sim_sweep;
+
+/// Runs `analyze` with `args`.
+fn run_analyze<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_analyze")).args(args).output().expect("analyze starts")
+}
+
+/// Runs `sim` with `args`.
+fn run_sim<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_sim")).args(args).output().expect("sim starts")
+}

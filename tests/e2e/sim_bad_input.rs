@@ -2,15 +2,12 @@
 //! and value on stderr, no panic, nothing written. The library's table of bad scenes is
 //! `sim/tests/bad_input.rs`.
 
+use crate::run_sim;
 use serde_json::json;
 use sim::scene::{PAPER_SCENE_JSON, PAPER_URDF};
 
 fn paper_json() -> serde_json::Value {
     serde_json::from_str(PAPER_SCENE_JSON).unwrap()
-}
-
-fn sim(args: &[&std::ffi::OsStr]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_sim")).args(args).output().unwrap()
 }
 
 /// Through the binary: exit status 2, the file, field and value on stderr, no panic, no output.
@@ -53,7 +50,7 @@ fn cli_rejects_bad_scenes_with_status_2() {
             commands.push(vec!["run".as_ref(), path.as_os_str(), "-o".as_ref(), out_dir.as_os_str(), "--quiet".as_ref()]);
         }
         for args in commands {
-            let out = sim(&args);
+            let out = run_sim(&args);
             let stderr = String::from_utf8_lossy(&out.stderr);
             assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
             assert!(stderr.starts_with(&format!("sim: error: {}", path.display())), "{args:?}: {stderr}");

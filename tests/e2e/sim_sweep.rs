@@ -1,20 +1,15 @@
 //! `sim sweep`: the shards of a job array together give exactly the unsharded sweep (the same
 //! files, byte for byte, and the same merged metrics), and bad input exits with 2 naming it.
 
+use crate::run_sim;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use sim::sweep::{Shard, Sweep};
 
-const SIM: &str = env!("CARGO_BIN_EXE_sim");
 
 fn sweep_file() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/sweeps/small-kp-integrator.json")
-}
-
-fn sim(args: &[&str]) -> std::process::Output {
-    Command::new(SIM).args(args).output().expect("sim runs")
 }
 
 /// File name -> bytes of every recording in `dir`.
@@ -49,7 +44,7 @@ fn shards_together_equal_the_unsharded_sweep() {
     let file = file.to_str().unwrap();
 
     let a = tmp.path().join("A");
-    let o = sim(&["sweep", file, "-o", a.to_str().unwrap(), "-j", "2", "--quiet", "--format", "csv"]);
+    let o = run_sim(&["sweep", file, "-o", a.to_str().unwrap(), "-j", "2", "--quiet", "--format", "csv"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = String::from_utf8(o.stdout).unwrap();
     assert_eq!(csv.lines().count(), 1 + 4 * 2, "{csv}");
@@ -66,7 +61,7 @@ fn shards_together_equal_the_unsharded_sweep() {
     for i in 0..3 {
         let b = tmp.path().join(format!("B{i}"));
         let shard = format!("{i}/3");
-        let o = sim(&["sweep", file, "--shard", &shard, "-o", b.to_str().unwrap(), "-j", "1", "--quiet", "--format", "json"]);
+        let o = run_sim(&["sweep", file, "--shard", &shard, "-o", b.to_str().unwrap(), "-j", "1", "--quiet", "--format", "json"]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let rows: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
         let files = recordings(&b);
@@ -112,7 +107,7 @@ fn bad_input_exits_2_naming_it() {
         (vec!["sweep", file, "--shard", "1/0", "-o", out], "1/0"),
         (vec!["sweep", "/nonexistent/sweep.json", "-o", out], "/nonexistent/sweep.json"),
     ] {
-        let o = sim(&args);
+        let o = run_sim(&args);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
@@ -125,7 +120,7 @@ fn bad_input_exits_2_naming_it() {
     ] {
         let p = tmp.path().join("bad.json");
         std::fs::write(&p, format!(r#"{{"name": "bad", "scene": {:?}, "duration": 0.1, "axes": {axes}}}"#, small.to_str().unwrap())).unwrap();
-        let o = sim(&["sweep", p.to_str().unwrap(), "-o", out, "--quiet"]);
+        let o = run_sim(&["sweep", p.to_str().unwrap(), "-o", out, "--quiet"]);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{err}");
         for n in needles {
@@ -146,7 +141,7 @@ fn the_example_sweeps_are_valid() {
         s.scene(&s.variant(0)).unwrap();
         s.scene(&s.variant(s.grid_size - 1)).unwrap();
     }
-    let o = sim(&["sweep", dir.join("paper-gains.json").to_str().unwrap(), "--dry-run", "--shard", "1/4"]);
+    let o = run_sim(&["sweep", dir.join("paper-gains.json").to_str().unwrap(), "--dry-run", "--shard", "1/4"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = String::from_utf8(o.stdout).unwrap();
     assert!(text.contains("paper-gains-001: controller.kp = 250, controller.kd = 20"), "{text}");

@@ -126,6 +126,21 @@ impl Query {
     }
 }
 
+/// `v OP x` per row (null where `v` is null).
+fn compare<C, R: Copy>(v: &C, x: R, op: Op) -> BooleanChunked
+where
+    C: ChunkCompareEq<R, Item = BooleanChunked> + ChunkCompareIneq<R, Item = BooleanChunked>,
+{
+    match op {
+        Op::Eq => v.equal(x),
+        Op::Ne => v.not_equal(x),
+        Op::Lt => v.lt(x),
+        Op::Le => v.lt_eq(x),
+        Op::Gt => v.gt(x),
+        Op::Ge => v.gt_eq(x),
+    }
+}
+
 /// The rows of `column` where `f` holds (a null never does): numbers compare as numbers, text
 /// as text.
 fn filter_mask(column: &Column, f: &Filter) -> Result<BooleanChunked, String> {
@@ -133,27 +148,10 @@ fn filter_mask(column: &Column, f: &Filter) -> Result<BooleanChunked, String> {
     let mask = if s.dtype().is_primitive_numeric() {
         let x: f64 = f.value.parse().map_err(|_| format!("filter {:?}: {:?} is not a number (the column is numeric)", f.column, f.value))?;
         let s = s.cast(&DataType::Float64).map_err(|e| e.to_string())?;
-        let v = s.f64().map_err(|e| e.to_string())?;
-        match f.op {
-            Op::Eq => v.equal(x),
-            Op::Ne => v.not_equal(x),
-            Op::Lt => v.lt(x),
-            Op::Le => v.lt_eq(x),
-            Op::Gt => v.gt(x),
-            Op::Ge => v.gt_eq(x),
-        }
+        compare(s.f64().map_err(|e| e.to_string())?, x, f.op)
     } else {
         let s = s.cast(&DataType::String).map_err(|e| e.to_string())?;
-        let v = s.str().map_err(|e| e.to_string())?;
-        let x = f.value.as_str();
-        match f.op {
-            Op::Eq => v.equal(x),
-            Op::Ne => v.not_equal(x),
-            Op::Lt => v.lt(x),
-            Op::Le => v.lt_eq(x),
-            Op::Gt => v.gt(x),
-            Op::Ge => v.gt_eq(x),
-        }
+        compare(s.str().map_err(|e| e.to_string())?, f.value.as_str(), f.op)
     };
     // a null compares as null: not kept
     Ok(mask.fill_null_with_values(false).map_err(|e| e.to_string())?)

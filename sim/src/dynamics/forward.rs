@@ -217,9 +217,7 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
     fd.qdd.copy_from(&fd.b);
     chol.solve_mut(&mut fd.qdd);
     if nc > 0 {
-        fd.y.tr_copy_from(&fd.jac);
-        chol.solve_mut(&mut fd.y);
-        fd.a.gemm(1.0, &fd.jac, &fd.y, 0.0);
+        schur_complement(&chol, &fd.jac, &mut fd.y, &mut fd.a);
         // f_n = A^{-1} (−J̇q̇ − J q̈_free)
         fd.f_n.copy_from(&fd.jdqd);
         fd.f_n.gemv(-1.0, &fd.jac, &fd.qdd, -1.0);
@@ -240,6 +238,14 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
     }
     fd.m_j = chol.unpack_dirty();
     Ok(())
+}
+
+/// `Y = M_J⁻¹ J_cᵀ` (nv x nc) and the Schur complement `A = J_c Y` (nc x nc) of the constraint
+/// rows, from the Cholesky factor of `M_J`, into `y` and `a` (RBDA §8.1, eq 8.9).
+pub fn schur_complement(chol_m_j: &Cholesky<f64, nalgebra::Dyn>, jac: &DMatrix<f64>, y: &mut DMatrix<f64>, a: &mut DMatrix<f64>) {
+    y.tr_copy_from(jac);
+    chol_m_j.solve_mut(y);
+    a.gemm(1.0, jac, y, 0.0);
 }
 
 fn solve_kkt(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), DynamicsError> {

@@ -19,6 +19,7 @@
 
 use nalgebra::{Cholesky, DMatrix};
 
+use crate::dynamics::forward::schur_complement;
 use crate::dynamics::motor::Electrical;
 use crate::dynamics::spd::solve_regularized;
 use crate::error::{DynamicsError, RunError};
@@ -49,9 +50,7 @@ impl ArmSystem<'_> {
         if nc > 0 {
             // Y = M_J⁻¹ J_cᵀ, A = J_c Y, then M_c⁻¹ = M_J⁻¹ − Y A⁻¹ Yᵀ (A regularised like the
             // force solve, dynamics/spd.rs)
-            js.y.tr_copy_from(&fd.jac);
-            chol.solve_mut(&mut js.y);
-            js.a.gemm(1.0, &fd.jac, &js.y, 0.0);
+            schur_complement(&chol, &fd.jac, &mut js.y, &mut js.a);
             js.ayt.tr_copy_from(&js.y);
             if solve_regularized(&js.a, &mut js.a_factor, &mut js.ayt).is_some() {
                 js.minv.gemm(-1.0, &js.y, &js.ayt, 1.0);

@@ -125,10 +125,13 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
                         bar.finish_with_message(format!("{:.3} s", scene.duration()));
                         if v.verbose > 0 {
                             let s = r.report.stats;
-                            bar.println(format!(
-                                "sim: {}: {} steps ({} rejected), {} right-hand sides, {:.2} s wall, {:.0}x real time",
-                                run.name, s.steps, s.rejected, s.rhs_evals, wall, scene.duration() / wall.max(1e-9)
-                            ));
+                            // (suspend the bars: `println` on a bar is dropped when stderr is no terminal)
+                            bar.suspend(|| {
+                                eprintln!(
+                                    "sim: {}: {} steps ({} rejected), {} right-hand sides, {:.2} s wall, {:.0}x real time",
+                                    run.name, s.steps, s.rejected, s.rhs_evals, wall, scene.duration() / wall.max(1e-9)
+                                )
+                            });
                         }
                         Done { path: Some(r.path), error: None }
                     }
