@@ -19,7 +19,7 @@ pub struct Verbosity {
     /// No progress bars or notes on standard error (errors are still printed).
     #[arg(short, long, global = true, conflicts_with = "verbose")]
     pub quiet: bool,
-    /// More detail on standard error: solver work, timings, files read (-vv: more).
+    /// More detail on standard error: each run's solver work and timing, each file read.
     #[arg(short, long, global = true, action = clap::ArgAction::Count)]
     pub verbose: u8,
 }
