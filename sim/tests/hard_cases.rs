@@ -69,6 +69,22 @@ fn sixty_seconds_with_bounded_drift() {
     assert!(r.max_drift_last <= 10.0 * r.max_drift_first.max(1e-14), "first {:e} last {:e}", r.max_drift_first, r.max_drift_last);
 }
 
+/// 60 s, twelve turns, of the paper scene as it is (Dormand–Prince rtol 1e-10) without
+/// stabilisation: eq 15 alone. Its drift is the integral of the acceleration-level error, so it
+/// can grow at most quadratically in time; from the paper scene's stated bound (|C| < 1e-13 m
+/// over 5 s, `paper.rs`) that gives (60/5)² × 1e-13 m = 1.44e-11 m over 60 s. The balance closes
+/// to 1e-11 of E, as on the paper scene.
+#[test]
+fn sixty_seconds_without_stabilisation() {
+    let s = hard("long-60s-plain").unwrap();
+    assert_eq!(s.duration(), 60.0);
+    assert_eq!(s.spec().dynamics.stabilization, sim::dynamics::forward::Stabilization::None);
+    let r = run(&s, "two-elbow");
+    assert!(r.finite);
+    assert!(r.max_drift <= (60.0f64 / 5.0).powi(2) * 1e-13, "drift {:e}", r.max_drift);
+    assert!(r.residual_rel <= 1e-11, "{:e}", r.residual_rel);
+}
+
 /// The target touches 0.9999 of the reach of the planar pair at t = 0: the near-singular IK
 /// gives large but finite joint rates; the run completes and balances to 1e-6.
 #[test]

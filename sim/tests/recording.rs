@@ -115,3 +115,57 @@ fn a_failed_run_leaves_a_valid_recording_that_says_why() {
     let motors = rec.read::<MotorState>().unwrap();
     assert!(motors.last().map_or(0.0, |m| m.0) <= t);
 }
+
+/// `model.*` describes the model that ran, and the recorded signals agree with it: the full
+/// paper model (L di/dt, friction, gravity, two contacts) stores magnetic energy, loses energy
+/// to friction, moves in gravity and records two contact forces; the reduced one (L = 0, no
+/// friction, no gravity, no contact) stores no magnetic energy, loses none to friction, has no
+/// potential energy, records no contact, and its currents are the quasi-static ones,
+/// v = R i + k_e ω (to 1e-12 of the terms) at every sample.
+#[test]
+fn model_metadata_describes_the_model_that_ran() {
+    let dir = tempfile::tempdir().unwrap();
+    let record = |scene: &Scene, run: &str| {
+        let run = scene.run(run).unwrap().clone();
+        let path = dir.path().join(format!("{}.mcap", run.name));
+        sim::run::run_to_file(scene, &run, &path, |_| {}).unwrap();
+        read_recording(&path).unwrap()
+    };
+    let full = Scene::paper().unwrap().vary(|s| s.duration = 0.2).unwrap();
+    let rec = record(&full, "two-elbow");
+    let model = rec.run().unwrap().setup.unwrap().model;
+    assert_eq!(model.electrical, sim::dynamics::motor::Electrical::Inductive.describe());
+    assert_eq!((model.contacts, model.friction, model.gravity), (2, true, true));
+    let energy = rec.read::<EnergyState>().unwrap();
+    let constraints = rec.read::<ConstraintState>().unwrap();
+    assert!(energy.iter().any(|(_, e)| e.magnetic > 0.0));
+    assert!(energy.last().unwrap().1.friction_loss > 0.0);
+    assert!(energy.iter().any(|(_, e)| e.potential != energy[0].1.potential));
+    assert!(constraints.iter().all(|(_, c)| c.normal_force.len() == 2));
+
+    let reduced = full
+        .vary(|s| {
+            s.motor.inductance = sim::scene::spec::PerJoint::All(0.0);
+            s.motor.gear_damping = sim::scene::spec::PerJoint::All(0.0);
+            s.joint_damping = sim::scene::spec::PerJoint::All(0.0);
+            s.gravity = [0.0; 3];
+        })
+        .unwrap();
+    let rec = record(&reduced, "no-elbow");
+    let model = rec.run().unwrap().setup.unwrap().model;
+    assert_eq!(model.electrical, sim::dynamics::motor::Electrical::QuasiStatic.describe());
+    assert_eq!((model.contacts, model.friction, model.gravity), (0, false, false));
+    for (_, e) in rec.read::<EnergyState>().unwrap() {
+        assert_eq!((e.magnetic, e.friction_loss, e.potential), (0.0, 0.0, 0.0));
+    }
+    assert!(rec.read::<ConstraintState>().unwrap().iter().all(|(_, c)| c.normal_force.is_empty()));
+    let resistance = 1.1;
+    let motors = rec.read::<MotorState>().unwrap();
+    assert!(motors.iter().any(|(_, m)| m.current.iter().any(|&i| i.abs() > 0.1)));
+    for (t, m) in motors {
+        for j in 0..m.current.len() {
+            let (v, ri, emf) = (m.voltage[j], resistance * m.current[j], m.back_emf[j]);
+            assert!((v - ri - emf).abs() <= 1e-12 * (v.abs() + ri.abs() + emf.abs()).max(1e-3), "t = {t}, motor {j}: v {v} R i {ri} emf {emf}");
+        }
+    }
+}
