@@ -141,6 +141,7 @@ mod tests {
     fn defaults_are_filled_in_one_place() {
         let i = Integrator::from_spec(&spec(r#"{"method":"dopri45","rtol":1e-10,"atol":1e-12}"#), "s.json", 5.0, 1e-3).unwrap();
         assert_eq!(i, Integrator::Dopri45(StepControl { rtol: 1e-10, atol: 1e-12, h_init: None, h_max: 1e-3, h_min: 0.0, max_steps: DEFAULT_MAX_STEPS }));
+        assert_eq!(DEFAULT_MAX_STEPS, 100_000_000, "the README states 10^8");
         let i = Integrator::from_spec(&spec(r#"{"method":"rosenbrock","rtol":1e-5,"atol":1e-7,"h_max":0.5}"#), "s.json", 5.0, 1e-3).unwrap();
         assert!(matches!(i, Integrator::Rosenbrock { jacobian_reuse: 1, control } if control.h_max == 0.5));
         assert_eq!(i.describe().phrase(), "rosenbrock (ROS34PW2, structured Jacobian) rtol 1e-5 atol 1e-7 h_max 5e-1 jacobian_reuse 1");

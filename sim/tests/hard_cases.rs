@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use sim::scene::spec::IntegratorSpec;
+use sim::scene::spec::{IntegratorSpec, PerJoint};
 use sim::scene::Scene;
 
 fn hard(name: &str) -> Result<Scene, sim::error::SceneError> {
@@ -45,6 +45,8 @@ fn run(scene: &Scene, run: &str) -> Result_ {
 #[test]
 fn stiff_motor() {
     let s = hard("stiff-motor").unwrap().vary(|sp| sp.duration = 0.3).unwrap();
+    let paper = Scene::paper().unwrap();
+    assert!(s.drives().l.iter().zip(&paper.drives().l).all(|(a, b)| (a / b - 0.01).abs() < 1e-12));
     for r in ["two-elbow", "no-elbow"] {
         assert!(run(&s, r).residual_rel <= 1e-6);
     }
@@ -54,6 +56,11 @@ fn stiff_motor() {
 #[test]
 fn gains_x10() {
     let s = hard("gains-x10").unwrap().vary(|sp| sp.duration = 1.0).unwrap();
+    let paper = Scene::paper().unwrap();
+    let (gains, paper) = (&s.spec().controller, &paper.spec().controller);
+    for (a, b) in [(&gains.kp, &paper.kp), (&gains.kd, &paper.kd)] {
+        assert!(matches!((a, b), (PerJoint::All(a), PerJoint::All(b)) if *a == 10.0 * b), "{a:?} against {b:?}");
+    }
     assert!(run(&s, "two-elbow").residual_rel <= 1e-6);
 }
 
@@ -72,8 +79,9 @@ fn sixty_seconds_with_bounded_drift() {
 /// 60 s, twelve turns, of the paper scene as it is (Dormand–Prince rtol 1e-10) without
 /// stabilisation: eq 15 alone. Its drift is the integral of the acceleration-level error, so it
 /// can grow at most quadratically in time; from the paper scene's stated bound (|C| < 1e-13 m
-/// over 5 s, `paper.rs`) that gives (60/5)² × 1e-13 m = 1.44e-11 m over 60 s. The balance closes
-/// to 1e-11 of E, as on the paper scene.
+/// over 5 s, `paper.rs`) that gives (60/5)² × 1e-13 m = 1.44e-11 m over 60 s (measured
+/// 1.4e-13 m: it grows about linearly). The balance closes to 1e-11 of E, as on the paper scene
+/// (measured 2.2e-13).
 #[test]
 fn sixty_seconds_without_stabilisation() {
     let s = hard("long-60s-plain").unwrap();
@@ -85,11 +93,28 @@ fn sixty_seconds_without_stabilisation() {
     assert!(r.residual_rel <= 1e-11, "{:e}", r.residual_rel);
 }
 
-/// The target touches 0.9999 of the reach of the planar pair at t = 0: the near-singular IK
-/// gives large but finite joint rates; the run completes and balances to 1e-6.
+/// The target touches 0.9999 of the reach of the planar pair: the farthest point of the circle,
+/// found by sampling it every 0.1 ms through the IK, is 0.9999 of joint 9's reach (to 1e-6).
+/// The near-singular IK gives large but finite joint rates; the run completes and balances to
+/// 1e-6.
 #[test]
 fn near_the_reach_limit() {
-    let s = hard("reach-limit").unwrap().vary(|sp| sp.duration = 0.5).unwrap();
+    let s = hard("reach-limit").unwrap();
+    let (model, ik, circle) = (s.model(), s.ik(), s.circle());
+    let mut data = sim::dynamics::Data::new(model);
+    let (mut q, mut qd) = (vec![0.0; model.nv], vec![0.0; model.nv]);
+    let joint9 = model.bodies.iter().position(|b| b.joint == "joint9").unwrap();
+    let farthest = (0..50_000)
+        .map(|k| {
+            let t = circle.period * k as f64 / 50_000.0;
+            let r = circle.position(t);
+            ik.solve(&r, &circle.velocity(t), &mut q, &mut qd).unwrap();
+            sim::dynamics::kinematics::forward_kinematics(model, &mut data, &q);
+            (r - data.x_world_body[joint9].translation.vector).norm()
+        })
+        .fold(0.0, f64::max);
+    assert!((farthest / ik.reach() - 0.9999).abs() < 1e-6, "farthest target at {} of the reach", farthest / ik.reach());
+    let s = s.vary(|sp| sp.duration = 0.5).unwrap();
     let r = run(&s, "two-elbow");
     assert!(r.finite && r.residual_rel <= 1e-6);
 }
@@ -130,6 +155,7 @@ fn inconsistent_start_is_rejected() {
 fn long_chains() {
     for (name, t) in [("chain30", 0.5), ("chain100", 0.1)] {
         let s = hard(name).unwrap().vary(|sp| sp.duration = t).unwrap();
+        assert_eq!(s.model().nv, if name == "chain30" { 30 } else { 100 });
         let r = run(&s, "free");
         assert!(r.finite && r.residual_rel <= 1e-6, "{name}: {}", r.residual_rel);
     }

@@ -131,6 +131,27 @@ fn bad_input_exits_2_naming_it() {
     }
 }
 
+/// A variant that fails numerically (RK4 with a step beyond its stability limit) makes the sweep
+/// exit with 1, while the other variants still complete: the manifest says which failed and
+/// why, and the failed run's recording says so too.
+#[test]
+fn a_failed_run_exits_1_and_the_others_complete() {
+    let tmp = tempfile::tempdir().unwrap();
+    let small = Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/small/small.json");
+    let sweep = tmp.path().join("mixed.json");
+    let axes = r#"[{"field": "integrator", "values": [{"method": "rk4", "step": 5e-3}, {"method": "dopri45", "rtol": 1e-8, "atol": 1e-10}]}]"#;
+    std::fs::write(&sweep, format!(r#"{{"name": "mixed", "scene": {:?}, "runs": ["free"], "duration": 0.5, "axes": {axes}}}"#, small.to_str().unwrap())).unwrap();
+    let out = tmp.path().join("out");
+    let o = run_sim(&["sweep", sweep.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet"]);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("sweep-manifest.json")).unwrap()).unwrap();
+    let status = |k: usize| manifest["variants"][k]["files"][0]["status"].as_str().unwrap().to_string();
+    assert_eq!((status(0), status(1)), ("failed".to_string(), "complete".to_string()), "{manifest}");
+    assert!(manifest["variants"][0]["files"][0]["error"].as_str().unwrap().contains("t = "), "{manifest}");
+    let result = |k: usize| schemas::read_recording(&out.join(format!("mixed-{k:03}-free.mcap"))).unwrap().result().unwrap().unwrap().status;
+    assert_eq!((result(0), result(1)), (schemas::RunStatus::Failed, schemas::RunStatus::Complete));
+}
+
 #[test]
 fn the_example_sweeps_are_valid() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/sweeps");

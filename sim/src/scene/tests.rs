@@ -23,9 +23,14 @@ fn paper_scene_matches_scene_md() {
     for c in &s.contacts {
         assert!(c.position(&data).abs() < 1e-15, "{} at z = {}", c.name, c.position(&data));
     }
+    // the target: a 0.1 m circle about (1.5, 1.5, 0.4) m, once in 5 s
+    assert_eq!((s.circle.center, s.circle.radius, s.circle.period), (nalgebra::Vector3::new(1.5, 1.5, 0.4), 0.1, 5.0));
     let hand = s.hand.position(&data);
     let dist = (hand - s.circle.center).norm();
     assert!((dist - 0.056).abs() < 1e-3, "hand starts {dist} m from the centre");
+    // and 0.054 m from where the target starts (the README's start-up transient)
+    let offset = (hand - s.circle.position(0.0)).norm();
+    assert!((offset - 0.054).abs() < 1e-3, "hand starts {offset} m from r_d(0)");
     // the hand is in the vertical plane through x = y
     assert!((hand.x - hand.y).abs() < 1e-14);
     // drives: K_m = 0.609, J_m = 0.001476, D_m = 0.09 on every joint
