@@ -85,6 +85,7 @@ fn tightening_the_default_integrator_moves_the_final_angles_by_less_than_1e_13_r
 ///   no weight);
 /// - with bilateral constraints the table pulls (f_n < 0) on elbow 4 for most of the two-elbow
 ///   run (more than half of the samples; the README's table says 4.96 s of 5).
+///
 /// Orderings and bounds only: no numbers copied from a run.
 #[test]
 fn more_elbows_use_less_energy_and_track_better() {
