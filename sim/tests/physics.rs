@@ -54,8 +54,8 @@ fn record(scene: &Scene, run: &str) -> Recorded {
 /// Eq 14 at every recorded sample of the paper's runs:
 /// `M(q) q'' + h(q, q') + D q' − τ − J_c(q)ᵀ f_n = 0`, τ the recorded effort (eq 12's torque on
 /// the link). q'' is recovered from eq 12 itself, `q'' = (K_m i − D_m q' − τ) / J_m`, from the
-/// recorded current and effort; `M q'' + h` is RNEA (checked against an independent library to
-/// 1e-15); J_c is central differences of the recorded contacts' positions.
+/// recorded current and effort; `M q'' + h` is RNEA (its identities with CRBA and Walker–Orin:
+/// `properties.rs`); J_c is central differences of the recorded contacts' positions.
 ///
 /// Tolerance: the differences' error, `h² |C'''| + ε |C| / h` with h = 1e-5 rad and |C''|,
 /// |C'''| ≲ 2 m (the arm's reach), is ~3e-10 per entry of J_c, times |f_n| ≤ 32 N: 1e-8 N m;
