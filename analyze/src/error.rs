@@ -50,6 +50,53 @@ pub enum Error {
         per: &'static str,
     },
 
+    /// A recorded value the metrics use is NaN or infinite: every peak and sum would be
+    /// meaningless, so nothing is computed.
+    #[error("{file}: topic {topic}, field {field}, message #{index} (t = {t_s} s): {value} is not a finite number")]
+    NonFinite {
+        file: String,
+        topic: String,
+        field: String,
+        value: f64,
+        index: usize,
+        t_s: f64,
+    },
+
+    /// A sample is not on the output grid its `run` record states (time scaled, shifted, a gap).
+    #[error(
+        "{file}: topic {topic}, message #{index}: t = {t_s} s, but the run's output grid \
+         ({rate_hz} Hz) puts sample #{index} at {expected_s} s (time scaled, shifted, or samples missing)"
+    )]
+    OffGrid {
+        file: String,
+        topic: String,
+        index: usize,
+        t_s: f64,
+        expected_s: f64,
+        rate_hz: f64,
+    },
+
+    /// A run recorded as complete stops before its duration.
+    #[error(
+        "{file}: topic {topic}: the run is recorded as complete, but its {samples} samples end at \
+         t = {t_end_s} s, before the duration {duration_s} s"
+    )]
+    ShortRun {
+        file: String,
+        topic: String,
+        samples: usize,
+        t_end_s: f64,
+        duration_s: f64,
+    },
+
+    /// What was recovered from a damaged recording is not enough for the metrics.
+    #[error("{report}; what it holds cannot be analysed: {source}")]
+    Damaged {
+        report: Box<schemas::RecoverReport>,
+        #[source]
+        source: Box<Error>,
+    },
+
     /// [`crate::Comparison::new`] was given no runs.
     #[error("no runs to compare")]
     NoRuns,

@@ -46,8 +46,8 @@ pub use compare::Comparison;
 pub use diff::{read_input, render_diff, Diff, DiffError, Tolerance};
 pub use error::Error;
 pub use metrics::{
-    read_run_metrics, read_run_metrics_recover, run_metrics, run_metrics_recovered, RunMetrics,
-    Status,
+    read_run_metrics, read_run_metrics_recover, run_metrics, run_metrics_recovered,
+    stream_run_metrics, Reductions, RunMetrics, Status,
 };
 pub use render::{render_comparison, render_metrics, Format};
 pub use schemas::RecoverReport;

@@ -24,19 +24,21 @@
 //!   `E - (ΔT + ΔV + ΔL i^2/2 + R-loss + friction-loss)`, and `max_k |residual|`, also
 //!   relative to the final electric energy.
 //!
-//! A non-finite sample is never hidden: a NaN wins every `max`/`min` (and spreads into RMS).
+//! Each message is checked before it counts (see [`Reductions`]): array sizes against the `run`
+//! record, finite values (a NaN or an infinity is an error, never a `null` peak), times on the
+//! output grid, and a complete run must reach its duration. The recording is streamed, so the
+//! memory of `analyze metrics` and `summary` does not grow with the run.
 
 use std::path::Path;
 
-use schemas::{
-    topics, ArraySizes, ConstraintState, EnergyState, HandState, MotorState, Recording, RecoverReport, RunResult, RunStatus,
-};
+use schemas::topics::ArrayIndex;
+use schemas::{topics, ConstraintState, DecodedMessage, EnergyState, HandState, MotorState, Recording, RecoverReport, RunResult, RunStatus};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
 
 mod signal;
-use signal::{argmin, min_with_time, negative_time, peak_abs};
+use signal::negative_time;
 
 /// How the run ended (metadata `result.status`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -195,17 +197,34 @@ pub struct RunMetrics {
 pub const METRIC_TOPICS: [&str; 4] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, topics::ENERGY];
 
 /// Reads the recording at `path` and computes its metrics; errors name the file.
+///
+/// The file is streamed ([`schemas::stream_recording`]): memory does not grow with the
+/// length of the run (running sums and extremes per joint and contact, see [`Reductions`]).
 pub fn read_run_metrics(path: &Path) -> Result<RunMetrics, Error> {
-    run_metrics(&schemas::read_recording_topics(path, Some(&METRIC_TOPICS))?)
+    stream_run_metrics(path).map(|(m, _)| m)
+}
+
+/// [`read_run_metrics`], and the recording's metadata and channels (no messages), for callers
+/// that also want the scene or the setup.
+pub fn stream_run_metrics(path: &Path) -> Result<(RunMetrics, Recording), Error> {
+    let mut acc = Reductions::default();
+    let rec = schemas::stream_recording(path, Some(&METRIC_TOPICS), &mut acc).map_err(|e| acc.take_error(e))?;
+    let m = acc.finish(&rec, None)?;
+    Ok((m, rec))
 }
 
 /// Reads the intact part of a possibly damaged recording at `path`
-/// ([`schemas::read_recording_recover`]) and computes its metrics
-/// ([`run_metrics_recovered`]). The report says how much was read; print it when it is not
+/// ([`schemas::stream_recording_recover`], streamed too) and computes its metrics (see
+/// [`run_metrics_recovered`]). The report says how much was read; print it when it is not
 /// `complete`.
 pub fn read_run_metrics_recover(path: &Path) -> Result<(RunMetrics, RecoverReport), Error> {
-    let (rec, report) = schemas::read_recording_recover(path)?;
-    Ok((run_metrics_recovered(&rec, &report)?, report))
+    let mut acc = Reductions::default();
+    let (rec, report) = schemas::stream_recording_recover(path, Some(&METRIC_TOPICS), &mut acc).map_err(|e| acc.take_error(e))?;
+    match incomplete(&rec, &report).and_then(|why| acc.finish(&rec, why)) {
+        Ok(m) => Ok((m, report)),
+        Err(e) if !report.complete => Err(Error::Damaged { report: Box::new(report), source: Box::new(e) }),
+        Err(e) => Err(e),
+    }
 }
 
 /// [`run_metrics`] of a recording read by [`schemas::read_recording_recover`]: the same,
@@ -213,15 +232,19 @@ pub fn read_run_metrics_recover(path: &Path) -> Result<(RunMetrics, RecoverRepor
 /// `error` stating where the recording stops and why. The metrics cover the messages
 /// recovered (`t_end_s` is the last recovered `/hand` sample).
 pub fn run_metrics_recovered(rec: &Recording, report: &RecoverReport) -> Result<RunMetrics, Error> {
-    let incomplete = (!report.complete && rec.result()?.is_none()).then(|| {
+    metrics(rec, incomplete(rec, report)?)
+}
+
+/// Why a recovered recording is [`Status::Incomplete`], if it is.
+fn incomplete(rec: &Recording, report: &RecoverReport) -> Result<Option<String>, Error> {
+    Ok((!report.complete && rec.result()?.is_none()).then(|| {
         format!(
             "recording damaged, stops at byte {} of {}: {}",
             report.stopped_at,
             report.file_len,
             report.reason.as_deref().unwrap_or("unknown")
         )
-    });
-    metrics(rec, incomplete)
+    }))
 }
 
 /// Computes the metrics of one decoded recording (see the module docs for the formulas).
@@ -236,126 +259,386 @@ pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
 
 /// `incomplete`: the recording was recovered without its `result` record; the reason.
 fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Error> {
-    let file = || rec.source.clone();
-    let run = rec.run()?;
-    let (status, error, error_time_s) = match &incomplete {
-        Some(why) => (Status::Incomplete, Some(why.clone()), None),
-        None => {
-            let r = rec.record::<RunResult>()?;
-            let status = match r.status {
-                RunStatus::Complete => Status::Complete,
-                RunStatus::Failed => Status::Failed,
-            };
-            (status, r.error, r.error_time_s)
+    let mut acc = Reductions::default();
+    rec.replay(&METRIC_TOPICS, &mut acc).map_err(|e| acc.take_error(e))?;
+    acc.finish(rec, incomplete)
+}
+
+/// `max_k |v_k|` and the time of its first occurrence.
+#[derive(Debug, Clone, Copy)]
+struct Peak {
+    abs: f64,
+    t: f64,
+}
+
+impl Default for Peak {
+    fn default() -> Self {
+        Peak { abs: f64::NAN, t: f64::NAN }
+    }
+}
+
+impl Peak {
+    fn add(&mut self, t: f64, v: f64) {
+        if self.abs.is_nan() || v.abs() > self.abs {
+            *self = Peak { abs: v.abs(), t };
         }
-    };
-    let sizes = ArraySizes { joints: run.joint_names.len(), contacts: run.contacts.len() };
-    let non_empty = |topic: &str, n: usize| if n == 0 { Err(Error::NoSamples { file: file(), topic: topic.into() }) } else { Ok(()) };
-    let hand = rec.read::<HandState>()?;
-    let motors = rec.read_sized::<MotorState>(sizes)?;
-    let constraints = rec.read_sized::<ConstraintState>(sizes)?;
-    let energy = rec.read_sized::<EnergyState>(sizes)?;
-    non_empty(topics::HAND, hand.len())?;
-    non_empty(topics::MOTORS, motors.len())?;
-    non_empty(topics::CONSTRAINTS, constraints.len())?;
-    non_empty(topics::ENERGY, energy.len())?;
-    let joint_names = run.joint_names;
-    let contacts = run.contacts;
+    }
+}
 
-    // hand error, per axis and in norm
-    let hand_t: Vec<f64> = hand.iter().map(|(t, _)| *t).collect();
-    let axis = |e: &dyn Fn(&HandState) -> f64| -> AxisError {
-        let e: Vec<f64> = hand.iter().map(|(_, h)| e(h)).collect();
-        let (max_abs_m, t_max_s) = peak_abs(&hand_t, &e);
-        let rms_m = (e.iter().map(|x| x * x).sum::<f64>() / e.len() as f64).sqrt();
-        AxisError { rms_m, max_abs_m, t_max_s }
-    };
-    let hand_error = HandError {
-        x: axis(&|h| h.error.x),
-        y: axis(&|h| h.error.y),
-        z: axis(&|h| h.error.z),
-        norm: axis(&|h| h.error_norm),
-    };
+/// `min_k v_k` and the time of its first occurrence.
+#[derive(Debug, Clone, Copy)]
+struct Min {
+    v: f64,
+    t: f64,
+}
 
-    // motor currents
-    let n = joint_names.len();
-    let cur_t: Vec<f64> = motors.iter().map(|(t, _)| *t).collect();
-    let peaks: Vec<(f64, f64)> = (0..n).map(|j| peak_abs(&cur_t, &motors.iter().map(|(_, m)| m.current[j]).collect::<Vec<_>>())).collect();
-    let peak_current = argmin(peaks.iter().map(|p| -p.0)).map(|j| PeakCurrent {
-        joint: joint_names[j].clone(),
-        current_a: peaks[j].0,
-        t_s: peaks[j].1,
-    });
+impl Default for Min {
+    fn default() -> Self {
+        Min { v: f64::NAN, t: f64::NAN }
+    }
+}
 
-    // per-link energy at the end
-    let (first, last) = (&energy[0].1, &energy[energy.len() - 1].1);
-    let links = (0..n)
-        .map(|j| LinkMetrics {
-            joint: joint_names[j].clone(),
-            work_j: last.link_work[j],
-            electric_energy_j: last.electric_energy[j],
-            peak_current_a: peaks[j].0,
-            t_peak_current_s: peaks[j].1,
-        })
-        .collect();
+impl Min {
+    fn add(&mut self, t: f64, v: f64) {
+        if self.v.is_nan() || v < self.v {
+            *self = Min { v, t };
+        }
+    }
+}
 
-    // contacts
-    let c_t: Vec<f64> = constraints.iter().map(|(t, _)| *t).collect();
-    let contact_forces = (0..contacts.len())
-        .map(|c| {
-            let column = |f: &dyn Fn(&ConstraintState) -> f64| -> Vec<f64> { constraints.iter().map(|(_, m)| f(m)).collect() };
-            let f = column(&|m| m.normal_force[c]);
-            let (min_normal_force_n, t_min_normal_force_s) = min_with_time(&c_t, &f);
-            ContactMetrics {
-                contact: contacts[c].clone(),
-                min_normal_force_n,
-                t_min_normal_force_s,
-                pull_time_s: negative_time(&c_t, &f),
-                first_pull_s: c_t.iter().zip(&f).find(|(_, &f)| f < 0.0).map(|(&t, _)| t),
-                max_abs_position_m: peak_abs(&c_t, &column(&|m| m.position[c])).0,
-                max_abs_velocity_m_s: peak_abs(&c_t, &column(&|m| m.velocity[c])).0,
+/// One error component: `Σ e²` and the peak.
+#[derive(Debug, Default, Clone, Copy)]
+struct Axis {
+    sum_sq: f64,
+    peak: Peak,
+}
+
+impl Axis {
+    fn add(&mut self, t: f64, e: f64) {
+        self.sum_sq += e * e;
+        self.peak.add(t, e);
+    }
+
+    fn of(&self, n: usize) -> AxisError {
+        AxisError { rms_m: (self.sum_sq / n as f64).sqrt(), max_abs_m: self.peak.abs, t_max_s: self.peak.t }
+    }
+}
+
+/// One contact over the run.
+#[derive(Debug, Default, Clone)]
+struct Contact {
+    min_force: Min,
+    /// The previous sample `(t, f_n)`, for the trapezoid rule on `1[f_n < 0]`.
+    previous: Option<(f64, f64)>,
+    pull_time: f64,
+    first_pull: Option<f64>,
+    position: Peak,
+    velocity: Peak,
+}
+
+/// Where the samples of one topic should lie: `t_k = k Δt` (`sim`'s output grid, from
+/// `run.setup.output_rate_hz`), and the samples seen.
+#[derive(Debug, Default, Clone, Copy)]
+struct Samples {
+    count: usize,
+    last_t: f64,
+}
+
+/// The running reductions behind [`RunMetrics`], fed one message at a time ([`schemas::Visitor`]):
+/// memory is a few numbers per joint and contact, whatever the length of the run.
+///
+/// Each message is checked as it comes: its arrays have one entry per joint or contact of the
+/// `run` record, its values are finite (a NaN or an infinity is an error naming the topic, the
+/// field and the time: it would make every peak and sum meaningless), and its time lies on the
+/// recorded output grid `t_k = k / output_rate` (to 1e-6 of the interval plus 2 ns of
+/// rounding; a file whose time was scaled, shifted or has a gap is refused).
+#[derive(Debug, Default)]
+pub struct Reductions {
+    hand: [Axis; 4],
+    hand_samples: Samples,
+    motor_peaks: Vec<Peak>,
+    motor_samples: Samples,
+    contacts: Vec<Contact>,
+    contact_samples: Samples,
+    energy_first: Option<EnergyState>,
+    energy_last: Option<EnergyState>,
+    residual: Peak,
+    energy_samples: Samples,
+    /// Joints and contacts of the arrays seen (every message must have the first's).
+    joints: Option<usize>,
+    n_contacts: Option<usize>,
+    /// Why the last message was refused (see the `Visitor` impl).
+    error: Option<Error>,
+}
+
+/// An array of `len` entries (one per `per`) where the first message of the run had `*seen`.
+fn fit(seen: &mut Option<usize>, m: &DecodedMessage<'_>, field: &str, len: usize, per: &'static str) -> Result<(), Error> {
+    match *seen {
+        None => {
+            *seen = Some(len);
+            Ok(())
+        }
+        Some(expected) if expected == len => Ok(()),
+        Some(expected) => Err(Error::WrongLength {
+            file: m.file.to_string(),
+            topic: m.topic.to_string(),
+            field: field.to_string(),
+            index: m.index,
+            t_s: m.t_s(),
+            found: len,
+            expected,
+            per,
+        }),
+    }
+}
+
+/// Every number of the message is finite, and its per-joint and per-contact arrays have the
+/// lengths of the first message's; the error names the first that is not.
+fn check(m: &DecodedMessage<'_>, joints: &mut Option<usize>, contacts: &mut Option<usize>) -> Result<(), Error> {
+    if let Some((field, value)) = m.non_finite() {
+        return Err(Error::NonFinite { file: m.file.to_string(), topic: m.topic.to_string(), field, value, index: m.index, t_s: m.t_s() });
+    }
+    for (field, kind, len) in m.arrays() {
+        match kind {
+            ArrayIndex::Joint => fit(joints, m, field, len, "joint")?,
+            ArrayIndex::Contact => fit(contacts, m, field, len, "contact")?,
+        }
+    }
+    Ok(())
+}
+
+impl Reductions {
+    /// The error that stopped the reader: the one kept by the visitor, or the reader's own.
+    fn take_error(&mut self, e: schemas::Error) -> Error {
+        self.error.take().unwrap_or(Error::Read(e))
+    }
+
+    /// The message's time against the output grid of its `run` record; counts it.
+    fn sample(samples: &mut Samples, m: &DecodedMessage<'_>) -> Result<f64, Error> {
+        let t = m.t_s();
+        if let Some(rate) = m.run.and_then(|r| r.setup.as_ref()).map(|s| s.output_rate_hz).filter(|r| r.is_finite() && *r > 0.0) {
+            let dt = 1.0 / rate;
+            let expected = samples.count as f64 * dt;
+            if (t - expected).abs() > 1e-6 * dt + 2e-9 {
+                return Err(Error::OffGrid {
+                    file: m.file.to_string(),
+                    topic: m.topic.to_string(),
+                    index: m.index,
+                    t_s: t,
+                    expected_s: expected,
+                    rate_hz: rate,
+                });
             }
+        }
+        samples.count += 1;
+        samples.last_t = t;
+        Ok(t)
+    }
+
+    /// The metrics, once every message went through; `rec` holds the metadata read.
+    pub fn finish(self, rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Error> {
+        let file = || rec.source.clone();
+        let run = rec.run()?;
+        for (what, names) in [("joint names", &run.joint_names), ("contact names", &run.contacts)] {
+            if let Some(dup) = names.iter().enumerate().find_map(|(k, n)| names[..k].contains(n).then_some(n)) {
+                return Err(Error::BadMetadata {
+                    file: file(),
+                    record: "run".into(),
+                    key: what.into(),
+                    value: dup.clone(),
+                    detail: "named twice: every joint and contact needs its own name".into(),
+                });
+            }
+        }
+        let (status, error, error_time_s) = match &incomplete {
+            Some(why) => (Status::Incomplete, Some(why.clone()), None),
+            None => {
+                let r = rec.record::<RunResult>()?;
+                let status = match r.status {
+                    RunStatus::Complete => Status::Complete,
+                    RunStatus::Failed => Status::Failed,
+                };
+                (status, r.error, r.error_time_s)
+            }
+        };
+        for topic in METRIC_TOPICS {
+            rec.check_topic(topic)?;
+        }
+        let non_empty = |topic: &str, s: &Samples| if s.count == 0 { Err(Error::NoSamples { file: file(), topic: topic.into() }) } else { Ok(()) };
+        non_empty(topics::HAND, &self.hand_samples)?;
+        non_empty(topics::MOTORS, &self.motor_samples)?;
+        non_empty(topics::CONSTRAINTS, &self.contact_samples)?;
+        non_empty(topics::ENERGY, &self.energy_samples)?;
+        // a complete run has every sample of its grid: [0, duration] at the output rate
+        if let (Status::Complete, Some(setup)) = (status, &run.setup) {
+            let dt = 1.0 / setup.output_rate_hz;
+            for (topic, s) in [(topics::HAND, &self.hand_samples), (topics::MOTORS, &self.motor_samples), (topics::CONSTRAINTS, &self.contact_samples), (topics::ENERGY, &self.energy_samples)] {
+                if s.last_t < setup.duration_s - dt * (1.0 + 1e-6) {
+                    return Err(Error::ShortRun {
+                        file: file(),
+                        topic: topic.into(),
+                        samples: s.count,
+                        t_end_s: s.last_t,
+                        duration_s: setup.duration_s,
+                    });
+                }
+            }
+        }
+        // arrays read before the `run` record (or without it) must match it now
+        for (seen, names, per) in [(self.joints, &run.joint_names, "joint"), (self.n_contacts, &run.contacts, "contact")] {
+            if let Some(n) = seen.filter(|&n| n != names.len()) {
+                return Err(Error::BadMetadata {
+                    file: file(),
+                    record: "run".into(),
+                    key: format!("{per} names"),
+                    value: names.join(", "),
+                    detail: format!("{} names, but the messages have {n} entries per {per}", names.len()),
+                });
+            }
+        }
+        let joint_names = run.joint_names;
+        let contacts = run.contacts;
+        let n = self.hand_samples.count;
+        let hand_error = HandError { x: self.hand[0].of(n), y: self.hand[1].of(n), z: self.hand[2].of(n), norm: self.hand[3].of(n) };
+        let peak_current = (0..self.motor_peaks.len())
+            .fold(None::<usize>, |best, j| match best {
+                Some(b) if self.motor_peaks[b].abs >= self.motor_peaks[j].abs => Some(b),
+                _ => Some(j),
+            })
+            .map(|j| PeakCurrent { joint: joint_names[j].clone(), current_a: self.motor_peaks[j].abs, t_s: self.motor_peaks[j].t });
+        let (Some(first), Some(last)) = (self.energy_first, self.energy_last) else {
+            return Err(Error::NoSamples { file: file(), topic: topics::ENERGY.into() });
+        };
+        let links = (0..joint_names.len())
+            .map(|j| LinkMetrics {
+                joint: joint_names[j].clone(),
+                work_j: last.link_work[j],
+                electric_energy_j: last.electric_energy[j],
+                peak_current_a: self.motor_peaks[j].abs,
+                t_peak_current_s: self.motor_peaks[j].t,
+            })
+            .collect();
+        let contact_forces = self
+            .contacts
+            .iter()
+            .zip(&contacts)
+            .map(|(c, name)| ContactMetrics {
+                contact: name.clone(),
+                min_normal_force_n: c.min_force.v,
+                t_min_normal_force_s: c.min_force.t,
+                pull_time_s: c.pull_time,
+                first_pull_s: c.first_pull,
+                max_abs_position_m: c.position.abs,
+                max_abs_velocity_m_s: c.velocity.abs,
+            })
+            .collect();
+        let electric_j = last.electric_energy_total;
+        let energy_audit = EnergyAudit {
+            electric_j,
+            kinetic_change_j: last.kinetic - first.kinetic,
+            potential_change_j: last.potential - first.potential,
+            magnetic_change_j: last.magnetic - first.magnetic,
+            resistive_loss_j: last.resistive_loss,
+            friction_loss_j: last.friction_loss,
+            gear_friction_loss_j: rec.has_gear_friction_loss().then_some(last.gear_friction_loss),
+            residual_j: last.balance_residual,
+            max_abs_residual_j: self.residual.abs,
+            t_max_abs_residual_s: self.residual.t,
+            max_abs_residual_rel: (electric_j != 0.0).then(|| self.residual.abs / electric_j.abs()),
+        };
+        Ok(RunMetrics {
+            file: file(),
+            scene: run.scene,
+            run: run.run,
+            contacts,
+            joint_names,
+            samples: n,
+            t_end_s: self.hand_samples.last_t,
+            status,
+            error,
+            error_time_s,
+            hand_error,
+            links,
+            link_work_total_j: last.link_work_total,
+            electric_energy_total_j: electric_j,
+            peak_current,
+            contact_forces,
+            energy: energy_audit,
         })
-        .collect();
+    }
+}
 
-    // energy audit
-    let e_t: Vec<f64> = energy.iter().map(|(t, _)| *t).collect();
-    let residual: Vec<f64> = energy.iter().map(|(_, e)| e.balance_residual).collect();
-    let (max_abs_residual_j, t_max_abs_residual_s) = peak_abs(&e_t, &residual);
-    let electric_j = last.electric_energy_total;
-    let energy_audit = EnergyAudit {
-        electric_j,
-        kinetic_change_j: last.kinetic - first.kinetic,
-        potential_change_j: last.potential - first.potential,
-        magnetic_change_j: last.magnetic - first.magnetic,
-        resistive_loss_j: last.resistive_loss,
-        friction_loss_j: last.friction_loss,
-        gear_friction_loss_j: rec.has_gear_friction_loss().then_some(last.gear_friction_loss),
-        residual_j: last.balance_residual,
-        max_abs_residual_j,
-        t_max_abs_residual_s,
-        max_abs_residual_rel: (electric_j != 0.0).then(|| max_abs_residual_j / electric_j.abs()),
-    };
+/// An error of [`Reductions::add`] stops the reader ([`schemas::Error::Stopped`]) and is kept
+/// in [`Reductions::error`], to be returned as it is.
+impl schemas::Visitor for Reductions {
+    fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        match self.add(&m) {
+            Ok(()) => Ok(()),
+            Err(Error::Read(e)) => Err(e),
+            Err(e) => {
+                self.error = Some(e);
+                Err(schemas::Error::Stopped { file: m.file.to_string() })
+            }
+        }
+    }
+}
 
-    Ok(RunMetrics {
-        file: file(),
-        scene: run.scene,
-        run: run.run,
-        contacts,
-        joint_names,
-        samples: hand_t.len(),
-        t_end_s: hand_t[hand_t.len() - 1],
-        status,
-        error,
-        error_time_s,
-        hand_error,
-        links,
-        link_work_total_j: last.link_work_total,
-        electric_energy_total_j: electric_j,
-        peak_current,
-        contact_forces,
-        energy: energy_audit,
-    })
+impl Reductions {
+    /// One message. When the `run` record came first (`sim` writes it first), its arrays are
+    /// checked against the run's joints and contacts as they come; otherwise (another producer,
+    /// or a record written late) every message must have the arrays of the first, and
+    /// [`Reductions::finish`] checks them against the run.
+    fn add(&mut self, m: &DecodedMessage<'_>) -> Result<(), Error> {
+        let sizes = m.sizes();
+        check(m, &mut self.joints, &mut self.n_contacts)?;
+        match m.topic {
+            topics::HAND => {
+                let h: HandState = m.decode(sizes)?;
+                let e = [h.error.x, h.error.y, h.error.z, h.error_norm];
+                let t = Self::sample(&mut self.hand_samples, m)?;
+                for (axis, e) in self.hand.iter_mut().zip(e) {
+                    axis.add(t, e);
+                }
+            }
+            topics::MOTORS => {
+                let motor: MotorState = m.decode(sizes)?;
+                let t = Self::sample(&mut self.motor_samples, m)?;
+                self.motor_peaks.resize(motor.current.len(), Peak::default());
+                for (p, &i) in self.motor_peaks.iter_mut().zip(&motor.current) {
+                    p.add(t, i);
+                }
+            }
+            topics::CONSTRAINTS => {
+                let c: ConstraintState = m.decode(sizes)?;
+                let t = Self::sample(&mut self.contact_samples, m)?;
+                self.contacts.resize(c.normal_force.len(), Contact::default());
+                for (k, acc) in self.contacts.iter_mut().enumerate() {
+                    let f = c.normal_force[k];
+                    acc.min_force.add(t, f);
+                    if let Some((t0, f0)) = acc.previous {
+                        acc.pull_time += negative_time(&[t0, t], &[f0, f]);
+                    }
+                    acc.previous = Some((t, f));
+                    if f < 0.0 && acc.first_pull.is_none() {
+                        acc.first_pull = Some(t);
+                    }
+                    acc.position.add(t, c.position[k]);
+                    acc.velocity.add(t, c.velocity[k]);
+                }
+            }
+            topics::ENERGY => {
+                let e: EnergyState = m.decode(sizes)?;
+                let t = Self::sample(&mut self.energy_samples, m)?;
+                self.residual.add(t, e.balance_residual);
+                if self.energy_first.is_none() {
+                    self.energy_first = Some(e.clone());
+                }
+                self.energy_last = Some(e);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

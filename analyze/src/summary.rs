@@ -17,7 +17,7 @@ use schemas::Recording;
 
 pub use crate::filter::{Filter, Op};
 use crate::Format;
-use crate::metrics::{run_metrics, RunMetrics, METRIC_TOPICS};
+use crate::metrics::{run_metrics, RunMetrics};
 use crate::Error;
 
 /// One recording's entry in the summary.
@@ -56,16 +56,21 @@ pub fn read_rows(
     }
 }
 
-/// One recording -> its row.
+/// One recording -> its row, streamed ([`crate::stream_run_metrics`]: memory does not grow
+/// with the recording).
 pub fn read_row(path: &Path, params: &[String]) -> Result<SummaryRow, Error> {
     let bytes = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    let rec = schemas::read_recording_topics(path, Some(&METRIC_TOPICS))?;
-    row(&rec, bytes, params)
+    let (metrics, rec) = crate::metrics::stream_run_metrics(path)?;
+    row_of(metrics, &rec, bytes, params)
 }
 
 /// The row of a decoded recording of `bytes` bytes.
 pub fn row(rec: &Recording, bytes: u64, params: &[String]) -> Result<SummaryRow, Error> {
-    let metrics = run_metrics(rec)?;
+    row_of(run_metrics(rec)?, rec, bytes, params)
+}
+
+/// The row of a recording's metrics; `rec` gives its metadata (scene, setup).
+fn row_of(metrics: RunMetrics, rec: &Recording, bytes: u64, params: &[String]) -> Result<SummaryRow, Error> {
     let scene: Option<serde_json::Value> = rec.scene().ok().and_then(|s| serde_json::from_str(&s.json).ok());
     let params = params.iter().map(|p| scene.as_ref().and_then(|s| s.pointer(&json_pointer(p))).cloned()).collect();
     Ok(SummaryRow {

@@ -59,7 +59,42 @@ pub enum Error {
 
     /// The bytes do not start with the MCAP magic (empty file, wrong format).
     #[error("{file}: not an MCAP file ({len} bytes, no MCAP magic at the start)")]
-    NotMcap { file: String, len: usize },
+    NotMcap { file: String, len: u64 },
+
+    /// The path is not a regular file (a directory, a device, a FIFO): refused before reading.
+    #[error("{file}: not a regular file ({kind}): a recording is read from a file")]
+    NotAFile { file: String, kind: &'static str },
+
+    /// Log time goes backwards on a channel: the messages are not a time series (a damaged,
+    /// spliced or foreign file); nothing is computed from them.
+    #[error(
+        "{file}: topic {topic}: message #{index} has log_time {log_time_ns} ns, before the \
+         previous message's {previous_ns} ns (time goes backwards)"
+    )]
+    TimeBackwards {
+        file: String,
+        topic: String,
+        index: usize,
+        log_time_ns: u64,
+        previous_ns: u64,
+    },
+
+    /// The consumer of a streamed read ([`crate::Visitor`]) refused a message and keeps the
+    /// reason (it returns that instead).
+    #[error("{file}: reading stopped by its consumer")]
+    Stopped { file: String },
+
+    /// The file says it is of a format version this reader does not know.
+    #[error(
+        "{file}: metadata record `{record}`: format_version = {version}: this reader knows \
+         versions 0 to {supported}; a newer file needs a newer reader"
+    )]
+    UnsupportedFormat {
+        file: String,
+        record: &'static str,
+        version: String,
+        supported: u32,
+    },
 
     /// The `mcap` library could not parse the file (truncation, bad CRC, bad record).
     #[error("{file}: unreadable MCAP: {source}")]

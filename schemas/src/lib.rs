@@ -47,8 +47,9 @@ pub use meta::{
 };
 pub use reader::{
     read_recording, read_recording_bytes, read_recording_bytes_topics, read_recording_recover,
-    read_recording_recover_bytes, read_recording_topics, ArraySizes, ChannelInfo, Recording,
-    RecoverReport, NOT_SELECTED,
+    read_recording_recover_bytes, read_recording_topics, stream_recording, stream_recording_recover,
+    ArraySizes, ChannelInfo, DecodedMessage, Recording, RecoverReport, Visitor, MAX_RECORD_BYTES,
+    NOT_SELECTED,
 };
 pub use value::Value;
 pub use writer::RecordingWriter;

@@ -1,4 +1,4 @@
-//! Generic, schema-driven reading of a whole recording.
+//! Generic, schema-driven reading of a recording, streamed.
 //!
 //! Nothing here assumes the file was written by [`crate::RecordingWriter`]: every channel is
 //! decoded from the schema stored in the file (MCAP spec, <https://mcap.dev/spec>):
@@ -11,24 +11,40 @@
 //!
 //! A channel with any other encoding (ros1, flatbuffer, ros2idl, cbor, ...) is **skipped**: it
 //! is listed in [`Recording::channels`] with [`ChannelInfo::undecoded`] saying why, and asking
-//! [`Recording::series`] for it is an [`Error::UndecodedTopic`]. A channel that claims a supported
-//! encoding but does not decode is an error, as is anything structurally wrong with the file
-//! (no magic, truncated, CRC mismatch, message on an unknown channel, statistics disagreeing
-//! with the data). Chunk CRCs are checked.
+//! for its messages is an [`Error::UndecodedTopic`]. A channel that claims a supported encoding
+//! but does not decode is an error, as is anything structurally wrong with the file (no magic,
+//! truncated, CRC mismatch, message on an unknown channel, statistics disagreeing with the data,
+//! a record over [`MAX_RECORD_BYTES`], log time going backwards on a channel, a format version
+//! newer than [`crate::FORMAT_VERSION`]). Chunk CRCs are checked before a chunk's records are
+//! used, and the data section's CRC at its end.
+//!
+//! **Memory is bounded by the work, not by the file.** The file is read through the `mcap`
+//! crate's sans-I/O linear reader ([`mcap::sans_io::LinearReader`]) from a buffered `File`, one
+//! record at a time (a chunk is at most [`MAX_RECORD_BYTES`] compressed and uncompressed), and
+//! each decoded message is handed to a [`Visitor`] ([`stream_recording`]) that keeps what its
+//! command needs — running sums for `analyze metrics`, the whole series for a table. Only
+//! [`read_recording`] collects every decoded message (as [`Value`]s, several times the file's
+//! size: use it for what needs the series). A path is checked before anything is read: it must
+//! be a regular file (not a directory, FIFO or `/dev/zero`) that starts with the MCAP magic.
 
 use std::collections::BTreeMap;
+use std::io::Read;
 use std::path::Path;
 
 use mcap::records::Record;
 use prost_reflect::{DescriptorPool, DynamicMessage, MessageDescriptor, ReflectMessage};
 
-use crate::value::Value;
+use crate::messages::TopicMessage;
+use crate::meta::{MetadataRecord, RunDescription};
+use crate::topics::{array_index, array_required, ArrayIndex};
+use crate::value::{from_value, Value};
 
+mod input;
 mod recover;
 mod typed;
-use crate::{ros2msg, Error};
+use crate::{from_log_time, ros2msg, Error};
+pub use recover::{read_recording_recover, read_recording_recover_bytes, stream_recording_recover, RecoverReport};
 pub use typed::ArraySizes;
-pub use recover::{read_recording_recover, read_recording_recover_bytes, RecoverReport};
 
 /// One channel of the file.
 #[derive(Debug, Clone, PartialEq)]
@@ -44,7 +60,8 @@ pub struct ChannelInfo {
     pub undecoded: Option<String>,
 }
 
-/// A whole recording, decoded.
+/// A recording, decoded: its metadata and channels, and the decoded messages when it was read
+/// by [`read_recording`] (a [`stream_recording`] hands them to its visitor instead).
 #[derive(Debug, Clone)]
 pub struct Recording {
     /// The label errors use: the path, or the `source` given to [`read_recording_bytes`].
@@ -54,12 +71,154 @@ pub struct Recording {
     pub(crate) metadata: BTreeMap<String, BTreeMap<String, String>>,
     /// Channels in channel-id order.
     pub channels: Vec<ChannelInfo>,
-    /// Decoded messages by topic, sorted by log time (stable: file order among equal times);
+    /// Decoded messages by topic, in log-time order (which the reader checks per channel);
     /// read them typed ([`Recording::read`]) or generically ([`Recording::messages`]).
     pub(crate) messages: BTreeMap<String, Vec<(u64, Value)>>,
+    /// Length of the first per-joint array decoded (names the joints of format 0).
+    pub(crate) first_joint_array_len: Option<usize>,
+    /// Whether the first `/energy` message decoded has `gear_friction_loss` (format ≥ 2).
+    pub(crate) energy_has_gear_friction: bool,
 }
 
-/// Reads and decodes the MCAP file at `path`; errors name the file.
+/// One decoded message, handed to a [`Visitor`].
+#[derive(Debug)]
+pub struct DecodedMessage<'a> {
+    /// The file (label) it comes from.
+    pub file: &'a str,
+    pub topic: &'a str,
+    /// Its index among the messages of its channel (0-based, file order).
+    pub index: usize,
+    pub log_time_ns: u64,
+    pub value: Value,
+    /// What ran (the `run` record), when the file has given it before this message (`sim`
+    /// writes it first): the array sizes and the output grid to check the message against.
+    pub run: Option<&'a RunDescription>,
+}
+
+impl DecodedMessage<'_> {
+    /// The first value of the message that is NaN or infinite, with its field path (`error.x`,
+    /// `current[2]`), in field order; `None` when every number is finite.
+    pub fn non_finite(&self) -> Option<(String, f64)> {
+        fn walk(v: &Value, path: &mut String) -> Option<(String, f64)> {
+            match v {
+                Value::F64(x) if !x.is_finite() => Some((path.clone(), *x)),
+                Value::Struct(fields) => fields.iter().find_map(|(name, v)| {
+                    let len = path.len();
+                    if !path.is_empty() {
+                        path.push('.');
+                    }
+                    path.push_str(name);
+                    let found = walk(v, path);
+                    path.truncate(len);
+                    found
+                }),
+                Value::List(items) => items.iter().enumerate().find_map(|(k, v)| {
+                    let len = path.len();
+                    path.push_str(&format!("[{k}]"));
+                    let found = walk(v, path);
+                    path.truncate(len);
+                    found
+                }),
+                _ => None,
+            }
+        }
+        walk(&self.value, &mut String::new())
+    }
+
+    /// The per-joint and per-contact arrays of the message: `(field, kind, length)`, leaving out
+    /// an optional array recorded empty ([`crate::topics::array_required`]).
+    pub fn arrays(&self) -> impl Iterator<Item = (&str, ArrayIndex, usize)> + '_ {
+        let fields = match &self.value {
+            Value::Struct(fields) => fields.as_slice(),
+            _ => &[],
+        };
+        fields.iter().filter_map(|(field, v)| match (array_index(self.topic, field), v) {
+            (Some(kind), Value::List(items)) if !items.is_empty() || array_required(self.topic, field) => Some((field.as_str(), kind, items.len())),
+            _ => None,
+        })
+    }
+
+    /// The per-joint and per-contact array sizes of [`DecodedMessage::run`].
+    pub fn sizes(&self) -> Option<ArraySizes> {
+        self.run.map(|r| ArraySizes { joints: r.joint_names.len(), contacts: r.contacts.len() })
+    }
+
+    /// Log time, s.
+    pub fn t_s(&self) -> f64 {
+        from_log_time(self.log_time_ns)
+    }
+
+    /// The message as `M` (by field name); with `sizes`, every per-joint and per-contact array
+    /// must have that many entries (see [`Recording::read_sized`]). Errors name the file, the
+    /// topic, the message and the field.
+    pub fn decode<M: TopicMessage>(&self, sizes: Option<ArraySizes>) -> Result<M, Error> {
+        decode_typed(self.file, self.topic, self.index, self.log_time_ns, &self.value, sizes)
+    }
+}
+
+/// Receives each decoded message of a [`stream_recording`], per channel in log-time order.
+/// An error stops the reading and is returned.
+pub trait Visitor {
+    fn message(&mut self, message: DecodedMessage<'_>) -> Result<(), Error>;
+}
+
+impl<F: FnMut(DecodedMessage<'_>) -> Result<(), Error>> Visitor for F {
+    fn message(&mut self, message: DecodedMessage<'_>) -> Result<(), Error> {
+        self(message)
+    }
+}
+
+/// Keeps every message: what [`read_recording`] returns.
+#[derive(Default)]
+struct Collect(BTreeMap<String, Vec<(u64, Value)>>);
+
+impl Visitor for Collect {
+    fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), Error> {
+        self.0.entry(m.topic.to_string()).or_default().push((m.log_time_ns, m.value));
+        Ok(())
+    }
+}
+
+/// Decodes one message as `M`, checking its array lengths against `sizes`.
+pub(crate) fn decode_typed<M: TopicMessage>(
+    file: &str,
+    topic: &str,
+    index: usize,
+    log_time_ns: u64,
+    v: &Value,
+    sizes: Option<ArraySizes>,
+) -> Result<M, Error> {
+    if let (Some(sizes), Value::Struct(fields)) = (sizes, v) {
+        for (field, value) in fields {
+            let (Some(kind), Value::List(items)) = (array_index(topic, field), value) else { continue };
+            let (expected, per) = match kind {
+                ArrayIndex::Joint => (sizes.joints, "joint"),
+                ArrayIndex::Contact => (sizes.contacts, "contact"),
+            };
+            if items.len() != expected && (array_required(topic, field) || !items.is_empty()) {
+                return Err(Error::WrongLength {
+                    file: file.to_string(),
+                    topic: topic.into(),
+                    field: field.clone(),
+                    index,
+                    t_s: from_log_time(log_time_ns),
+                    found: items.len(),
+                    expected,
+                    per,
+                });
+            }
+        }
+    }
+    from_value(v).map_err(|e| Error::Field {
+        file: file.to_string(),
+        topic: topic.into(),
+        index,
+        log_time_ns,
+        detail: e.to_string(),
+    })
+}
+
+/// Reads and decodes the MCAP file at `path`, keeping every message; errors name the file.
 pub fn read_recording(path: &Path) -> Result<Recording, Error> {
     read_recording_topics(path, None)
 }
@@ -72,13 +231,45 @@ pub fn read_recording(path: &Path) -> Result<Recording, Error> {
 /// [`ChannelInfo::undecoded`] = "not selected", so asking for them is an error, never an empty
 /// series.
 pub fn read_recording_topics(path: &Path, topics: Option<&[&str]>) -> Result<Recording, Error> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        file: file.clone(),
-        op: "reading",
-        source,
-    })?;
-    read_recording_bytes_topics(&bytes, &file, topics)
+    let mut all = Collect::default();
+    let mut rec = stream_recording(path, topics, &mut all)?;
+    rec.messages = all.0;
+    Ok(rec)
+}
+
+/// Reads the MCAP file at `path` once, from the start, handing every decoded message of
+/// `topics` (all when `None`) to `visitor` as it is read, and returns the metadata and
+/// channels (its `messages` are empty). Memory: one record at a time plus what `visitor`
+/// keeps. The visitor may have seen messages of a file that turns out bad: only an `Ok`
+/// result says the whole file was read and checked.
+pub fn stream_recording(path: &Path, topics: Option<&[&str]>, visitor: &mut dyn Visitor) -> Result<Recording, Error> {
+    let (mut file, len, label) = input::open(path)?;
+    Ok(read_state(&mut file, len, label, topics, visitor)?.into_recording())
+}
+
+/// Reads a whole MCAP input of `len` bytes into the state (messages to `visitor`) and checks
+/// that it is complete and consistent.
+fn read_state(
+    input: &mut dyn Read,
+    len: u64,
+    label: String,
+    topics: Option<&[&str]>,
+    visitor: &mut dyn Visitor,
+) -> Result<State, Error> {
+    let mut state = State::new(label, topics);
+    feed(input, reader_options(), &mut state, visitor)?;
+    state.check_read_all(len)?;
+    state.check_complete()?;
+    Ok(state)
+}
+
+/// Drops every message (a check of the file alone).
+struct Null;
+
+impl Visitor for Null {
+    fn message(&mut self, _: DecodedMessage<'_>) -> Result<(), Error> {
+        Ok(())
+    }
 }
 
 struct SchemaRec {
@@ -134,9 +325,10 @@ fn decoder_for(
 /// [`ChannelInfo::undecoded`] of a channel left out by [`read_recording_topics`].
 pub const NOT_SELECTED: &str = "not selected: the file was read for other topics only";
 
-/// Smallest record-length limit: no record (inside a chunk or not) may be longer than the
-/// larger of this and the file itself, so a corrupt length cannot make us allocate wildly.
-const MIN_RECORD_LENGTH_LIMIT: usize = 64 << 20;
+/// The longest record (and the longest chunk, compressed or uncompressed) the reader accepts:
+/// it bounds the reader's memory whatever the file says. `sim` writes chunks of 1 MiB; a file
+/// with a longer record (a large attachment, a huge chunk) is refused with the record's size.
+pub const MAX_RECORD_BYTES: usize = 64 << 20;
 
 /// Reads and decodes MCAP bytes; `source` labels the bytes in errors (e.g. a path).
 ///
@@ -156,28 +348,30 @@ pub fn read_recording_bytes_topics(
     source: &str,
     topics: Option<&[&str]>,
 ) -> Result<Recording, Error> {
-    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        read_mcap(bytes, source, topics)
-    }));
-    parsed.unwrap_or_else(|panic| {
-        let why = panic
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| panic.downcast_ref::<String>().cloned())
-            .unwrap_or_default();
-        Err(Error::Malformed {
-            file: source.to_string(),
-            detail: format!("the MCAP parser panicked on this input: {why}"),
-        })
-    })
+    if !bytes.starts_with(mcap::MAGIC) {
+        return Err(Error::NotMcap { file: source.to_string(), len: bytes.len() as u64 });
+    }
+    let mut all = Collect::default();
+    let mut input = bytes;
+    let mut rec = read_state(&mut input, bytes.len() as u64, source.to_string(), topics, &mut all)?.into_recording();
+    rec.messages = all.0;
+    Ok(rec)
+}
+
+/// The text of a caught panic.
+pub(crate) fn panic_text(panic: &(dyn std::any::Any + Send)) -> String {
+    panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_default()
 }
 
 /// The reader options: every CRC the format has is checked, chunks before any of their records
-/// are used, and no record may be longer than the larger of the input and
-/// [`MIN_RECORD_LENGTH_LIMIT`].
-fn reader_options(len: usize) -> mcap::sans_io::LinearReaderOptions {
+/// are used, and no record may be longer than [`MAX_RECORD_BYTES`].
+fn reader_options() -> mcap::sans_io::LinearReaderOptions {
     mcap::sans_io::LinearReaderOptions::default()
-        .with_record_length_limit(len.max(MIN_RECORD_LENGTH_LIMIT))
+        .with_record_length_limit(MAX_RECORD_BYTES)
         .with_validate_chunk_crcs(true)
         .with_prevalidate_chunk_crcs(true)
         .with_validate_data_section_crc(true)
@@ -185,15 +379,34 @@ fn reader_options(len: usize) -> mcap::sans_io::LinearReaderOptions {
         .with_check_finishes_after_end_magic(true)
 }
 
-/// Runs `bytes` through a linear reader with `options`, handing every record to `state`.
+/// Runs `input` through a linear reader with `options`, handing every record to `state` (and
+/// its messages to `visitor`). A panic of a dependency on corrupt input is caught and returned
+/// as [`Error::Malformed`] (see [`read_recording_bytes`]).
 fn feed(
-    bytes: &[u8],
+    input: &mut dyn Read,
     options: mcap::sans_io::LinearReaderOptions,
     state: &mut State,
+    visitor: &mut dyn Visitor,
+) -> Result<(), Error> {
+    let fed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        feed_records(input, options, state, visitor)
+    }));
+    fed.unwrap_or_else(|panic| {
+        Err(Error::Malformed {
+            file: state.file.clone(),
+            detail: format!("the MCAP parser panicked on this input: {}", panic_text(&*panic)),
+        })
+    })
+}
+
+fn feed_records(
+    input: &mut dyn Read,
+    options: mcap::sans_io::LinearReaderOptions,
+    state: &mut State,
+    visitor: &mut dyn Visitor,
 ) -> Result<(), Error> {
     use mcap::sans_io::{LinearReadEvent, LinearReader};
     let mut reader = LinearReader::new_with_options(options);
-    let mut rest = bytes;
     while let Some(event) = reader.next_event() {
         let event = event.map_err(|source| Error::McapRead {
             file: state.file.clone(),
@@ -201,10 +414,18 @@ fn feed(
         })?;
         match event {
             LinearReadEvent::ReadRequest(need) => {
-                let n = need.min(rest.len());
-                reader.insert(n).copy_from_slice(&rest[..n]);
+                let buf = reader.insert(need);
+                let n = loop {
+                    match input.read(buf) {
+                        Ok(n) => break n,
+                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                        Err(source) => {
+                            return Err(Error::Io { file: state.file.clone(), op: "reading", source });
+                        }
+                    }
+                };
+                state.bytes_read += n as u64;
                 reader.notify_read(n);
-                rest = &rest[n..];
             }
             LinearReadEvent::Record { opcode, data } => {
                 let record =
@@ -212,28 +433,20 @@ fn feed(
                         file: state.file.clone(),
                         source,
                     })?;
-                state.record(record)?;
+                state.record(record, visitor)?;
             }
         }
     }
     Ok(())
 }
 
-fn read_mcap(bytes: &[u8], source: &str, topics: Option<&[&str]>) -> Result<Recording, Error> {
-    let file = source.to_string();
-    if !bytes.starts_with(mcap::MAGIC) {
-        return Err(Error::NotMcap {
-            file,
-            len: bytes.len(),
-        });
-    }
-    let mut state = State {
-        file,
-        only: topics.map(|t| t.iter().map(|s| s.to_string()).collect()),
-        ..State::default()
-    };
-    feed(bytes, reader_options(bytes.len()), &mut state)?;
-    state.finish()
+/// A decoded message waiting for its record to be read whole (recovery: a chunk that fails
+/// halfway gives nothing).
+struct Pending {
+    channel_id: u16,
+    index: usize,
+    log_time_ns: u64,
+    value: Value,
 }
 
 /// What has been read so far.
@@ -246,13 +459,33 @@ struct State {
     channels: BTreeMap<u16, ChannelInfo>,
     decoders: BTreeMap<u16, Decoder>,
     metadata: BTreeMap<String, BTreeMap<String, String>>,
-    messages: BTreeMap<String, Vec<(u64, Value)>>,
+    /// Log time of the last message of each channel (time must not go backwards).
+    last_time: BTreeMap<u16, u64>,
+    /// Largest log time of any message, ns.
+    t_end_ns: Option<u64>,
+    first_joint_array_len: Option<usize>,
+    energy_has_gear_friction: Option<bool>,
+    /// The `run` record as read so far ([`DecodedMessage::run`]).
+    run: Option<RunDescription>,
+    /// `Some` while messages are held back until their record is complete ([`State::commit`]).
+    pending: Option<Vec<Pending>>,
     stats_count: Option<u64>,
+    stats_chunks: Option<u32>,
     total: u64,
     footer: bool,
+    /// Bytes handed to the MCAP reader.
+    bytes_read: u64,
 }
 
 impl State {
+    fn new(file: String, topics: Option<&[&str]>) -> Self {
+        State {
+            file,
+            only: topics.map(|t| t.iter().map(|s| s.to_string()).collect()),
+            ..State::default()
+        }
+    }
+
     fn malformed(&self, detail: String) -> Error {
         Error::Malformed {
             file: self.file.clone(),
@@ -260,7 +493,7 @@ impl State {
         }
     }
 
-    fn record(&mut self, record: Record<'_>) -> Result<(), Error> {
+    fn record(&mut self, record: Record<'_>, visitor: &mut dyn Visitor) -> Result<(), Error> {
         match record {
             Record::Schema { header, data } => {
                 let new = SchemaRec {
@@ -285,13 +518,46 @@ impl State {
                 }
             }
             Record::Channel(ch) => self.channel(ch)?,
-            Record::Message { header, data } => self.message(&header, &data)?,
-            Record::Metadata(m) => self.metadata.entry(m.name).or_default().extend(m.metadata),
-            Record::Statistics(s) => self.stats_count = Some(s.message_count),
+            Record::Message { header, data } => self.message(&header, &data, visitor)?,
+            Record::Metadata(m) => {
+                if m.name == crate::meta::RecordingInfo::NAME {
+                    self.check_format_version(&m.metadata)?;
+                }
+                let run = m.name == crate::meta::RunNames::NAME || m.name == crate::meta::RecordingInfo::NAME;
+                self.metadata.entry(m.name).or_default().extend(m.metadata);
+                if run {
+                    self.update_run();
+                }
+            }
+            Record::Statistics(s) => {
+                self.stats_count = Some(s.message_count);
+                self.stats_chunks = Some(s.chunk_count);
+            }
             Record::Footer(_) => self.footer = true,
+            // 0x00 is no MCAP opcode (the spec reserves it): zeros where a record should be
+            Record::Unknown { opcode: 0, .. } => {
+                return Err(self.malformed(
+                    "a record with opcode 0x00, which MCAP does not define (zeros where a record should start)".into(),
+                ));
+            }
             _ => {}
         }
         Ok(())
+    }
+
+    /// A `recording` record with a format version this reader does not know is an error: its
+    /// fields may mean something else.
+    fn check_format_version(&self, entries: &BTreeMap<String, String>) -> Result<(), Error> {
+        let Some(v) = entries.get("format_version") else { return Ok(()) };
+        match v.trim().parse::<u64>() {
+            Ok(n) if n <= u64::from(crate::FORMAT_VERSION) => Ok(()),
+            _ => Err(Error::UnsupportedFormat {
+                file: self.file.clone(),
+                version: v.clone(),
+                supported: crate::FORMAT_VERSION,
+                record: crate::meta::RecordingInfo::NAME,
+            }),
+        }
     }
 
     fn channel(&mut self, ch: mcap::records::Channel) -> Result<(), Error> {
@@ -337,7 +603,12 @@ impl State {
         Ok(())
     }
 
-    fn message(&mut self, header: &mcap::records::MessageHeader, data: &[u8]) -> Result<(), Error> {
+    fn message(
+        &mut self,
+        header: &mcap::records::MessageHeader,
+        data: &[u8],
+        visitor: &mut dyn Visitor,
+    ) -> Result<(), Error> {
         let (Some(info), Some(decoder)) = (
             self.channels.get_mut(&header.channel_id),
             self.decoders.get(&header.channel_id),
@@ -348,6 +619,19 @@ impl State {
             )));
         };
         let index = info.message_count;
+        if let Some(&previous_ns) = self.last_time.get(&header.channel_id) {
+            if header.log_time < previous_ns {
+                return Err(Error::TimeBackwards {
+                    file: self.file.clone(),
+                    topic: info.topic.clone(),
+                    index,
+                    log_time_ns: header.log_time,
+                    previous_ns,
+                });
+            }
+        }
+        self.last_time.insert(header.channel_id, header.log_time);
+        self.t_end_ns = Some(self.t_end_ns.map_or(header.log_time, |t| t.max(header.log_time)));
         info.message_count += 1;
         self.total += 1;
         let decode_err = |detail: String| Error::Decode {
@@ -368,16 +652,70 @@ impl State {
                 .map(|j| Value::from_json(&j))
                 .map_err(|e| decode_err(e.to_string()))?,
         };
-        self.messages
-            .entry(info.topic.clone())
-            .or_default()
-            .push((header.log_time, value));
+        if self.first_joint_array_len.is_none() {
+            if let Value::Struct(fields) = &value {
+                let topic = &info.topic;
+                self.first_joint_array_len = fields.iter().find_map(|(field, v)| match (array_index(topic, field), v) {
+                    (Some(ArrayIndex::Joint), Value::List(items)) => Some(items.len()),
+                    _ => None,
+                });
+                if self.first_joint_array_len.is_some() && self.run.as_ref().is_some_and(|r| r.joint_names.is_empty()) {
+                    self.update_run(); // format 0 names its joints after this length
+                }
+            }
+        }
+        let topic = &self.channels[&header.channel_id].topic;
+        if topic == crate::topics::ENERGY && self.energy_has_gear_friction.is_none() {
+            self.energy_has_gear_friction = Some(value.get("gear_friction_loss").is_some());
+        }
+        let channel_id = header.channel_id;
+        match &mut self.pending {
+            Some(pending) => pending.push(Pending { channel_id, index, log_time_ns: header.log_time, value }),
+            None => visitor.message(DecodedMessage { file: &self.file, topic, index, log_time_ns: header.log_time, value, run: self.run.as_ref() })?,
+        }
         Ok(())
     }
 
-    fn finish(self) -> Result<Recording, Error> {
+    /// [`State::run`] from the metadata read so far (`None` while it does not read: the typed
+    /// accessors of the finished [`Recording`] report why).
+    fn update_run(&mut self) {
+        let view = Recording {
+            source: self.file.clone(),
+            metadata: self.metadata.clone(),
+            channels: Vec::new(),
+            messages: BTreeMap::new(),
+            first_joint_array_len: self.first_joint_array_len,
+            energy_has_gear_friction: false,
+        };
+        self.run = view.run_opt().ok().flatten();
+    }
+
+    /// Hands the messages held back to `visitor` (recovery, after their record read whole).
+    fn commit(&mut self, visitor: &mut dyn Visitor) -> Result<(), Error> {
+        let Some(pending) = self.pending.as_mut() else { return Ok(()) };
+        for p in pending.drain(..) {
+            let topic = &self.channels[&p.channel_id].topic;
+            visitor.message(DecodedMessage { file: &self.file, topic, index: p.index, log_time_ns: p.log_time_ns, value: p.value, run: self.run.as_ref() })?;
+        }
+        Ok(())
+    }
+
+    /// The reader stopped at the end magic; a file that goes on (trailing bytes) was refused by
+    /// the MCAP reader, one that changed size while read is refused here.
+    fn check_read_all(&self, len: u64) -> Result<(), Error> {
+        if self.bytes_read != len {
+            return Err(self.malformed(format!(
+                "read {} bytes, but the file has {len} (it changed while being read?)",
+                self.bytes_read
+            )));
+        }
+        Ok(())
+    }
+
+    /// The file had its footer and its statistics agree with the data.
+    fn check_complete(&self) -> Result<(), Error> {
         if !self.footer {
-            return Err(Error::Truncated { file: self.file });
+            return Err(Error::Truncated { file: self.file.clone() });
         }
         if let Some(n) = self.stats_count.filter(|&n| n != self.total) {
             return Err(self.malformed(format!(
@@ -385,19 +723,18 @@ impl State {
                 self.total
             )));
         }
-        Ok(self.into_recording())
+        Ok(())
     }
 
-    /// The recording read so far, messages sorted by log time (stable).
-    fn into_recording(mut self) -> Recording {
-        for list in self.messages.values_mut() {
-            list.sort_by_key(|(t, _)| *t);
-        }
+    /// The recording read so far (its messages went to the visitor).
+    fn into_recording(self) -> Recording {
         Recording {
             source: self.file,
             metadata: self.metadata,
             channels: self.channels.into_values().collect(),
-            messages: self.messages,
+            messages: BTreeMap::new(),
+            first_joint_array_len: self.first_joint_array_len,
+            energy_has_gear_friction: self.energy_has_gear_friction.unwrap_or(false),
         }
     }
 }

@@ -44,6 +44,10 @@ pub struct Synth {
     pub joint_states: Option<Signal<JointState>>,
     /// `/hand_points` from the hand's actual and desired positions.
     pub hand_points: bool,
+    /// Log times are `t_k × time_scale` (1: `sim`'s; another producer's clock otherwise).
+    pub time_scale: f64,
+    /// A sample left out of every topic (a gap), by index.
+    pub drop_sample: Option<usize>,
 }
 
 impl Synth {
@@ -74,7 +78,25 @@ impl Synth {
             energy: Some(Box::new(move |t| linear_energy(t, n_joints, 1.0, 2.0))),
             joint_states: None,
             hand_points: false,
+            time_scale: 1.0,
+            drop_sample: None,
         }
+    }
+
+    /// With the `run` record's [`Setup`] as `sim` writes it: output rate `1/dt`, duration `n dt`.
+    pub fn with_setup(mut self) -> Self {
+        self.setup = Some(Setup {
+            integrator: crate::IntegratorInfo { method: "rk4".into(), step: Some(self.dt), rtol: None, atol: None, h_max: None, max_steps: None, jacobian_reuse: None },
+            duration_s: self.n as f64 * self.dt,
+            output_rate_hz: 1.0 / self.dt,
+            mass_matrix: "crba".into(),
+            constraint_solver: "schur".into(),
+            stabilization: r#"{"method":"none"}"#.into(),
+            model: crate::ModelInfo { electrical: "L di/dt (one state per motor)".into(), contacts: self.names.as_ref().map_or(0, |n| n.contacts.len()), friction: false, gravity: true },
+            hand_frame: "world".into(),
+            tool: "synth".into(),
+        });
+        self
     }
 
     /// Writes `dir/<run>.mcap` (`synthetic.mcap` without a run record); returns its path.
@@ -103,8 +125,11 @@ impl Synth {
             (None, _) => {}
         }
         for k in 0..=self.n {
+            if self.drop_sample == Some(k) {
+                continue;
+            }
             let t = k as f64 * self.dt;
-            let ns = to_log_time(t);
+            let ns = to_log_time(t * self.time_scale);
             if let Some(f) = &self.hand {
                 let h = HandState { time: t, ..f(t) };
                 w.write(topics::HAND, ns, &h).expect("hand");

@@ -215,3 +215,81 @@ fn chunk_size_option_reads_the_same() {
         Some(vec![7.0; 4])
     );
 }
+
+/// Top-level records of an intact file: (start, opcode, length of the body).
+fn records(b: &[u8]) -> Vec<(usize, u8, usize)> {
+    let mut out = Vec::new();
+    let mut at = 8;
+    while at + 9 <= b.len() - 8 {
+        let len = u64::from_le_bytes(b[at + 1..at + 9].try_into().unwrap()) as usize;
+        out.push((at, b[at], len));
+        at += 9 + len;
+    }
+    out
+}
+
+/// A metadata record changed in place (same length: "two-elbow" -> "two-elbox") passes the
+/// MCAP parser but not the data section's CRC. Recovery keeps every message (the chunks pass
+/// their own CRCs) and leaves out every metadata record, saying why: no label from bytes that
+/// failed a CRC.
+#[test]
+fn metadata_that_fails_the_data_section_crc_is_left_out() {
+    let full = recording();
+    let at = full.windows(9).position(|w| w == b"two-elbow").unwrap();
+    let mut b = full.clone();
+    b[at + 8] = b'x';
+    let e = read_recording_bytes(&b, "x").unwrap_err();
+    assert!(e.to_string().to_lowercase().contains("crc"), "{e}");
+    let (rec, report) = read_recording_recover_bytes(&b, "meta.mcap").unwrap();
+    assert!(!report.complete && !report.metadata_verified, "{report}");
+    assert!(rec.metadata_records().is_empty(), "{:?}", rec.metadata_records());
+    let reason = report.reason.as_deref().unwrap();
+    assert!(reason.contains("data section's CRC does not match") && reason.contains("run"), "{reason}");
+    assert_eq!(count(&rec), u64::from(SAMPLES) * 2);
+    // the intact file's metadata is verified
+    let (_, intact) = read_recording_recover_bytes(&full, "r.mcap").unwrap();
+    assert!(intact.metadata_verified);
+}
+
+/// A chunk copied twice in a row (a copy that went wrong): the normal reader refuses the file,
+/// recovery reads every message once and counts the repeat.
+#[test]
+fn a_repeated_chunk_is_read_once() {
+    let full = recording();
+    let (start, _, len) = *records(&full).iter().filter(|r| r.1 == 0x06).nth(2).unwrap();
+    let chunk = &full[start..start + 9 + len];
+    let mut b = full[..start + 9 + len].to_vec();
+    b.extend_from_slice(chunk);
+    b.extend_from_slice(&full[start + 9 + len..]);
+    assert!(read_recording_bytes(&b, "x").is_err());
+    let (rec, report) = read_recording_recover_bytes(&b, "dup.mcap").unwrap();
+    assert_eq!(report.duplicate_chunks, 1, "{report}");
+    assert!(report.to_string().contains("1 repeated chunks skipped"), "{report}");
+    let normal = read_recording_bytes(&full, "r.mcap").unwrap();
+    assert_eq!(rec.message_map(), normal.message_map());
+    assert_eq!(count(&rec), u64::from(SAMPLES) * 2);
+}
+
+/// Two chunks swapped: time goes backwards on their channels. The normal reader names the topic
+/// and the message; recovery stops at the first message whose time goes backwards, keeping
+/// what came before it (chunks 0 and 2: time in order, with a gap that `analyze` finds
+/// against the output grid).
+#[test]
+fn chunks_out_of_time_order_are_refused() {
+    let full = recording();
+    let chunks: Vec<_> = records(&full).into_iter().filter(|r| r.1 == 0x06).collect();
+    // chunk 1 and chunk 2, each with the message-index records after it, swapped
+    let (a, b0, c0) = (chunks[1].0, chunks[2].0, chunks[3].0);
+    let mut b = full[..a].to_vec();
+    b.extend_from_slice(&full[b0..c0]);
+    b.extend_from_slice(&full[a..b0]);
+    b.extend_from_slice(&full[c0..]);
+    let e = read_recording_bytes(&b, "swap.mcap").unwrap_err();
+    assert!(matches!(e, Error::TimeBackwards { .. }) && e.to_string().contains("time goes backwards"), "{e}");
+    let (rec, report) = read_recording_recover_bytes(&b, "swap.mcap").unwrap();
+    assert!(report.reason.as_deref().unwrap().contains("time goes backwards"), "{report}");
+    assert_eq!(report.stopped_at, (a + (c0 - b0)) as u64, "{report}");
+    for list in rec.message_map().values() {
+        assert!(list.windows(2).all(|w| w[0].0 < w[1].0));
+    }
+}

@@ -312,3 +312,55 @@ fn corruption_without_crcs_never_panics() {
         full.len() * 4
     );
 }
+
+/// Paths that are not regular files are refused before any byte is read (`/dev/zero` would
+/// never end), and a huge file without the MCAP magic after its first 8 bytes: a 20 GB sparse
+/// file is refused as fast as an empty one.
+#[test]
+fn not_a_file_and_huge_non_mcap_files_are_refused_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    for (path, kind) in [(std::path::Path::new("/dev/zero"), "character device"), (dir.path(), "directory")] {
+        let e = schemas::read_recording(path).unwrap_err();
+        assert!(matches!(e, Error::NotAFile { .. }) && e.to_string().contains(kind), "{e}");
+        let e = schemas::read_recording_recover(path).unwrap_err();
+        assert!(matches!(e, Error::NotAFile { .. }), "{e}");
+    }
+    let big = dir.path().join("big.mcap");
+    std::fs::File::create(&big).unwrap().set_len(20 << 30).unwrap();
+    let e = schemas::read_recording(&big).unwrap_err();
+    assert!(matches!(e, Error::NotMcap { len, .. } if len == 20 << 30), "{e}");
+    // the magic, then zeros: opcode 0x00 is no MCAP record, refused at once
+    let zeros = dir.path().join("zeros.mcap");
+    let mut f = std::fs::File::create(&zeros).unwrap();
+    std::io::Write::write_all(&mut f, mcap::MAGIC).unwrap();
+    f.set_len(20 << 30).unwrap();
+    let e = schemas::read_recording(&zeros).unwrap_err();
+    assert!(e.to_string().contains("opcode 0x00"), "{e}");
+    let (_, report) = schemas::read_recording_recover(&zeros).unwrap();
+    assert!(report.reason.as_deref().unwrap().contains("opcode 0x00") && report.messages == 0, "{report}");
+    // a valid recording followed by gigabytes of zeros
+    let tail = dir.path().join("tail.mcap");
+    std::fs::write(&tail, valid_file()).unwrap();
+    std::fs::OpenOptions::new().write(true).open(&tail).unwrap().set_len(20 << 30).unwrap();
+    assert!(schemas::read_recording(&tail).is_err());
+}
+
+/// A file that says it is of a format version newer than this reader's is refused, naming the
+/// record and the version; older versions read.
+#[test]
+fn an_unknown_format_version_is_refused() {
+    for (version, ok) in [("0", true), ("2", true), ("3", false), ("99", false), ("two", false)] {
+        let b = foreign(|w| {
+            let mut m = std::collections::BTreeMap::new();
+            m.insert("format_version".to_string(), version.to_string());
+            w.write_metadata(&mcap::records::Metadata { name: "recording".into(), metadata: m }).unwrap();
+        });
+        match read_recording_bytes(&b, "v.mcap") {
+            Ok(_) => assert!(ok, "version {version} read"),
+            Err(e) => {
+                assert!(!ok, "version {version}: {e}");
+                assert!(matches!(e, Error::UnsupportedFormat { .. }) && e.to_string().contains(&format!("format_version = {version}")), "{e}");
+            }
+        }
+    }
+}

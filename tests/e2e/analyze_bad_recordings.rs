@@ -101,35 +101,36 @@ fn damaged_and_foreign_files_are_clear_errors() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
-        stderr.contains("warning") && stderr.contains("recovered 0 messages"),
+        stderr.contains("damaged recording") && stderr.contains("recovered 0 messages") && stderr.contains("no such record"),
         "{stderr}"
     );
 }
 
-fn metrics_json(args: &[&str]) -> (serde_json::Value, String) {
+fn metrics_json(args: &[&str], code: i32) -> (serde_json::Value, String) {
     let out = run_analyze(args);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
     (serde_json::from_slice(&out.stdout).unwrap(), stderr)
 }
 
-/// `metrics --recover` on a truncated file: exit 0, a warning naming the file and the byte
+/// `metrics --recover` on a truncated file: the metrics of what survived with exit 1 (numbers
+/// from a damaged file are never a plain success), a warning naming the file and the byte
 /// offset, status `incomplete`, fewer samples ending at the last recovered one; an intact file
-/// gives exactly what it gives without `--recover`, without a warning; `compare --recover`
-/// works with a mix of intact and damaged files.
+/// gives exactly what it gives without `--recover`, without a warning, exit 0; `compare
+/// --recover` works with a mix of intact and damaged files (exit 1).
 #[test]
 fn recover_reads_the_intact_part() {
     let dir = tempfile::tempdir().unwrap();
     let good = small().write(&dir.path().join("good.mcap"));
     let bytes = std::fs::read(&good).unwrap();
-    let (plain, _) = metrics_json(&["metrics", s(&good), "-f", "json"]);
-    let (recovered, stderr) = metrics_json(&["metrics", "--recover", s(&good), "-f", "json"]);
+    let (plain, _) = metrics_json(&["metrics", s(&good), "-f", "json"], 0);
+    let (recovered, stderr) = metrics_json(&["metrics", "--recover", s(&good), "-f", "json"], 0);
     assert_eq!(plain, recovered);
     assert!(stderr.is_empty(), "{stderr}");
 
     let cut = dir.path().join("cut.mcap");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    let (m, stderr) = metrics_json(&["metrics", "--recover", s(&cut), "-f", "json"]);
+    let (m, stderr) = metrics_json(&["metrics", "--recover", s(&cut), "-f", "json"], 1);
     assert!(
         stderr.starts_with(&format!(
             "analyze: warning: {}: damaged recording: stopped at byte ",
@@ -164,7 +165,7 @@ fn recover_reads_the_intact_part() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(
         out.status.code(),
-        Some(0),
+        Some(1),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );

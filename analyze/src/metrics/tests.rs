@@ -254,3 +254,65 @@ fn json_round_trips() {
     assert_eq!(serde_json::from_str::<RunMetrics>(&text).unwrap(), m);
     assert!(text.contains(r#""status":"complete""#), "{text}");
 }
+
+fn read_err(s: &Synth) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    read_run_metrics(&s.write_in(dir.path())).unwrap_err().to_string()
+}
+
+/// A NaN or an infinity in any field of a metric topic is an error naming the topic, the
+/// field, the message and the time, never a `null` peak.
+#[test]
+fn non_finite_values_are_errors_naming_topic_field_and_time() {
+    let mut s = Synth::new("nan", &["elbow"], 2);
+    s.motors = Some(currents(|t| vec![1.0, if (t - 0.5).abs() < 1e-9 { f64::NAN } else { t }]));
+    let e = read_err(&s);
+    assert!(e.contains("topic /motors, field current[1], message #50 (t = 0.5 s): NaN is not a finite number"), "{e}");
+    let mut s = Synth::new("inf", &["elbow"], 2);
+    s.constraints = Some(contact_forces(|t| vec![[if t > 0.25 { f64::INFINITY } else { 1.0 }, 0.0, 0.0]]));
+    let e = read_err(&s);
+    assert!(e.contains("topic /constraints, field normal_force[0], message #26") && e.contains("inf is not a finite number"), "{e}");
+}
+
+/// With the `run` record's output grid (`sim` writes it), every sample must lie on it: a clock
+/// scaled by 1000 (another producer's ms for s) or a missing sample is an error naming the
+/// first sample off the grid; a complete run must reach its duration. Without a setup (other
+/// producers) only the order of time is checked.
+#[test]
+fn samples_off_the_recorded_grid_are_errors() {
+    let (_d, m) = read(&Synth::new("on-grid", &["elbow"], 2).with_setup());
+    assert_eq!(m.samples, 101);
+    let mut s = Synth::new("scaled", &["elbow"], 2).with_setup();
+    s.time_scale = 1000.0;
+    let e = read_err(&s);
+    assert!(e.contains("message #1: t = 10 s, but the run's output grid (100 Hz) puts sample #1 at 0.01 s"), "{e}");
+    let mut s = Synth::new("gap", &["elbow"], 2).with_setup();
+    s.drop_sample = Some(40);
+    let e = read_err(&s);
+    assert!(e.contains("message #40: t = 0.41 s") && e.contains("samples missing"), "{e}");
+    let mut s = Synth::new("short", &["elbow"], 2).with_setup();
+    s.n = 50;
+    s.setup.as_mut().unwrap().duration_s = 1.0;
+    let e = read_err(&s);
+    assert!(e.contains("recorded as complete, but its 51 samples end at t = 0.5 s, before the duration 1 s"), "{e}");
+    // a failed run may stop early
+    s.result = Some(RunResult { status: RunStatus::Failed, error: Some("step size underflow".into()), error_time_s: Some(0.5), ..RunResult::complete(0, 0, 0) });
+    let (_d, m) = read(&s);
+    assert_eq!((m.status, m.samples), (Status::Failed, 51));
+    let mut s = Synth::new("foreign", &["elbow"], 2);
+    s.time_scale = 1000.0;
+    let (_d, m) = read(&s);
+    assert_eq!(m.t_end_s, 1000.0);
+}
+
+/// Two joints (or contacts) with one name would make a joint disappear from every table.
+#[test]
+fn duplicate_joint_or_contact_names_are_refused() {
+    let mut s = Synth::new("dup", &["elbow", "elbow"], 2);
+    let e = read_err(&s);
+    assert!(e.contains("metadata run.contact names = \"elbow\": named twice"), "{e}");
+    s.names.as_mut().unwrap().contacts = vec!["a".into(), "b".into()];
+    s.names.as_mut().unwrap().joint_names = Some(vec!["j".into(), "j".into()]);
+    let e = read_err(&s);
+    assert!(e.contains("run.joint names = \"j\": named twice"), "{e}");
+}

@@ -1,23 +1,41 @@
 //! Reading the intact part of a damaged recording (`analyze ... --recover`).
 //!
-//! A recording cut short (a killed run leaves its hidden `.NAME.partial`, a copy stops, a disk
-//! fills) has no summary and no footer, so [`super::read_recording_bytes`] rejects it. Its data
+//! A recording cut short (a killed run leaves its hidden temporary file, a copy stops, a disk
+//! fills) has no summary and no footer, so [`super::stream_recording`] rejects it. Its data
 //! section is still a sequence of self-contained records (MCAP spec: a chunk carries its own
 //! schemas and channels, is compressed on its own and has its own CRC), so everything before the
-//! damage can be read: [`read_recording_recover_bytes`] walks the top-level records from the
-//! start and decodes them one at a time (a chunk as a whole: its CRC is checked before any of its
+//! damage can be read: [`stream_recording_recover`] first checks the file as the normal reader
+//! does without decoding anything; if that fails, it walks the top-level records from the start
+//! and decodes them one at a time (a chunk as a whole: its CRC is checked before any of its
 //! messages is used, and a chunk that fails anywhere contributes nothing), and stops at the first
 //! record that is cut short or does not read, or at the end of the data section. Messages and
 //! metadata records before that point are returned, with a [`RecoverReport`] saying how much
 //! was read and where and why it stopped.
+//!
+//! Nothing that failed a CRC is used:
+//! - a chunk is used only after its own CRC matched;
+//! - metadata records lie outside chunks and have no CRC of their own: the data section's CRC
+//!   (in its Data End record) covers them. When that CRC does not match, the damage is outside
+//!   the chunks that passed, so **every metadata record is left out** (the report says so) — a
+//!   record with swapped contact names would otherwise label the forces wrongly. When the file
+//!   ends before the Data End record, its metadata cannot be checked and the report says
+//!   [`RecoverReport::metadata_verified`] = false;
+//! - a chunk that is byte for byte a repeat of one already read (a copy that went wrong) is
+//!   skipped and counted ([`RecoverReport::duplicate_chunks`]); any other repeat makes time go
+//!   backwards on a channel, which stops the reading there.
+//!
+//! Memory: one record at a time (at most [`super::MAX_RECORD_BYTES`]), the decoded messages of
+//! one chunk until it is read whole, and a fingerprint (length and CRC-32) per chunk.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::fmt;
+use std::io::Read;
 use std::path::Path;
 
 use mcap::records::op;
 
-use super::{feed, read_recording_bytes, reader_options, Recording, State};
+use super::input::{open, read_up_to};
+use super::{feed, read_state, reader_options, Collect, Null, Recording, State, Visitor, MAX_RECORD_BYTES};
 use crate::Error;
 
 /// How much of a recording [`read_recording_recover`] read.
@@ -44,6 +62,12 @@ pub struct RecoverReport {
     pub t_end_ns: Option<u64>,
     /// Names of the metadata records read.
     pub metadata: Vec<String>,
+    /// Whether the metadata records were checked by the data section's CRC (always when
+    /// `complete`; never when the file ends before its Data End record). Metadata that failed
+    /// the check is not read at all.
+    pub metadata_verified: bool,
+    /// Chunks skipped because they repeat, byte for byte, a chunk already read.
+    pub duplicate_chunks: usize,
 }
 
 impl RecoverReport {
@@ -73,93 +97,119 @@ impl fmt::Display for RecoverReport {
         write!(
             f,
             "{}: damaged recording: stopped at byte {} of {}: {}; recovered {} messages in {} \
-             complete chunks ({t_end}) and metadata records: {meta}",
+             complete chunks ({t_end}) and metadata records: {meta}{}",
             self.source,
             self.stopped_at,
             self.file_len,
             self.reason.as_deref().unwrap_or("unknown"),
             self.messages,
-            self.chunks
-        )
+            self.chunks,
+            if self.metadata_verified || self.metadata.is_empty() {
+                ""
+            } else {
+                " (not checked by a CRC: the file ends before the data section's CRC)"
+            }
+        )?;
+        if self.duplicate_chunks > 0 {
+            write!(f, "; {} repeated chunks skipped", self.duplicate_chunks)?;
+        }
+        Ok(())
     }
 }
 
-/// Reads the intact part of the MCAP file at `path` (see the module docs). An intact file
-/// gives what [`crate::read_recording`] gives, with `complete: true`.
+/// Reads the intact part of the MCAP file at `path`, keeping every message (see the module
+/// docs). An intact file gives what [`crate::read_recording`] gives, with `complete: true`.
 ///
-/// Errors only when nothing can be read at all: the file cannot be read, or is not MCAP (no
-/// magic). A file whose damage starts at its first record gives an empty recording.
+/// Errors only when nothing can be read at all: the file cannot be read, is not a regular
+/// file, or is not MCAP (no magic). A file whose damage starts at its first record gives an
+/// empty recording.
 pub fn read_recording_recover(path: &Path) -> Result<(Recording, RecoverReport), Error> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        file: file.clone(),
-        op: "reading",
-        source,
-    })?;
-    read_recording_recover_bytes(&bytes, &file)
+    let mut all = Collect::default();
+    let (mut rec, report) = stream_recording_recover(path, None, &mut all)?;
+    rec.messages = all.0;
+    Ok((rec, report))
 }
 
 /// [`read_recording_recover`] on bytes; `source` labels them in errors and in the report.
-pub fn read_recording_recover_bytes(
-    bytes: &[u8],
-    source: &str,
+pub fn read_recording_recover_bytes(bytes: &[u8], source: &str) -> Result<(Recording, RecoverReport), Error> {
+    if !bytes.starts_with(mcap::MAGIC) {
+        return Err(Error::NotMcap { file: source.to_string(), len: bytes.len() as u64 });
+    }
+    let mut all = Collect::default();
+    let open_bytes = || -> Result<(Box<dyn Read + '_>, u64, String), Error> { Ok((Box::new(bytes), bytes.len() as u64, source.to_string())) };
+    let (mut rec, report) = recover_from(open_bytes, None, &mut all)?;
+    rec.messages = all.0;
+    Ok((rec, report))
+}
+
+/// Streams the intact part of the MCAP file at `path` to `visitor` (see the module docs):
+/// the messages of `topics` (all when `None`), then the metadata and channels read, and the
+/// report. An intact file is read twice (checked first without decoding anything, then read).
+pub fn stream_recording_recover(
+    path: &Path,
+    topics: Option<&[&str]>,
+    visitor: &mut dyn Visitor,
 ) -> Result<(Recording, RecoverReport), Error> {
-    let normal = match read_recording_bytes(bytes, source) {
-        Ok(rec) => {
-            let report = RecoverReport {
-                source: source.to_string(),
-                file_len: bytes.len() as u64,
-                complete: true,
-                stopped_at: bytes.len() as u64,
-                reason: None,
-                chunks: count_chunks(bytes),
-                messages: rec.channels.iter().map(|c| c.message_count as u64).sum(),
-                t_end_ns: rec
-                    .messages
-                    .values()
-                    .filter_map(|l| l.iter().map(|(t, _)| *t).max())
-                    .max(),
-                metadata: rec.metadata.keys().cloned().collect(),
-            };
-            return Ok((rec, report));
-        }
-        Err(e @ Error::NotMcap { .. }) => return Err(e),
-        Err(e) => e,
+    let open_path = || -> Result<(Box<dyn Read>, u64, String), Error> {
+        let (file, len, label) = open(path)?;
+        Ok((Box::new(file), len, label))
     };
-    Ok(scan(bytes, source, &normal))
+    recover_from(open_path, topics, visitor)
+}
+
+/// `open` gives the input from its start, its length and its label, each time it is called.
+fn recover_from<'a>(
+    open: impl Fn() -> Result<(Box<dyn Read + 'a>, u64, String), Error>,
+    topics: Option<&[&str]>,
+    visitor: &mut dyn Visitor,
+) -> Result<(Recording, RecoverReport), Error> {
+    let (mut input, len, label) = open()?;
+    let checked = read_state(&mut input, len, label, Some(&[]), &mut Null);
+    let (state, report) = match checked {
+        Ok(_) => {
+            let (mut input, len, label) = open()?;
+            let state = read_state(&mut input, len, label, topics, visitor)?;
+            let report = complete_report(&state, len);
+            (state, report)
+        }
+        Err(e @ (Error::NotMcap { .. } | Error::NotAFile { .. } | Error::Io { .. })) => return Err(e),
+        Err(e) => {
+            let (mut input, len, label) = open()?;
+            scan(&mut input, len, &label, topics, visitor, &e)?
+        }
+    };
+    Ok((state.into_recording(), report))
+}
+
+/// The report of a file the normal reader accepted whole.
+fn complete_report(state: &State, len: u64) -> RecoverReport {
+    RecoverReport {
+        source: state.file.clone(),
+        file_len: len,
+        complete: true,
+        stopped_at: len,
+        reason: None,
+        chunks: state.stats_chunks.map_or(0, |n| n as usize),
+        messages: state.total,
+        t_end_ns: state.t_end_ns,
+        metadata: state.metadata.keys().cloned().collect(),
+        metadata_verified: true,
+        duplicate_chunks: 0,
+    }
 }
 
 /// Opcode (1 byte) and length (u64 LE) before every record.
 const RECORD_HEAD: usize = 9;
 
-/// Chunk records in the data section of an intact file.
-fn count_chunks(bytes: &[u8]) -> usize {
-    let mut at = mcap::MAGIC.len();
-    let mut n = 0;
-    while let Some(head) = bytes.get(at..at + RECORD_HEAD) {
-        let len = u64::from_le_bytes(head[1..].try_into().unwrap_or([0; 8]));
-        match head[0] {
-            op::DATA_END | op::FOOTER => break,
-            op::CHUNK => n += 1,
-            _ => {}
-        }
-        let Some(next) = usize::try_from(len)
-            .ok()
-            .and_then(|l| at.checked_add(RECORD_HEAD)?.checked_add(l))
-        else {
-            break;
-        };
-        at = next;
-    }
-    n
-}
-
 /// What the state held before a record, to undo a record that fails halfway.
 struct Snapshot {
     schemas: BTreeSet<u16>,
     channels: BTreeMap<u16, usize>,
-    messages: BTreeMap<String, usize>,
+    last_time: BTreeMap<u16, u64>,
+    t_end_ns: Option<u64>,
     metadata: BTreeMap<String, BTreeMap<String, String>>,
+    first_joint_array_len: Option<usize>,
+    energy_has_gear_friction: Option<bool>,
     total: u64,
 }
 
@@ -167,17 +217,12 @@ impl Snapshot {
     fn take(s: &State) -> Self {
         Snapshot {
             schemas: s.schemas.keys().copied().collect(),
-            channels: s
-                .channels
-                .iter()
-                .map(|(&id, c)| (id, c.message_count))
-                .collect(),
-            messages: s
-                .messages
-                .iter()
-                .map(|(t, l)| (t.clone(), l.len()))
-                .collect(),
+            channels: s.channels.iter().map(|(&id, c)| (id, c.message_count)).collect(),
+            last_time: s.last_time.clone(),
+            t_end_ns: s.t_end_ns,
             metadata: s.metadata.clone(),
+            first_joint_array_len: s.first_joint_array_len,
+            energy_has_gear_friction: s.energy_has_gear_friction,
             total: s.total,
         }
     }
@@ -189,100 +234,126 @@ impl Snapshot {
         for (id, c) in &mut s.channels {
             c.message_count = self.channels[id];
         }
-        s.messages.retain(|t, _| self.messages.contains_key(t));
-        for (t, l) in &mut s.messages {
-            l.truncate(self.messages[t]);
-        }
+        s.last_time = self.last_time;
+        s.t_end_ns = self.t_end_ns;
         s.metadata = self.metadata;
+        s.first_joint_array_len = self.first_joint_array_len;
+        s.energy_has_gear_friction = self.energy_has_gear_friction;
         s.total = self.total;
+        if let Some(p) = s.pending.as_mut() {
+            p.clear();
+        }
     }
 }
 
-fn scan(bytes: &[u8], source: &str, normal: &Error) -> (Recording, RecoverReport) {
-    let mut state = State {
-        file: source.to_string(),
-        ..State::default()
-    };
+/// Walks the top-level records of `input` (at its start, `len` bytes) one at a time; `normal`
+/// is why the normal reader refused the file.
+fn scan(
+    input: &mut dyn Read,
+    len: u64,
+    source: &str,
+    topics: Option<&[&str]>,
+    visitor: &mut dyn Visitor,
+    normal: &Error,
+) -> Result<(State, RecoverReport), Error> {
+    let mut state = State::new(source.to_string(), topics);
+    state.pending = Some(Vec::new());
     // one record at a time: no magic before it, none expected after it
-    let options = reader_options(bytes.len())
+    let options = reader_options()
         .with_skip_start_magic(true)
         .with_skip_end_magic(true)
         .with_check_finishes_after_end_magic(false);
+    let read_err = |e: std::io::Error| Error::Io { file: source.to_string(), op: "reading", source: e };
     let prefix = format!("{source}: ");
-    let mut at = mcap::MAGIC.len();
+    let strip = |e: &Error| {
+        let why = e.to_string();
+        why.strip_prefix(&prefix).unwrap_or(&why).to_string()
+    };
+    // the data section's CRC covers every byte from the magic to the Data End record
+    let mut crc = crc32fast::Hasher::new();
+    let mut magic = [0u8; 8];
+    let n = read_up_to(input, &mut magic).map_err(read_err)?;
+    crc.update(&magic[..n]);
+    let mut at = n as u64;
     let mut chunks = 0;
-    let mut t_end_ns: Option<u64> = None;
+    let mut duplicate_chunks = 0;
+    let mut seen_chunks: HashSet<(u64, u32)> = HashSet::new();
+    let mut metadata_verified = false;
+    let mut buf: Vec<u8> = Vec::new();
     let reason = loop {
-        let left = bytes.len() - at;
+        let left = len - at;
         if left == 0 {
-            break "the file ends after a complete record, before the end of the data section"
-                .to_string();
+            break "the file ends after a complete record, before the end of the data section".to_string();
         }
-        if left < RECORD_HEAD {
-            break format!("a record header is cut short ({left} of {RECORD_HEAD} bytes)");
+        let mut head = [0u8; RECORD_HEAD];
+        let got = read_up_to(input, &mut head).map_err(read_err)?;
+        if got < RECORD_HEAD {
+            break format!("a record header is cut short ({got} of {RECORD_HEAD} bytes)");
         }
-        let opcode = bytes[at];
-        let len = u64::from_le_bytes(bytes[at + 1..at + RECORD_HEAD].try_into().unwrap_or([0; 8]));
-        if len > (left - RECORD_HEAD) as u64 {
+        let opcode = head[0];
+        let rec_len = u64::from_le_bytes(head[1..].try_into().unwrap_or([0; 8]));
+        let rest = left - RECORD_HEAD as u64;
+        if rec_len > rest {
+            break format!("record (opcode {opcode:#04x}) of {rec_len} bytes is cut short: {rest} bytes remain");
+        }
+        if rec_len > MAX_RECORD_BYTES as u64 {
             break format!(
-                "record (opcode {opcode:#04x}) of {len} bytes is cut short: {} bytes remain",
-                left - RECORD_HEAD
+                "record (opcode {opcode:#04x}) of {rec_len} bytes is longer than this reader's limit of {MAX_RECORD_BYTES} bytes"
             );
+        }
+        buf.clear();
+        buf.extend_from_slice(&head);
+        buf.resize(RECORD_HEAD + rec_len as usize, 0);
+        let got = read_up_to(input, &mut buf[RECORD_HEAD..]).map_err(read_err)?;
+        if got < rec_len as usize {
+            break format!("record (opcode {opcode:#04x}) of {rec_len} bytes is cut short: {got} bytes remain");
         }
         if opcode == op::DATA_END || opcode == op::FOOTER {
-            let why = normal.to_string();
-            break format!(
-                "the data section is intact, what follows it is not: {}",
-                why.strip_prefix(&prefix).unwrap_or(&why)
-            );
+            if opcode == op::DATA_END {
+                let saved = buf.get(RECORD_HEAD..RECORD_HEAD + 4).map_or(0, |b| u32::from_le_bytes(b.try_into().unwrap_or([0; 4])));
+                let calculated = crc.clone().finalize();
+                if saved != 0 && saved != calculated {
+                    let dropped: Vec<String> = state.metadata.keys().cloned().collect();
+                    state.metadata.clear();
+                    break format!(
+                        "the data section's CRC does not match (saved {saved:#010x}, calculated {calculated:#010x}): the chunks passed their own CRCs, so the damage is outside them, and the metadata records ({}) are left out",
+                        if dropped.is_empty() { "none".to_string() } else { dropped.join(", ") }
+                    );
+                }
+                metadata_verified = true;
+            }
+            break format!("the data section is intact, what follows it is not: {}", strip(normal));
         }
-        let end = at + RECORD_HEAD + len as usize;
+        crc.update(&buf);
+        if opcode == op::CHUNK && !seen_chunks.insert((rec_len, crc32fast::hash(&buf))) {
+            duplicate_chunks += 1;
+            at += buf.len() as u64;
+            continue;
+        }
         let snapshot = Snapshot::take(&state);
-        let before: BTreeMap<String, usize> = snapshot.messages.clone();
-        let fed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            feed(&bytes[at..end], options.clone(), &mut state)
-        }));
-        let failure = match fed {
-            Ok(Ok(())) => None,
-            Ok(Err(e)) => {
-                let why = e.to_string();
-                Some(why.strip_prefix(&prefix).unwrap_or(&why).to_string())
-            }
-            Err(panic) => {
-                let why = panic
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| panic.downcast_ref::<String>().cloned())
-                    .unwrap_or_default();
-                Some(format!("the MCAP parser panicked on this record: {why}"))
-            }
-        };
-        if let Some(why) = failure {
+        let mut record = buf.as_slice();
+        let fed = feed(&mut record, options.clone(), &mut state, visitor);
+        if let Err(e) = fed.and_then(|()| state.commit(visitor)) {
             snapshot.restore(&mut state);
-            break format!("record (opcode {opcode:#04x}) is unreadable: {why}");
-        }
-        for (topic, list) in &state.messages {
-            let from = before.get(topic).copied().unwrap_or(0);
-            if let Some(t) = list[from..].iter().map(|(t, _)| *t).max() {
-                t_end_ns = Some(t_end_ns.map_or(t, |e| e.max(t)));
-            }
+            break format!("record (opcode {opcode:#04x}) at byte {at} is unreadable: {}", strip(&e));
         }
         if opcode == op::CHUNK {
             chunks += 1;
         }
-        at = end;
+        at += buf.len() as u64;
     };
-    // messages of undecoded channels count too, but have no time in `state.messages`
     let report = RecoverReport {
         source: source.to_string(),
-        file_len: bytes.len() as u64,
+        file_len: len,
         complete: false,
-        stopped_at: at as u64,
+        stopped_at: at,
         reason: Some(reason),
         chunks,
         messages: state.total,
-        t_end_ns,
+        t_end_ns: state.t_end_ns,
         metadata: state.metadata.keys().cloned().collect(),
+        metadata_verified,
+        duplicate_chunks,
     };
-    (state.into_recording(), report)
+    Ok((state, report))
 }

@@ -6,11 +6,10 @@
 
 use std::collections::BTreeMap;
 
-use super::Recording;
+use super::{decode_typed, Recording};
 use crate::messages::TopicMessage;
 use crate::meta::{from_entries, MetadataRecord, RecordingInfo, RunDescription, RunNames, RunResult, SceneRecord, Setup, UrdfRecord, SETUP_KEY};
-use crate::topics::{self, array_index, array_required, ArrayIndex};
-use crate::value::{from_value, Value};
+use crate::value::Value;
 use crate::{from_log_time, Error};
 
 /// How long the per-joint and per-contact arrays of every message must be
@@ -60,7 +59,7 @@ impl Recording {
         let names: RunNames = self.record()?;
         let joint_names = match (names.joint_names, self.format_version()) {
             (Some(j), _) => j,
-            (None, Some(0)) => (1..=self.first_joint_array_len().unwrap_or(0)).map(|k| format!("joint{k}")).collect(),
+            (None, Some(0)) => (1..=self.first_joint_array_len.unwrap_or(0)).map(|k| format!("joint{k}")).collect(),
             (None, _) => return Err(self.meta_err(RunNames::NAME, "missing field `joint_names` (every format since 1 has it)".into())),
         };
         let entries = &self.metadata[RunNames::NAME];
@@ -77,18 +76,6 @@ impl Recording {
             true => self.run().map(Some),
             false => Ok(None),
         }
-    }
-
-    /// The length of the first joint-indexed array among the decoded messages (format 0).
-    fn first_joint_array_len(&self) -> Option<usize> {
-        self.messages.iter().find_map(|(topic, list)| {
-            let (_, first) = list.first()?;
-            let Value::Struct(fields) = first else { return None };
-            fields.iter().find_map(|(field, v)| match (array_index(topic, field), v) {
-                (Some(ArrayIndex::Joint), Value::List(items)) => Some(items.len()),
-                _ => None,
-            })
-        })
     }
 
     /// Record `scene`: the scene JSON as run, and where it came from.
@@ -125,36 +112,7 @@ impl Recording {
         let list = self.topic_messages(topic)?;
         let mut out = Vec::with_capacity(list.len());
         for (index, (t_ns, v)) in list.iter().enumerate() {
-            let t_s = from_log_time(*t_ns);
-            if let (Some(sizes), Value::Struct(fields)) = (sizes, v) {
-                for (field, value) in fields {
-                    let (Some(kind), Value::List(items)) = (array_index(topic, field), value) else { continue };
-                    let (expected, per) = match kind {
-                        ArrayIndex::Joint => (sizes.joints, "joint"),
-                        ArrayIndex::Contact => (sizes.contacts, "contact"),
-                    };
-                    if items.len() != expected && (array_required(topic, field) || !items.is_empty()) {
-                        return Err(Error::WrongLength {
-                            file: self.source.clone(),
-                            topic: topic.into(),
-                            field: field.clone(),
-                            index,
-                            t_s,
-                            found: items.len(),
-                            expected,
-                            per,
-                        });
-                    }
-                }
-            }
-            let msg = from_value(v).map_err(|e| Error::Field {
-                file: self.source.clone(),
-                topic: topic.into(),
-                index,
-                log_time_ns: *t_ns,
-                detail: e.to_string(),
-            })?;
-            out.push((t_s, msg));
+            out.push((from_log_time(*t_ns), decode_typed(&self.source, topic, index, *t_ns, v, sizes)?));
         }
         Ok(out)
     }
@@ -162,8 +120,15 @@ impl Recording {
     /// The decoded messages of `topic` (empty for a channel without messages); an error when the
     /// file has no such topic or did not decode it.
     fn topic_messages(&self, topic: &str) -> Result<&[(u64, Value)], Error> {
-        if let Some(list) = self.messages.get(topic) {
-            return Ok(list);
+        self.check_topic(topic)?;
+        Ok(self.messages.get(topic).map_or(&[], Vec::as_slice))
+    }
+
+    /// The file has a channel on `topic` and decoded it (when read for that topic); an error
+    /// naming the topics it has, or why it was not decoded.
+    pub fn check_topic(&self, topic: &str) -> Result<(), Error> {
+        if self.messages.contains_key(topic) {
+            return Ok(());
         }
         let chans: Vec<_> = self.channels.iter().filter(|c| c.topic == topic).collect();
         if chans.is_empty() {
@@ -173,12 +138,26 @@ impl Recording {
         if let Some(reason) = chans.iter().find_map(|c| c.undecoded.clone()) {
             return Err(Error::UndecodedTopic { file: self.source.clone(), topic: topic.into(), reason });
         }
-        Ok(&[])
+        Ok(())
+    }
+
+    /// Hands the decoded messages of `topics` to `visitor`, topic by topic in the order given,
+    /// each in time order, as [`crate::stream_recording`] would (with the `run` record read):
+    /// one computation serves a streamed read and a recording already in memory.
+    pub fn replay(&self, topics: &[&str], visitor: &mut dyn crate::Visitor) -> Result<(), Error> {
+        let run = self.run_opt()?;
+        for &topic in topics {
+            for (index, (log_time_ns, value)) in self.topic_messages(topic)?.iter().enumerate() {
+                let m = crate::DecodedMessage { file: &self.source, topic, index, log_time_ns: *log_time_ns, value: value.clone(), run: run.as_ref() };
+                visitor.message(m)?;
+            }
+        }
+        Ok(())
     }
 
     /// Whether `/energy` records the gears' friction loss apart (format 2 on; the field is in
     /// the file's schema), so that a 0 read from an older file is not taken for a value.
     pub fn has_gear_friction_loss(&self) -> bool {
-        self.messages.get(topics::ENERGY).and_then(|l| l.first()).is_some_and(|(_, v)| v.get("gear_friction_loss").is_some())
+        self.energy_has_gear_friction
     }
 }

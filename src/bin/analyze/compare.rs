@@ -52,7 +52,9 @@ pub struct MetricsArgs {
     /// Read what is intact of damaged (e.g. truncated) recordings: the messages of every
     /// complete chunk and the metadata before the damage. A warning on stderr names each
     /// damaged file, the byte offset where reading stopped and what was recovered; a run cut
-    /// short before its result is reported as status `incomplete`.
+    /// short before its result is reported as status `incomplete`. Nothing that failed a CRC
+    /// is used (metadata that fails the data section's CRC is left out; a repeated chunk is
+    /// read once). Exit status 1 when any file was damaged.
     #[arg(long)]
     pub recover: bool,
     #[command(flatten)]
@@ -60,14 +62,14 @@ pub struct MetricsArgs {
 }
 
 pub fn compare(a: &CompareArgs, v: Verbosity) -> Result<u8> {
-    let runs = crate::load::metrics(&a.inputs, a.recover, v)?;
+    let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
     let cmp = Comparison::new(&runs, a.baseline.as_deref())?;
     print_out(&render_comparison(&cmp, a.format.format)?)?;
-    Ok(exit::SUCCESS)
+    Ok(if damaged { exit::FAILED } else { exit::SUCCESS })
 }
 
 pub fn metrics(a: &MetricsArgs, v: Verbosity) -> Result<u8> {
-    let runs = crate::load::metrics(&a.inputs, a.recover, v)?;
+    let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
     print_out(&render_metrics(&runs, a.format.format)?)?;
-    Ok(exit::SUCCESS)
+    Ok(if damaged { exit::FAILED } else { exit::SUCCESS })
 }
