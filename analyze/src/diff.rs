@@ -23,7 +23,10 @@
 //! `|B − A| / max(|A|, |B|)` (0 when both are 0). A quantity one run has and the other lacks
 //! (a joint or contact only on one side, no motors) is **missing**, which counts as a
 //! difference; one that the other input's *format* does not carry (e.g. per-link peak currents
-//! in a CSV table) is **not compared** and does not.
+//! in a CSV table, or a section left out of a JSON table) is **not compared**, which also counts
+//! as a difference unless the caller asks for the common quantities only
+//! ([`Diff::common_only`], `analyze diff --common-only`): "no differences" is never said of
+//! quantities that were not compared.
 
 use serde::{Deserialize, Serialize};
 
@@ -301,12 +304,23 @@ pub struct Diff {
     pub missing: usize,
     pub same: usize,
     pub not_compared: usize,
+    /// Quantities that only one input's format carries are left out of the verdict.
+    #[serde(default)]
+    pub common_only: bool,
 }
 
 impl Diff {
-    /// True when something moved beyond the tolerances or is missing on one side.
+    /// True when something moved beyond the tolerances or is missing on one side (or, unless
+    /// [`Diff::common_only`], is carried by one input's format only).
     pub fn differs(&self) -> bool {
-        self.moved + self.missing + self.only_in_a.len() + self.only_in_b.len() > 0
+        let uncompared = if self.common_only { 0 } else { self.not_compared };
+        self.moved + self.missing + uncompared + self.only_in_a.len() + self.only_in_b.len() > 0
+    }
+
+    /// Judges only the quantities both inputs carry (`--common-only`).
+    pub fn common_only(mut self, yes: bool) -> Self {
+        self.common_only = yes;
+        self
     }
 }
 
@@ -360,6 +374,7 @@ pub fn diff(a: &Input, b: &Input, tol: Tolerance) -> Result<Diff, DiffError> {
         missing: 0,
         same: 0,
         not_compared: 0,
+        common_only: false,
     };
     for (ra, rb) in pairs {
         out.runs.push(RunPair {

@@ -287,11 +287,16 @@ fn exported_tables_match_the_recordings_they_came_from() {
         assert_eq!(code, 0, "{err}");
         std::fs::write(&table, text).unwrap();
         let (code, out, err) = run(&["diff", s(&table), s(&runs)]);
-        assert_eq!(code, 0, "{cmd} {fmt}: {out}{err}");
-        assert!(out.contains("no differences beyond"), "{out}");
         if fmt == "csv" {
-            // CSV has no per-link peak currents: 4 joints x 2 runs, not compared
-            assert!(out.contains("8 quantities not compared"), "{out}");
+            // CSV has no per-link peak currents: 4 joints x 2 runs, a difference unless told
+            assert_eq!(code, 1, "{cmd} {fmt}: {out}{err}");
+            assert!(out.contains("8 carried by one input only"), "{out}");
+            let (code, out, err) = run(&["diff", s(&table), s(&runs), "--common-only"]);
+            assert_eq!(code, 0, "{cmd} {fmt}: {out}{err}");
+            assert!(out.contains("8 quantities not compared") && out.contains("no differences beyond"), "{out}");
+        } else {
+            assert_eq!(code, 0, "{cmd} {fmt}: {out}{err}");
+            assert!(out.contains("no differences beyond"), "{out}");
         }
         // the table's one run against the recording alone (matched by run name)
         let (code, out, _) = run(&["diff", s(&a), s(&table)]);
@@ -378,7 +383,7 @@ fn previous_format_version_still_loads_and_diffs() {
     std::fs::write(&csv, &table).unwrap();
     assert!(table.lines().next().unwrap().contains("W.joint1_j"), "{table}");
     assert_eq!(table.lines().count(), 2);
-    let (code, out, err) = run(&["diff", s(&csv), s(&old)]);
+    let (code, out, err) = run(&["diff", s(&csv), s(&old), "--common-only"]);
     assert_eq!(code, 0, "{out}{err}");
 
     // the tolerance is for version 0 only: a current file without joint_names is an error
@@ -390,4 +395,26 @@ fn previous_format_version_still_loads_and_diffs() {
     let (code, _, err) = run(&["metrics", s(&bad)]);
     assert_eq!(code, 2);
     assert!(err.contains("joint_names"), "{err}");
+}
+
+/// A JSON table with a section left out (here every contact's quantities, or the energy audit)
+/// is not "no differences": the quantities it lacks are a difference (exit 1) unless
+/// `--common-only` asks for the common ones.
+#[test]
+fn a_table_with_missing_sections_is_a_difference() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = write_run(&dir.path().join("small.mcap"), &Run::default());
+    let (code, text, err) = run(&["metrics", s(&a), "-f", "json"]);
+    assert_eq!(code, 0, "{err}");
+    for section in ["contact_forces", "energy", "links"] {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v[0].as_object_mut().unwrap().remove(section).unwrap();
+        let table = dir.path().join(format!("no-{section}.json"));
+        std::fs::write(&table, v.to_string()).unwrap();
+        let (code, out, err) = run(&["diff", s(&table), s(&a)]);
+        assert_eq!(code, 1, "{section}: {out}{err}");
+        assert!(out.contains("carried by one input only") && !out.contains("no differences"), "{section}: {out}");
+        let (code, out, err) = run(&["diff", s(&table), s(&a), "--common-only"]);
+        assert_eq!(code, 0, "{section}: {out}{err}");
+    }
 }

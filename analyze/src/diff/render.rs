@@ -123,9 +123,9 @@ pub fn render_diff(d: &Diff, format: Format, all: bool) -> Result<String, Error>
                     d.same
                 );
             }
-            if d.not_compared > 0 {
+            if d.not_compared > 0 && d.common_only {
                 out += &format!(
-                    "{} quantities not compared (only one input's format carries them)\n",
+                    "{} quantities not compared (only one input's format carries them; --common-only)\n",
                     d.not_compared
                 );
             }
@@ -134,6 +134,12 @@ pub fn render_diff(d: &Diff, format: Format, all: bool) -> Result<String, Error>
                 let mut what = vec![format!("{} quantities moved beyond {tol}", d.moved)];
                 if d.missing > 0 {
                     what.push(format!("{} missing on one side", d.missing));
+                }
+                if d.not_compared > 0 && !d.common_only {
+                    what.push(format!(
+                        "{} carried by one input only (a table of another format or version, or with sections left out; --common-only compares the rest)",
+                        d.not_compared
+                    ));
                 }
                 let runs = d.only_in_a.len() + d.only_in_b.len();
                 if runs > 0 {

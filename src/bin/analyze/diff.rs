@@ -8,7 +8,8 @@ use cli::{exit, print_out, TableFormat};
 /// Compare two recordings, directories of recordings or exported tables run by run (matched by
 /// run name): hand error, E and W totals, per-link W_j and E_j, currents, contact forces,
 /// energy residual, with absolute and relative differences. Exit status 0: nothing moved beyond
-/// the tolerances; 1: something moved (or is missing on one side); 2: bad input.
+/// the tolerances; 1: something moved, is missing on one side, or is carried by one input only;
+/// 2: bad input.
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Output: the quantities that moved (--all: every one), with A, B, B - A and the relative
@@ -19,7 +20,8 @@ Examples:
   analyze diff recordings/paper-archive-two-elbow.mcap out/paper-two-elbow.mcap
   analyze diff old-table.json out/          a table written by `analyze metrics -f json`
   analyze diff a.mcap b.mcap --rtol 1e-6 --all
-  analyze diff a.csv b.csv -f json")]
+  analyze diff a.csv b.csv -f json
+  analyze diff old.csv new.json --common-only   only what both tables carry")]
 pub struct DiffArgs {
     /// A: a recording (.mcap), a directory of recordings, or a table written by
     /// `analyze metrics|compare -f json|csv`.
@@ -37,6 +39,11 @@ pub struct DiffArgs {
     /// List every compared quantity in the table, not only those that moved.
     #[arg(long)]
     pub all: bool,
+    /// Judge only the quantities both inputs carry (e.g. a CSV table, which has no per-link
+    /// peak currents, against a JSON one); by default a quantity one input's table does not
+    /// carry is a difference.
+    #[arg(long)]
+    pub common_only: bool,
     #[command(flatten)]
     pub format: TableFormat,
 }
@@ -44,7 +51,7 @@ pub struct DiffArgs {
 pub fn run(a: &DiffArgs) -> Result<u8> {
     let (left, right) = (analyze::read_input(&a.a)?, analyze::read_input(&a.b)?);
     let tol = analyze::Tolerance { rtol: a.rtol, atol: a.atol };
-    let d = analyze::diff::diff(&left, &right, tol)?;
+    let d = analyze::diff::diff(&left, &right, tol)?.common_only(a.common_only);
     print_out(&analyze::render_diff(&d, a.format.format, a.all)?)?;
     Ok(if d.differs() { exit::FAILED } else { exit::SUCCESS })
 }
