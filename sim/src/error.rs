@@ -21,6 +21,10 @@ pub enum ModelError {
     BadValue { file: String, item: &'static str, name: String, field: &'static str, value: String, why: &'static str },
     #[error("{file}: the URDF has no movable joint")]
     NoJoints { file: String },
+    #[error("{file}: elements nested more than {limit} deep (a URDF is about 6 deep); refused before parsing")]
+    TooDeep { file: String, limit: usize },
+    #[error("{file}: {count} {items}, more than the limit of {limit} (sim::limits::MAX_URDF_JOINTS)")]
+    TooMany { file: String, items: &'static str, count: usize, limit: usize },
 }
 
 /// A scene file that cannot be turned into a validated [`crate::scene::Scene`].
@@ -36,6 +40,16 @@ pub struct SceneError {
 impl SceneError {
     pub fn new(file: &str, field: impl Into<String>, value: impl std::fmt::Display, why: impl Into<String>) -> Self {
         Self { file: file.to_string(), field: field.into(), value: value.to_string(), why: why.into() }
+    }
+}
+
+/// `x` as written by people, for a value in a message: plain in [1e-4, 1e9) (`0.001`), else
+/// with an exponent (`1e-12`, `1e300`, not 300 digits).
+pub(crate) fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
     }
 }
 
