@@ -73,13 +73,17 @@ pub enum DynamicsError {
 pub enum RunError {
     #[error("{0}")]
     Dynamics(#[from] DynamicsError),
-    #[error("the integrator stopped: step size collapsed to h = {h:e} s at t = {t:.9} s")]
+    #[error("the integrator stopped at t = {t:.9} s: the step size collapsed to h = {h:e} s and can no longer advance t; the solution is not smooth there (a contact force, the inverse kinematics at its reach) or too stiff for the method: check the scene at that time, or use rosenbrock")]
     StepSizeTooSmall { t: f64, h: f64 },
+    #[error("the integrator stopped at t = {t:.9} s: the problem is stiff for an explicit method (h lambda = {h_lambda:.2} at the stability limit, h = {h:.3e} s, more than 10^6 steps to go): use rosenbrock or imex")]
+    Stiff { t: f64, h: f64, h_lambda: f64 },
+    #[error("the run stopped at t = {t:.9} s: it used its wall-time limit of {limit_s} s; its steps are very small (a problem too stiff for an explicit method: use rosenbrock or imex; a fast target; tight tolerances), or the run is long: to allow more, give --max-wall-time SECONDS")]
+    OutOfTime { t: f64, limit_s: f64 },
     #[error("the implicit integrator stopped: its iteration matrix I - h gamma J is singular at t = {t:.9} s (h = {h:e} s)")]
     SingularIterationMatrix { t: f64, h: f64 },
     #[error("the integrator stopped: state component {index} ({name}) became non-finite at t = {t:.9} s")]
     NonFiniteState { t: f64, index: usize, name: String },
-    #[error("the integrator stopped: more than {max_steps} steps before t = {t:.9} s")]
+    #[error("the integrator stopped at t = {t:.9} s: more than {max_steps} steps (integrator.max_steps); the problem may be stiff for the method (use rosenbrock or imex) or the tolerances too tight; raise integrator.max_steps if the run needs more")]
     TooManySteps { t: f64, max_steps: usize },
     #[error("recording {path}: {source}")]
     Recording { path: PathBuf, source: schemas::Error },
@@ -103,6 +107,8 @@ impl RunError {
         match self {
             RunError::Dynamics(e) => Some(e.time()),
             RunError::StepSizeTooSmall { t, .. }
+            | RunError::Stiff { t, .. }
+            | RunError::OutOfTime { t, .. }
             | RunError::SingularIterationMatrix { t, .. }
             | RunError::NonFiniteState { t, .. }
             | RunError::TooManySteps { t, .. } => Some(*t),

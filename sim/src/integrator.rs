@@ -8,7 +8,7 @@ use schemas::IntegratorInfo;
 
 use crate::error::{short, SceneError};
 use crate::integrate::{
-    integrate_sampled, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rosenbrock, SplitSystem, Stats,
+    integrate_sampled_within, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rosenbrock, SplitSystem, Stats,
     StepControl, Stepper,
 };
 use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, RosenbrockSpec};
@@ -126,13 +126,16 @@ impl Integrator {
     }
 
     /// Integrates `sys` from `y0` at t = 0 to `t_end` with this method and hands the solution to
-    /// `on_sample` on the grid `k dt_out` (dense output, independent of the steps).
+    /// `on_sample` on the grid `k dt_out` (dense output, independent of the steps), stopping
+    /// with [`crate::integrate::IntegrateError::OutOfTime`] once the wall clock passes
+    /// `deadline`.
     pub fn integrate<S: OdeJacobian + SplitSystem>(
         &self,
         sys: &mut S,
         y0: &[f64],
         t_end: f64,
         dt_out: f64,
+        deadline: Option<std::time::Instant>,
         on_sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
     ) -> Result<Stats, IntegrateError<S::Error>> {
         let dim = y0.len();
@@ -142,7 +145,7 @@ impl Integrator {
             Integrator::Rosenbrock { control, jacobian_reuse } => Box::new(Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse)),
             Integrator::Imex(c) => Box::new(ArkImex::new(dim, c)),
         };
-        integrate_sampled(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, on_sample)
+        integrate_sampled_within(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, deadline, on_sample)
     }
 }
 
