@@ -506,6 +506,11 @@ mod tests {
         s.scene(&s.variant(0)).unwrap();
         let e = s.scene(&s.variant(1)).unwrap_err().to_string();
         assert!(e.contains("t-001") && e.contains("controller.kp = -1") && e.contains("must be >= 0"), "{e}");
+        // a step budget of 0 (it used to panic in every adaptive integrator when run)
+        let s = paper_sweep(json!([{"field": "integrator.max_steps", "values": [100000, 0]}])).unwrap();
+        s.scene(&s.variant(0)).unwrap();
+        let e = s.scene(&s.variant(1)).unwrap_err().to_string();
+        assert!(e.contains("t-001") && e.contains("integrator.max_steps` = 0") && e.contains("must be >= 1"), "{e}");
     }
 
     #[test]
