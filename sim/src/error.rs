@@ -77,16 +77,26 @@ pub enum RunError {
     StepSizeTooSmall { t: f64, h: f64 },
     #[error("the integrator stopped at t = {t:.9} s: the problem is stiff for an explicit method (h lambda = {h_lambda:.2} at the stability limit, h = {h:.3e} s, more than 10^6 steps to go): use rosenbrock or imex")]
     Stiff { t: f64, h: f64, h_lambda: f64 },
-    #[error("the run stopped at t = {t:.9} s: it used its wall-time limit of {limit_s} s; its steps are very small (a problem too stiff for an explicit method: use rosenbrock or imex; a fast target; tight tolerances), or the run is long: to allow more, give --max-wall-time SECONDS")]
-    OutOfTime { t: f64, limit_s: f64 },
+    #[error("the run stopped at t = {t:.9} s: it used its wall-time limit of {limit_s} s with {method}; {hint}, or the run is long: to allow more, give --max-wall-time SECONDS", hint = slow_run_hint(method))]
+    OutOfTime { t: f64, limit_s: f64, method: &'static str },
     #[error("the implicit integrator stopped: its iteration matrix I - h gamma J is singular at t = {t:.9} s (h = {h:e} s)")]
     SingularIterationMatrix { t: f64, h: f64 },
     #[error("the integrator stopped: state component {index} ({name}) became non-finite at t = {t:.9} s")]
     NonFiniteState { t: f64, index: usize, name: String },
-    #[error("the integrator stopped at t = {t:.9} s: more than {max_steps} steps (integrator.max_steps); the problem may be stiff for the method (use rosenbrock or imex) or the tolerances too tight; raise integrator.max_steps if the run needs more")]
-    TooManySteps { t: f64, max_steps: usize },
+    #[error("the integrator stopped at t = {t:.9} s: more than {max_steps} steps (integrator.max_steps) with {method}; {hint}; raise integrator.max_steps if the run needs more", hint = slow_run_hint(method))]
+    TooManySteps { t: f64, max_steps: usize, method: &'static str },
     #[error("recording {path}: {source}")]
     Recording { path: PathBuf, source: schemas::Error },
+}
+
+/// What makes a run with `method` (a scene's `integrator.method`) take tiny steps, and what
+/// to do about it.
+fn slow_run_hint(method: &str) -> &'static str {
+    match method {
+        "rk4" | "dopri45" => "its steps are very small (a problem too stiff for an explicit method: use rosenbrock or imex; a fast target; tight tolerances)",
+        "imex" => "its steps are very small (stiff mechanics, e.g. extreme damping, which imex treats explicitly: use rosenbrock; a fast target; tight tolerances)",
+        _ => "its steps are very small (a fast target, tight tolerances, or a solution that is not smooth: check the scene)",
+    }
 }
 
 impl DynamicsError {

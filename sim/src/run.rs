@@ -34,16 +34,16 @@ impl Default for Budget {
     }
 }
 
-fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget: Budget) -> RunError {
+fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget: Budget, method: &'static str) -> RunError {
     match e {
         IntegrateError::Stiff { t, h, h_lambda } => RunError::Stiff { t, h, h_lambda },
-        IntegrateError::OutOfTime { t } => RunError::OutOfTime { t, limit_s: budget.wall_time.as_secs_f64() },
+        IntegrateError::OutOfTime { t } => RunError::OutOfTime { t, limit_s: budget.wall_time.as_secs_f64(), method },
         IntegrateError::Rhs(e) | IntegrateError::Sample { source: e, .. } => e,
         IntegrateError::StepSizeTooSmall { t, h } => RunError::StepSizeTooSmall { t, h },
         IntegrateError::SingularMatrix { t, h } => RunError::SingularIterationMatrix { t, h },
         IntegrateError::NonFiniteState { t, index } => RunError::NonFiniteState { t, index, name: names(index) },
         IntegrateError::TooManySteps { t, max_steps } => {
-            RunError::TooManySteps { t, max_steps: usize::try_from(max_steps).unwrap_or(usize::MAX) }
+            RunError::TooManySteps { t, max_steps: usize::try_from(max_steps).unwrap_or(usize::MAX), method }
         }
         IntegrateError::InvalidOutputGrid { t0, t_end, dt_out } => RunError::Dynamics(crate::error::DynamicsError::NonFinite {
             t: t0,
@@ -90,7 +90,7 @@ pub fn simulate_within(
     let stats = scene
         .integrator
         .integrate(&mut sys, &y0, scene.duration, dt_out, deadline, &mut on_sample)
-        .map_err(|e| map_err(e, &names, budget))?;
+        .map_err(|e| map_err(e, &names, budget, scene.integrator.method()))?;
     Ok(RunReport { stats, samples, last: out })
 }
 

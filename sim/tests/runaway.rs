@@ -99,12 +99,13 @@ fn a_run_past_its_wall_time_fails_and_is_recorded_as_failed() {
     let err = sim::run::run_to_file_within(&scene, &run, &path, budget, |_| {}).unwrap_err();
     let wall = t0.elapsed();
     eprintln!("paper two-elbow within 0.2 s: {wall:.2?}: {err}");
-    let RunError::OutOfTime { t, limit_s } = err else { panic!("{err}") };
+    let RunError::OutOfTime { t, limit_s, method } = err else { panic!("{err}") };
+    assert_eq!(method, "dopri45");
     assert_eq!(limit_s, 0.2);
     assert!(t > 0.0 && t < scene.duration(), "{t}");
     assert!(wall < Duration::from_secs(5), "{wall:?}");
     let msg = err.to_string();
-    assert!(msg.contains("wall-time limit of 0.2 s") && msg.contains("--max-wall-time"), "{msg}");
+    assert!(msg.contains("wall-time limit of 0.2 s with dopri45") && msg.contains("use rosenbrock or imex") && msg.contains("--max-wall-time"), "{msg}");
     let rec = schemas::read_recording(&path).unwrap();
     let result = rec.result().unwrap().unwrap();
     assert_eq!(result.status, RunStatus::Failed);
@@ -121,5 +122,12 @@ fn a_run_past_its_step_budget_says_when_and_what_to_do() {
     let (err, _) = fails(&scene);
     let msg = err.to_string();
     assert!(matches!(err, RunError::TooManySteps { max_steps: 6000, .. }), "{msg}");
-    assert!(msg.starts_with("the integrator stopped at t = ") && msg.contains("integrator.max_steps") && msg.contains("use rosenbrock or imex"), "{msg}");
+    assert!(msg.starts_with("the integrator stopped at t = ") && msg.contains("integrator.max_steps) with dopri45") && msg.contains("use rosenbrock or imex"), "{msg}");
+    // the hint fits the method: imex treats the mechanics explicitly, rosenbrock everything
+    let imex = paper_with(|s| {
+        s.joint_damping = PerJoint::All(1e6);
+        s.integrator = serde_json::from_value(json!({"method": "imex", "rtol": 1e-6, "atol": 1e-8, "max_steps": 6000})).unwrap();
+    });
+    let msg = fails(&imex).0.to_string();
+    assert!(msg.contains("with imex") && msg.contains("stiff mechanics, e.g. extreme damping, which imex treats explicitly: use rosenbrock"), "{msg}");
 }
