@@ -21,6 +21,10 @@ pub enum ModelError {
     BadValue { file: String, item: &'static str, name: String, field: &'static str, value: String, why: &'static str },
     #[error("{file}: the URDF has no movable joint")]
     NoJoints { file: String },
+    #[error("{file}: elements nested more than {limit} deep (a URDF is about 6 deep); refused before parsing")]
+    TooDeep { file: String, limit: usize },
+    #[error("{file}: {count} {items}, more than the limit of {limit} (sim::limits::MAX_URDF_JOINTS)")]
+    TooMany { file: String, items: &'static str, count: usize, limit: usize },
 }
 
 /// A scene file that cannot be turned into a validated [`crate::scene::Scene`].
@@ -36,6 +40,16 @@ pub struct SceneError {
 impl SceneError {
     pub fn new(file: &str, field: impl Into<String>, value: impl std::fmt::Display, why: impl Into<String>) -> Self {
         Self { file: file.to_string(), field: field.into(), value: value.to_string(), why: why.into() }
+    }
+}
+
+/// `x` as written by people, for a value in a message: plain in [1e-4, 1e9) (`0.001`), else
+/// with an exponent (`1e-12`, `1e300`, not 300 digits).
+pub(crate) fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
     }
 }
 
@@ -59,16 +73,30 @@ pub enum DynamicsError {
 pub enum RunError {
     #[error("{0}")]
     Dynamics(#[from] DynamicsError),
-    #[error("the integrator stopped: step size collapsed to h = {h:e} s at t = {t:.9} s")]
+    #[error("the integrator stopped at t = {t:.9} s: the step size collapsed to h = {h:e} s and can no longer advance t; the solution is not smooth there (a contact force, the inverse kinematics at its reach) or too stiff for the method: check the scene at that time, or use rosenbrock")]
     StepSizeTooSmall { t: f64, h: f64 },
+    #[error("the integrator stopped at t = {t:.9} s: the problem is stiff for an explicit method (h lambda = {h_lambda:.2} at the stability limit, h = {h:.3e} s, more than 10^6 steps to go): use rosenbrock or imex")]
+    Stiff { t: f64, h: f64, h_lambda: f64 },
+    #[error("the run stopped at t = {t:.9} s: it used its wall-time limit of {limit_s} s with {method}; {hint}, or the run is long: to allow more, give --max-wall-time SECONDS", hint = slow_run_hint(method))]
+    OutOfTime { t: f64, limit_s: f64, method: &'static str },
     #[error("the implicit integrator stopped: its iteration matrix I - h gamma J is singular at t = {t:.9} s (h = {h:e} s)")]
     SingularIterationMatrix { t: f64, h: f64 },
     #[error("the integrator stopped: state component {index} ({name}) became non-finite at t = {t:.9} s")]
     NonFiniteState { t: f64, index: usize, name: String },
-    #[error("the integrator stopped: more than {max_steps} steps before t = {t:.9} s")]
-    TooManySteps { t: f64, max_steps: usize },
+    #[error("the integrator stopped at t = {t:.9} s: more than {max_steps} steps (integrator.max_steps) with {method}; {hint}; raise integrator.max_steps if the run needs more", hint = slow_run_hint(method))]
+    TooManySteps { t: f64, max_steps: usize, method: &'static str },
     #[error("recording {path}: {source}")]
     Recording { path: PathBuf, source: schemas::Error },
+}
+
+/// What makes a run with `method` (a scene's `integrator.method`) take tiny steps, and what
+/// to do about it.
+fn slow_run_hint(method: &str) -> &'static str {
+    match method {
+        "rk4" | "dopri45" => "its steps are very small (a problem too stiff for an explicit method: use rosenbrock or imex; a fast target; tight tolerances)",
+        "imex" => "its steps are very small (stiff mechanics, e.g. extreme damping, which imex treats explicitly: use rosenbrock; a fast target; tight tolerances)",
+        _ => "its steps are very small (a fast target, tight tolerances, or a solution that is not smooth: check the scene)",
+    }
 }
 
 impl DynamicsError {
@@ -89,6 +117,8 @@ impl RunError {
         match self {
             RunError::Dynamics(e) => Some(e.time()),
             RunError::StepSizeTooSmall { t, .. }
+            | RunError::Stiff { t, .. }
+            | RunError::OutOfTime { t, .. }
             | RunError::SingularIterationMatrix { t, .. }
             | RunError::NonFiniteState { t, .. }
             | RunError::TooManySteps { t, .. } => Some(*t),

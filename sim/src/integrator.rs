@@ -6,9 +6,9 @@
 
 use schemas::IntegratorInfo;
 
-use crate::error::SceneError;
+use crate::error::{short, SceneError};
 use crate::integrate::{
-    integrate_sampled, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rosenbrock, SplitSystem, Stats,
+    integrate_sampled_within, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rosenbrock, SplitSystem, Stats,
     StepControl, Stepper,
 };
 use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, RosenbrockSpec};
@@ -50,12 +50,29 @@ impl Integrator {
             if max_steps == 0 {
                 return Err(err("max_steps", &max_steps, "must be >= 1"));
             }
+            // no step is longer than h_max: a run needs at least duration / h_max of them
+            let fewest = (duration / h_max).ceil();
+            if fewest > max_steps as f64 {
+                return Err(err(
+                    "h_max",
+                    &short(h_max),
+                    &format!("needs at least {fewest:.3e} steps in duration = {duration} s, more than max_steps = {max_steps} (h_max defaults to the output interval)"),
+                ));
+            }
             Ok(StepControl { rtol, atol, h_init: None, h_max, h_min: 0.0, max_steps })
         };
         Ok(match spec {
             IntegratorSpec::Rk4(s) => {
                 if !(s.step.is_finite() && s.step > 0.0 && s.step <= duration) {
                     return Err(err("step", &s.step, "must be > 0 s and <= duration"));
+                }
+                let steps = (duration / s.step).ceil();
+                if steps > DEFAULT_MAX_STEPS as f64 {
+                    return Err(err(
+                        "step",
+                        &short(s.step),
+                        &format!("gives {steps:.3e} steps in duration = {duration} s, more than the limit of {DEFAULT_MAX_STEPS}; use a larger step, or an adaptive method"),
+                    ));
                 }
                 Integrator::Rk4 { step: s.step }
             }
@@ -109,13 +126,16 @@ impl Integrator {
     }
 
     /// Integrates `sys` from `y0` at t = 0 to `t_end` with this method and hands the solution to
-    /// `on_sample` on the grid `k dt_out` (dense output, independent of the steps).
+    /// `on_sample` on the grid `k dt_out` (dense output, independent of the steps), stopping
+    /// with [`crate::integrate::IntegrateError::OutOfTime`] once the wall clock passes
+    /// `deadline`.
     pub fn integrate<S: OdeJacobian + SplitSystem>(
         &self,
         sys: &mut S,
         y0: &[f64],
         t_end: f64,
         dt_out: f64,
+        deadline: Option<std::time::Instant>,
         on_sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
     ) -> Result<Stats, IntegrateError<S::Error>> {
         let dim = y0.len();
@@ -125,7 +145,7 @@ impl Integrator {
             Integrator::Rosenbrock { control, jacobian_reuse } => Box::new(Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse)),
             Integrator::Imex(c) => Box::new(ArkImex::new(dim, c)),
         };
-        integrate_sampled(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, on_sample)
+        integrate_sampled_within(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, deadline, on_sample)
     }
 }
 
@@ -168,5 +188,27 @@ mod tests {
         assert!(msg(r#"{"method":"imex","rtol":1e-6,"atol":1e-8,"max_steps":0}"#).contains("integrator.max_steps` = 0"));
         assert!(msg(r#"{"method":"rosenbrock","rtol":1e-6,"atol":1e-8,"jacobian_reuse":0}"#).contains("jacobian_reuse` = 0"));
         assert!(msg(r#"{"method":"rk4","step":6}"#).contains("integrator.step` = 6"));
+        for method in ["dopri45", "imex", "rosenbrock"] {
+            let m = msg(&format!(r#"{{"method":"{method}","rtol":1e-6,"atol":1e-8,"max_steps":0}}"#));
+            assert!(m.contains("integrator.max_steps` = 0: must be >= 1"), "{m}");
+        }
+    }
+
+    /// A step so small that the run needs more steps than its budget is refused up front,
+    /// with the count: rk4's fixed step, an adaptive method's h_max (default: the output
+    /// interval) against its max_steps.
+    #[test]
+    fn too_many_steps_are_refused_before_the_run() {
+        let msg = |json: &str| Integrator::from_spec(&spec(json), "s.json", 5.0, 1e-3).unwrap_err().to_string();
+        assert_eq!(
+            msg(r#"{"method":"rk4","step":1e-12}"#),
+            "s.json: field `integrator.step` = 1e-12: gives 5.000e12 steps in duration = 5 s, more than the limit of 100000000; use a larger step, or an adaptive method"
+        );
+        Integrator::from_spec(&spec(r#"{"method":"rk4","step":5e-8}"#), "s.json", 5.0, 1e-3).expect("exactly 10^8 steps");
+        let m = msg(r#"{"method":"dopri45","rtol":1e-6,"atol":1e-8,"h_max":1e-300}"#);
+        assert!(m.contains("integrator.h_max` = 1e-300: needs at least 5.000e300 steps") && m.contains("max_steps = 100000000"), "{m}");
+        let m = msg(r#"{"method":"imex","rtol":1e-6,"atol":1e-8,"max_steps":4999}"#);
+        assert!(m.contains("integrator.h_max` = 0.001: needs at least 5.000e3 steps") && m.contains("defaults to the output interval"), "{m}");
+        Integrator::from_spec(&spec(r#"{"method":"imex","rtol":1e-6,"atol":1e-8,"max_steps":5000}"#), "s.json", 5.0, 1e-3).unwrap();
     }
 }

@@ -11,10 +11,11 @@
 //! (PD voltage law, target trajectory, inverse kinematics), `integrate` (ODE methods with dense
 //! output, robot-agnostic), `scene` (JSON spec → validated `Scene`), `system` (the ODE of a
 //! scene: state layout and right-hand side), `run` (one run sampled on a fixed grid and
-//! recorded through `schemas`).
+//! recorded through `schemas`), `limits` (the bounds on every input and run).
 
 pub mod dynamics;
 pub mod error;
+pub mod limits;
 pub mod control;
 pub mod scene;
 pub mod integrate;

@@ -2,7 +2,10 @@
 //! sampled on a fixed grid (the scene's output rate) independent of the solver's steps, to a
 //! sink (the recorder, or a test). Knows nothing about the recording format.
 
+use std::time::{Duration, Instant};
+
 use crate::error::RunError;
+use crate::limits::DEFAULT_MAX_WALL_TIME;
 use crate::integrate::{IntegrateError, Stats};
 use crate::scene::{Run, Scene};
 use crate::ode::{ArmSystem, Outputs};
@@ -16,14 +19,31 @@ pub struct RunReport {
     pub last: Outputs,
 }
 
-fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String) -> RunError {
+/// What one run may spend besides its steps (`integrator.max_steps`, a setting of the scene):
+/// wall-clock time, a setting of the command (`--max-wall-time`), since it depends on the
+/// machine and not on the experiment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Budget {
+    pub wall_time: Duration,
+}
+
+impl Default for Budget {
+    /// [`DEFAULT_MAX_WALL_TIME`].
+    fn default() -> Self {
+        Budget { wall_time: DEFAULT_MAX_WALL_TIME }
+    }
+}
+
+fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget: Budget, method: &'static str) -> RunError {
     match e {
+        IntegrateError::Stiff { t, h, h_lambda } => RunError::Stiff { t, h, h_lambda },
+        IntegrateError::OutOfTime { t } => RunError::OutOfTime { t, limit_s: budget.wall_time.as_secs_f64(), method },
         IntegrateError::Rhs(e) | IntegrateError::Sample { source: e, .. } => e,
         IntegrateError::StepSizeTooSmall { t, h } => RunError::StepSizeTooSmall { t, h },
         IntegrateError::SingularMatrix { t, h } => RunError::SingularIterationMatrix { t, h },
         IntegrateError::NonFiniteState { t, index } => RunError::NonFiniteState { t, index, name: names(index) },
         IntegrateError::TooManySteps { t, max_steps } => {
-            RunError::TooManySteps { t, max_steps: usize::try_from(max_steps).unwrap_or(usize::MAX) }
+            RunError::TooManySteps { t, max_steps: usize::try_from(max_steps).unwrap_or(usize::MAX), method }
         }
         IntegrateError::InvalidOutputGrid { t0, t_end, dt_out } => RunError::Dynamics(crate::error::DynamicsError::NonFinite {
             t: t0,
@@ -32,12 +52,26 @@ fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String) -> RunE
     }
 }
 
-/// Integrate `run` of `scene`, calling `sink` at every output time with the derived outputs.
+/// Integrate `run` of `scene`, calling `sink` at every output time with the derived outputs,
+/// within the default [`Budget`].
 pub fn simulate(
     scene: &Scene,
     run: &Run,
+    sink: impl FnMut(&Outputs) -> Result<(), RunError>,
+) -> Result<RunReport, RunError> {
+    simulate_within(scene, run, Budget::default(), sink)
+}
+
+/// [`simulate`] within `budget`: past its wall time the run fails with
+/// [`RunError::OutOfTime`] at the time reached.
+#[allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `simulate`
+pub fn simulate_within(
+    scene: &Scene,
+    run: &Run,
+    budget: Budget,
     mut sink: impl FnMut(&Outputs) -> Result<(), RunError>,
 ) -> Result<RunReport, RunError> {
+    let deadline = Instant::now().checked_add(budget.wall_time);
     let mut sys = ArmSystem::new(scene, run);
     let y0 = sys.initial_state();
     let dt_out = 1.0 / scene.output_rate;
@@ -53,8 +87,10 @@ pub fn simulate(
         samples += 1;
         sink(&out)
     };
-    let stats = scene.integrator.integrate(&mut sys, &y0, scene.duration, dt_out, &mut on_sample)
-    .map_err(|e| map_err(e, &names))?;
+    let stats = scene
+        .integrator
+        .integrate(&mut sys, &y0, scene.duration, dt_out, deadline, &mut on_sample)
+        .map_err(|e| map_err(e, &names, budget, scene.integrator.method()))?;
     Ok(RunReport { stats, samples, last: out })
 }
 
@@ -73,10 +109,22 @@ pub fn run_to_file(
     scene: &Scene,
     run: &Run,
     path: &std::path::Path,
+    progress: impl FnMut(f64),
+) -> Result<FileReport, RunError> {
+    run_to_file_within(scene, run, path, Budget::default(), progress)
+}
+
+/// [`run_to_file`] within `budget` (a run out of time is a failure, recorded as such).
+#[allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `run_to_file`
+pub fn run_to_file_within(
+    scene: &Scene,
+    run: &Run,
+    path: &std::path::Path,
+    budget: Budget,
     mut progress: impl FnMut(f64),
 ) -> Result<FileReport, RunError> {
     let mut rec = crate::record::Recorder::create(path, scene, run)?;
-    let result = simulate(scene, run, |o| {
+    let result = simulate_within(scene, run, budget, |o| {
         progress(o.t);
         rec.record(o)
     });

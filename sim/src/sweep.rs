@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use crate::error::SceneError;
+use crate::limits::{read_text, MAX_INPUT_BYTES};
 use crate::scene::{Scene, SceneSpec, PAPER_SCENE_JSON, PAPER_URDF};
 
 /// The sweep file as written by people.
@@ -225,14 +226,14 @@ impl Sweep {
     /// Read a sweep file; its `scene` is relative to the file's directory.
     pub fn load(path: &Path) -> Result<Sweep, SweepError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError::new(&file, "(file)", "", e.to_string()))?;
+        let text = read_text(path, MAX_INPUT_BYTES).map_err(|e| SceneError::new(&file, "(file)", "", e.to_string()))?;
         let spec = parse_spec(&text, &file)?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let (scene_source, scene_text, urdf) = match &spec.scene {
             None => ("built-in paper scene".to_string(), PAPER_SCENE_JSON.to_string(), UrdfSource::BuiltIn),
             Some(s) => {
                 let p = dir.join(s);
-                let t = std::fs::read_to_string(&p)
+                let t = read_text(&p, MAX_INPUT_BYTES)
                     .map_err(|e| SceneError::new(&file, "scene", s, format!("cannot read {}: {e}", p.display())))?;
                 (p.display().to_string(), t, UrdfSource::Dir(p.parent().map(Path::to_path_buf).unwrap_or_default()))
             }
@@ -354,10 +355,7 @@ impl Sweep {
         let read_urdf = |name: &str| match &self.urdf {
             UrdfSource::BuiltIn if name == "paper_arm.urdf" => Ok(PAPER_URDF.to_string()),
             UrdfSource::BuiltIn => Err(format!("the built-in scene has no file `{name}`")),
-            UrdfSource::Dir(dir) => {
-                let p = dir.join(name);
-                std::fs::read_to_string(&p).map_err(|e| format!("cannot read {}: {e}", p.display()))
-            }
+            UrdfSource::Dir(dir) => crate::scene::read_urdf_file(dir, name),
         };
         let scene = Scene::from_json(&text, &source, read_urdf).map_err(|source| SweepError::Variant {
             file: self.file.clone(),
@@ -508,6 +506,11 @@ mod tests {
         s.scene(&s.variant(0)).unwrap();
         let e = s.scene(&s.variant(1)).unwrap_err().to_string();
         assert!(e.contains("t-001") && e.contains("controller.kp = -1") && e.contains("must be >= 0"), "{e}");
+        // a step budget of 0 (it used to panic in every adaptive integrator when run)
+        let s = paper_sweep(json!([{"field": "integrator.max_steps", "values": [100000, 0]}])).unwrap();
+        s.scene(&s.variant(0)).unwrap();
+        let e = s.scene(&s.variant(1)).unwrap_err().to_string();
+        assert!(e.contains("t-001") && e.contains("integrator.max_steps` = 0") && e.contains("must be >= 1"), "{e}");
     }
 
     #[test]

@@ -135,6 +135,31 @@ fn cases() -> Vec<Case> {
             want: &["controller.kp` = an array of 2", "one value per joint (10)"],
         },
         Case { what: "zero duration", edit: Json(|v| v["duration"] = json!(0)), want: &["duration` = 0", "> 0 s"] },
+        Case {
+            what: "huge duration",
+            edit: Json(|v| v["duration"] = json!(1e300)),
+            want: &["field `duration` = 1e300: duration = 1e300 s at output_rate = 1000 Hz gives 1.000e303 samples, more than the limit of 10^8 per run"],
+        },
+        Case {
+            what: "huge output rate",
+            edit: Json(|v| v["output_rate"] = json!(1e9)),
+            want: &["field `output_rate` = 1e9: duration = 5 s at output_rate = 1e9 Hz gives 5.000e9 samples"],
+        },
+        Case {
+            what: "a single sample",
+            edit: Json(|v| v["output_rate"] = json!(0.001)),
+            want: &["field `output_rate` = 0.001", "a single sample (t = 0) in duration = 5 s", "output_rate >= 1 / duration = 0.2 Hz"],
+        },
+        Case {
+            what: "max_steps of 0",
+            edit: Json(|v| v["integrator"]["max_steps"] = json!(0)),
+            want: &["field `integrator.max_steps` = 0", "must be >= 1"],
+        },
+        Case {
+            what: "rk4 step too small for the step budget",
+            edit: Json(|v| v["integrator"] = json!({"method": "rk4", "step": 1e-12})),
+            want: &["field `integrator.step` = 1e-12", "gives 5.000e12 steps", "limit of 100000000"],
+        },
         Case { what: "negative gain", edit: Json(|v| v["controller"]["kd"] = json!(-20)), want: &["controller.kd` = -20", ">= 0"] },
         Case { what: "zero plane normal", edit: Json(|v| v["contacts"][0]["plane"]["normal"] = json!([0, 0, 0])), want: &["contacts[0].plane.normal", "non-zero"] },
         Case { what: "rtol of 1", edit: Json(|v| v["integrator"]["rtol"] = json!(1.0)), want: &["integrator.rtol` = 1", "[1e-14, 1)"] },
@@ -267,6 +292,26 @@ fn cases() -> Vec<Case> {
             want: &["one root", "\"base_link\", \"floating_box\""],
         },
         Case {
+            what: "duplicate joint name",
+            edit: Urdf(|u| u.replace(r#"<joint name="joint6" type="revolute">"#, r#"<joint name="joint5" type="revolute">"#)),
+            want: &["joint `joint5`: name = joint5", "defined twice"],
+        },
+        Case {
+            what: "URDF nested too deep",
+            edit: Urdf(|u| insert_before_end(u, &format!("{}{}", "<a>".repeat(200_000), "</a>".repeat(200_000)))),
+            want: &["paper_arm.urdf: elements nested more than 100 deep", "refused before parsing"],
+        },
+        Case {
+            what: "URDF with too many joints",
+            edit: Urdf(|u| {
+                let chain: String = (0..1000)
+                    .map(|k| format!(r#"<link name="x{k}"/><joint name="xj{k}" type="fixed"><parent link="{}"/><child link="x{k}"/></joint>"#, if k == 0 { "hand".to_string() } else { format!("x{}", k - 1) }))
+                    .collect();
+                insert_before_end(u, &chain)
+            }),
+            want: &["paper_arm.urdf: 1011 joints, more than the limit of 1000"],
+        },
+        Case {
             what: "unknown joint type",
             edit: Urdf(|u| u.replace(r#"<joint name="joint2" type="revolute">"#, r#"<joint name="joint2" type="hinge">"#)),
             want: &["paper_arm.urdf: the URDF could not be parsed", "hinge"],
@@ -314,6 +359,57 @@ fn table_of_bad_scenes() {
     }
     assert!(failures.is_empty(), "{} of {} cases wrong:\n{}", failures.len(), cases.len(), failures.join("\n"));
     assert!(cases.len() >= 50);
+}
+
+/// Files that are not files, or too large, are refused before they are read whole (a device
+/// such as /dev/zero would otherwise be read until memory runs out), naming the file and the
+/// limit; a URDF next to the scene likewise, naming the scene's `urdf` field.
+#[test]
+fn scene_and_urdf_files_are_bounded() {
+    use std::path::Path;
+    let dir = tempfile::tempdir().unwrap();
+    let msg = |p: &Path| Scene::load(p).unwrap_err().to_string();
+    #[cfg(unix)]
+    {
+        let m = msg(Path::new("/dev/zero"));
+        assert_eq!(m, "/dev/zero: field `(file)`: not a regular file (it is a character device); give the path of a file");
+    }
+    let m = msg(dir.path());
+    assert!(m.contains("not a regular file (it is a directory)"), "{m}");
+    let big = dir.path().join("big.json");
+    std::fs::File::create(&big).unwrap().set_len(20 << 30).unwrap(); // sparse
+    let m = msg(&big);
+    assert!(m.starts_with(&format!("{}: field `(file)`: more than the limit of 4194304 bytes", big.display())), "{m}");
+    // the URDF: a device, then a sparse file above the limit
+    let scene = dir.path().join("s.json");
+    for (urdf, want) in [("/dev/zero", "not a regular file (it is a character device)"), ("big.urdf", "more than the limit of 4194304 bytes")] {
+        let mut v = paper_json();
+        v["urdf"] = json!(urdf);
+        std::fs::write(&scene, v.to_string()).unwrap();
+        if urdf == "big.urdf" {
+            std::fs::File::create(dir.path().join(urdf)).unwrap().set_len(1 << 30).unwrap();
+        } else if !cfg!(unix) {
+            continue;
+        }
+        let m = msg(&scene);
+        assert!(m.starts_with(&format!("{}: field `urdf` = {urdf}: cannot read ", scene.display())) && m.contains(want), "{m}");
+    }
+    // the same scene with the real URDF loads
+    std::fs::write(dir.path().join("paper_arm.urdf"), PAPER_URDF).unwrap();
+    std::fs::write(&scene, PAPER_SCENE_JSON).unwrap();
+    Scene::load(&scene).unwrap();
+}
+
+/// The limits leave room: a URDF nested 100 deep and one with 1000 joints are accepted.
+#[test]
+fn urdf_limits_leave_room() {
+    let deep = insert_before_end(PAPER_URDF, &format!("{}{}", "<a>".repeat(98), "</a>".repeat(98)));
+    build(PAPER_SCENE_JSON, &deep, FILE).unwrap();
+    let chain: String = (0..989)
+        .map(|k| format!(r#"<link name="x{k}"/><joint name="xj{k}" type="fixed"><parent link="{}"/><child link="x{k}"/></joint>"#, if k == 0 { "hand".to_string() } else { format!("x{}", k - 1) }))
+        .collect();
+    let s = build(PAPER_SCENE_JSON, &insert_before_end(PAPER_URDF, &chain), FILE).unwrap();
+    assert_eq!(s.model().urdf_joints.len(), 1000);
 }
 
 /// The unedited scene and URDF are valid (so every case above fails for its own edit).

@@ -14,6 +14,7 @@ use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 
 use super::spatial::Inertia;
 use crate::error::ModelError;
+use crate::limits::{xml_shape, MAX_URDF_DEPTH, MAX_URDF_JOINTS};
 
 /// One moving body: the link after a revolute joint plus everything welded to it.
 #[derive(Clone, Debug)]
@@ -85,14 +86,42 @@ impl Model {
     /// Build a model from URDF text. `source` names the file in error messages.
     pub fn from_urdf(xml: &str, source: &str, gravity: Vector3<f64>) -> Result<Model, ModelError> {
         let file = source.to_string();
+        // the XML reader recurses once per nesting level: bound the depth before it runs
+        // and count the joints and links, so that too many are refused before parsing
+        let shape = xml_shape(xml, MAX_URDF_DEPTH);
+        if shape.depth > MAX_URDF_DEPTH {
+            return Err(ModelError::TooDeep { file, limit: MAX_URDF_DEPTH });
+        }
+        if shape.joints > MAX_URDF_JOINTS {
+            return Err(ModelError::TooMany { file, items: "joints", count: shape.joints, limit: MAX_URDF_JOINTS });
+        }
+        if shape.links > MAX_URDF_JOINTS + 1 {
+            return Err(ModelError::TooMany { file, items: "links", count: shape.links, limit: MAX_URDF_JOINTS + 1 });
+        }
         let robot = urdf_rs::read_from_string(xml)
             .map_err(|e| ModelError::Parse { file: file.clone(), message: e.to_string() })?;
+        if robot.joints.len() > MAX_URDF_JOINTS {
+            return Err(ModelError::TooMany { file, items: "joints", count: robot.joints.len(), limit: MAX_URDF_JOINTS });
+        }
+        if robot.links.len() > MAX_URDF_JOINTS + 1 {
+            return Err(ModelError::TooMany { file, items: "links", count: robot.links.len(), limit: MAX_URDF_JOINTS + 1 });
+        }
 
         let mut link_index = HashMap::new();
         for (i, link) in robot.links.iter().enumerate() {
             if link_index.insert(link.name.as_str(), i).is_some() {
                 return Err(ModelError::BadValue {
                     file, item: "link", name: link.name.clone(), field: "name", value: link.name.clone(),
+                    why: "defined twice",
+                });
+            }
+        }
+        // joint names are the keys of the recorded tables: each once
+        let mut joint_names = std::collections::HashSet::new();
+        for joint in &robot.joints {
+            if !joint_names.insert(joint.name.as_str()) {
+                return Err(ModelError::BadValue {
+                    file, item: "joint", name: joint.name.clone(), field: "name", value: joint.name.clone(),
                     why: "defined twice",
                 });
             }

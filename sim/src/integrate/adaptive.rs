@@ -74,6 +74,9 @@ pub(super) struct Core {
     pub failure: Failure,
     pub stats: Stats,
     pub initialized: bool,
+    /// Where the current call of [`step`] must stop (for a stepper's look ahead, e.g. how many
+    /// steps remain).
+    pub t_stop: f64,
 }
 
 impl Core {
@@ -89,6 +92,7 @@ impl Core {
             failure: Failure::None,
             stats: Stats::default(),
             initialized: false,
+            t_stop: 0.0,
         }
     }
 
@@ -203,6 +207,7 @@ pub(super) fn step<S: OdeSystem, A: Adaptive<S>>(
         (None, None) => st.starting_step(sys)?,
     };
     st.core().h_next = Some(h_first);
+    st.core().t_stop = t_stop;
     loop {
         let core = st.core();
         let max_steps = core.control.max_steps;

@@ -16,6 +16,17 @@
 //! - dense output: the continuous extension of HNW I §II.6 as coded in `dopri5.f`'s `contd5`:
 //!   `y(t_prev + s h) = r0 + s (r1 + (1-s) (r2 + s (r3 + (1-s) r4)))`, of order 4.
 //!
+//! - stiffness detection: `dopri5.f`'s test (HNW I §II.10, "Automatic Stiffness Detection";
+//!   Hairer & Wanner, HNW II §IV.2): on every [`NSTIFF`]-th accepted step, and on every step
+//!   once a check was positive, `h λ ≈ h ||f(t+h, y_new) − f(t+h, Y6)|| / ||y_new − Y6||`
+//!   (both at the step's end: the 7th stage and the 6th stage's argument `Y6`); beyond 3.25
+//!   (DOPRI5's stability boundary on the negative real axis is ≈ 3.3) it counts as stiff, 15
+//!   stiff checks in a row mean the problem is stiff, 6 non-stiff ones reset the count.
+//!   `dopri5.f` then stops (IDID = −4); here [`IntegrateError::Stiff`] is returned only when
+//!   more than [`STIFF_STEPS_LEFT`] steps of the current size remain before `t_stop`, so a
+//!   mildly stiff problem still completes and one that would crawl for hours ends at once.
+//!   The test only reads the stages: it never changes a step.
+//!
 //! Deviations from `dopri5.f`, all deliberate:
 //! - a non-finite stage derivative or trial state counts as a failed error test and shrinks `h`
 //!   by `fac_min` (a too-large trial step may leave the domain of `f`); only if the step size
@@ -86,6 +97,19 @@ const CONTROLLER: Controller = Controller {
 /// PI stabilisation exponent of `dopri5.f` (BETA = 0.04; 0 would give the plain controller).
 const BETA: f64 = 0.04;
 
+/// Stiffness test every `NSTIFF` accepted steps (`dopri5.f`'s default NSTIFF = 1000).
+pub const NSTIFF: u64 = 1000;
+/// `h λ` beyond this counts as a stiff check (`dopri5.f`: 3.25).
+const STIFF_H_LAMBDA: f64 = 3.25;
+/// Stiff checks in a row that make the problem stiff (`dopri5.f`: 15).
+const STIFF_CHECKS: u32 = 15;
+/// Non-stiff checks in a row that reset the count (`dopri5.f`: 6).
+const NON_STIFF_CHECKS: u32 = 6;
+/// A stiff problem is given up ([`IntegrateError::Stiff`]) when more steps than this, of the
+/// current size, remain before `t_stop` (at 6 evaluations a step, 6 10^6 evaluations: what an
+/// implicit method does in a few hundred).
+pub const STIFF_STEPS_LEFT: f64 = 1e6;
+
 /// Adaptive Dormand–Prince 5(4) stepper (`dopri5.f`) with dense output.
 #[derive(Clone, Debug)]
 pub struct DormandPrince45 {
@@ -112,6 +136,11 @@ pub struct DormandPrince45 {
     y_new: Vec<f64>,
     /// Dense-output coefficients r0..r4 of the last accepted step (`contd5`); `r0 = y(t_prev)`.
     dense: [Vec<f64>; 5],
+    /// Stiffness detection (`dopri5.f`'s IASTI, NONSTI, HLAMB): stiff and non-stiff checks in
+    /// a row, the last estimate of `h λ`.
+    stiff_checks: u32,
+    non_stiff_checks: u32,
+    h_lambda: f64,
 }
 
 impl DormandPrince45 {
@@ -149,6 +178,9 @@ impl DormandPrince45 {
             y_stage: z(),
             y_new: z(),
             dense: [z(), z(), z(), z(), z()],
+            stiff_checks: 0,
+            non_stiff_checks: 0,
+            h_lambda: 0.0,
         })
     }
 
@@ -221,6 +253,14 @@ impl<S: OdeSystem> Adaptive<S> for DormandPrince45 {
                 return Err(IntegrateError::NonFiniteState {
                     t: self.core.t,
                     index,
+                });
+            }
+            let Core { t, t_stop, h_last, .. } = self.core;
+            if self.stiff_checks >= STIFF_CHECKS && (t_stop - t) / h_last > STIFF_STEPS_LEFT {
+                return Err(IntegrateError::Stiff {
+                    t,
+                    h: h_last,
+                    h_lambda: self.h_lambda,
                 });
             }
         }
@@ -301,6 +341,17 @@ impl DormandPrince45 {
             return Ok(self.core.reject_non_finite(h, t_new, i));
         }
 
+        // stiffness test (dopri5.f), read before y_stage (= Y6) is overwritten; it counts only
+        // if the step is accepted (then it is accepted step number steps + 1)
+        let stiff_check = (self.core.stats.steps + 1).is_multiple_of(NSTIFF) || self.stiff_checks > 0;
+        let (mut stnum, mut stden) = (0.0, 0.0);
+        if stiff_check {
+            for i in 0..n {
+                stnum += (self.k7[i] - self.k6[i]).powi(2);
+                stden += (self.y_new[i] - self.y_stage[i]).powi(2);
+            }
+        }
+
         // error estimate (into y_stage) in the tolerance-weighted RMS norm, HNW I §II.4
         let StepControl { atol, rtol, .. } = self.core.control;
         let Controller {
@@ -330,6 +381,20 @@ impl DormandPrince45 {
             .max(1.0 / fac_max);
         let h_new = self.core.limit_growth(h / fac, h, h_proposed);
         self.err_old = err.max(1e-4);
+        if stiff_check {
+            if stden > 0.0 {
+                self.h_lambda = h * (stnum / stden).sqrt();
+            }
+            if self.h_lambda > STIFF_H_LAMBDA {
+                self.non_stiff_checks = 0;
+                self.stiff_checks += 1;
+            } else {
+                self.non_stiff_checks += 1;
+                if self.non_stiff_checks == NON_STIFF_CHECKS {
+                    self.stiff_checks = 0;
+                }
+            }
+        }
 
         // dense output coefficients (dopri5.f, contd5)
         for i in 0..n {
@@ -357,6 +422,7 @@ impl<S: OdeSystem> Stepper<S> for DormandPrince45 {
         self.core
             .init("DormandPrince45", self.dim, sys.dim(), t0, y0)?;
         self.err_old = 1e-4;
+        (self.stiff_checks, self.non_stiff_checks, self.h_lambda) = (0, 0, 0.0);
         self.y.copy_from_slice(y0);
         self.dense[0].copy_from_slice(y0);
         eval_finite(&mut self.core.stats, sys, t0, y0, &mut self.k1)?;

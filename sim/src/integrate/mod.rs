@@ -114,12 +114,12 @@ pub mod test_problems;
 mod testutil;
 
 pub use self::control::{SettingsError, StepControl};
-pub use self::dopri5::DormandPrince45;
+pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
 pub use self::imex::ArkImex;
 pub use self::jacobian::{fd_jacobian, FdJacobian};
 pub use self::rk4::Rk4;
 pub use self::rosenbrock::Rosenbrock;
-pub use self::sampled::integrate_sampled;
+pub use self::sampled::{integrate_sampled, integrate_sampled_within};
 
 /// What gets integrated: y' = f(t, y). Must be a pure function of (t, y) apart from scratch.
 ///
@@ -222,6 +222,15 @@ pub enum IntegrateError<E> {
     /// [`integrate_sampled`] was asked for an empty or non-finite output grid (`dt_out <= 0`,
     /// `t_end < t0`, a non-finite value, or more than 2^53 samples).
     InvalidOutputGrid { t0: f64, t_end: f64, dt_out: f64 },
+    /// [`DormandPrince45`] found the problem stiff (HNW I §II.10, `dopri5.f`'s test: `h λ`
+    /// beyond the stability boundary on 15 checks in a row) while more than
+    /// [`STIFF_STEPS_LEFT`] steps of the current size `h` remained before `t_stop`: an
+    /// explicit method would crawl at its stability limit. `t` is the end of the last accepted
+    /// step, `h_lambda` the last estimate of `h λ`.
+    Stiff { t: f64, h: f64, h_lambda: f64 },
+    /// [`integrate_sampled_within`]'s wall-clock deadline passed; `t` is where the stepper
+    /// stands (the state there is valid).
+    OutOfTime { t: f64 },
     /// The iteration matrix `I - gamma h J` of [`Rosenbrock`] was (numerically) singular in the
     /// step from `t`, still at the last step size tried, `h` (the step is halved up to 5 times
     /// in a row, and not below `h_min`, before giving up).
@@ -256,6 +265,14 @@ impl<E: fmt::Display> fmt::Display for IntegrateError<E> {
                 "invalid output grid: t0 = {t0}, t_end = {t_end}, dt_out = {dt_out} \
                  (need finite values, dt_out > 0, t_end >= t0)"
             ),
+            IntegrateError::Stiff { t, h, h_lambda } => write!(
+                f,
+                "the problem is stiff at t = {t}: h lambda = {h_lambda:.2} is at the explicit \
+                 method's stability limit (h = {h:e}); use an implicit method"
+            ),
+            IntegrateError::OutOfTime { t } => {
+                write!(f, "the wall-clock deadline passed at t = {t}")
+            }
             IntegrateError::SingularMatrix { t, h } => write!(
                 f,
                 "singular iteration matrix I - gamma h J in the step from t = {t} \

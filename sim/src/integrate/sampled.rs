@@ -8,6 +8,8 @@
 //! whatever the output rate, and a recording never depends on step sizes. After every accepted
 //! step the system may project the state ([`OdeSystem::project`]).
 
+use std::time::Instant;
+
 use super::{IntegrateError, OdeSystem, Stats, Stepper};
 
 /// Relative slack for treating `(t_end - t0) / dt_out` as an integer.
@@ -40,6 +42,27 @@ pub fn integrate_sampled<S: OdeSystem, St: Stepper<S> + ?Sized>(
     y0: &[f64],
     t_end: f64,
     dt_out: f64,
+    sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
+) -> Result<Stats, IntegrateError<S::Error>> {
+    integrate_sampled_within(stepper, sys, t0, y0, t_end, dt_out, None, sample)
+}
+
+/// Accepted steps between two looks at the clock in [`integrate_sampled_within`].
+const CLOCK_EVERY: u64 = 16;
+
+/// [`integrate_sampled`] with a wall-clock `deadline`: after it passes, the run stops with
+/// [`IntegrateError::OutOfTime`] at the stepper's time (the clock is read every
+/// [`CLOCK_EVERY`] accepted steps; a step ends before it is read, so a run may overrun by
+/// those steps). `None`: no deadline.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
+    stepper: &mut St,
+    sys: &mut S,
+    t0: f64,
+    y0: &[f64],
+    t_end: f64,
+    dt_out: f64,
+    deadline: Option<Instant>,
     mut sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
 ) -> Result<Stats, IntegrateError<S::Error>> {
     // output grid: n intervals, the last one ending exactly on t_end when it fits
@@ -71,6 +94,7 @@ pub fn integrate_sampled<S: OdeSystem, St: Stepper<S> + ?Sized>(
 
     let mut buf = vec![0.0; y0.len()];
     let mut k = 1;
+    let mut steps = 0u64;
     loop {
         // report every grid point inside the last accepted step [t_prev, t]
         while k <= n_out {
@@ -109,6 +133,12 @@ pub fn integrate_sampled<S: OdeSystem, St: Stepper<S> + ?Sized>(
                 t: t_before,
                 h: t_after - t_before,
             });
+        }
+        steps += 1;
+        if let Some(deadline) = deadline {
+            if steps.is_multiple_of(CLOCK_EVERY) && Instant::now() >= deadline {
+                return Err(IntegrateError::OutOfTime { t: t_after });
+            }
         }
     }
     Ok(stepper.stats())
@@ -267,6 +297,29 @@ mod tests {
             "{res:?}"
         );
         assert!(last < 0.42);
+    }
+
+    /// A deadline in the past stops the run after the first clock reading, with the time
+    /// reached; without one the same run completes.
+    #[test]
+    fn sampled_deadline_stops_the_run() {
+        let mut p = HarmonicOscillator::default();
+        let mut st = Rk4::new(2, 1e-3);
+        let mut samples = 0;
+        let res = integrate_sampled_within(&mut st, &mut p, 0.0, &[1.0, 0.0], 1.0, 0.1, Some(Instant::now()), |_, _| {
+            samples += 1;
+            Ok(())
+        });
+        match res {
+            Err(IntegrateError::OutOfTime { t }) => assert_eq!(t, st.t()),
+            other => panic!("expected OutOfTime, got {other:?}"),
+        }
+        assert_eq!(st.stats().steps, CLOCK_EVERY);
+        assert_eq!(samples, 1);
+        let mut st = Rk4::new(2, 1e-3);
+        let later = Instant::now() + std::time::Duration::from_secs(3600);
+        let stats = integrate_sampled_within(&mut st, &mut p, 0.0, &[1.0, 0.0], 1.0, 0.1, Some(later), |_, _| Ok(())).unwrap();
+        assert_eq!(stats.steps, 1000);
     }
 
     #[test]

@@ -14,7 +14,8 @@ use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization
 use crate::dynamics::kinematics::{body_point, forward_kinematics, forward_velocities, BodyPoint};
 use crate::dynamics::motor::{Drives, Electrical, MotorParams};
 use crate::dynamics::{Data, Model};
-use crate::error::SceneError;
+use crate::error::{short, SceneError};
+use crate::limits::{read_text, MAX_INPUT_BYTES, MAX_SAMPLES};
 pub use spec::SceneSpec;
 use spec::{Branch, Direction, PerJoint, PointSpec};
 
@@ -164,12 +165,9 @@ impl Scene {
     /// Read a scene file; its `urdf` is resolved relative to the file's directory.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError::new(&file, "(file)", "", e.to_string()))?;
+        let text = read_text(path, MAX_INPUT_BYTES).map_err(|e| SceneError::new(&file, "(file)", "", e.to_string()))?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        Self::from_json(&text, &file, |name| {
-            let p = dir.join(name);
-            std::fs::read_to_string(&p).map_err(|e| format!("cannot read {}: {e}", p.display()))
-        })
+        Self::from_json(&text, &file, |name| read_urdf_file(&dir, name))
     }
 
     /// Parse and validate scene JSON. `read_urdf` returns the text of the named URDF.
@@ -218,6 +216,13 @@ impl Scene {
     pub fn run_contacts(&self, run: &Run) -> Vec<PointOnPlane> {
         run.contacts.iter().map(|&k| self.contacts[k].clone()).collect()
     }
+}
+
+/// The text of the URDF `name` next to a scene in `dir` (a regular file of at most
+/// [`MAX_INPUT_BYTES`]), or why not, naming the path.
+pub fn read_urdf_file(dir: &Path, name: &str) -> Result<String, String> {
+    let p = dir.join(name);
+    read_text(&p, MAX_INPUT_BYTES).map_err(|e| format!("cannot read {}: {e}", p.display()))
 }
 
 /// The number literal a "number out of range" error points at (e.g. `1e999`), else "".
@@ -323,8 +328,25 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
     let nv = model.nv;
     let duration = c.number("duration", spec.duration, positive, "must be > 0 s")?;
     let output_rate = c.number("output_rate", spec.output_rate, positive, "must be > 0 Hz")?;
-    if duration * output_rate > 1e8 {
-        return Err(c.err("output_rate", output_rate, "more than 10^8 samples per run"));
+    // the output grid has floor(duration / (1 / output_rate)) + 1 samples (`integrate_sampled`,
+    // which rounds a span within 1e-9 of whole intervals): at least 2, at most MAX_SAMPLES
+    let intervals = duration / (1.0 / output_rate);
+    if intervals < 1.0 - 1e-9 {
+        return Err(c.err(
+            "output_rate",
+            short(output_rate),
+            format!("gives a single sample (t = 0) in duration = {} s; a run needs at least 2: use output_rate >= 1 / duration = {} Hz", short(duration), short(1.0 / duration)),
+        ));
+    }
+    if intervals + 1.0 > MAX_SAMPLES {
+        // blame the factor that is out of scale (a rate in Hz larger than the duration in s)
+        let (field, value) = if output_rate > duration { ("output_rate", output_rate) } else { ("duration", duration) };
+        let (d, r) = (short(duration), short(output_rate));
+        return Err(c.err(
+            field,
+            short(value),
+            format!("duration = {d} s at output_rate = {r} Hz gives {:.3e} samples, more than the limit of 10^8 per run; shorten duration or lower output_rate", intervals + 1.0),
+        ));
     }
 
     // motors and joints

@@ -24,6 +24,8 @@ pub struct ReplayArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub format: TableFormat,
+    #[command(flatten)]
+    pub wall_time: crate::run::WallTime,
 }
 
 pub fn run(a: &ReplayArgs, v: Verbosity) -> Result<u8> {
@@ -38,6 +40,6 @@ pub fn run(a: &ReplayArgs, v: Verbosity) -> Result<u8> {
     if path.canonicalize().ok() == a.recording.canonicalize().ok() {
         bail!("{}: replaying into the same file would overwrite the original; choose another -o", path.display());
     }
-    let done = crate::run::run_all(&scene, &[run], |_| path.clone(), &Jobs { jobs: Some(1) }, v);
+    let done = crate::run::run_all(&scene, &[run], |_| path.clone(), &Jobs { jobs: Some(1) }, a.wall_time.budget(), v);
     crate::run::finish(&done, a.format, None)
 }

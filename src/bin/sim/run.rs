@@ -6,12 +6,12 @@
 //! `analyze`; this binary composes the two).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use cli::{exit, print_out, Jobs, TableFormat, Verbosity};
 use rayon::prelude::*;
-use sim::run::run_to_file;
+use sim::run::{run_to_file_within, Budget};
 use sim::scene::{Run, Scene};
 
 /// The options of a run, with `sim` alone or `sim run`.
@@ -34,6 +34,27 @@ pub struct RunArgs {
     /// validated, so the recording stores the scene that ran.
     #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
     pub duration: Option<f64>,
+    #[command(flatten)]
+    pub wall_time: WallTime,
+}
+
+/// `--max-wall-time`: the wall-clock budget of each run (`sim run`, `sweep`, `replay`).
+#[derive(Debug, Clone, Copy, Default, clap::Args)]
+pub struct WallTime {
+    /// Stop any run still going after this much wall-clock time, s [default: 600]: it fails
+    /// (exit 1), and its recording says at which simulated time.
+    #[arg(long = "max-wall-time", value_name = "SECONDS", value_parser = positive_seconds)]
+    pub max_wall_time: Option<f64>,
+}
+
+impl WallTime {
+    /// The budget of each run.
+    pub fn budget(&self) -> Budget {
+        match self.max_wall_time {
+            Some(s) => Budget { wall_time: Duration::try_from_secs_f64(s).unwrap_or(Duration::MAX) },
+            None => Budget::default(),
+        }
+    }
 }
 
 /// Run a scene (the default command): every run to <out>/<scene>-<run>.mcap, then the table.
@@ -45,6 +66,7 @@ energy totals and ratios to the baseline, per-link energy, contacts, energy bala
 
 Examples:
   sim run                                    the built-in paper scene (same as `sim`)
+  sim run my_scene.json --max-wall-time 60   fail any run still going after a minute
   sim run sim/scenes/small/small.json -o /tmp/small
   sim run --run two-elbow --duration 1 -f csv")]
 pub struct RunCommand {
@@ -72,7 +94,7 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     };
     let runs = select_runs(&scene, &a.runs)?;
     cli::create_dir(&a.out)?;
-    let done = run_all(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, v);
+    let done = run_all(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, a.wall_time.budget(), v);
     finish(&done, a.format, a.baseline.as_deref())
 }
 
@@ -101,7 +123,7 @@ pub struct Done {
 }
 
 /// Runs `runs` of `scene` on `jobs` threads, run `r` to `path(r)`, with a progress bar each.
-pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Sync, jobs: &Jobs, v: Verbosity) -> Vec<Done> {
+pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Sync, jobs: &Jobs, budget: Budget, v: Verbosity) -> Vec<Done> {
     let bars = cli::progress::RunBars::new(v.quiet);
     let bars: Vec<_> = runs.iter().map(|r| bars.add(&r.name, scene.duration())).collect();
     let threads = jobs.threads(runs.len());
@@ -113,7 +135,7 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
                 let target = path(run);
                 let t0 = Instant::now();
                 let mut count = 0u32;
-                let res = run_to_file(scene, run, &target, |t| {
+                let res = run_to_file_within(scene, run, &target, budget, |t| {
                     count += 1;
                     if count % 64 == 0 {
                         cli::progress::set_time(bar, t);

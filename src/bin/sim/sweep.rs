@@ -12,7 +12,7 @@ use cli::{exit, print_out, Jobs, TableFormat, Verbosity};
 use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::Value;
-use sim::run::run_to_file;
+use sim::run::run_to_file_within;
 use sim::sweep::{compact, Shard, Sweep, Variant};
 
 /// Run a grid of scene variations in parallel (optionally one shard of it, for job arrays).
@@ -48,6 +48,8 @@ pub struct SweepArgs {
     /// Validate every variant of the shard and list them, without running.
     #[arg(long)]
     pub dry_run: bool,
+    #[command(flatten)]
+    pub wall_time: crate::run::WallTime,
 }
 
 /// One recording of the manifest.
@@ -151,13 +153,14 @@ pub fn run(args: &SweepArgs, v: Verbosity) -> Result<u8> {
     let prefix = if shard == Shard::ALL { sweep.spec.name.clone() } else { format!("{} {shard}", sweep.spec.name) };
     let bar = cli::progress::count(work.len(), &prefix, "runs", v.quiet);
     let started = Instant::now();
+    let budget = args.wall_time.budget();
     let one = |&(vi, ri): &(usize, usize)| -> Done {
         let (var, scene) = (&variants[vi], &scenes[vi]);
         let run_name = &sweep.runs[ri];
         let run = scene.run(run_name).expect("runs checked when the variant was validated");
         bar.set_message(format!("{} {run_name}", var.name));
         let path = out.join(Sweep::file_name(var, run_name));
-        let done = match run_to_file(scene, run, &path, |_| {}) {
+        let done = match run_to_file_within(scene, run, &path, budget, |_| {}) {
             Ok(rep) => Done { metrics: Some(read_metrics(&rep.path)), path: Some(rep.path), error: None },
             Err(e) => {
                 // a numerical failure still leaves a recording that says when and why
