@@ -1,15 +1,15 @@
 //! Reading the intact part of a damaged recording (`analyze ... --recover`).
 //!
-//! A recording cut short (a killed run leaves its hidden `.NAME.partial`, a copy stops, a disk
-//! fills) has no summary and no footer, so [`super::read_recording_bytes`] rejects it. Its data
-//! section is still a sequence of self-contained records (MCAP spec: a chunk carries its own
+//! A recording cut short (a killed run leaves its hidden `.NAME.<pid>-<n>.partial`, a copy stops, a
+//! disk fills) has no summary and no footer, so [`super::read_recording_bytes`] rejects it. Its
+//! data section is still a sequence of self-contained records (MCAP spec: a chunk carries its own
 //! schemas and channels, is compressed on its own and has its own CRC), so everything before the
-//! damage can be read: [`read_recording_recover_bytes`] walks the top-level records from the
-//! start and decodes them one at a time (a chunk as a whole: its CRC is checked before any of its
+//! damage can be read: [`read_recording_recover_bytes`] walks the top-level records from the start
+//! and decodes them one at a time (a chunk as a whole: its CRC is checked before any of its
 //! messages is used, and a chunk that fails anywhere contributes nothing), and stops at the first
 //! record that is cut short or does not read, or at the end of the data section. Messages and
-//! metadata records before that point are returned, with a [`RecoverReport`] saying how much
-//! was read and where and why it stopped.
+//! metadata records before that point are returned, with a [`RecoverReport`] saying how much was
+//! read and where and why it stopped.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
