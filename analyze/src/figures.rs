@@ -56,7 +56,7 @@ pub enum FigureError {
     },
     /// Writing the index failed (names the file and the OS reason, or another writer).
     #[error(transparent)]
-    Write(#[from] schemas::Error),
+    Write(Box<schemas::Error>),
     /// plotters could not draw or write a figure.
     #[error("drawing {0}")]
     Draw(String),

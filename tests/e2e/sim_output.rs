@@ -209,3 +209,19 @@ fn a_replay_of_a_failed_run_exits_1_like_the_run() {
         );
     }
 }
+
+/// The other files the tools write go through the same helper: a man page whose name is taken
+/// by a directory is an I/O error (exit 2) naming the path and the OS reason, once.
+#[test]
+fn other_outputs_report_io_errors_with_path_and_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("sim.1");
+    std::fs::create_dir(&page).unwrap();
+    let o = sim().arg("man").arg("-o").arg(dir.path()).output().unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(&*page.to_string_lossy()), "{err}");
+    assert_eq!(err.matches("Is a directory").count(), 1, "{err}");
+    let left: Vec<String> = listing(dir.path()).into_iter().filter(|n| n.starts_with('.')).collect();
+    assert!(left.is_empty(), "temporary or lock files left: {left:?}");
+}
