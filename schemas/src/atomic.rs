@@ -65,6 +65,14 @@ const LOCK_ATTEMPTS: usize = 64;
 /// threads) never share a temporary name either.
 static NEXT_TEMP: AtomicU64 = AtomicU64::new(0);
 
+#[cfg(test)]
+thread_local! {
+    /// Tests only: a pause between opening the lock file and locking it, to widen the window
+    /// in which its holder can release (and unlink) it (the race of step 2).
+    static PAUSE_BEFORE_LOCK: std::cell::Cell<std::time::Duration> =
+        const { std::cell::Cell::new(std::time::Duration::ZERO) };
+}
+
 /// The file name `.NAME.lock` of the lock file of `name`.
 fn lock_name(name: &OsStr) -> OsString {
     let mut s = OsString::from(".");
@@ -223,6 +231,8 @@ fn lock(lock_path: &Path, path: &Path) -> Result<File, Error> {
             .truncate(false)
             .open(lock_path)
             .map_err(|e| io("creating its lock file", e))?;
+        #[cfg(test)]
+        std::thread::sleep(PAUSE_BEFORE_LOCK.with(|p| p.get()));
         match f.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
@@ -408,5 +418,49 @@ mod tests {
         assert_eq!(bytes.len(), 1 << 20);
         assert!(bytes.iter().all(|&b| b == bytes[0]));
         assert_eq!(listing(dir.path()), ["c.txt"]);
+    }
+
+    /// Exclusivity under churn: threads that write the same name over and over (each lock is
+    /// released, its file unlinked and a new one created many times) never hold it together.
+    /// This is the race of the module docs' step 2: without the inode check, a writer that
+    /// locked an unlinked lock file would write alongside the holder of the new one.
+    #[test]
+    fn writers_of_one_name_never_overlap_under_churn() {
+        use std::sync::atomic::AtomicUsize;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("churn.txt");
+        let active = AtomicUsize::new(0);
+        let (wrote, refused) = (AtomicUsize::new(0), AtomicUsize::new(0));
+        std::thread::scope(|s| {
+            for k in 0..4u8 {
+                let (path, active, wrote, refused) = (&path, &active, &wrote, &refused);
+                s.spawn(move || {
+                    for i in 0..300u64 {
+                        // open the lock file, then lock it up to 2 ms later
+                        PAUSE_BEFORE_LOCK.with(|p| p.set(std::time::Duration::from_micros(i % 5 * 500)));
+                        let r = write_with(path, |f| {
+                            let before = active.fetch_add(1, Ordering::SeqCst);
+                            let bytes = [b'0' + k; 4096];
+                            let r = f.write_all(&bytes);
+                            std::thread::yield_now();
+                            let after = active.fetch_sub(1, Ordering::SeqCst);
+                            assert_eq!((before, after), (0, 1), "two writers of one name at once");
+                            r.map_err(|e| Error::Io { file: "churn.txt".into(), op: "writing", source: e })
+                        });
+                        match r {
+                            Ok(_) => wrote.fetch_add(1, Ordering::Relaxed),
+                            Err(Error::Busy { .. }) => refused.fetch_add(1, Ordering::Relaxed),
+                            Err(e) => panic!("{e}"),
+                        };
+                    }
+                });
+            }
+        });
+        let (wrote, refused) = (wrote.into_inner(), refused.into_inner());
+        assert_eq!(wrote + refused, 1200);
+        assert!(wrote > 0);
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(bytes.len() == 4096 && bytes.iter().all(|&b| b == bytes[0]));
+        assert_eq!(listing(dir.path()), ["churn.txt"]);
     }
 }
