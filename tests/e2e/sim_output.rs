@@ -225,3 +225,17 @@ fn other_outputs_report_io_errors_with_path_and_reason() {
     let left: Vec<String> = listing(dir.path()).into_iter().filter(|n| n.starts_with('.')).collect();
     assert!(left.is_empty(), "temporary or lock files left: {left:?}");
 }
+
+/// Standard output on a full disk (`/dev/full`, where every write fails with ENOSPC) is an I/O
+/// error too: exit 2 and the OS reason, in both tools.
+#[test]
+fn a_full_standard_output_exits_2_with_enospc() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        eprintln!("skipped: no /dev/full here");
+        return;
+    };
+    let o = sim().arg("check").arg(small_scene()).stdout(full).output().unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("standard output") && err.contains("No space left on device"), "{err}");
+}
