@@ -30,21 +30,26 @@
 //!    removes the first (step 3) and reuses the second (the kernel releases a dead process's
 //!    `flock`).
 //!
-//! The lock is advisory: it binds only writers that use this module (both our tools do). The
-//! bytes written never depend on the temporary name, so identical writes still give identical
-//! files.
+//! The lock is advisory: it binds only writers that use this module (both our tools do). On a
+//! filesystem that cannot lock at all (`flock` fails with `ENOLCK` or `EOPNOTSUPP`, or the
+//! platform has no locks), the output is written without the lock and without step 3 (a
+//! temporary file there might be a live writer's): files stay whole (step 4), but a second
+//! writer is not refused. The bytes written never depend on the temporary name, so identical
+//! writes still give identical files.
 //!
 //! # Errors
 //! Every failure is an [`Error::Io`] naming the final path and the operation, with the
 //! operating system's reason (`No space left on device (os error 28)`, …) as its source and in
-//! its message, or [`Error::Busy`].
+//! its message, or [`Error::Busy`] (or [`Error::NotAFilePath`] for a path without a file name).
 //!
 //! # References
-//! - `rename(2)`, `fsync(2)`, `flock(2)`, `open(2)` (`O_EXCL`): Linux man-pages 6.x; POSIX.1-2017
-//!   `rename()` ("If the link named by the new argument exists, it shall be removed and old
-//!   renamed to new ... atomic").
-//! - The lock-then-verify-inode pattern for deletable lock files: the `flock(1)` man page's
-//!   discussion, and e.g. Rust's `cargo` `util/flock.rs` (which keeps its lock files instead).
+//! - `rename(2)`, `fsync(2)`, `flock(2)`, `open(2)` (`O_EXCL`): Linux man-pages. POSIX.1-2017
+//!   `rename()`: a link named new "shall remain visible to other threads throughout the renaming
+//!   operation and refer either to the file referred to by new or old before the operation
+//!   began".
+//! - [`File::try_lock`] (std, stable since Rust 1.89): `flock(fd, LOCK_EX | LOCK_NB)` on Unix. A
+//!   `flock` lock belongs to an open file description of an inode, whatever name that inode has
+//!   (or has lost) since: hence the inode check of step 2.
 //! - Directory `fsync` after `rename`: "Files are hard", Dan Luu (2015),
 //!   <https://danluu.com/file-consistency/>.
 
@@ -131,7 +136,7 @@ impl Output {
             .ok_or_else(|| Error::NotAFilePath { file: file.clone() })?;
         let io = |op, source| Error::Io { file: file.clone(), op, source };
         let lock_path = path.with_file_name(lock_name(name));
-        let lock = lock(&lock_path, path)?;
+        let (lock, locked) = lock(&lock_path, path)?;
         let mut out = Self {
             path: path.to_path_buf(),
             tmp: PathBuf::new(),
@@ -139,7 +144,9 @@ impl Output {
             lock: Some(lock),
             committed: false,
         };
-        out.remove_stale_temps(name);
+        if locked {
+            out.remove_stale_temps(name);
+        }
         let mut tmp_name = OsString::from(".");
         tmp_name.push(name);
         tmp_name.push(format!(
@@ -218,9 +225,17 @@ impl Drop for Output {
     }
 }
 
+/// Whether `e` says that the filesystem (or platform) cannot lock files at all.
+fn locks_unsupported(e: &std::io::Error) -> bool {
+    const ENOLCK: i32 = 37; // Linux
+    const EOPNOTSUPP: i32 = 95; // Linux
+    e.kind() == std::io::ErrorKind::Unsupported || matches!(e.raw_os_error(), Some(ENOLCK | EOPNOTSUPP))
+}
+
 /// Takes the exclusive lock of `lock_path` (steps 1 and 2 of the module docs); `path` is the
-/// final path, for the messages.
-fn lock(lock_path: &Path, path: &Path) -> Result<File, Error> {
+/// final path, for the messages. Returns the open lock file and whether it is locked (`false`
+/// only where the filesystem cannot lock, see the module docs).
+fn lock(lock_path: &Path, path: &Path) -> Result<(File, bool), Error> {
     let file = path.display().to_string();
     let io = |op, source| Error::Io { file: file.clone(), op, source };
     for _ in 0..LOCK_ATTEMPTS {
@@ -241,11 +256,12 @@ fn lock(lock_path: &Path, path: &Path) -> Result<File, Error> {
                     lock: lock_path.display().to_string(),
                 })
             }
+            Err(std::fs::TryLockError::Error(e)) if locks_unsupported(&e) => return Ok((f, false)),
             Err(std::fs::TryLockError::Error(e)) => return Err(io("locking its lock file", e)),
         }
         let held = f.metadata().map_err(|e| io("reading its lock file", e))?;
         match std::fs::metadata(lock_path) {
-            Ok(now) if now.dev() == held.dev() && now.ino() == held.ino() => return Ok(f),
+            Ok(now) if now.dev() == held.dev() && now.ino() == held.ino() => return Ok((f, true)),
             // unlinked (or replaced) by a writer that finished meanwhile: try again
             Ok(_) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -313,6 +329,16 @@ mod tests {
         }
     }
 
+    /// Only "cannot lock here" lets a write go on unlocked; any other locking error stops it.
+    #[test]
+    fn filesystems_without_locks_are_recognised() {
+        assert!(locks_unsupported(&std::io::Error::from_raw_os_error(37))); // ENOLCK
+        assert!(locks_unsupported(&std::io::Error::from_raw_os_error(95))); // EOPNOTSUPP
+        assert!(locks_unsupported(&std::io::ErrorKind::Unsupported.into()));
+        assert!(!locks_unsupported(&std::io::Error::from_raw_os_error(13))); // EACCES
+        assert!(!locks_unsupported(&std::io::Error::from_raw_os_error(5))); // EIO
+    }
+
     #[test]
     fn a_second_writer_is_refused_while_the_first_holds_the_name() {
         let dir = tempfile::tempdir().unwrap();
@@ -365,7 +391,8 @@ mod tests {
         // and `lock` (which opens by name) sees the new one as busy
         assert!(matches!(lock(&lock_path, &path), Err(Error::Busy { .. })));
         drop(new);
-        let f = lock(&lock_path, &path).unwrap();
+        let (f, locked) = lock(&lock_path, &path).unwrap();
+        assert!(locked);
         let (a, b) = (f.metadata().unwrap(), std::fs::metadata(&lock_path).unwrap());
         assert_eq!((a.dev(), a.ino()), (b.dev(), b.ino()));
     }
