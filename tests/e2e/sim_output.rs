@@ -239,3 +239,25 @@ fn a_full_standard_output_exits_2_with_enospc() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("standard output") && err.contains("No space left on device"), "{err}");
 }
+
+/// In a sweep, a recording that cannot be written makes the exit status 2 even when another
+/// run failed numerically (which alone gives 1): the lost result outranks the reported failure.
+/// The manifest still lists every run with its status.
+#[test]
+fn a_sweep_with_an_unwritable_recording_exits_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = tmp.path().join("mixed.json");
+    let axes = r#"[{"field": "integrator", "values": [{"method": "rk4", "step": 5e-3}, {"method": "dopri45", "rtol": 1e-8, "atol": 1e-10}]}]"#;
+    let spec = format!(r#"{{"name": "mixed", "scene": {:?}, "runs": ["free"], "duration": 0.2, "axes": {axes}}}"#, small_scene().to_str().unwrap());
+    std::fs::write(&sweep, spec).unwrap();
+    let out = tmp.path().join("out");
+    std::fs::create_dir_all(out.join("mixed-001-free.mcap")).unwrap();
+    let o = sim().arg("sweep").arg(&sweep).arg("-o").arg(&out).arg("--quiet").output().unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("t = "), "the numerical failure is reported too: {err}");
+    assert!(err.contains(&*out.join("mixed-001-free.mcap").to_string_lossy()) && err.contains("Is a directory"), "{err}");
+    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("sweep-manifest.json")).unwrap()).unwrap();
+    let status = |k: usize| manifest["variants"][k]["files"][0]["status"].as_str().unwrap().to_string();
+    assert_eq!((status(0), status(1)), ("failed".to_string(), "not written".to_string()), "{manifest}");
+}
