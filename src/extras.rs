@@ -30,9 +30,25 @@ pub fn completions(mut cmd: clap::Command, shell: Shell) -> Result<()> {
     crate::print_out(&String::from_utf8_lossy(&script))
 }
 
-/// Writes the man pages of `cmd` into `dir`; returns how many.
+/// Writes the man pages of `cmd` into `dir` (as `clap_mangen::generate_to` names them: one
+/// per command and visible subcommand), each atomically through `crate::write_file`; returns
+/// how many.
 pub fn man_pages(cmd: clap::Command, dir: &Path) -> Result<usize> {
+    fn generate(cmd: clap::Command, dir: &Path, count: &mut usize) -> Result<()> {
+        for sub in cmd.get_subcommands().filter(|s| !s.is_hide_set()).cloned() {
+            generate(sub, dir, count)?;
+        }
+        let man = clap_mangen::Man::new(cmd);
+        let mut page = Vec::new();
+        man.render(&mut page).with_context(|| format!("rendering the man page {}", man.get_filename()))?;
+        crate::write_file(&dir.join(man.get_filename()), page)?;
+        *count += 1;
+        Ok(())
+    }
     crate::output::create_dir(dir)?;
-    clap_mangen::generate_to(cmd, dir).with_context(|| format!("writing man pages into {}", dir.display()))?;
-    Ok(std::fs::read_dir(dir).map(|d| d.filter_map(|e| e.ok()).filter(|e| e.path().extension().is_some_and(|x| x == "1")).count()).unwrap_or(0))
+    let mut cmd = cmd.disable_help_subcommand(true);
+    cmd.build();
+    let mut count = 0;
+    generate(cmd, dir, &mut count)?;
+    Ok(count)
 }

@@ -1,5 +1,6 @@
 //! Where output goes: tables to standard output (`--format table|json|csv`), files into a
-//! directory (`-o DIR`), every file through a temporary name and a rename so that a crash never
+//! directory (`-o DIR`), every file through `schemas::atomic` (a lock on the final name, a
+//! temporary name of its own and a rename) so that neither a crash nor a second writer ever
 //! leaves a half-written file under its final name.
 
 use std::io::Write;
@@ -16,21 +17,11 @@ pub fn print_out(text: &str) -> Result<()> {
     }
 }
 
-/// Writes `bytes` to `path` through a hidden temporary sibling (`.NAME.partial`) renamed into
-/// place, so `path` is either absent, the old file, or the whole new one.
+/// Writes `bytes` to `path` atomically and exclusively (`schemas::atomic`): `path` is either
+/// absent, the old file, or the whole new one; a second writer of `path` at the same time is
+/// refused. Errors name the path and the OS reason.
 pub fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
-    let name = path.file_name().with_context(|| format!("{}: not a file path", path.display()))?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(name);
-    tmp_name.push(".partial");
-    let tmp = path.with_file_name(tmp_name);
-    let written = std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(bytes.as_ref()).and_then(|()| f.sync_all()))
-        .and_then(|()| std::fs::rename(&tmp, path));
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e).with_context(|| format!("writing {}", path.display()));
-    }
+    schemas::atomic::write_file(path, bytes)?;
     Ok(())
 }
 

@@ -1,7 +1,8 @@
 //! `analyze export` as one call: a recording's topics ([`crate::frames`], feature `tables`) as
 //! Parquet or CSV tables and `metadata.json`, so that a caller needs no polars type and a build
-//! without the feature says what is missing. Every file goes through a temporary name and a
-//! rename, so a killed export never leaves a half-written table under its final name.
+//! without the feature says what is missing. Every file goes through `schemas::atomic` (a lock on
+//! the final name, a temporary name of its own, a rename), so neither a killed export nor a
+//! second one at the same time ever leaves a half-written table under its final name.
 
 use std::path::Path;
 #[cfg(feature = "tables")]
@@ -121,8 +122,7 @@ pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportForm
         write_atomic(&path, |f| match format {
             ExportFormat::Parquet => ParquetWriter::new(f).finish(df).map(drop),
             ExportFormat::Csv => CsvWriter::new(f).include_header(true).finish(df),
-        })
-        .map_err(|e| e.into_error(&path))?;
+        })?;
         written.push(path);
     }
     let meta = serde_json::json!({
@@ -138,49 +138,17 @@ pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportForm
     });
     let path = dir.join("metadata.json");
     let text = serde_json::to_string_pretty(&meta).unwrap_or_default() + "\n";
-    write_atomic(&path, |f| {
-        use std::io::Write;
-        f.write_all(text.as_bytes()).map_err(PolarsError::from)
-    })
-    .map_err(|e| e.into_error(&path))?;
+    schemas::atomic::write_file(&path, text)?;
     written.push(path);
     Ok(written)
 }
 
+/// Writes `path` with `write` atomically and exclusively (`schemas::atomic`); errors name the
+/// file.
 #[cfg(feature = "tables")]
-enum WriteError {
-    Io(std::io::Error),
-    Polars(PolarsError),
-}
-
-#[cfg(feature = "tables")]
-impl WriteError {
-    /// The library's error, naming the file being written.
-    fn into_error(self, path: &Path) -> Error {
-        let file = path.display().to_string();
-        match self {
-            WriteError::Io(source) => Error::Io { file, op: "writing", source },
-            WriteError::Polars(e) => Error::Table { file, detail: format!("writing the table: {e}") },
-        }
-    }
-}
-
-/// Writes through `.NAME.partial` in the same directory, then renames over `path`.
-#[cfg(feature = "tables")]
-fn write_atomic(
-    path: &Path,
-    write: impl FnOnce(&mut std::fs::File) -> PolarsResult<()>,
-) -> Result<(), WriteError> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.partial"));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp).map_err(WriteError::Io)?;
-        write(&mut f).map_err(WriteError::Polars)?;
-        f.sync_all().map_err(WriteError::Io)?;
-        std::fs::rename(&tmp, path).map_err(WriteError::Io)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+fn write_atomic(path: &Path, write: impl FnOnce(&mut std::fs::File) -> PolarsResult<()>) -> Result<(), Error> {
+    schemas::atomic::write_with(path, |f| {
+        write(f).map_err(|e| Error::Table { file: path.display().to_string(), detail: format!("writing the table: {e}") })
+    })?;
+    Ok(())
 }

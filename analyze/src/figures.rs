@@ -54,6 +54,9 @@ pub enum FigureError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// Writing the index failed (names the file and the OS reason, or another writer).
+    #[error(transparent)]
+    Write(Box<schemas::Error>),
     /// plotters could not draw or write a figure.
     #[error("drawing {0}")]
     Draw(String),

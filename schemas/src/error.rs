@@ -9,7 +9,8 @@
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// An operating-system I/O error (create, write, fsync, rename, read).
+    /// An operating-system I/O error (create, write, fsync, rename, read). The message ends
+    /// with the OS reason (e.g. "No space left on device (os error 28)").
     #[error("{file}: {op}: {source}")]
     Io {
         file: String,
@@ -17,6 +18,14 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+
+    /// Another writer (process or thread) holds the lock of this output's final path
+    /// ([`crate::atomic`]): refused up front, nothing was written.
+    #[error(
+        "{file}: another process is writing it (it holds the lock {lock}); nothing was written: \
+         wait until it has finished, or choose another output"
+    )]
+    Busy { file: String, lock: String },
 
     /// The path handed to [`crate::RecordingWriter::create`] has no file name.
     #[error("{file}: not a file path")]

@@ -4,7 +4,8 @@
 //! topic names ([`topics`]), message structs and their schemas ([`messages`], [`cdr`]), the
 //! time convention ([`to_log_time`]), the writer ([`RecordingWriter`]) and a generic,
 //! schema-driven reader ([`read_recording`]) that decodes any protobuf / ROS 2 CDR / JSON
-//! channel from the schema stored in the file.
+//! channel from the schema stored in the file. It also owns how every file the tools write
+//! appears under its name: atomically, complete, with one writer at a time ([`atomic`]).
 //!
 //! # Conventions
 //! - A recording is one MCAP file (<https://mcap.dev/spec>), zstd-compressed chunks.
@@ -24,6 +25,7 @@
 //!   DDS-XTypes 1.3 §7.4.3 (XCDR1 encapsulation); ROS 2 uses it through Fast-CDR.
 //! - Foxglove schemas: <https://docs.foxglove.dev/docs/visualization/message-schemas/>.
 
+pub mod atomic;
 pub mod cdr;
 pub mod error;
 pub mod messages;

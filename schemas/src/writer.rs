@@ -1,15 +1,19 @@
-//! [`RecordingWriter`]: deterministic, crash-safe MCAP writing.
+//! [`RecordingWriter`]: deterministic, crash-safe, exclusive MCAP writing.
 //!
-//! - **Crash safety.** Everything goes to a hidden sibling `.<name>.partial` in the target
-//!   directory; only [`RecordingWriter::finish`] (MCAP summary + footer, flush, fsync, rename,
+//! - **Crash safety and exclusion.** The writer is an [`atomic::Output`](crate::atomic::Output):
+//!   it locks the final name (a second writer of the same path, in this or another process, is
+//!   refused with [`Error::Busy`]), writes a hidden sibling `.<name>.<pid>-<n>.partial` of its
+//!   own, and only [`RecordingWriter::finish`] (MCAP summary + footer, flush, fsync, rename,
 //!   fsync of the directory) makes `path` appear, atomically. Dropping the writer without
 //!   `finish` (error path, panic) deletes the temporary file; a kill leaves at most that hidden
-//!   file, which the next `create` for the same path overwrites.
+//!   file (and the lock file), which the next writer of the same path deletes.
+//! - **Errors.** An I/O failure at any point is an [`Error::Io`] naming `path` and carrying the
+//!   OS reason (the `mcap` crate's own I/O error hides it; it is unwrapped here).
 //! - **Determinism.** Two runs that write the same calls produce byte-identical files: fixed
-//!   library string, no wall-clock or host data, single-threaded zstd (zstd output depends on
-//!   its worker count, which the `mcap` crate defaults to the host's core count), schema and
-//!   channel ids in order of first use, metadata in `BTreeMap` order, per-channel sequence
-//!   numbers counting from 0, `publish_time = log_time`.
+//!   library string, no wall-clock or host data (the temporary name never reaches the bytes),
+//!   single-threaded zstd (zstd output depends on its worker count, which the `mcap` crate
+//!   defaults to the host's core count), schema and channel ids in order of first use, metadata
+//!   in `BTreeMap` order, per-channel sequence numbers counting from 0, `publish_time = log_time`.
 //! - **Format version.** The `recording` metadata record ([`RecordingInfo`]) always carries
 //!   `format_version = FORMAT_VERSION`: the caller's, checked, or written alone by `finish` if
 //!   the caller wrote none.
@@ -21,6 +25,7 @@ use std::path::{Path, PathBuf};
 
 use mcap::records::{MessageHeader, Metadata};
 
+use crate::atomic::Output;
 use crate::messages::Message;
 use crate::meta::{to_entries, MetadataRecord, RecordingInfo};
 use crate::{Error, FORMAT_VERSION};
@@ -41,20 +46,32 @@ struct TopicChannel {
 pub struct RecordingWriter {
     /// `None` only after `finish` took it.
     mcap: Option<mcap::Writer<BufWriter<File>>>,
+    /// The lock of the final name and the temporary file; committed by `finish`, and deletes
+    /// the temporary file when dropped uncommitted. `None` only inside `finish`.
+    output: Option<Output>,
     path: PathBuf,
-    tmp_path: PathBuf,
     file: String,
     topics: HashMap<String, TopicChannel>,
     /// Reused for every message, so writing allocates only when a message outgrows it.
     buf: Vec<u8>,
     wrote_recording_metadata: bool,
-    finished: bool,
+}
+
+/// An error of the `mcap` writer as ours: its I/O errors (disk full, …) as [`Error::Io`] with
+/// the OS reason, which `mcap::McapError::Io`'s message leaves out.
+fn write_error(file: &str, source: mcap::McapError) -> Error {
+    match source {
+        mcap::McapError::Io(source) => Error::Io { file: file.to_string(), op: "writing", source },
+        source => Error::McapWrite { file: file.to_string(), source },
+    }
 }
 
 impl RecordingWriter {
-    /// Writes to a temporary sibling file (`.NAME.partial` in the same directory) and only
+    /// Locks `path` against other writers ([`Error::Busy`] if one holds it), writes to a
+    /// temporary sibling file (`.NAME.<pid>-<n>.partial` in the same directory), and only
     /// [`finish`](Self::finish) renames it to `path`. If dropped without `finish` (error,
-    /// panic), the temp file is removed. A kill leaves at most the hidden temp file, never `path`.
+    /// panic), the temp file is removed. A kill leaves at most the hidden temp file, never
+    /// `path`. See [`crate::atomic`].
     pub fn create(path: &Path) -> Result<Self, Error> {
         Self::create_with(path, None)
     }
@@ -69,19 +86,7 @@ impl RecordingWriter {
 
     fn create_with(path: &Path, chunk_size: Option<u64>) -> Result<Self, Error> {
         let file = path.display().to_string();
-        let name = path
-            .file_name()
-            .ok_or_else(|| Error::NotAFilePath { file: file.clone() })?;
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(name);
-        tmp_name.push(".partial");
-        let tmp_path = path.with_file_name(tmp_name);
-        let io = |op, source| Error::Io {
-            file: tmp_path.display().to_string(),
-            op,
-            source,
-        };
-        let out = File::create(&tmp_path).map_err(|e| io("creating", e))?;
+        let (output, out) = Output::create(path)?;
         // Profile "": the MCAP registry's "ros2" profile means every channel is cdr/ros2msg,
         // and ours mix protobuf with CDR. Neither Foxglove nor Rerun needs a profile
         // (VIEWERS.md; check_mcap.py only reports it).
@@ -94,28 +99,18 @@ impl RecordingWriter {
             Some(n) => options.chunk_size(Some(n)),
             None => options,
         };
+        // (an error drops `output`, which deletes the temporary file)
         let mcap = options
             .create(BufWriter::new(out))
-            .map_err(|source| Error::McapWrite {
-                file: tmp_path.display().to_string(),
-                source,
-            });
-        let mcap = match mcap {
-            Ok(w) => w,
-            Err(e) => {
-                let _ = std::fs::remove_file(&tmp_path);
-                return Err(e);
-            }
-        };
+            .map_err(|source| write_error(&file, source))?;
         Ok(Self {
             mcap: Some(mcap),
+            output: Some(output),
             path: path.to_path_buf(),
-            tmp_path,
             file,
             topics: HashMap::new(),
             buf: Vec::with_capacity(4096),
             wrote_recording_metadata: false,
-            finished: false,
         })
     }
 
@@ -126,14 +121,11 @@ impl RecordingWriter {
 
     /// The temporary file being written.
     pub fn temp_path(&self) -> &Path {
-        &self.tmp_path
+        self.output.as_ref().map_or(Path::new(""), Output::temp_path)
     }
 
     fn mcap_err(&self, source: mcap::McapError) -> Error {
-        Error::McapWrite {
-            file: self.file.clone(),
-            source,
-        }
+        write_error(&self.file, source)
     }
 
     fn mcap(&mut self) -> &mut mcap::Writer<BufWriter<File>> {
@@ -232,10 +224,7 @@ impl RecordingWriter {
             unreachable!("RecordingWriter used after finish");
         };
         w.write_to_known_channel(&header, &self.buf)
-            .map_err(|source| Error::McapWrite {
-                file: self.file.clone(),
-                source,
-            })
+            .map_err(|source| write_error(&self.file, source))
     }
 
     fn register<M: Message>(&mut self, topic: &str) -> Result<u16, Error> {
@@ -250,53 +239,65 @@ impl RecordingWriter {
     }
 
     /// Finishes the MCAP (summary, footer), flushes, fsyncs and renames the temporary file to
-    /// `path`. Returns `path`. On error the temporary file is removed and `path` is untouched.
+    /// `path`, and releases the lock. Returns `path`. On error the temporary file is removed
+    /// and `path` is untouched.
     pub fn finish(mut self) -> Result<PathBuf, Error> {
         if !self.wrote_recording_metadata {
             self.write_metadata_raw(RecordingInfo::NAME, &BTreeMap::new())?;
         }
-        let tmp_file = self.tmp_path.display().to_string();
-        let io = |op, source| Error::Io {
-            file: tmp_file.clone(),
-            op,
-            source,
-        };
         let Some(mut w) = self.mcap.take() else {
             unreachable!("finish consumes self");
         };
-        w.finish().map_err(|source| Error::McapWrite {
+        w.finish().map_err(|source| write_error(&self.file, source))?;
+        let out = w.into_inner().into_inner().map_err(|e| Error::Io {
             file: self.file.clone(),
-            source,
+            op: "writing",
+            source: e.into_error(),
         })?;
-        let out = w
-            .into_inner()
-            .into_inner()
-            .map_err(|e| io("flushing", e.into_error()))?;
-        out.sync_all().map_err(|e| io("fsync", e))?;
-        drop(out);
-        std::fs::rename(&self.tmp_path, &self.path)
-            .map_err(|e| io("renaming to the final path", e))?;
-        self.finished = true;
-        // make the rename itself durable; best effort, since some filesystems refuse to fsync
-        // a directory, and the complete file is already in place
-        let dir = match self.path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
+        let Some(output) = self.output.take() else {
+            unreachable!("finish consumes self");
         };
-        let _ = File::open(dir).and_then(|d| d.sync_all());
-        Ok(self.path.clone())
+        output.commit(out)
     }
 }
 
 impl Drop for RecordingWriter {
     fn drop(&mut self) {
-        if self.finished {
-            return;
-        }
         if let Some(w) = self.mcap.take() {
-            // into_inner() skips writing the summary that mcap's own Drop would write
+            // into_inner() skips writing the summary that mcap's own Drop would write; the
+            // `output` field, dropped next, deletes the temporary file
             drop(w.into_inner());
         }
-        let _ = std::fs::remove_file(&self.tmp_path);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A full disk, for real: the `mcap` writer over `/dev/full` (every write fails with
+    /// ENOSPC), its error mapped as the writer maps it. The OS reason must reach the message,
+    /// which `mcap::McapError::Io` alone ("I/O error from writing ...") leaves out.
+    #[test]
+    fn a_full_disk_is_reported_with_the_os_reason() {
+        let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+            eprintln!("skipped: no /dev/full here");
+            return;
+        };
+        // more than the buffer, so the error surfaces at a write or at finish
+        let meta = Metadata { name: "x".into(), metadata: BTreeMap::from([("k".into(), "v".repeat(1 << 16))]) };
+        let result = (|| -> Result<(), mcap::McapError> {
+            let mut w = mcap::WriteOptions::new()
+                .compression(None)
+                .create(BufWriter::with_capacity(16, full))?;
+            w.write_metadata(&meta)?;
+            w.finish().map(drop)
+        })();
+        let e = write_error("out/run.mcap", result.expect_err("writing to /dev/full fails"));
+        let msg = e.to_string();
+        assert!(matches!(e, Error::Io { .. }), "{msg}");
+        assert!(msg.starts_with("out/run.mcap: ") && msg.contains("No space left on device"), "{msg}");
+        let Error::Io { source, .. } = e else { unreachable!() };
+        assert_eq!(source.raw_os_error(), Some(28)); // ENOSPC
     }
 }

@@ -1,5 +1,6 @@
 //! The writer's guarantees: byte-identical output for identical input, no file at `path`
-//! unless `finish` succeeded, no leftover temporary file, misuse reported with the file named.
+//! unless `finish` succeeded, no leftover temporary file, one writer per path at a time, I/O
+//! errors and misuse reported with the file named (and the OS reason).
 
 mod common;
 
@@ -48,7 +49,11 @@ fn dropped_writer_leaves_nothing_and_finish_leaves_only_path() {
     {
         let mut w = RecordingWriter::create(&path).unwrap();
         w.write(topics::MOTORS, 0, &MotorState::default()).unwrap();
-        assert_eq!(listing(), [".run.mcap.partial"]);
+        // its own temporary name, and the lock of the final name (schemas::atomic)
+        let temp = w.temp_path().file_name().unwrap().to_string_lossy().into_owned();
+        let expected = format!(".run.mcap.{}-", std::process::id());
+        assert!(temp.starts_with(&expected) && temp.ends_with(".partial"), "{temp}");
+        assert_eq!(listing(), [temp, ".run.mcap.lock".to_string()]);
         assert!(!path.exists());
     }
     assert!(listing().is_empty(), "{:?}", listing());
@@ -63,12 +68,11 @@ fn dropped_writer_leaves_nothing_and_finish_leaves_only_path() {
     assert!(result.is_err());
     assert!(listing().is_empty(), "{:?}", listing());
 
-    // a stale temp file from a killed run is overwritten, and finish leaves only `path`
-    std::fs::write(
-        dir.path().join(".run.mcap.partial"),
-        b"garbage from a killed run",
-    )
-    .unwrap();
+    // stale temp files from killed runs (this version's names and the older fixed one) and a
+    // stale lock file are removed, and finish leaves only `path`
+    for stale in [".run.mcap.partial", ".run.mcap.4242-0.partial", ".run.mcap.lock"] {
+        std::fs::write(dir.path().join(stale), b"garbage from a killed run").unwrap();
+    }
     let mut w = RecordingWriter::create(&path).unwrap();
     w.write(topics::MOTORS, 0, &MotorState::default()).unwrap();
     assert_eq!(w.finish().unwrap(), path);

@@ -85,7 +85,9 @@ pub enum RunError {
     NonFiniteState { t: f64, index: usize, name: String },
     #[error("the integrator stopped at t = {t:.9} s: more than {max_steps} steps (integrator.max_steps) with {method}; {hint}; raise integrator.max_steps if the run needs more", hint = slow_run_hint(method))]
     TooManySteps { t: f64, max_steps: usize, method: &'static str },
-    #[error("recording {path}: {source}")]
+    /// The recording could not be written (I/O error, full disk, another writer of the same
+    /// path): `source` names the path and the OS reason.
+    #[error("writing the recording: {source}")]
     Recording { path: PathBuf, source: schemas::Error },
 }
 
@@ -124,5 +126,11 @@ impl RunError {
             | RunError::TooManySteps { t, .. } => Some(*t),
             RunError::Recording { .. } => None,
         }
+    }
+
+    /// Whether the run failed because its recording could not be written (an I/O error, exit
+    /// status 2 in the tools) rather than numerically (exit status 1).
+    pub fn is_io(&self) -> bool {
+        matches!(self, RunError::Recording { .. })
     }
 }

@@ -103,7 +103,7 @@ impl<'a> Recorder<'a> {
     pub fn record(&mut self, o: &Outputs) -> Result<(), RunError> {
         let t_ns = to_log_time(o.t);
         let model = &self.scene.model;
-        let path = self.path.clone();
+        let path = &self.path;
         let err = |source| RunError::Recording { path: path.clone(), source };
 
         // joint states (effort = the motor torque delivered to the link, eq 12)

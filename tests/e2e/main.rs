@@ -12,6 +12,7 @@ mod format_ownership;
 mod pipeline;
 mod sampled_energy;
 mod sim_bad_input;
+mod sim_output;
 mod sim_sweep;
 
 /// Runs `analyze` with `args`.

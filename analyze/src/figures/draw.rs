@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use image::ImageEncoder;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -110,15 +111,35 @@ pub(super) struct Plot {
 
 /// Writes `<stem>.svg` and `<stem>.png`.
 pub(super) fn write(plot: &Plot, stem: &Path) -> Result<(), String> {
-    let svg = stem.with_extension("svg");
-    let png = stem.with_extension("png");
-    draw(SVGBackend::new(&svg, plot.size).into_drawing_area(), plot)
-        .map_err(|e| format!("{}: {e}", svg.display()))?;
-    draw(
-        BitMapBackend::new(&png, plot.size).into_drawing_area(),
-        plot,
-    )
-    .map_err(|e| format!("{}: {e}", png.display()))
+    save_svg_png(stem, plot.size, |a| draw(a, plot), |a| draw(a, plot))
+}
+
+/// Draws a figure of `size` pixels twice, with `svg` and `png`, in memory, and writes
+/// `<stem>.svg` and `<stem>.png` each atomically and exclusively (`schemas::atomic`; plotters'
+/// own file backends write in place). The PNG is encoded as plotters encodes its files (the
+/// `image` crate's PNG defaults). Errors name the file.
+pub(super) fn save_svg_png(
+    stem: &Path,
+    size: (u32, u32),
+    svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> Result<(), String>,
+    png: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> Result<(), String>,
+) -> Result<(), String> {
+    let svg_path = stem.with_extension("svg");
+    let png_path = stem.with_extension("png");
+    let mut text = String::new();
+    svg(SVGBackend::with_string(&mut text, size).into_drawing_area())
+        .map_err(|e| format!("{}: {e}", svg_path.display()))?;
+    schemas::atomic::write_file(&svg_path, text).map_err(|e| e.to_string())?;
+    let (w, h) = size;
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    png(BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area())
+        .map_err(|e| format!("{}: {e}", png_path.display()))?;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(&rgb, w, h, image::ColorType::Rgb8)
+        .map_err(|e| format!("{}: encoding the PNG: {e}", png_path.display()))?;
+    schemas::atomic::write_file(&png_path, bytes).map_err(|e| e.to_string())?;
+    Ok(())
 }
 
 fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, plot: &Plot) -> Result<(), String>

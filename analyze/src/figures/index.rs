@@ -15,7 +15,7 @@ pub fn write_index(
 ) -> Result<(), FigureError> {
     let write = |name: &str, text: String| {
         let path = dir.join(name);
-        std::fs::write(&path, text).map_err(|source| FigureError::Io { path, source })
+        schemas::atomic::write_file(&path, text).map(drop).map_err(|e| FigureError::Write(Box::new(e)))
     };
     write("index.md", markdown(figures, runs, sources))?;
     write("index.html", html(figures, runs, sources))

@@ -85,8 +85,5 @@ where
 /// error on the y axis.
 pub fn work_precision(series: &[WorkPrecisionSeries], title: &str, y_desc: &str, stem: &Path) -> Result<(), String> {
     register_font();
-    let svg = stem.with_extension("svg");
-    let png = stem.with_extension("png");
-    draw(SVGBackend::new(&svg, (1000, 700)).into_drawing_area(), series, title, y_desc).map_err(|e| format!("{}: {e}", svg.display()))?;
-    draw(BitMapBackend::new(&png, (1000, 700)).into_drawing_area(), series, title, y_desc).map_err(|e| format!("{}: {e}", png.display()))
+    super::draw::save_svg_png(stem, (1000, 700), |a| draw(a, series, title, y_desc), |a| draw(a, series, title, y_desc))
 }

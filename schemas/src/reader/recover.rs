@@ -1,6 +1,6 @@
 //! Reading the intact part of a damaged recording (`analyze ... --recover`).
 //!
-//! A recording cut short (a killed run leaves its hidden temporary file, a copy stops, a disk
+//! A recording cut short (a killed run leaves its hidden `.NAME.<pid>-<n>.partial`, a copy stops, a disk
 //! fills) has no summary and no footer, so [`super::stream_recording`] rejects it. Its data
 //! section is still a sequence of self-contained records (MCAP spec: a chunk carries its own
 //! schemas and channels, is compressed on its own and has its own CRC), so everything before the

@@ -18,7 +18,7 @@ Examples:
   analyze compare out/
   analyze compare out/paper-no-elbow.mcap out/paper-two-elbow.mcap
   analyze compare out/ --baseline two-elbow -f json > comparison.json
-  analyze compare --recover out/ out/.paper-no-elbow.mcap.partial")]
+  analyze compare --recover out/ out/.paper-no-elbow.mcap.*.partial")]
 pub struct CompareArgs {
     /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
     #[arg(required = true, value_name = "FILES_OR_DIRS")]
@@ -44,7 +44,7 @@ number under stable keys (what `analyze diff` reads back), -f csv one row per ru
 Examples:
   analyze metrics out/paper-two-elbow.mcap
   analyze metrics out/ -f json > metrics.json
-  analyze metrics --recover out/.paper-two-elbow.mcap.partial   what a killed run left")]
+  analyze metrics --recover out/.paper-two-elbow.mcap.*.partial   what a killed run left")]
 pub struct MetricsArgs {
     /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
     #[arg(required = true, value_name = "FILES_OR_DIRS")]

@@ -77,24 +77,10 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => ExitCode::from(code),
         Err(err) => {
-            eprintln!("analyze: error: {}", message(&err));
+            eprintln!("analyze: error: {}", cli::exit::message(&err));
             ExitCode::from(exit::BAD_INPUT)
         }
     }
-}
-
-/// The error and its causes, `: `-separated, leaving out a cause whose text is already in the
-/// message (errors that print their source would repeat it).
-fn message(err: &anyhow::Error) -> String {
-    let mut msg = err.to_string();
-    for cause in err.chain().skip(1) {
-        let c = cause.to_string();
-        if !msg.contains(&c) {
-            msg.push_str(": ");
-            msg.push_str(&c);
-        }
-    }
-    msg
 }
 
 #[cfg(test)]

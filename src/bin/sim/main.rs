@@ -85,7 +85,7 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
-            eprintln!("sim: error: {e:#}");
+            eprintln!("sim: error: {}", exit::message(&e));
             ExitCode::from(exit::BAD_INPUT)
         }
     }

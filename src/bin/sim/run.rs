@@ -120,6 +120,8 @@ pub struct Done {
     pub path: Option<PathBuf>,
     /// The failure, if any.
     pub error: Option<String>,
+    /// The failure is an I/O error (the recording could not be written), not a numerical one.
+    pub io_error: bool,
 }
 
 /// Runs `runs` of `scene` on `jobs` threads, run `r` to `path(r)`, with a progress bar each.
@@ -155,13 +157,13 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
                                 )
                             });
                         }
-                        Done { path: Some(r.path), error: None }
+                        Done { path: Some(r.path), error: None, io_error: false }
                     }
                     Err(e) => {
                         bar.abandon_with_message(format!("failed at {}", e.time().map_or("?".into(), |t| format!("{t:.3} s"))));
                         // a numerical failure still leaves a recording that says when and why
                         let written = e.time().is_some() && target.is_file();
-                        Done { path: written.then_some(target), error: Some(format!("run `{}`: {e}", run.name)) }
+                        Done { path: written.then_some(target), error: Some(format!("run `{}`: {e}", run.name)), io_error: e.is_io() }
                     }
                 }
             })
@@ -182,7 +184,9 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
     done
 }
 
-/// Prints the comparison of the complete runs and the failures; the exit status.
+/// Prints the comparison of the complete runs and the failures; the exit status: 2 if a
+/// recording could not be written (an I/O error: its run's result is lost), else 1 if a run
+/// failed numerically (its recording says when and why), else 0.
 pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>) -> Result<u8> {
     let complete: Vec<&Path> = done.iter().filter(|d| d.error.is_none()).filter_map(|d| d.path.as_deref()).collect();
     if !complete.is_empty() {
@@ -192,7 +196,13 @@ pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>) -> Res
     for f in &failures {
         eprintln!("sim: error: {f}");
     }
-    Ok(if failures.is_empty() { exit::SUCCESS } else { exit::FAILED })
+    Ok(if done.iter().any(|d| d.io_error) {
+        exit::BAD_INPUT
+    } else if failures.is_empty() {
+        exit::SUCCESS
+    } else {
+        exit::FAILED
+    })
 }
 
 /// Reads the recordings back and prints the comparison of the runs.

@@ -130,6 +130,8 @@ fn ser_values<S: serde::Serializer>(v: &[(String, Value)], s: S) -> Result<S::Ok
 struct Done {
     path: Option<PathBuf>,
     error: Option<String>,
+    /// The failure is an I/O error (the recording could not be written), not a numerical one.
+    io_error: bool,
     metrics: Option<Result<analyze::RunMetrics, String>>,
 }
 
@@ -161,13 +163,13 @@ pub fn run(args: &SweepArgs, v: Verbosity) -> Result<u8> {
         bar.set_message(format!("{} {run_name}", var.name));
         let path = out.join(Sweep::file_name(var, run_name));
         let done = match run_to_file_within(scene, run, &path, budget, |_| {}) {
-            Ok(rep) => Done { metrics: Some(read_metrics(&rep.path)), path: Some(rep.path), error: None },
+            Ok(rep) => Done { metrics: Some(read_metrics(&rep.path)), path: Some(rep.path), error: None, io_error: false },
             Err(e) => {
                 // a numerical failure still leaves a recording that says when and why
                 let written = e.time().is_some() && path.is_file();
                 let error = format!("{} run `{run_name}` ({}): {e}", var.name, var.describe());
                 bar.println(format!("sim: error: {error}"));
-                Done { metrics: written.then(|| read_metrics(&path)), path: written.then(|| path.clone()), error: Some(error) }
+                Done { metrics: written.then(|| read_metrics(&path)), path: written.then(|| path.clone()), error: Some(error), io_error: e.is_io() }
             }
         };
         bar.inc(1);
@@ -237,7 +239,14 @@ pub fn run(args: &SweepArgs, v: Verbosity) -> Result<u8> {
     for f in &failures {
         eprintln!("sim: error: {f}");
     }
-    Ok(if failures.is_empty() { exit::SUCCESS } else { exit::FAILED })
+    // as `sim run`: 2 if a recording could not be written, 1 if a run failed numerically
+    Ok(if results.iter().any(|d| d.io_error) {
+        exit::BAD_INPUT
+    } else if failures.is_empty() {
+        exit::SUCCESS
+    } else {
+        exit::FAILED
+    })
 }
 
 /// `--dry-run`: the variants of the shard, for people or as JSON.
