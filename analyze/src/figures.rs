@@ -20,7 +20,7 @@
 use std::path::{Path, PathBuf};
 
 use plotters::style::FontStyle;
-use schemas::{ConstraintState, EnergyState, HandState, MotorState, Recording, TopicMessage, Vec3};
+use schemas::{topics, ConstraintState, EnergyState, HandState, MotorState, Recording, TopicMessage, Vec3};
 
 use crate::Error;
 
@@ -85,6 +85,19 @@ impl Series {
 
     pub fn is_empty(&self) -> bool {
         self.t.is_empty() || self.cols.is_empty()
+    }
+
+    /// Appends one row, as [`Series::from_rows`] would lay it out (a longer row adds columns,
+    /// NaN before it; a shorter one leaves NaN).
+    fn push(&mut self, t: f64, row: &[f64]) {
+        let n = self.t.len();
+        while self.cols.len() < row.len() {
+            self.cols.push(vec![f64::NAN; n]);
+        }
+        for (j, col) in self.cols.iter_mut().enumerate() {
+            col.push(row.get(j).copied().unwrap_or(f64::NAN));
+        }
+        self.t.push(t);
     }
 }
 
@@ -153,14 +166,62 @@ pub fn load_run(rec: &Recording, fallback_name: &str) -> Result<RunSeries, Error
     })
 }
 
-/// Reads a recording file and [`load_run`]s it (named by its file stem if it has no run name).
+/// The topics the figures draw.
+pub const FIGURE_TOPICS: [&str; 4] = [topics::HAND, topics::ENERGY, topics::MOTORS, topics::CONSTRAINTS];
+
+/// [`RunSeries`] collected as a recording is streamed: only the drawn numbers are kept (about
+/// 50 per sample for the paper arm), not the decoded messages.
+#[derive(Default)]
+struct Collect(RunSeries);
+
+impl schemas::Visitor for Collect {
+    fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        let (t, s) = (m.t_s(), &mut self.0);
+        let xyz = |v: &Vec3| [v.x, v.y, v.z];
+        match m.topic {
+            topics::HAND => {
+                let h: HandState = m.decode(None)?;
+                s.actual.push(t, &xyz(&h.actual));
+                s.desired.push(t, &xyz(&h.desired));
+                s.error_norm.push(t, &[h.error_norm]);
+            }
+            topics::ENERGY => {
+                let e: EnergyState = m.decode(None)?;
+                s.work.push(t, &e.link_work);
+                s.work_total.push(t, &[e.link_work_total]);
+                s.electric.push(t, &e.electric_energy);
+                s.electric_total.push(t, &[e.electric_energy_total]);
+            }
+            topics::MOTORS => {
+                let mo: MotorState = m.decode(None)?;
+                s.current.push(t, &mo.current);
+                s.voltage.push(t, &mo.voltage);
+            }
+            topics::CONSTRAINTS => {
+                let c: ConstraintState = m.decode(None)?;
+                s.normal_force.push(t, &c.normal_force);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// Reads a recording file, streamed, into its [`RunSeries`] (named by its file stem if it has
+/// no run name): memory is the drawn series, not the recording.
 pub fn read_run(path: &Path) -> Result<RunSeries, Error> {
-    let rec = schemas::read_recording(path)?;
+    let mut c = Collect::default();
+    let rec = schemas::stream_recording(path, Some(&FIGURE_TOPICS), &mut c)?;
+    let run = rec.run_opt()?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    load_run(&rec, &stem)
+    Ok(RunSeries {
+        name: run.as_ref().map_or(stem, |r| r.run.clone()),
+        contacts: run.map(|r| r.contacts).unwrap_or_default(),
+        ..c.0
+    })
 }
 
 /// One written figure: `<stem>.svg` and `<stem>.png` in the output directory.

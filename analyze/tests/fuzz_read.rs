@@ -1,19 +1,25 @@
-//! Fuzzing the reading path: [`FUZZ_CASES`] = 10,000 inputs (fixed seed) derived from a real
+//! Fuzzing the reading path: 10,000 inputs by default (`FUZZ_CASES=100000 cargo test -p
+//! analyze --test fuzz_read` for more, `FUZZ_SEED` for another sequence) derived from a real
 //! small recording (several chunks) — random bytes, random bytes behind the MCAP magic,
 //! truncations, 1-8 bit flips, and record-level mutations (a top-level record's length or
-//! opcode changed, a record deleted, duplicated or swapped with the next) — each through
-//! `schemas::read_recording_bytes` (+ `analyze::run_metrics` when it reads) and
-//! `schemas::read_recording_recover_bytes` (+ `analyze::run_metrics_recovered`), under
-//! `catch_unwind`: no panic may escape, and every error names the input. Panics that the reader
-//! catches itself (mcap 0.26 and prost-reflect 0.16 on corrupt input no CRC covers; see
+//! opcode changed, a record deleted, duplicated or swapped with the next) — each written to a
+//! file and read as users read it: `schemas::read_recording` (+ `analyze::run_metrics`),
+//! the streamed `analyze::read_run_metrics`, and `analyze::read_run_metrics_recover`, under
+//! `catch_unwind`: no panic may escape, every error names the input, and **no wrong answer**: a
+//! damaged file whose metrics compute without `--recover` gives exactly the intact file's
+//! metrics, and the streamed metrics are the in-memory ones. Panics that the reader catches
+//! itself (mcap 0.26 and prost-reflect 0.16 on corrupt input no CRC covers; see
 //! `schemas/src/reader.rs`) are errors, not failures; the panic hook is silenced meanwhile.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use schemas::synth::Synth;
 
-const FUZZ_CASES: usize = 10_000;
-const SEED: u64 = 0xF022_0000_2EAD_0001;
+/// `FUZZ_CASES` (default 10,000) and `FUZZ_SEED` from the environment.
+fn config() -> (usize, u64) {
+    let var = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<u64>().ok());
+    (var("FUZZ_CASES").map_or(10_000, |n| n as usize), var("FUZZ_SEED").unwrap_or(0xF022_0000_2EAD_0001))
+}
 
 struct Rng(u64);
 
@@ -115,16 +121,28 @@ fn reading_path_never_panics() {
         "want several chunks"
     );
     let full = schemas::read_recording_bytes(&base, "base").unwrap();
-    analyze::run_metrics(&full).unwrap();
+    let intact = analyze::run_metrics(&full).unwrap();
+    let (cases, seed) = config();
 
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
-    let mut r = Rng(SEED);
+    let mut r = Rng(seed);
     let mut escaped = Vec::new();
     let (mut read_ok, mut metrics_ok, mut recovered_metrics_ok) = (0, 0, 0);
-    for case in 0..FUZZ_CASES {
+    for case in 0..cases {
         let input = mutate(&mut r, &base, &recs);
-        let label = format!("case{case}.mcap");
+        let file = dir.path().join(format!("case{case}.mcap"));
+        std::fs::write(&file, &input).unwrap();
+        let label = file.display().to_string();
+        // the metrics of a file the normal reader accepts: the intact file's, whatever the damage
+        let same = |m: &analyze::RunMetrics, how: &str| -> Result<(), String> {
+            let m = analyze::RunMetrics { file: intact.file.clone(), ..m.clone() };
+            if format!("{m:?}") == format!("{intact:?}") {
+                Ok(())
+            } else {
+                Err(format!("{how}: a damaged file read without error gives other metrics"))
+            }
+        };
         let outcome = catch_unwind(AssertUnwindSafe(
             || -> Result<(usize, usize, usize), String> {
                 let named = |e: String| {
@@ -135,18 +153,37 @@ fn reading_path_never_panics() {
                     }
                 };
                 let mut n = (0, 0, 0);
-                match schemas::read_recording_bytes(&input, &label) {
+                let in_memory = match schemas::read_recording(&file) {
                     Ok(rec) => {
                         n.0 = 1;
                         match analyze::run_metrics(&rec) {
-                            Ok(_) => n.1 = 1,
-                            Err(e) => named(e.to_string())?,
+                            Ok(m) => {
+                                n.1 = 1;
+                                same(&m, "read_recording + run_metrics")?;
+                                Some(m)
+                            }
+                            Err(e) => {
+                                named(e.to_string())?;
+                                None
+                            }
+                        }
+                    }
+                    Err(e) => {
+                        named(e.to_string())?;
+                        None
+                    }
+                };
+                match analyze::read_run_metrics(&file) {
+                    Ok(m) => {
+                        same(&m, "read_run_metrics")?;
+                        if in_memory.is_none() {
+                            return Err("the streamed metrics read a file the in-memory reader refuses".into());
                         }
                     }
                     Err(e) => named(e.to_string())?,
                 }
-                match schemas::read_recording_recover_bytes(&input, &label) {
-                    Ok((rec, report)) => {
+                match analyze::read_run_metrics_recover(&file) {
+                    Ok((m, report)) => {
                         named(report.to_string())?;
                         if report.complete != (n.0 == 1) {
                             return Err(format!(
@@ -154,10 +191,10 @@ fn reading_path_never_panics() {
                                 report.complete
                             ));
                         }
-                        match analyze::run_metrics_recovered(&rec, &report) {
-                            Ok(_) => n.2 = 1,
-                            Err(e) => named(e.to_string())?,
+                        if report.complete {
+                            same(&m, "read_run_metrics_recover of a complete file")?;
                         }
+                        n.2 = 1;
                     }
                     Err(e) => named(e.to_string())?,
                 }
@@ -173,10 +210,11 @@ fn reading_path_never_panics() {
             Ok(Err(why)) => escaped.push(format!("case {case} ({} bytes): {why}", input.len())),
             Err(_) => escaped.push(format!("case {case} ({} bytes): panicked", input.len())),
         }
+        std::fs::remove_file(&file).unwrap();
     }
     std::panic::set_hook(hook);
     eprintln!(
-        "reading_path_never_panics: {FUZZ_CASES} inputs; read {read_ok}, metrics {metrics_ok}, \
+        "reading_path_never_panics: {cases} inputs (seed {seed:#x}); read {read_ok}, metrics {metrics_ok}, \
          metrics after recovery {recovered_metrics_ok}"
     );
     assert!(
@@ -187,7 +225,7 @@ fn reading_path_never_panics() {
     );
     // the generator reaches the deep paths: recovery yields metrics far more often than a full read
     assert!(
-        recovered_metrics_ok > metrics_ok && recovered_metrics_ok > 1000,
+        recovered_metrics_ok > metrics_ok && recovered_metrics_ok > cases / 10,
         "{recovered_metrics_ok}"
     );
 }

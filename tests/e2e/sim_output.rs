@@ -184,7 +184,7 @@ fn a_full_disk_exits_2_with_enospc_and_leaves_nothing() {
 fn a_replay_of_a_failed_run_exits_1_like_the_run() {
     let integrators = [
         serde_json::json!({"method": "rk4", "step": 5e-3}),
-        serde_json::json!({"method": "dopri45", "rtol": 1e-9, "atol": 1e-11, "max_steps": 50}),
+        serde_json::json!({"method": "dopri45", "rtol": 1e-9, "atol": 1e-11, "max_steps": 50, "h_max": 0.5}),
     ];
     for integrator in integrators {
         let dir = tempfile::tempdir().unwrap();

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use analyze::report::{render_report, FigureLink, RunInfo};
 use analyze::{run_metrics, Comparison};
+use schemas::topics;
 use anyhow::{Context, Result};
 use cli::{exit, Verbosity};
 
@@ -40,6 +41,9 @@ pub struct ReportArgs {
     pub check_from: f64,
 }
 
+/// What a report reads of each recording.
+const REPORT_TOPICS: [&str; 5] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, topics::ENERGY, topics::JOINT_STATES];
+
 pub fn run(a: &ReportArgs, v: Verbosity) -> Result<u8> {
     let paths = cli::inputs::expand(&a.inputs)?;
     let mut metrics = Vec::new();
@@ -47,7 +51,8 @@ pub fn run(a: &ReportArgs, v: Verbosity) -> Result<u8> {
     let mut series = Vec::new();
     for p in &paths {
         let ctx = || format!("reporting on {}", p.display());
-        let rec = schemas::read_recording(p).with_context(ctx)?;
+        // the topics of the metrics, the figures and the integrals' check (not /tf, most of a file)
+        let rec = schemas::read_recording_topics(p, Some(&REPORT_TOPICS)).with_context(ctx)?;
         metrics.push(run_metrics(&rec).with_context(ctx)?);
         info.push(RunInfo {
             tool: rec.info().ok().and_then(|i| i.tool),
