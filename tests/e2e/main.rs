@@ -7,6 +7,7 @@ mod analyze_cli;
 mod analyze_diff;
 mod analyze_figures;
 mod analyze_tables;
+mod bounded_memory;
 mod cli_voice;
 mod format_ownership;
 mod pipeline;

@@ -261,3 +261,28 @@ fn a_sweep_with_an_unwritable_recording_exits_2() {
     let status = |k: usize| manifest["variants"][k]["files"][0]["status"].as_str().unwrap().to_string();
     assert_eq!((status(0), status(1)), ("failed".to_string(), "not written".to_string()), "{manifest}");
 }
+
+/// `--max-wall-time` through the binary: a run that would take minutes (RK4 with 10^7 steps)
+/// stops at its wall-time budget with exit 1, the simulated time it reached and the flag to
+/// raise, and its recording is complete and valid, recording the failure and its time.
+#[test]
+fn a_run_past_its_wall_time_stops_with_exit_1_and_a_valid_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(small_scene()).unwrap()).unwrap();
+    v["integrator"] = serde_json::json!({"method": "rk4", "step": 1e-7});
+    v["duration"] = serde_json::json!(1.0);
+    v["runs"] = serde_json::json!([{"name": "free", "contacts": []}]);
+    let scene = dir.path().join("slow.json");
+    std::fs::write(&scene, v.to_string()).unwrap();
+    std::fs::copy(small_scene().with_file_name("small_arm.urdf"), dir.path().join("small_arm.urdf")).unwrap();
+    let out = dir.path().join("out");
+    let o = sim().arg("run").arg(&scene).arg("-o").arg(&out).arg("--quiet").arg("--max-wall-time").arg("0.5").output().unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("wall-time limit of 0.5 s") && err.contains("--max-wall-time"), "{err}");
+    let rec = schemas::read_recording(&out.join("small-free.mcap")).unwrap();
+    let result = rec.result().unwrap().unwrap();
+    assert_eq!(result.status, schemas::RunStatus::Failed);
+    let t = result.error_time_s.unwrap();
+    assert!(t > 0.0 && t < 1.0, "{t}");
+}

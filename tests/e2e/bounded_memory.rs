@@ -1,0 +1,45 @@
+//! The long-run memory check: `analyze metrics`, `summary` and `metrics --recover` read a long
+//! recording in bounded memory. The recording is synthetic (`schemas::synth`, 300 000 samples of
+//! the four metric topics, 300 s at 1 kHz) and the commands run under an address-space limit
+//! (`ulimit -v`) of 200 MB: a reader that holds the decoded messages needs several GB for it and
+//! is killed by the limit (the reader before issue 12 took 2 GB on a 60 s run); the streamed
+//! reader needs about 10 MB of heap (BENCHMARKS.md, "Peak memory"). The metrics must still be
+//! right: the sample count and the peak current of the known signal.
+
+use schemas::synth::Synth;
+
+/// Runs `analyze args…` with an address-space limit of `limit_kb`.
+fn analyze_limited(limit_kb: u64, args: &[&str]) -> std::process::Output {
+    let cmd = format!("ulimit -v {limit_kb} && exec \"$0\" \"$@\"");
+    std::process::Command::new("sh")
+        .arg("-c")
+        .arg(cmd)
+        .arg(env!("CARGO_BIN_EXE_analyze"))
+        .args(args)
+        .output()
+        .expect("sh starts")
+}
+
+#[test]
+fn long_recordings_are_read_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Synth::new("long", &["elbow"], 3);
+    (s.dt, s.n) = (1e-3, 300_000);
+    let s = s.with_setup();
+    let path = s.write_in(dir.path());
+    let bytes = std::fs::metadata(&path).unwrap().len();
+    let p = path.to_str().unwrap();
+    for args in [vec!["metrics", p, "-f", "json"], vec!["metrics", "--recover", p, "-f", "json"], vec!["summary", p, "-f", "json"]] {
+        let out = analyze_limited(200_000, &args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?} ({bytes} bytes) within 200 MB: {stderr}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let text = v.to_string();
+        assert!(text.contains("\"samples\":300001"), "{args:?}: {text:.300}");
+    }
+    // the metrics themselves: currents (j+1) sin(2 pi t), peak 3 A on joint 3
+    let out = analyze_limited(200_000, &["metrics", p, "-f", "json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let peak = v[0]["peak_current"]["current_a"].as_f64().unwrap();
+    assert!((peak - 3.0).abs() < 1e-9, "{peak}");
+}
