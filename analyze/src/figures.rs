@@ -20,7 +20,7 @@
 use std::path::{Path, PathBuf};
 
 use plotters::style::FontStyle;
-use schemas::{topics, ConstraintState, EnergyState, HandState, MotorState, Recording, TopicMessage, Vec3};
+use schemas::{topics, ConstraintState, EnergyState, HandState, MotorState, Recording, Vec3};
 
 use crate::Error;
 
@@ -70,25 +70,12 @@ pub struct Series {
 }
 
 impl Series {
-    /// From rows of values; a short row leaves NaN (not drawn) in its columns.
-    fn from_rows(t: Vec<f64>, rows: &[Vec<f64>]) -> Self {
-        let width = rows.iter().map(Vec::len).max().unwrap_or(0);
-        let cols = (0..width)
-            .map(|j| {
-                rows.iter()
-                    .map(|r| r.get(j).copied().unwrap_or(f64::NAN))
-                    .collect()
-            })
-            .collect();
-        Series { t, cols }
-    }
-
     pub fn is_empty(&self) -> bool {
         self.t.is_empty() || self.cols.is_empty()
     }
 
-    /// Appends one row, as [`Series::from_rows`] would lay it out (a longer row adds columns,
-    /// NaN before it; a shorter one leaves NaN).
+    /// Appends one row: a longer row than the ones before adds columns (NaN before it, not
+    /// drawn); a shorter one leaves NaN in the columns it lacks.
     fn push(&mut self, t: f64, row: &[f64]) {
         let n = self.t.len();
         while self.cols.len() < row.len() {
@@ -127,54 +114,36 @@ pub struct RunSeries {
     pub normal_force: Series,
 }
 
-/// Every message of `M`'s topic, none if the recording has no such topic.
-fn read_or_none<M: TopicMessage>(rec: &Recording) -> Result<Vec<(f64, M)>, Error> {
-    match rec.read::<M>() {
-        Ok(v) => Ok(v),
-        Err(schemas::Error::UnknownTopic { .. }) => Ok(Vec::new()),
-        Err(e) => Err(e.into()),
-    }
-}
-
-/// One row per message, `row(message)` its values.
-fn series<M>(messages: &[(f64, M)], row: impl Fn(&M) -> Vec<f64>) -> Series {
-    let rows: Vec<Vec<f64>> = messages.iter().map(|(_, m)| row(m)).collect();
-    Series::from_rows(messages.iter().map(|(t, _)| *t).collect(), &rows)
-}
-
-/// The series of one recording; `fallback_name` names it if it has no `run` record.
+/// The series of one recording in memory; `fallback_name` names it if it has no `run` record.
+/// (Files are read streamed by [`read_run`].)
 pub fn load_run(rec: &Recording, fallback_name: &str) -> Result<RunSeries, Error> {
-    let run = rec.run_opt()?;
-    let hand = read_or_none::<HandState>(rec)?;
-    let energy = read_or_none::<EnergyState>(rec)?;
-    let motors = read_or_none::<MotorState>(rec)?;
-    let constraints = read_or_none::<ConstraintState>(rec)?;
-    let xyz = |v: &Vec3| vec![v.x, v.y, v.z];
-    Ok(RunSeries {
-        name: run.as_ref().map_or_else(|| fallback_name.to_string(), |r| r.run.clone()),
-        contacts: run.map(|r| r.contacts).unwrap_or_default(),
-        actual: series(&hand, |h| xyz(&h.actual)),
-        desired: series(&hand, |h| xyz(&h.desired)),
-        error_norm: series(&hand, |h| vec![h.error_norm]),
-        work: series(&energy, |e| e.link_work.clone()),
-        work_total: series(&energy, |e| vec![e.link_work_total]),
-        electric: series(&energy, |e| e.electric_energy.clone()),
-        electric_total: series(&energy, |e| vec![e.electric_energy_total]),
-        current: series(&motors, |m| m.current.clone()),
-        voltage: series(&motors, |m| m.voltage.clone()),
-        normal_force: series(&constraints, |c| c.normal_force.clone()),
-    })
+    let mut c = SeriesCollect::default();
+    let topics: Vec<&str> = FIGURE_TOPICS.iter().filter(|t| rec.check_topic(t).is_ok()).copied().collect();
+    rec.replay(&topics, &mut c)?;
+    c.into_series(rec, fallback_name)
 }
 
 /// The topics the figures draw.
 pub const FIGURE_TOPICS: [&str; 4] = [topics::HAND, topics::ENERGY, topics::MOTORS, topics::CONSTRAINTS];
 
-/// [`RunSeries`] collected as a recording is streamed: only the drawn numbers are kept (about
-/// 50 per sample for the paper arm), not the decoded messages.
+/// [`RunSeries`] collected as a recording is streamed ([`schemas::Visitor`]): only the drawn
+/// numbers are kept (about 50 per sample for the paper arm), not the decoded messages.
 #[derive(Default)]
-struct Collect(RunSeries);
+pub struct SeriesCollect(RunSeries);
 
-impl schemas::Visitor for Collect {
+impl SeriesCollect {
+    /// The series, named by the `run` record of `rec` (or `stem` without one).
+    pub fn into_series(self, rec: &Recording, stem: &str) -> Result<RunSeries, Error> {
+        let run = rec.run_opt()?;
+        Ok(RunSeries {
+            name: run.as_ref().map_or_else(|| stem.to_string(), |r| r.run.clone()),
+            contacts: run.map(|r| r.contacts).unwrap_or_default(),
+            ..self.0
+        })
+    }
+}
+
+impl schemas::Visitor for SeriesCollect {
     fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
         let (t, s) = (m.t_s(), &mut self.0);
         let xyz = |v: &Vec3| [v.x, v.y, v.z];
@@ -210,18 +179,13 @@ impl schemas::Visitor for Collect {
 /// Reads a recording file, streamed, into its [`RunSeries`] (named by its file stem if it has
 /// no run name): memory is the drawn series, not the recording.
 pub fn read_run(path: &Path) -> Result<RunSeries, Error> {
-    let mut c = Collect::default();
+    let mut c = SeriesCollect::default();
     let rec = schemas::stream_recording(path, Some(&FIGURE_TOPICS), &mut c)?;
-    let run = rec.run_opt()?;
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    Ok(RunSeries {
-        name: run.as_ref().map_or(stem, |r| r.run.clone()),
-        contacts: run.map(|r| r.contacts).unwrap_or_default(),
-        ..c.0
-    })
+    c.into_series(&rec, &stem)
 }
 
 /// One written figure: `<stem>.svg` and `<stem>.png` in the output directory.

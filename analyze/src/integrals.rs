@@ -21,7 +21,7 @@
 //! at 8 kHz) miss joules of E_9 and E_10; [`sampled_integrals_from`] checks the run after such a
 //! transient, where the samples converge as h².
 
-use schemas::{topics, ArraySizes, EnergyState, JointState, MotorState, Recording};
+use schemas::{topics, EnergyState, JointState, MotorState, Recording};
 use serde::{Deserialize, Serialize};
 
 use crate::Error;
@@ -132,63 +132,129 @@ pub fn sampled_integrals(rec: &Recording) -> Result<SampledIntegrals, Error> {
 /// step (the paper arm's light wrist links ring for the first milliseconds) makes the samples
 /// unable to reproduce the integral over the whole run, while after it they converge as h².
 pub fn sampled_integrals_from(rec: &Recording, from_s: f64) -> Result<SampledIntegrals, Error> {
-    let file = || rec.source.clone();
-    let motors = rec.read::<MotorState>()?;
-    if motors.len() < 3 {
-        // the error estimate needs every second sample of at least two intervals
-        return Err(Error::Table {
-            file: file(),
-            detail: format!("{} has {} samples: at least 3 are needed to check the integrals", topics::MOTORS, motors.len()),
-        });
+    let mut samples = IntegralSamples::default();
+    rec.replay(&INTEGRAL_TOPICS, &mut samples)?;
+    samples.integrals(rec, from_s)
+}
+
+/// The topics the check reads.
+pub const INTEGRAL_TOPICS: [&str; 3] = [topics::MOTORS, topics::JOINT_STATES, topics::ENERGY];
+
+/// The samples the check needs, as columns (`i_j v_j`, `τ_j`, `q'_j`, and the recorded `E_j`,
+/// `W_j`): fed one message at a time ([`schemas::Visitor`]) from a recording in memory or
+/// streamed from a file, so a long run costs 5 numbers per joint and sample, not its messages.
+#[derive(Debug, Default)]
+pub struct IntegralSamples {
+    joints: Option<usize>,
+    t: [Vec<f64>; 3],
+    /// Per sample of `/motors`: `i_j v_j` and `τ_j`, row after row (`joints` per row).
+    power: Vec<f64>,
+    torque: Vec<f64>,
+    /// Per sample of `/joint_states`: `q'_j`.
+    velocity: Vec<f64>,
+    /// Per sample of `/energy`: `E_j` and `W_j`.
+    electric: Vec<f64>,
+    work: Vec<f64>,
+    /// `(topic, field)` of an array some message does not record for every joint.
+    unrecorded: Option<(&'static str, &'static str)>,
+}
+
+impl schemas::Visitor for IntegralSamples {
+    fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        let sizes = m.sizes();
+        match m.topic {
+            topics::MOTORS => {
+                let mo: MotorState = m.decode(sizes)?;
+                let n = *self.joints.get_or_insert(mo.current.len());
+                let full = |v: &[f64]| v.len() == n;
+                if !(full(&mo.current) && full(&mo.voltage) && full(&mo.torque)) {
+                    let field = if !full(&mo.voltage) { "voltage" } else if !full(&mo.torque) { "torque" } else { "current" };
+                    self.unrecorded.get_or_insert((topics::MOTORS, field));
+                    return Ok(());
+                }
+                self.t[0].push(m.t_s());
+                self.power.extend(mo.current.iter().zip(&mo.voltage).map(|(i, v)| i * v));
+                self.torque.extend_from_slice(&mo.torque);
+            }
+            topics::JOINT_STATES => {
+                let q: JointState = m.decode(sizes)?;
+                if self.joints.is_some_and(|n| q.velocity.len() != n) {
+                    self.unrecorded.get_or_insert((topics::JOINT_STATES, "velocity"));
+                    return Ok(());
+                }
+                self.t[1].push(m.t_s());
+                self.velocity.extend_from_slice(&q.velocity);
+            }
+            topics::ENERGY => {
+                let e: EnergyState = m.decode(sizes)?;
+                if self.joints.is_some_and(|n| e.electric_energy.len() != n || e.link_work.len() != n) {
+                    self.unrecorded.get_or_insert((topics::ENERGY, "joint's energies"));
+                    return Ok(());
+                }
+                self.t[2].push(m.t_s());
+                self.electric.extend_from_slice(&e.electric_energy);
+                self.work.extend_from_slice(&e.link_work);
+            }
+            _ => {}
+        }
+        Ok(())
     }
-    let n = motors[0].1.current.len();
-    let sizes = ArraySizes { joints: n, contacts: rec.run().map_or(0, |r| r.contacts.len()) };
-    let motors = rec.read_sized::<MotorState>(sizes)?;
-    let joint_states = rec.read_sized::<JointState>(sizes)?;
-    let energy = rec.read_sized::<EnergyState>(sizes)?;
-    let t: Vec<f64> = motors.iter().map(|m| m.0).collect();
-    let same_times = |times: &mut dyn Iterator<Item = f64>| times.eq(t.iter().copied());
-    let which = if !same_times(&mut joint_states.iter().map(|m| m.0)) {
-        Some(topics::JOINT_STATES)
-    } else if !same_times(&mut energy.iter().map(|m| m.0)) {
-        Some(topics::ENERGY)
-    } else {
-        None
-    };
-    if let Some(which) = which {
-        return Err(Error::Table {
-            file: file(),
-            detail: format!("{which} is not sampled at the times of {}: cannot integrate their product", topics::MOTORS),
-        });
+}
+
+impl IntegralSamples {
+    /// The check over the samples with `t >= from_s`; `rec` gives the file and the joint names.
+    pub fn integrals(&self, rec: &Recording, from_s: f64) -> Result<SampledIntegrals, Error> {
+        let file = || rec.source.clone();
+        let t = &self.t[0];
+        if t.len() < 3 {
+            // the error estimate needs every second sample of at least two intervals
+            return Err(Error::Table {
+                file: file(),
+                detail: format!("{} has {} samples: at least 3 are needed to check the integrals", topics::MOTORS, t.len()),
+            });
+        }
+        if let Some((topic, what)) = self.unrecorded {
+            return Err(Error::Table { file: file(), detail: format!("{topic} does not record every {what}: cannot check the integrals") });
+        }
+        let which = if self.t[1] != *t {
+            Some(topics::JOINT_STATES)
+        } else if self.t[2] != *t {
+            Some(topics::ENERGY)
+        } else {
+            None
+        };
+        if let Some(which) = which {
+            return Err(Error::Table {
+                file: file(),
+                detail: format!("{which} is not sampled at the times of {}: cannot integrate their product", topics::MOTORS),
+            });
+        }
+        let n = self.joints.unwrap_or(0);
+        let rows = |v: &[f64], k: usize| v.len() == k * n;
+        if !(rows(&self.power, t.len()) && rows(&self.torque, t.len()) && rows(&self.velocity, t.len()) && rows(&self.electric, t.len()) && rows(&self.work, t.len())) {
+            return Err(Error::Table { file: file(), detail: "the arrays of /motors, /joint_states and /energy do not all have one entry per joint: cannot check the integrals".into() });
+        }
+        let joints = rec.run().ok().map(|r| r.joint_names).filter(|j| j.len() == n).unwrap_or_else(|| (1..=n).map(|k| format!("joint{k}")).collect());
+        let first = t.iter().position(|&x| x >= from_s).unwrap_or(t.len());
+        if t.len() - first < 3 {
+            return Err(Error::Table {
+                file: file(),
+                detail: format!("fewer than 3 samples from t = {from_s} s on: cannot check the integrals"),
+            });
+        }
+        let last = t.len() - 1;
+        let ts = &t[first..];
+        let at = |rows: &[f64], k: usize, j: usize| rows[k * n + j];
+        let mut electric = Vec::with_capacity(n);
+        let mut work = Vec::with_capacity(n);
+        for j in 0..n {
+            let p: Vec<f64> = (first..=last).map(|k| at(&self.power, k, j)).collect();
+            electric.push(integral(ts, &p, at(&self.electric, last, j) - at(&self.electric, first, j)));
+            let p: Vec<f64> = (first..=last).map(|k| at(&self.torque, k, j) * at(&self.velocity, k, j)).collect();
+            work.push(integral(ts, &p, at(&self.work, last, j) - at(&self.work, first, j)));
+        }
+        Ok(SampledIntegrals { from_s: ts[0], dt_s: t[1] - t[0], joints, electric, work })
     }
-    let unrecorded = [
-        (topics::MOTORS, "voltage", motors.iter().any(|(_, m)| m.voltage.len() != n)),
-        (topics::MOTORS, "torque", motors.iter().any(|(_, m)| m.torque.len() != n)),
-        (topics::JOINT_STATES, "velocity", joint_states.iter().any(|(_, q)| q.velocity.len() != n)),
-    ];
-    if let Some((topic, what, _)) = unrecorded.iter().find(|u| u.2) {
-        return Err(Error::Table { file: file(), detail: format!("{topic} does not record every {what}: cannot check the integrals") });
-    }
-    let joints = rec.run().ok().map(|r| r.joint_names).filter(|j| j.len() == n).unwrap_or_else(|| (1..=n).map(|k| format!("joint{k}")).collect());
-    let first = t.iter().position(|&x| x >= from_s).unwrap_or(t.len());
-    if t.len() - first < 3 {
-        return Err(Error::Table {
-            file: file(),
-            detail: format!("fewer than 3 samples from t = {from_s} s on: cannot check the integrals"),
-        });
-    }
-    let last = t.len() - 1;
-    let ts = &t[first..];
-    let (e_first, e_last) = (&energy[first].1, &energy[last].1);
-    let mut electric = Vec::with_capacity(n);
-    let mut work = Vec::with_capacity(n);
-    for j in 0..n {
-        let p: Vec<f64> = motors[first..].iter().map(|(_, m)| m.current[j] * m.voltage[j]).collect();
-        electric.push(integral(ts, &p, e_last.electric_energy[j] - e_first.electric_energy[j]));
-        let p: Vec<f64> = motors[first..].iter().zip(&joint_states[first..]).map(|((_, m), (_, q))| m.torque[j] * q.velocity[j]).collect();
-        work.push(integral(ts, &p, e_last.link_work[j] - e_first.link_work[j]));
-    }
-    Ok(SampledIntegrals { from_s: ts[0], dt_s: t[1] - t[0], joints, electric, work })
 }
 
 #[cfg(test)]

@@ -409,7 +409,7 @@ fn check(m: &DecodedMessage<'_>, joints: &mut Option<usize>, contacts: &mut Opti
 
 impl Reductions {
     /// The error that stopped the reader: the one kept by the visitor, or the reader's own.
-    fn take_error(&mut self, e: schemas::Error) -> Error {
+    pub fn take_error(&mut self, e: schemas::Error) -> Error {
         self.error.take().unwrap_or(Error::Read(e))
     }
 

@@ -12,8 +12,50 @@
 
 use std::fmt::Write as _;
 
-use crate::integrals::{SampledIntegral, SampledIntegrals, AGREEMENT_FACTOR, AGREEMENT_FLOOR};
-use crate::{Comparison, RunMetrics};
+use std::path::Path;
+
+use crate::integrals::{IntegralSamples, SampledIntegral, SampledIntegrals, AGREEMENT_FACTOR, AGREEMENT_FLOOR, INTEGRAL_TOPICS};
+use crate::metrics::{Reductions, METRIC_TOPICS};
+use crate::{Comparison, Error, RunMetrics};
+
+/// One recording as the report needs it, read in one streamed pass: its metrics, what it says
+/// about itself and its integrals, and (with `series`) what the figures draw.
+#[cfg(feature = "figures")]
+pub fn read_run(path: &Path, check_from: f64, series: bool) -> Result<(RunMetrics, RunInfo, Option<crate::figures::RunSeries>), Error> {
+    /// Each message to every reader that wants it.
+    struct Tee {
+        metrics: Reductions,
+        samples: IntegralSamples,
+        series: Option<crate::figures::SeriesCollect>,
+    }
+    impl schemas::Visitor for Tee {
+        fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+            if let Some(s) = &mut self.series {
+                s.message(m.clone())?;
+            }
+            if INTEGRAL_TOPICS.contains(&m.topic) {
+                self.samples.message(m.clone())?;
+            }
+            if METRIC_TOPICS.contains(&m.topic) {
+                self.metrics.message(m)?;
+            }
+            Ok(())
+        }
+    }
+    let topics: Vec<&str> = METRIC_TOPICS.iter().chain(&INTEGRAL_TOPICS).copied().collect();
+    let mut tee = Tee { metrics: Reductions::default(), samples: IntegralSamples::default(), series: series.then(Default::default) };
+    let rec = schemas::stream_recording(path, Some(&topics), &mut tee).map_err(|e| tee.metrics.take_error(e))?;
+    let metrics = tee.metrics.finish(&rec, None)?;
+    let info = RunInfo {
+        tool: rec.info().ok().and_then(|i| i.tool),
+        format_version: rec.format_version(),
+        integrator: rec.run().ok().and_then(|r| r.setup).map(|s| s.integrator.phrase()),
+        sampled: [0.0, check_from].map(|from| tee.samples.integrals(&rec, from).map_err(|e| e.to_string())),
+    };
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let series = tee.series.map(|s| s.into_series(&rec, &stem)).transpose()?;
+    Ok((metrics, info, series))
+}
 
 /// What the report says about one recording beyond its metrics.
 #[derive(Debug, Clone)]

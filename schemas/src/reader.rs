@@ -81,7 +81,7 @@ pub struct Recording {
 }
 
 /// One decoded message, handed to a [`Visitor`].
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct DecodedMessage<'a> {
     /// The file (label) it comes from.
     pub file: &'a str,

@@ -3,9 +3,8 @@
 
 use std::path::PathBuf;
 
-use analyze::report::{render_report, FigureLink, RunInfo};
-use analyze::{run_metrics, Comparison};
-use schemas::topics;
+use analyze::report::{render_report, FigureLink};
+use analyze::Comparison;
 use anyhow::{Context, Result};
 use cli::{exit, Verbosity};
 
@@ -41,31 +40,20 @@ pub struct ReportArgs {
     pub check_from: f64,
 }
 
-/// What a report reads of each recording.
-const REPORT_TOPICS: [&str; 5] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, topics::ENERGY, topics::JOINT_STATES];
-
 pub fn run(a: &ReportArgs, v: Verbosity) -> Result<u8> {
     let paths = cli::inputs::expand(&a.inputs)?;
     let mut metrics = Vec::new();
     let mut info = Vec::new();
     let mut series = Vec::new();
     for p in &paths {
-        let ctx = || format!("reporting on {}", p.display());
-        // the topics of the metrics, the figures and the integrals' check (not /tf, most of a file)
-        let rec = schemas::read_recording_topics(p, Some(&REPORT_TOPICS)).with_context(ctx)?;
-        metrics.push(run_metrics(&rec).with_context(ctx)?);
-        info.push(RunInfo {
-            tool: rec.info().ok().and_then(|i| i.tool),
-            format_version: rec.format_version(),
-            integrator: rec.run().ok().and_then(|r| r.setup).map(|s| s.integrator.phrase()),
-            sampled: [0.0, a.check_from].map(|from| {
-                analyze::integrals::sampled_integrals_from(&rec, from).map_err(|e| e.to_string())
-            }),
-        });
-        if !a.no_figures {
-            let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-            series.push(analyze::figures::load_run(&rec, &stem).with_context(ctx)?);
+        if v.verbose > 0 {
+            eprintln!("analyze: reading {}", p.display());
         }
+        // one streamed pass: the metrics, the integrals' check and the figures' series
+        let (m, i, s) = analyze::report::read_run(p, a.check_from, !a.no_figures).with_context(|| format!("reporting on {}", p.display()))?;
+        metrics.push(m);
+        info.push(i);
+        series.extend(s);
     }
     let cmp = Comparison::new(&metrics, a.baseline.as_deref())?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
