@@ -800,7 +800,7 @@ impl Recording {
         self.channels.iter().find(|c| c.topic == topic)
     }
 
-    /// Every decoded message by topic, sorted by log time: for tools that handle any topic
+    /// Every decoded message by topic, in log-time order (the reader refuses time going backwards): for tools that handle any topic
     /// generically (tables, export, checks).
     pub fn message_map(&self) -> &BTreeMap<String, Vec<(u64, Value)>> {
         &self.messages
