@@ -79,6 +79,8 @@ pub enum RunError {
     Stiff { t: f64, h: f64, h_lambda: f64 },
     #[error("the run stopped at t = {t:.9} s: it used its wall-time limit of {limit_s} s with {method}; {hint}, or the run is long: to allow more, give --max-wall-time SECONDS", hint = slow_run_hint(method))]
     OutOfTime { t: f64, limit_s: f64, method: &'static str },
+    #[error("the run stopped at t = {t:.9} s: at its pace so far it would need about {projected_s:.0} s of wall time with {method}, more than twice its limit of {limit_s} s; {hint}, or the run is long: to allow more, give --max-wall-time SECONDS", hint = slow_run_hint(method))]
+    TooSlow { t: f64, projected_s: f64, limit_s: f64, method: &'static str },
     #[error("the implicit integrator stopped: its iteration matrix I - h gamma J is singular at t = {t:.9} s (h = {h:e} s)")]
     SingularIterationMatrix { t: f64, h: f64 },
     #[error("the integrator stopped: state component {index} ({name}) became non-finite at t = {t:.9} s")]
@@ -121,6 +123,7 @@ impl RunError {
             RunError::StepSizeTooSmall { t, .. }
             | RunError::Stiff { t, .. }
             | RunError::OutOfTime { t, .. }
+            | RunError::TooSlow { t, .. }
             | RunError::SingularIterationMatrix { t, .. }
             | RunError::NonFiniteState { t, .. }
             | RunError::TooManySteps { t, .. } => Some(*t),

@@ -128,14 +128,14 @@ impl Integrator {
     /// Integrates `sys` from `y0` at t = 0 to `t_end` with this method and hands the solution to
     /// `on_sample` on the grid `k dt_out` (dense output, independent of the steps), stopping
     /// with [`crate::integrate::IntegrateError::OutOfTime`] once the wall clock passes
-    /// `deadline`.
+    /// `deadline` (or [`crate::integrate::IntegrateError::TooSlow`] when its pace cannot make it).
     pub fn integrate<S: OdeJacobian + SplitSystem>(
         &self,
         sys: &mut S,
         y0: &[f64],
         t_end: f64,
         dt_out: f64,
-        deadline: Option<std::time::Instant>,
+        deadline: Option<crate::integrate::Deadline>,
         on_sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
     ) -> Result<Stats, IntegrateError<S::Error>> {
         let dim = y0.len();

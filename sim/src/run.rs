@@ -25,12 +25,22 @@ pub struct RunReport {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Budget {
     pub wall_time: Duration,
+    /// After this much wall time a run whose pace projects more than twice `wall_time` stops
+    /// ([`RunError::TooSlow`]) rather than at its limit.
+    pub judge_pace_after: Duration,
+}
+
+impl Budget {
+    /// `wall_time`, the pace judged after [`crate::integrate::PACE_AFTER`].
+    pub fn wall_time(wall_time: Duration) -> Self {
+        Budget { wall_time, judge_pace_after: crate::integrate::PACE_AFTER }
+    }
 }
 
 impl Default for Budget {
     /// [`DEFAULT_MAX_WALL_TIME`].
     fn default() -> Self {
-        Budget { wall_time: DEFAULT_MAX_WALL_TIME }
+        Budget::wall_time(DEFAULT_MAX_WALL_TIME)
     }
 }
 
@@ -38,6 +48,7 @@ fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget:
     match e {
         IntegrateError::Stiff { t, h, h_lambda } => RunError::Stiff { t, h, h_lambda },
         IntegrateError::OutOfTime { t } => RunError::OutOfTime { t, limit_s: budget.wall_time.as_secs_f64(), method },
+        IntegrateError::TooSlow { t, projected_s } => RunError::TooSlow { t, projected_s, limit_s: budget.wall_time.as_secs_f64(), method },
         IntegrateError::Rhs(e) | IntegrateError::Sample { source: e, .. } => e,
         IntegrateError::StepSizeTooSmall { t, h } => RunError::StepSizeTooSmall { t, h },
         IntegrateError::SingularMatrix { t, h } => RunError::SingularIterationMatrix { t, h },
@@ -71,7 +82,9 @@ pub fn simulate_within(
     budget: Budget,
     mut sink: impl FnMut(&Outputs) -> Result<(), RunError>,
 ) -> Result<RunReport, RunError> {
-    let deadline = Instant::now().checked_add(budget.wall_time);
+    let deadline = Instant::now()
+        .checked_add(budget.wall_time)
+        .map(|at| crate::integrate::Deadline { at, judge_pace_after: budget.judge_pace_after });
     let mut sys = ArmSystem::new(scene, run);
     let y0 = sys.initial_state();
     let dt_out = 1.0 / scene.output_rate;

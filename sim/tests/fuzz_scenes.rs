@@ -361,7 +361,7 @@ fn run_bounded(scene: &Scene, pick: usize, counts: &mut RunCounts, case: usize, 
     };
     let run = scene.runs()[pick % scene.runs().len()].clone();
     let t0 = Instant::now();
-    let res = catch_unwind(AssertUnwindSafe(|| sim::run::simulate_within(&scene, &run, Budget { wall_time: RUN_WALL }, |_| Ok(()))));
+    let res = catch_unwind(AssertUnwindSafe(|| sim::run::simulate_within(&scene, &run, Budget::wall_time(RUN_WALL), |_| Ok(()))));
     let wall = t0.elapsed();
     counts.longest = counts.longest.max(wall);
     assert!(wall <= RUN_WALL + RUN_SLACK, "case {case}: the run took {wall:?} with a budget of {RUN_WALL:?}\nscene: {json}");

@@ -9,7 +9,7 @@ use std::cell::Cell;
 
 use std::time::{Duration, Instant};
 
-use sim::integrate::{integrate_sampled_within, ArkImex, DormandPrince45, Rk4, Rosenbrock, StepControl, Stepper};
+use sim::integrate::{integrate_sampled_within, ArkImex, Deadline, DormandPrince45, Rk4, Rosenbrock, StepControl, Stepper};
 use sim::scene::Scene;
 use sim::ode::ArmSystem;
 
@@ -95,7 +95,7 @@ fn the_driver_with_a_deadline_does_not_allocate_per_step() {
     let y0 = sys.initial_state();
     let mut count = |t_end: f64| {
         let mut st = Rk4::new(y0.len(), 1e-4);
-        let deadline = Some(Instant::now() + Duration::from_secs(3600));
+        let deadline = Some(Deadline::new(Instant::now() + Duration::from_secs(3600)));
         let before = allocs();
         integrate_sampled_within(&mut st, &mut sys, 0.0, &y0, t_end, 1e-3, deadline, |_, _| Ok(())).unwrap();
         allocs() - before

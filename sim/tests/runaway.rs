@@ -94,7 +94,7 @@ fn a_run_past_its_wall_time_fails_and_is_recorded_as_failed() {
     let run = scene.run("two-elbow").unwrap().clone();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("slow.mcap");
-    let budget = Budget { wall_time: Duration::from_millis(200) };
+    let budget = Budget::wall_time(Duration::from_millis(200));
     let t0 = Instant::now();
     let err = sim::run::run_to_file_within(&scene, &run, &path, budget, |_| {}).unwrap_err();
     let wall = t0.elapsed();
@@ -130,4 +130,31 @@ fn a_run_past_its_step_budget_says_when_and_what_to_do() {
     });
     let msg = fails(&imex).0.to_string();
     assert!(msg.contains("with imex") && msg.contains("stiff mechanics, e.g. extreme damping, which imex treats explicitly: use rosenbrock"), "{msg}");
+}
+
+/// A run whose pace cannot make its budget stops when the pace is judged, not at the deadline:
+/// the paper's two-elbow run stretched to 500 s (about a hundred times the wall time of the 5-s
+/// run, about a minute here) with a budget of 1 s, its pace judged after 0.05 s, projects far
+/// more than 2 s. Its error
+/// gives the time, the projection and the flag; its recording says failed.
+#[test]
+fn a_run_that_cannot_make_its_budget_stops_when_its_pace_is_judged() {
+    let scene = paper_with(|s| s.duration = 500.0);
+    let run = scene.run("two-elbow").unwrap().clone();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("slow.mcap");
+    let budget = Budget { wall_time: Duration::from_secs(1), judge_pace_after: Duration::from_millis(50) };
+    let err = sim::run::run_to_file_within(&scene, &run, &path, budget, |_| {}).unwrap_err();
+    let RunError::TooSlow { t, projected_s, limit_s, method } = err else { panic!("{err}") };
+    assert_eq!((limit_s, method), (1.0, "dopri45"));
+    assert!(projected_s > 2.0 && t > 0.0 && t < 500.0, "{projected_s} {t}");
+    let msg = err.to_string();
+    assert!(msg.contains("at its pace so far it would need about") && msg.contains("--max-wall-time"), "{msg}");
+    let result = schemas::read_recording(&path).unwrap().result().unwrap().unwrap();
+    assert_eq!(result.status, RunStatus::Failed);
+    assert_eq!(result.error_time_s, Some(t));
+    // with the pace judged only after the deadline, the same run ends at the deadline
+    let late = Budget { wall_time: Duration::from_millis(200), judge_pace_after: Duration::from_secs(5) };
+    let err = sim::run::simulate_within(&scene, &run, late, |_| Ok(())).unwrap_err();
+    assert!(matches!(err, RunError::OutOfTime { .. }), "{err}");
 }

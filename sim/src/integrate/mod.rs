@@ -119,7 +119,7 @@ pub use self::imex::ArkImex;
 pub use self::jacobian::{fd_jacobian, FdJacobian};
 pub use self::rk4::Rk4;
 pub use self::rosenbrock::Rosenbrock;
-pub use self::sampled::{integrate_sampled, integrate_sampled_within};
+pub use self::sampled::{integrate_sampled, integrate_sampled_within, Deadline, PACE_AFTER};
 
 /// What gets integrated: y' = f(t, y). Must be a pure function of (t, y) apart from scratch.
 ///
@@ -231,6 +231,10 @@ pub enum IntegrateError<E> {
     /// [`integrate_sampled_within`]'s wall-clock deadline passed; `t` is where the stepper
     /// stands (the state there is valid).
     OutOfTime { t: f64 },
+    /// At the pace of its first [`Deadline::judge_pace_after`] of wall time, the run would need
+    /// `projected_s` of wall time, more than twice its budget: stopped at `t` rather than at the
+    /// deadline.
+    TooSlow { t: f64, projected_s: f64 },
     /// The iteration matrix `I - gamma h J` of [`Rosenbrock`] was (numerically) singular in the
     /// step from `t`, still at the last step size tried, `h` (the step is halved up to 5 times
     /// in a row, and not below `h_min`, before giving up).
@@ -272,6 +276,9 @@ impl<E: fmt::Display> fmt::Display for IntegrateError<E> {
             ),
             IntegrateError::OutOfTime { t } => {
                 write!(f, "the wall-clock deadline passed at t = {t}")
+            }
+            IntegrateError::TooSlow { t, projected_s } => {
+                write!(f, "at t = {t} the pace so far projects {projected_s:.0} s of wall time, more than twice the budget")
             }
             IntegrateError::SingularMatrix { t, h } => write!(
                 f,

@@ -8,7 +8,7 @@
 //! whatever the output rate, and a recording never depends on step sizes. After every accepted
 //! step the system may project the state ([`OdeSystem::project`]).
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use super::{IntegrateError, OdeSystem, Stats, Stepper};
 
@@ -50,10 +50,33 @@ pub fn integrate_sampled<S: OdeSystem, St: Stepper<S> + ?Sized>(
 /// Accepted steps between two looks at the clock in [`integrate_sampled_within`].
 const CLOCK_EVERY: u64 = 16;
 
+/// After this much wall time [`integrate_sampled_within`] judges the pace: a run whose
+/// simulated time so far projects more than twice its budget stops then
+/// ([`IntegrateError::TooSlow`]) instead of at its deadline. A sane run is either done by then
+/// (the paper's runs take about a second) or keeps its pace well inside the budget.
+pub const PACE_AFTER: Duration = Duration::from_secs(5);
+
+/// When [`integrate_sampled_within`] must stop: at `at`, or as soon as, after
+/// `judge_pace_after` of wall time, the pace so far projects more than twice the time to `at`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Deadline {
+    pub at: Instant,
+    pub judge_pace_after: Duration,
+}
+
+impl Deadline {
+    /// At `at`, the pace judged after [`PACE_AFTER`].
+    pub fn new(at: Instant) -> Self {
+        Deadline { at, judge_pace_after: PACE_AFTER }
+    }
+}
+
 /// [`integrate_sampled`] with a wall-clock `deadline`: after it passes, the run stops with
 /// [`IntegrateError::OutOfTime`] at the stepper's time (the clock is read every
 /// [`CLOCK_EVERY`] accepted steps; a step ends before it is read, so a run may overrun by
-/// those steps). `None`: no deadline.
+/// those steps). After [`Deadline::judge_pace_after`], a run whose pace so far,
+/// `elapsed × (t_end − t0) / (t − t0)`, projects more than twice the budget stops at once
+/// ([`IntegrateError::TooSlow`]). `None`: no deadline.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
     stepper: &mut St,
@@ -62,7 +85,7 @@ pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
     y0: &[f64],
     t_end: f64,
     dt_out: f64,
-    deadline: Option<Instant>,
+    deadline: Option<Deadline>,
     mut sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
 ) -> Result<Stats, IntegrateError<S::Error>> {
     // output grid: n intervals, the last one ending exactly on t_end when it fits
@@ -95,6 +118,7 @@ pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
     let mut buf = vec![0.0; y0.len()];
     let mut k = 1;
     let mut steps = 0u64;
+    let started = Instant::now();
     loop {
         // report every grid point inside the last accepted step [t_prev, t]
         while k <= n_out {
@@ -136,8 +160,19 @@ pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
         }
         steps += 1;
         if let Some(deadline) = deadline {
-            if steps.is_multiple_of(CLOCK_EVERY) && Instant::now() >= deadline {
-                return Err(IntegrateError::OutOfTime { t: t_after });
+            if steps.is_multiple_of(CLOCK_EVERY) {
+                let now = Instant::now();
+                if now >= deadline.at {
+                    return Err(IntegrateError::OutOfTime { t: t_after });
+                }
+                let spent = now.duration_since(started);
+                let done = (t_after - t0) / (t_end - t0);
+                if spent >= deadline.judge_pace_after && done > 0.0 {
+                    let projected_s = spent.as_secs_f64() / done;
+                    if projected_s > 2.0 * deadline.at.duration_since(started).as_secs_f64() {
+                        return Err(IntegrateError::TooSlow { t: t_after, projected_s });
+                    }
+                }
             }
         }
     }
@@ -306,7 +341,7 @@ mod tests {
         let mut p = HarmonicOscillator::default();
         let mut st = Rk4::new(2, 1e-3);
         let mut samples = 0;
-        let res = integrate_sampled_within(&mut st, &mut p, 0.0, &[1.0, 0.0], 1.0, 0.1, Some(Instant::now()), |_, _| {
+        let res = integrate_sampled_within(&mut st, &mut p, 0.0, &[1.0, 0.0], 1.0, 0.1, Some(Deadline::new(Instant::now())), |_, _| {
             samples += 1;
             Ok(())
         });
@@ -318,7 +353,7 @@ mod tests {
         assert_eq!(samples, 1);
         let mut st = Rk4::new(2, 1e-3);
         let later = Instant::now() + std::time::Duration::from_secs(3600);
-        let stats = integrate_sampled_within(&mut st, &mut p, 0.0, &[1.0, 0.0], 1.0, 0.1, Some(later), |_, _| Ok(())).unwrap();
+        let stats = integrate_sampled_within(&mut st, &mut p, 0.0, &[1.0, 0.0], 1.0, 0.1, Some(Deadline::new(later)), |_, _| Ok(())).unwrap();
         assert_eq!(stats.steps, 1000);
     }
 

@@ -51,7 +51,7 @@ impl WallTime {
     /// The budget of each run.
     pub fn budget(&self) -> Budget {
         match self.max_wall_time {
-            Some(s) => Budget { wall_time: Duration::try_from_secs_f64(s).unwrap_or(Duration::MAX) },
+            Some(s) => Budget::wall_time(Duration::try_from_secs_f64(s).unwrap_or(Duration::MAX)),
             None => Budget::default(),
         }
     }
