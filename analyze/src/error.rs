@@ -8,9 +8,11 @@
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// The recording could not be read, or a topic / field it needs is absent or not numeric.
+    /// The recording could not be read, or a topic / field it needs is absent or not numeric
+    /// (boxed: the reader's errors carry the file, topic and field, and would make every
+    /// `Result` of this crate large).
     #[error(transparent)]
-    Read(#[from] schemas::Error),
+    Read(Box<schemas::Error>),
 
     /// A metadata record or key the metrics need is absent.
     #[error("{file}: metadata record {record:?} has no key {key:?}")]
@@ -133,4 +135,10 @@ pub enum Error {
     /// Serializing to JSON failed.
     #[error("writing JSON: {0}")]
     Json(#[from] serde_json::Error),
+}
+
+impl From<schemas::Error> for Error {
+    fn from(e: schemas::Error) -> Self {
+        Error::Read(Box::new(e))
+    }
 }

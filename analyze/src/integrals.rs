@@ -104,7 +104,7 @@ pub fn trapezoid(t: &[f64], p: &[f64]) -> (f64, Option<f64>) {
         coarse += (t[k] - t[k - 2]) * (p[k] + p[k - 2]) / 2.0;
         k += 2;
     }
-    if t.len() % 2 == 0 {
+    if t.len().is_multiple_of(2) {
         let n = t.len() - 1;
         coarse += (t[n] - t[n - 1]) * (p[n] + p[n - 1]) / 2.0;
     }

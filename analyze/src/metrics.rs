@@ -410,7 +410,7 @@ fn check(m: &DecodedMessage<'_>, joints: &mut Option<usize>, contacts: &mut Opti
 impl Reductions {
     /// The error that stopped the reader: the one kept by the visitor, or the reader's own.
     pub fn take_error(&mut self, e: schemas::Error) -> Error {
-        self.error.take().unwrap_or(Error::Read(e))
+        self.error.take().unwrap_or_else(|| e.into())
     }
 
     /// The message's time against the output grid of its `run` record; counts it.
@@ -574,7 +574,7 @@ impl schemas::Visitor for Reductions {
     fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), schemas::Error> {
         match self.add(&m) {
             Ok(()) => Ok(()),
-            Err(Error::Read(e)) => Err(e),
+            Err(Error::Read(e)) => Err(*e),
             Err(e) => {
                 self.error = Some(e);
                 Err(schemas::Error::Stopped { file: m.file.to_string() })

@@ -154,6 +154,6 @@ fn filter_mask(column: &Column, f: &Filter) -> Result<BooleanChunked, String> {
         compare(s.str().map_err(|e| e.to_string())?, f.value.as_str(), f.op)
     };
     // a null compares as null: not kept
-    Ok(mask.fill_null_with_values(false).map_err(|e| e.to_string())?)
+    mask.fill_null_with_values(false).map_err(|e| e.to_string())
 }
 
