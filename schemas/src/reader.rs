@@ -32,19 +32,23 @@ use std::io::Read;
 use std::path::Path;
 
 use mcap::records::Record;
-use prost_reflect::{DescriptorPool, DynamicMessage, MessageDescriptor, ReflectMessage};
+use prost_reflect::DynamicMessage;
 
-use crate::messages::TopicMessage;
 use crate::meta::{MetadataRecord, RunDescription};
-use crate::topics::{array_index, array_required, ArrayIndex};
-use crate::value::{from_value, Value};
+use crate::topics::{array_index, ArrayIndex};
+use crate::value::Value;
 
+mod decode;
 mod input;
 mod recover;
 mod typed;
-use crate::{from_log_time, ros2msg, Error};
+mod visit;
+use crate::Error;
 pub use recover::{read_recording_recover, read_recording_recover_bytes, stream_recording_recover, RecoverReport};
 pub use typed::ArraySizes;
+pub use visit::{DecodedMessage, Visitor};
+pub(crate) use visit::{decode_typed, Collect};
+use decode::{decoder_for, message_to_value, Decoder, SchemaRec};
 
 /// One channel of the file.
 #[derive(Debug, Clone, PartialEq)]
@@ -78,144 +82,6 @@ pub struct Recording {
     pub(crate) first_joint_array_len: Option<usize>,
     /// Whether the first `/energy` message decoded has `gear_friction_loss` (format ≥ 2).
     pub(crate) energy_has_gear_friction: bool,
-}
-
-/// One decoded message, handed to a [`Visitor`].
-#[derive(Debug, Clone)]
-pub struct DecodedMessage<'a> {
-    /// The file (label) it comes from.
-    pub file: &'a str,
-    pub topic: &'a str,
-    /// Its index among the messages of its channel (0-based, file order).
-    pub index: usize,
-    pub log_time_ns: u64,
-    pub value: Value,
-    /// What ran (the `run` record), when the file has given it before this message (`sim`
-    /// writes it first): the array sizes and the output grid to check the message against.
-    pub run: Option<&'a RunDescription>,
-}
-
-impl DecodedMessage<'_> {
-    /// The first value of the message that is NaN or infinite, with its field path (`error.x`,
-    /// `current[2]`), in field order; `None` when every number is finite.
-    pub fn non_finite(&self) -> Option<(String, f64)> {
-        fn walk(v: &Value, path: &mut String) -> Option<(String, f64)> {
-            match v {
-                Value::F64(x) if !x.is_finite() => Some((path.clone(), *x)),
-                Value::Struct(fields) => fields.iter().find_map(|(name, v)| {
-                    let len = path.len();
-                    if !path.is_empty() {
-                        path.push('.');
-                    }
-                    path.push_str(name);
-                    let found = walk(v, path);
-                    path.truncate(len);
-                    found
-                }),
-                Value::List(items) => items.iter().enumerate().find_map(|(k, v)| {
-                    let len = path.len();
-                    path.push_str(&format!("[{k}]"));
-                    let found = walk(v, path);
-                    path.truncate(len);
-                    found
-                }),
-                _ => None,
-            }
-        }
-        walk(&self.value, &mut String::new())
-    }
-
-    /// The per-joint and per-contact arrays of the message: `(field, kind, length)`, leaving out
-    /// an optional array recorded empty ([`crate::topics::array_required`]).
-    pub fn arrays(&self) -> impl Iterator<Item = (&str, ArrayIndex, usize)> + '_ {
-        let fields = match &self.value {
-            Value::Struct(fields) => fields.as_slice(),
-            _ => &[],
-        };
-        fields.iter().filter_map(|(field, v)| match (array_index(self.topic, field), v) {
-            (Some(kind), Value::List(items)) if !items.is_empty() || array_required(self.topic, field) => Some((field.as_str(), kind, items.len())),
-            _ => None,
-        })
-    }
-
-    /// The per-joint and per-contact array sizes of [`DecodedMessage::run`].
-    pub fn sizes(&self) -> Option<ArraySizes> {
-        self.run.map(|r| ArraySizes { joints: r.joint_names.len(), contacts: r.contacts.len() })
-    }
-
-    /// Log time, s.
-    pub fn t_s(&self) -> f64 {
-        from_log_time(self.log_time_ns)
-    }
-
-    /// The message as `M` (by field name); with `sizes`, every per-joint and per-contact array
-    /// must have that many entries (see [`Recording::read_sized`]). Errors name the file, the
-    /// topic, the message and the field.
-    pub fn decode<M: TopicMessage>(&self, sizes: Option<ArraySizes>) -> Result<M, Error> {
-        decode_typed(self.file, self.topic, self.index, self.log_time_ns, &self.value, sizes)
-    }
-}
-
-/// Receives each decoded message of a [`stream_recording`], per channel in log-time order.
-/// An error stops the reading and is returned.
-pub trait Visitor {
-    fn message(&mut self, message: DecodedMessage<'_>) -> Result<(), Error>;
-}
-
-impl<F: FnMut(DecodedMessage<'_>) -> Result<(), Error>> Visitor for F {
-    fn message(&mut self, message: DecodedMessage<'_>) -> Result<(), Error> {
-        self(message)
-    }
-}
-
-/// Keeps every message: what [`read_recording`] returns.
-#[derive(Default)]
-struct Collect(BTreeMap<String, Vec<(u64, Value)>>);
-
-impl Visitor for Collect {
-    fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), Error> {
-        self.0.entry(m.topic.to_string()).or_default().push((m.log_time_ns, m.value));
-        Ok(())
-    }
-}
-
-/// Decodes one message as `M`, checking its array lengths against `sizes`.
-pub(crate) fn decode_typed<M: TopicMessage>(
-    file: &str,
-    topic: &str,
-    index: usize,
-    log_time_ns: u64,
-    v: &Value,
-    sizes: Option<ArraySizes>,
-) -> Result<M, Error> {
-    if let (Some(sizes), Value::Struct(fields)) = (sizes, v) {
-        for (field, value) in fields {
-            let (Some(kind), Value::List(items)) = (array_index(topic, field), value) else { continue };
-            let (expected, per) = match kind {
-                ArrayIndex::Joint => (sizes.joints, "joint"),
-                ArrayIndex::Contact => (sizes.contacts, "contact"),
-            };
-            if items.len() != expected && (array_required(topic, field) || !items.is_empty()) {
-                return Err(Error::WrongLength {
-                    file: file.to_string(),
-                    topic: topic.into(),
-                    field: field.clone(),
-                    index,
-                    t_s: from_log_time(log_time_ns),
-                    found: items.len(),
-                    expected,
-                    per,
-                });
-            }
-        }
-    }
-    from_value(v).map_err(|e| Error::Field {
-        file: file.to_string(),
-        topic: topic.into(),
-        index,
-        log_time_ns,
-        detail: e.to_string(),
-    })
 }
 
 /// Reads and decodes the MCAP file at `path`, keeping every message; errors name the file.
@@ -272,56 +138,6 @@ impl Visitor for Null {
     }
 }
 
-struct SchemaRec {
-    name: String,
-    encoding: String,
-    data: Vec<u8>,
-}
-
-enum Decoder {
-    Protobuf(MessageDescriptor),
-    Ros2(ros2msg::MsgSchema),
-    Json,
-    Skip(String),
-}
-
-/// Chooses and builds the decoder of a channel from its encodings and schema.
-fn decoder_for(
-    file: &str,
-    info: &ChannelInfo,
-    schema: Option<&SchemaRec>,
-) -> Result<Decoder, Error> {
-    let bad = |detail: String| Error::BadSchema {
-        file: file.to_string(),
-        topic: info.topic.clone(),
-        schema: info.schema_name.clone(),
-        encoding: info.schema_encoding.clone(),
-        detail,
-    };
-    let (menc, senc) = (
-        info.message_encoding.as_str(),
-        info.schema_encoding.as_str(),
-    );
-    match (menc, senc, schema) {
-        ("json", _, _) => Ok(Decoder::Json),
-        ("protobuf", "protobuf", Some(s)) => {
-            let pool = DescriptorPool::decode(s.data.as_slice()).map_err(|e| bad(e.to_string()))?;
-            let desc = pool
-                .get_message_by_name(&s.name)
-                .ok_or_else(|| bad(format!("the descriptor set has no message {}", s.name)))?;
-            Ok(Decoder::Protobuf(desc))
-        }
-        ("cdr", "ros2msg", Some(s)) => {
-            let text = std::str::from_utf8(&s.data)
-                .map_err(|e| bad(format!("schema text is not UTF-8: {e}")))?;
-            Ok(Decoder::Ros2(ros2msg::parse(&s.name, text).map_err(bad)?))
-        }
-        _ => Ok(Decoder::Skip(format!(
-            "message encoding {menc:?} with schema encoding {senc:?} is not decoded by this reader"
-        ))),
-    }
-}
-
 /// [`ChannelInfo::undecoded`] of a channel left out by [`read_recording_topics`].
 pub const NOT_SELECTED: &str = "not selected: the file was read for other topics only";
 
@@ -359,7 +175,7 @@ pub fn read_recording_bytes_topics(
 }
 
 /// The text of a caught panic.
-pub(crate) fn panic_text(panic: &(dyn std::any::Any + Send)) -> String {
+fn panic_text(panic: &(dyn std::any::Any + Send)) -> String {
     panic
         .downcast_ref::<&str>()
         .map(|s| s.to_string())
@@ -679,9 +495,11 @@ impl State {
     /// [`State::run`] from the metadata read so far (`None` while it does not read: the typed
     /// accessors of the finished [`Recording`] report why).
     fn update_run(&mut self) {
+        // only the records `run()` reads (not the scene and URDF texts)
+        let records = [crate::meta::RunNames::NAME, crate::meta::RecordingInfo::NAME];
         let view = Recording {
             source: self.file.clone(),
-            metadata: self.metadata.clone(),
+            metadata: self.metadata.iter().filter(|(name, _)| records.contains(&name.as_str())).map(|(k, v)| (k.clone(), v.clone())).collect(),
             channels: Vec::new(),
             messages: BTreeMap::new(),
             first_joint_array_len: self.first_joint_array_len,
@@ -735,61 +553,6 @@ impl State {
             messages: BTreeMap::new(),
             first_joint_array_len: self.first_joint_array_len,
             energy_has_gear_friction: self.energy_has_gear_friction.unwrap_or(false),
-        }
-    }
-}
-
-/// Converts a decoded protobuf message, fields in descriptor order. Members of a oneof (and
-/// proto3 `optional` fields) that are not set are left out; other unset fields read as their
-/// default, as protobuf defines.
-fn message_to_value(msg: &DynamicMessage) -> Value {
-    let mut out = Vec::new();
-    for fd in msg.descriptor().fields() {
-        if fd.containing_oneof().is_some() && !msg.has_field(&fd) {
-            continue;
-        }
-        out.push((fd.name().to_string(), proto_to_value(&msg.get_field(&fd))));
-    }
-    Value::Struct(out)
-}
-
-fn proto_to_value(v: &prost_reflect::Value) -> Value {
-    use prost_reflect::{MapKey, Value as P};
-    match v {
-        P::Bool(b) => Value::Bool(*b),
-        P::I32(x) => Value::I64(i64::from(*x)),
-        P::I64(x) => Value::I64(*x),
-        P::U32(x) => Value::U64(u64::from(*x)),
-        P::U64(x) => Value::U64(*x),
-        P::F32(x) => Value::F64(f64::from(*x)),
-        P::F64(x) => Value::F64(*x),
-        P::String(s) => Value::String(s.clone()),
-        P::Bytes(b) => Value::Bytes(b.to_vec()),
-        P::EnumNumber(n) => Value::I64(i64::from(*n)),
-        P::Message(m) => message_to_value(m),
-        P::List(items) => Value::List(items.iter().map(proto_to_value).collect()),
-        P::Map(map) => {
-            let mut entries: Vec<(&MapKey, &P)> = map.iter().collect();
-            entries.sort_by(|a, b| a.0.cmp(b.0));
-            let key = |k: &MapKey| match k {
-                MapKey::Bool(b) => Value::Bool(*b),
-                MapKey::I32(x) => Value::I64(i64::from(*x)),
-                MapKey::I64(x) => Value::I64(*x),
-                MapKey::U32(x) => Value::U64(u64::from(*x)),
-                MapKey::U64(x) => Value::U64(*x),
-                MapKey::String(s) => Value::String(s.clone()),
-            };
-            Value::List(
-                entries
-                    .into_iter()
-                    .map(|(k, v)| {
-                        Value::Struct(vec![
-                            ("key".into(), key(k)),
-                            ("value".into(), proto_to_value(v)),
-                        ])
-                    })
-                    .collect(),
-            )
         }
     }
 }
