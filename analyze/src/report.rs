@@ -30,7 +30,7 @@ pub fn read_run(path: &Path, check_from: f64, series: bool) -> Result<(RunMetric
     }
     impl schemas::Visitor for Tee {
         fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
-            if let Some(s) = &mut self.series {
+            if let Some(s) = self.series.as_mut().filter(|_| crate::figures::FIGURE_TOPICS.contains(&m.topic)) {
                 s.message(m.clone())?;
             }
             if INTEGRAL_TOPICS.contains(&m.topic) {

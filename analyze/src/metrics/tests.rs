@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use super::signal::negative_time;
 use super::*;
 use schemas::synth::{contact_forces, currents, hand_error, linear_energy, Synth};
-use schemas::EnergyState;
+use schemas::{EnergyState, RunResult, RunStatus};
 
 fn read(s: &Synth) -> (tempfile::TempDir, RunMetrics) {
     let dir = tempfile::tempdir().unwrap();
