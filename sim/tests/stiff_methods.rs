@@ -9,6 +9,18 @@ use sim::scene::Scene;
 use sim::ode::ArmSystem;
 use std::ops::Range;
 
+/// The system of `run` and its initial state with every motor current set to a different
+/// non-zero value, so that the current-dependent terms are exercised.
+fn with_currents<'a>(scene: &'a Scene, run: &'a sim::scene::Run) -> (ArmSystem<'a>, Vec<f64>) {
+    let sys = ArmSystem::new(scene, run);
+    let l = sys.layout();
+    let mut y = sys.initial_state();
+    for (k, v) in y[l.current()].iter_mut().enumerate() {
+        *v = 0.3 * (k as f64 - 4.0);
+    }
+    (sys, y)
+}
+
 /// Central differences of the right-hand side (h relative to each component).
 fn central_jacobian(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {
     let dim = y.len();
@@ -55,13 +67,9 @@ fn structured_jacobian_matches_central_differences_for_every_plant() {
                 })
                 .unwrap();
             for run in scene.runs() {
-                let mut sys = ArmSystem::new(&scene, run);
+                let (mut sys, y) = with_currents(&scene, run);
                 let l = sys.layout();
                 let dim = l.dim();
-                let mut y = sys.initial_state();
-                for (k, v) in y[l.current()].iter_mut().enumerate() {
-                    *v = 0.3 * (k as f64 - 4.0);
-                }
                 let t = 0.37;
                 let mut f = vec![0.0; dim];
                 sys.rhs(t, &y, &mut f).unwrap();
@@ -111,13 +119,9 @@ fn imex_split_and_implicit_solve_are_exact_for_every_plant() {
     for solver in [ConstraintSolver::Schur, ConstraintSolver::Kkt] {
         let scene = Scene::paper().unwrap().vary(|s| s.dynamics.constraint_solver = solver).unwrap();
         for run in scene.runs() {
-            let mut sys = ArmSystem::new(&scene, run);
+            let (mut sys, y) = with_currents(&scene, run);
             let l = sys.layout();
             let dim = l.dim();
-            let mut y = sys.initial_state();
-            for (k, v) in y[l.current()].iter_mut().enumerate() {
-                *v = 0.3 * (k as f64 - 4.0);
-            }
             let t = 0.37;
             let (mut f, mut fe, mut fi) = (vec![0.0; dim], vec![0.0; dim], vec![0.0; dim]);
             sys.rhs(t, &y, &mut f).unwrap();
