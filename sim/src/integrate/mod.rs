@@ -29,6 +29,11 @@
 //!   Jacobian), for an [`OdeJacobian`]: an analytic Jacobian, or [`FdJacobian`] around any
 //!   [`OdeSystem`] (forward differences, [`fd_jacobian`]). Linear algebra: a dense in-place LU
 //!   with partial pivoting (`lu.rs`).
+//! - [`Rodas`]: the classical Rosenbrock methods RODAS5P (Steinebach, BIT 63 (2023) 27; order
+//!   5(4), the default) and RODAS4 (HNW II §VI.4, `rodas.f`; order 4(3)), L-stable, stiffly
+//!   accurate, with dense output of order 4 (3); they need the exact Jacobian
+//!   ([`OdeJacobian::exact_jacobian`], else finite differences) and factor only the block of the
+//!   state that feeds back ([`OdeJacobian::coupled_dim`]).
 //! - [`ArkImex`]: the additive Runge–Kutta pair `ARK4(3)6L[2]SA` of Kennedy & Carpenter, Appl.
 //!   Numer. Math. 44 (2003) 139–181 (explicit part + L-stable ESDIRK part, order 4(3)), for a
 //!   [`SplitSystem`] that solves its own implicit stage equations.
@@ -107,6 +112,7 @@ mod imex;
 mod jacobian;
 mod lu;
 mod rk4;
+mod rodas;
 mod rosenbrock;
 mod sampled;
 pub mod test_problems;
@@ -118,6 +124,7 @@ pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
 pub use self::imex::ArkImex;
 pub use self::jacobian::{fd_jacobian, FdJacobian};
 pub use self::rk4::Rk4;
+pub use self::rodas::{Rodas, RodasMethod};
 pub use self::rosenbrock::Rosenbrock;
 pub use self::sampled::{integrate_sampled, integrate_sampled_within, Deadline, PACE_AFTER};
 
@@ -171,6 +178,31 @@ pub trait OdeJacobian: OdeSystem {
     ) -> Result<bool, Self::Error> {
         let _ = (t, y, fy, dfdt);
         Ok(false)
+    }
+
+    /// For the classical Rosenbrock methods ([`Rodas`]), whose order needs the exact `∂f/∂y`:
+    /// writes it like [`OdeJacobian::jacobian`] and returns `Ok(true)`, or returns `Ok(false)`
+    /// without writing, and the stepper differences `f` over the coupled columns
+    /// (`0..coupled_dim()`). The default is [`OdeJacobian::jacobian`], right for systems
+    /// whose `jacobian` is exact; a system whose `jacobian` is a deliberate approximation
+    /// (fine for a W-method) must override this.
+    fn exact_jacobian(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        fy: &[f64],
+        jac: &mut [f64],
+    ) -> Result<bool, Self::Error> {
+        self.jacobian(t, y, fy, jac)?;
+        Ok(true)
+    }
+
+    /// The number `nc` of leading state components that feed back: `f` must not depend on
+    /// the components `nc..dim` (quadratures such as energies), so their Jacobian columns are
+    /// zero and [`Rodas`] factors only the leading `nc x nc` block. The default, `dim()`,
+    /// assumes nothing.
+    fn coupled_dim(&self) -> usize {
+        self.dim()
     }
 }
 

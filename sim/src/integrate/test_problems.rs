@@ -281,7 +281,7 @@ impl OdeJacobian for Kepler {
 
 /// Writes the Kepler Jacobian (rows and columns 0..4 of `y = [qx, qy, px, py, ..]`) into the
 /// row-major `n x n` matrix `jac`, zeroing everything else.
-fn kepler_jacobian(y: &[f64], n: usize, jac: &mut [f64]) {
+pub(crate) fn kepler_jacobian(y: &[f64], n: usize, jac: &mut [f64]) {
     let (qx, qy) = (y[0], y[1]);
     let r2 = qx * qx + qy * qy;
     let r = r2.sqrt();

@@ -1,0 +1,518 @@
+//! RODAS5P (default) and RODAS4: adaptive Rosenbrock methods of order 5(4) and 4(3) for stiff
+//! systems with the exact Jacobian, a dense output of order 4 (3), and linear algebra that
+//! factors only the block of the state that feeds back.
+//!
+//! References (HNW II = Hairer & Wanner, *Solving Ordinary Differential Equations II*, 2nd ed.,
+//! Springer 1996):
+//! - RODAS5P: G. Steinebach, "Construction of Rosenbrock–Wanner method Rodas5P and numerical
+//!   benchmarks within the Julia Differential Equations package", BIT Numer. Math. 63 (2023)
+//!   27: 8 stages, order 5 with an embedded order-4 solution, L-stable, stiffly accurate, a
+//!   dense output of order 4 (coefficients: `rodas/tableau.rs`).
+//! - RODAS4: HNW II §VI.4 and Hairer's `rodas.f`: 6 stages, order 4(3), L-stable, stiffly
+//!   accurate, dense output of order 3.
+//! - formulation: a *classical* Rosenbrock method (HNW II §IV.7, (7.4)), not a W-method: its
+//!   order needs `J = ∂f/∂y` and `f_t = ∂f/∂t` exact (up to the accuracy of a finite
+//!   difference). In the transformed variables of HNW II (7.25), as in `rodas.f`:
+//!   `(I/(h gamma) - J) u_i = f(t + c_i h, y + sum_j a_ij u_j) + sum_j (C_ij / h) u_j +
+//!   d_i h f_t`, `y_new = y + sum_j m_j u_j` (stiffly accurate: `m` is the last stage's
+//!   argument plus the last stage); the error estimate is the last stage `u_s`
+//!   (`y_new - y_hat`, with `y_hat` the last stage's argument).
+//! - dense output (as in OrdinaryDiffEq.jl's Rodas interpolants, Steinebach 2023 §4):
+//!   `y(t + theta h) = (1 - theta) y + theta (y_new + (1 - theta) (w_1 + theta (w_2 +
+//!   theta w_3)))` with `w_k = sum_j H_kj u_j` (RODAS4: `w_1`, `w_2` only).
+//! - error norm and step-size control: the RMS norm of HNW I §II.4 with `atol + rtol max(|y|,
+//!   |y_new|)`; `h_new = h min(6, max(0.2, 0.9 err^(-1/(q+1))))` with `q` the embedded order
+//!   (Hairer's `rodas.f`: SAFE = 0.9, FAC1 = 5, FAC2 = 1/6); after a rejection the next
+//!   accepted step may not grow.
+//! - Jacobian: [`OdeJacobian::exact_jacobian`]; if the system has none, forward differences
+//!   (HNW II §IV.8, increment `sqrt(eps) max(|y_j|, 1e-5)`, as [`super::fd_jacobian`]) over the
+//!   *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`. `f_t`:
+//!   [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
+//!   [`super::Rosenbrock`]. Both are evaluated at the start of every step by default;
+//!   `with_jacobian_reuse(k)` keeps `J` for `k` accepted steps (this loses the order, which
+//!   the error control then pays for in step size; `f_t` stays fresh).
+//! - structure: with `nc = ` [`OdeJacobian::coupled_dim`], the components `nc..n`
+//!   (quadratures) do not enter `f`, so `J = [[J_cc, 0], [J_qc, 0]]` and `I/(h gamma) - J` is
+//!   block lower triangular: only `I/(h gamma) - J_cc` (`nc x nc`) is factored (LU with
+//!   partial pivoting, `lu.rs`, once per step and reused by every stage), and the quadrature
+//!   part of each stage is the substitution `u_q = h gamma (r_q + J_qc u_c)`.
+//! - singular matrix, non-finite stages, `t_stop`, `max_steps`: as in [`super::Rosenbrock`].
+
+use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
+use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::control::Controller;
+use super::lu::{lu_factor, lu_solve};
+use super::{
+    dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeJacobian, SettingsError,
+    Stats, StepControl, Stepper,
+};
+
+pub(crate) mod tableau;
+
+/// The step-size controller of Hairer's `rodas.f` (SAFE = 0.9, FAC1 = 5, FAC2 = 1/6).
+const CONTROLLER: Controller = Controller {
+    safety: 0.9,
+    fac_min: 0.2,
+    fac_max: 6.0,
+};
+
+/// Which Rosenbrock tableau a [`Rodas`] stepper runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RodasMethod {
+    /// Steinebach 2023: order 5(4), 8 stages, dense output of order 4.
+    Rodas5P,
+    /// Hairer & Wanner: order 4(3), 6 stages, dense output of order 3.
+    Rodas4,
+}
+
+impl RodasMethod {
+    fn tableau(self) -> &'static Tableau {
+        match self {
+            RodasMethod::Rodas5P => &RODAS5P,
+            RodasMethod::Rodas4 => &RODAS4,
+        }
+    }
+
+    /// The tableau's name (`"RODAS5P"`, `"RODAS4"`).
+    pub fn name(self) -> &'static str {
+        self.tableau().name
+    }
+}
+
+/// Adaptive RODAS5P / RODAS4 stepper (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Rodas {
+    dim: usize,
+    /// Components `0..nc` feed back (set from the system in `init`).
+    nc: usize,
+    jacobian_reuse: usize,
+    core: Core,
+    tab: &'static Tableau,
+    /// Current state, `f0 = f(t, y)`; the state at the start of the last accepted step; the
+    /// dense-output vectors `w_k` of that step.
+    y: Vec<f64>,
+    f0: Vec<f64>,
+    y_prev: Vec<f64>,
+    w: [Vec<f64>; 3],
+    singular_run: u32,
+    /// Jacobian (row-major `dim x dim`, columns `nc..` zero) and `f_t`; see `Rosenbrock`.
+    jac: Vec<f64>,
+    dfdt: Vec<f64>,
+    jac_valid: bool,
+    jac_fresh: bool,
+    dfdt_fresh: bool,
+    steps_since_jac: usize,
+    jac_max: f64,
+    /// LU of `I/(h gamma) - J_cc` (`nc x nc`, row-major) and the `h` it was formed for.
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    lu_h: f64,
+    /// Stages, stage argument, stage right-hand side, trial solution, f at it.
+    u: [Vec<f64>; MAX_STAGES],
+    y_stage: Vec<f64>,
+    f_stage: Vec<f64>,
+    y_new: Vec<f64>,
+    f_new: Vec<f64>,
+}
+
+impl Rodas {
+    /// A RODAS5P stepper for systems of dimension `dim`, a fresh Jacobian every step; all
+    /// buffers are allocated here.
+    ///
+    /// # Panics
+    /// If `control.validate()` fails; use [`Rodas::try_new`] for user input.
+    pub fn new(dim: usize, control: StepControl) -> Self {
+        match Self::try_new(dim, control) {
+            Ok(s) => s,
+            Err(e) => panic!("Rodas::new: {e}"),
+        }
+    }
+
+    /// Like [`Rodas::new`], returning the settings error instead of panicking.
+    ///
+    /// # Errors
+    /// The first out-of-range field of `control` (see [`StepControl::validate`]).
+    pub fn try_new(dim: usize, control: StepControl) -> Result<Self, SettingsError> {
+        control.validate()?;
+        let z = || vec![0.0; dim];
+        Ok(Self {
+            dim,
+            nc: dim,
+            jacobian_reuse: 1,
+            core: Core::new(control, CONTROLLER),
+            tab: &RODAS5P,
+            y: z(),
+            f0: z(),
+            y_prev: z(),
+            w: [z(), z(), z()],
+            singular_run: 0,
+            jac: vec![0.0; dim * dim],
+            dfdt: z(),
+            jac_valid: false,
+            jac_fresh: false,
+            dfdt_fresh: false,
+            steps_since_jac: 0,
+            jac_max: 0.0,
+            lu: vec![0.0; dim * dim],
+            piv: vec![0; dim],
+            lu_h: f64::NAN,
+            u: std::array::from_fn(|_| z()),
+            y_stage: z(),
+            f_stage: z(),
+            y_new: z(),
+            f_new: z(),
+        })
+    }
+
+    /// The same stepper running `method`'s tableau.
+    pub fn with_method(mut self, method: RodasMethod) -> Self {
+        self.tab = method.tableau();
+        self
+    }
+
+    /// Keeps each Jacobian for `k` accepted steps (`k >= 1`; default 1). Unlike
+    /// [`super::Rosenbrock`] (a W-method) this costs order: the method is then only of order 2
+    /// or so in the terms `J` enters, and the error control shortens the steps.
+    ///
+    /// # Errors
+    /// `k == 0` (`settings = "Rodas"`, `field = "jacobian_reuse"`).
+    pub fn try_with_jacobian_reuse(mut self, k: usize) -> Result<Self, SettingsError> {
+        if k == 0 {
+            return Err(SettingsError {
+                settings: "Rodas",
+                field: "jacobian_reuse",
+                value: 0.0,
+                requirement: ">= 1",
+            });
+        }
+        self.jacobian_reuse = k;
+        Ok(self)
+    }
+
+    /// The tableau's name.
+    pub fn method_name(&self) -> &'static str {
+        self.tab.name
+    }
+
+    adaptive_accessors!();
+
+    /// The dense output on `[t_prev, t]` (module docs); outside, the same polynomial.
+    pub fn interpolate(&self, t_query: f64, out: &mut [f64]) {
+        let Core {
+            t_prev,
+            t,
+            h_last: h,
+            ..
+        } = self.core;
+        let (y_prev, y, w, dense) = (&self.y_prev, &self.y, &self.w, self.tab.dense);
+        dense_output("Rodas", t_query, out, t_prev, t, h, y_prev, y, |th, out| {
+            let th1 = 1.0 - th;
+            for (i, o) in out.iter_mut().enumerate() {
+                let mut p = 0.0;
+                for k in (0..dense).rev() {
+                    p = w[k][i] + th * p;
+                }
+                // p = w_1 + theta (w_2 + theta w_3)
+                *o = th1 * y_prev[i] + th * (y[i] + th1 * p);
+            }
+        });
+    }
+
+    /// `J` at the current point: the system's exact one, else forward differences over the
+    /// coupled columns.
+    fn evaluate_jacobian<S: OdeJacobian>(
+        &mut self,
+        sys: &mut S,
+    ) -> Result<(), IntegrateError<S::Error>> {
+        let (t, n, nc) = (self.core.t, self.dim, self.nc);
+        self.core.stats.jacobian_evals += 1;
+        let exact = sys
+            .exact_jacobian(t, &self.y, &self.f0, &mut self.jac)
+            .map_err(IntegrateError::Rhs)?;
+        if !exact {
+            self.jac.fill(0.0);
+            let sqrt_eps = f64::EPSILON.sqrt();
+            self.y_stage.copy_from_slice(&self.y);
+            for j in 0..nc {
+                let yj = self.y[j];
+                let delta = sqrt_eps * yj.abs().max(1e-5);
+                self.y_stage[j] = if yj < 0.0 { yj - delta } else { yj + delta };
+                let d = self.y_stage[j] - yj;
+                let bad = eval(
+                    &mut self.core.stats,
+                    sys,
+                    t,
+                    &self.y_stage,
+                    &mut self.f_stage,
+                )?;
+                self.y_stage[j] = yj;
+                if let Some(i) = bad {
+                    return Err(IntegrateError::NonFiniteState { t, index: i });
+                }
+                for i in 0..n {
+                    self.jac[i * n + j] = (self.f_stage[i] - self.f0[i]) / d;
+                }
+            }
+        }
+        if let Some(k) = first_non_finite(&self.jac) {
+            return Err(IntegrateError::NonFiniteState {
+                t,
+                index: k / n.max(1),
+            });
+        }
+        self.jac_max = self.jac.iter().fold(0.0, |m, v| m.max(v.abs()));
+        self.jac_valid = true;
+        self.jac_fresh = true;
+        self.steps_since_jac = 0;
+        self.lu_h = f64::NAN;
+        Ok(())
+    }
+
+    /// `f_t` at the current point (as in `Rosenbrock`).
+    fn evaluate_dfdt<S: OdeJacobian>(
+        &mut self,
+        sys: &mut S,
+    ) -> Result<(), IntegrateError<S::Error>> {
+        let (t, n) = (self.core.t, self.dim);
+        if !sys
+            .time_derivative(t, &self.y, &self.f0, &mut self.dfdt)
+            .map_err(IntegrateError::Rhs)?
+        {
+            let delta = (f64::EPSILON * t.abs().max(1e-5)).sqrt();
+            self.dfdt.fill(0.0);
+            for d in [delta, -delta] {
+                if eval(&mut self.core.stats, sys, t + d, &self.y, &mut self.f_stage)?.is_none() {
+                    let dt = (t + d) - t;
+                    for i in 0..n {
+                        self.dfdt[i] = (self.f_stage[i] - self.f0[i]) / dt;
+                    }
+                    break;
+                }
+            }
+        }
+        if let Some(i) = first_non_finite(&self.dfdt) {
+            return Err(IntegrateError::NonFiniteState { t, index: i });
+        }
+        self.dfdt_fresh = true;
+        Ok(())
+    }
+
+    /// LU of `I/(h gamma) - J_cc`; `false` if singular.
+    fn factor(&mut self, h: f64) -> bool {
+        let (n, nc) = (self.dim, self.nc);
+        let d = 1.0 / (h * self.tab.gamma);
+        for i in 0..nc {
+            for j in 0..nc {
+                self.lu[i * nc + j] = -self.jac[i * n + j];
+            }
+            self.lu[i * nc + i] += d;
+        }
+        self.core.stats.lu_decompositions += 1;
+        let ok = lu_factor(&mut self.lu[..nc * nc], nc, &mut self.piv[..nc], d + self.jac_max).is_ok();
+        self.lu_h = if ok { h } else { f64::NAN };
+        ok
+    }
+
+    /// Solves `(I/(h gamma) - J) x = r` in place: the coupled block by the LU, the rest by
+    /// substitution.
+    fn solve(&self, h: f64, x: &mut [f64]) {
+        let (n, nc) = (self.dim, self.nc);
+        let (xc, xq) = x.split_at_mut(nc);
+        lu_solve(&self.lu[..nc * nc], nc, &self.piv[..nc], xc);
+        let hg = h * self.tab.gamma;
+        for (k, v) in xq.iter_mut().enumerate() {
+            let row = &self.jac[(nc + k) * n..(nc + k) * n + nc];
+            let s: f64 = row.iter().zip(xc.iter()).map(|(j, u)| j * u).sum();
+            *v = hg * (*v + s);
+        }
+    }
+
+    /// See `Rosenbrock::reject_singular`.
+    fn reject_singular<E>(&mut self, h: f64) -> Result<Attempt, IntegrateError<E>> {
+        let t = self.core.t;
+        self.core.stats.rejected += 1;
+        self.singular_run += 1;
+        self.core.rejected_last = true;
+        self.core.failure = Failure::Singular { t, h };
+        if self.singular_run >= 5 {
+            return Err(IntegrateError::SingularMatrix { t, h });
+        }
+        self.core.h_next = Some(0.5 * h);
+        Ok(Attempt::Rejected)
+    }
+}
+
+impl<S: OdeJacobian> Adaptive<S> for Rodas {
+    const NAME: &'static str = "Rodas";
+
+    fn core(&mut self) -> &mut Core {
+        &mut self.core
+    }
+
+    fn starting_step(&mut self, sys: &mut S) -> Result<f64, IntegrateError<S::Error>> {
+        let core = &mut self.core;
+        initial_step(
+            sys,
+            &mut core.stats,
+            core.t,
+            &self.y,
+            &self.f0,
+            &mut self.y_stage,
+            &mut self.f_stage,
+            &core.control,
+            self.tab.order as i32,
+        )
+    }
+
+    fn attempt(
+        &mut self,
+        sys: &mut S,
+        h: f64,
+        t_new: f64,
+        h_proposed: f64,
+    ) -> Result<Attempt, IntegrateError<S::Error>> {
+        let need_jac = !self.jac_valid
+            || self.steps_since_jac >= self.jacobian_reuse
+            || (self.core.rejected_last && !self.jac_fresh);
+        if need_jac {
+            self.evaluate_jacobian(sys)?;
+        }
+        if !self.dfdt_fresh {
+            self.evaluate_dfdt(sys)?;
+        }
+        if self.lu_h != h && !self.factor(h) {
+            return self.reject_singular(h);
+        }
+        self.singular_run = 0;
+        let (t, n, tab) = (self.core.t, self.dim, self.tab);
+        let s_last = tab.stages - 1;
+
+        for s in 0..tab.stages {
+            let ts = if tab.c[s] == 1.0 { t_new } else { t + tab.c[s] * h };
+            if s > 0 {
+                for i in 0..n {
+                    let mut v = self.y[i];
+                    for j in 0..s {
+                        v += tab.a[s][j] * self.u[j][i];
+                    }
+                    self.y_stage[i] = v;
+                }
+                if let Some(i) = eval(
+                    &mut self.core.stats,
+                    sys,
+                    ts,
+                    &self.y_stage,
+                    &mut self.f_stage,
+                )? {
+                    return Ok(self.core.reject_non_finite(h, ts, i));
+                }
+            } else {
+                self.f_stage.copy_from_slice(&self.f0);
+            }
+            let hd = h * tab.d[s];
+            let (done, rest) = self.u.split_at_mut(s);
+            let us = &mut rest[0];
+            for i in 0..n {
+                let mut v = self.f_stage[i] + hd * self.dfdt[i];
+                for (j, uj) in done.iter().enumerate() {
+                    v += tab.c_ij[s][j] / h * uj[i];
+                }
+                us[i] = v;
+            }
+            let mut x = std::mem::take(&mut self.u[s]);
+            self.solve(h, &mut x);
+            self.u[s] = x;
+            if let Some(i) = first_non_finite(&self.u[s]) {
+                return Ok(self.core.reject_non_finite(h, ts, i));
+            }
+        }
+
+        // solution; the error estimate is the last stage
+        for i in 0..n {
+            let mut yn = self.y[i];
+            for j in 0..tab.stages {
+                yn += tab.m[j] * self.u[j][i];
+            }
+            self.y_new[i] = yn;
+        }
+        let c = self.core.control;
+        let err = error_norm(&self.u[s_last], &self.y, &self.y_new, c.atol, c.rtol);
+        let fac = CONTROLLER.factor(err, 1.0 / f64::from(tab.embedded_order + 1));
+        if err > 1.0 {
+            return Ok(self.core.reject(h * fac.min(1.0), Failure::None));
+        }
+        if let Some(i) = first_non_finite(&self.y_new) {
+            return Ok(self.core.reject_non_finite(h, t_new, i));
+        }
+        if let Some(i) = eval(
+            &mut self.core.stats,
+            sys,
+            t_new,
+            &self.y_new,
+            &mut self.f_new,
+        )? {
+            return Ok(self.core.reject_non_finite(h, t_new, i));
+        }
+
+        // dense output of this step
+        for k in 0..tab.dense {
+            let (w, hk) = (&mut self.w[k], &tab.h[k]);
+            for i in 0..n {
+                let mut v = 0.0;
+                for j in 0..tab.stages {
+                    v += hk[j] * self.u[j][i];
+                }
+                w[i] = v;
+            }
+        }
+        let h_new = self.core.limit_growth(h * fac, h, h_proposed);
+        std::mem::swap(&mut self.y_prev, &mut self.y);
+        std::mem::swap(&mut self.y, &mut self.y_new);
+        std::mem::swap(&mut self.f0, &mut self.f_new);
+        self.core.accept(t_new, h, h_new);
+        self.jac_fresh = false;
+        self.dfdt_fresh = false;
+        self.steps_since_jac += 1;
+        Ok(Attempt::Accepted)
+    }
+}
+
+impl<S: OdeJacobian> Stepper<S> for Rodas {
+    /// Evaluates `f(t0, y0)` once and reads the system's coupled dimension; the Jacobian is
+    /// evaluated by the first step.
+    ///
+    /// # Panics
+    /// Also if `sys.coupled_dim() > dim`.
+    fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        self.core.init("Rodas", self.dim, sys.dim(), t0, y0)?;
+        self.nc = sys.coupled_dim();
+        assert!(self.nc <= self.dim, "Rodas::init: coupled_dim {} > dim {}", self.nc, self.dim);
+        self.singular_run = 0;
+        self.jac_valid = false;
+        self.jac_fresh = false;
+        self.dfdt_fresh = false;
+        self.lu_h = f64::NAN;
+        self.y.copy_from_slice(y0);
+        self.y_prev.copy_from_slice(y0);
+        for w in &mut self.w {
+            w.fill(0.0);
+        }
+        eval_finite(&mut self.core.stats, sys, t0, y0, &mut self.f0)?;
+        self.core.initialized = true;
+        Ok(())
+    }
+
+    fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {
+        adaptive::step(self, sys, t_stop)
+    }
+
+    forward_stepper_accessors!(Rodas);
+
+    fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        self.y.copy_from_slice(y);
+        eval_finite(&mut self.core.stats, sys, self.core.t, y, &mut self.f0)
+    }
+}
+
+#[cfg(test)]
+mod tests;
