@@ -28,16 +28,45 @@ pub fn fd_jacobian<S: OdeSystem>(
     scratch_y: &mut [f64],
     scratch_f: &mut [f64],
 ) -> Result<(), S::Error> {
+    fd_jacobian_columns(sys, t, y, fy, jac, y.len(), 1e-5, scratch_y, scratch_f)
+}
+
+/// [`fd_jacobian`] for the first `cols` columns only (`cols` evaluations of `rhs`), with the
+/// increment `sqrt(eps) max(|y_j|, floor)` (`fd_jacobian`: `floor = 1e-5`); the other columns
+/// of `jac` are left untouched. For systems whose trailing components do not feed back
+/// ([`OdeJacobian::coupled_dim`]): their columns are zero. The floor is the size below which a
+/// component counts as zero: at `y_j = 0` the increment is `sqrt(eps) floor`, and the
+/// rounding error of the column is `eps |f| / (sqrt(eps) floor)`, so a floor far below the
+/// component's natural scale (an angle at 0 rad with a floor of 1e-5 rad) buys a rounding
+/// error of `1e3 sqrt(eps) |f|`-ish.
+///
+/// # Errors
+/// The first error of `sys.rhs` (the remaining columns are not computed).
+///
+/// # Panics
+/// If the slice lengths do not match `n` (`jac`: `n * n`) or `cols > n`.
+#[allow(clippy::too_many_arguments)]
+pub fn fd_jacobian_columns<S: OdeSystem>(
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    fy: &[f64],
+    jac: &mut [f64],
+    cols: usize,
+    floor: f64,
+    scratch_y: &mut [f64],
+    scratch_f: &mut [f64],
+) -> Result<(), S::Error> {
     let n = y.len();
     assert!(
-        fy.len() == n && scratch_y.len() == n && scratch_f.len() == n && jac.len() == n * n,
-        "fd_jacobian: slice lengths vs dim {n}"
+        fy.len() == n && scratch_y.len() == n && scratch_f.len() == n && jac.len() == n * n && cols <= n,
+        "fd_jacobian: slice lengths vs dim {n}, columns {cols}"
     );
     let sqrt_eps = f64::EPSILON.sqrt();
     scratch_y.copy_from_slice(y);
-    for j in 0..n {
+    for j in 0..cols {
         let yj = y[j];
-        let delta = sqrt_eps * yj.abs().max(1e-5);
+        let delta = sqrt_eps * yj.abs().max(floor);
         scratch_y[j] = if yj < 0.0 { yj - delta } else { yj + delta };
         let d = scratch_y[j] - yj; // the increment actually represented
         let res = sys.rhs(t, scratch_y, scratch_f);

@@ -122,7 +122,7 @@ mod testutil;
 pub use self::control::{SettingsError, StepControl};
 pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
 pub use self::imex::ArkImex;
-pub use self::jacobian::{fd_jacobian, FdJacobian};
+pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, FdJacobian};
 pub use self::rk4::Rk4;
 pub use self::rodas::{Rodas, RodasMethod};
 pub use self::rosenbrock::Rosenbrock;

@@ -25,8 +25,9 @@
 //!   (Hairer's `rodas.f`: SAFE = 0.9, FAC1 = 5, FAC2 = 1/6); after a rejection the next
 //!   accepted step may not grow.
 //! - Jacobian: [`OdeJacobian::exact_jacobian`]; if the system has none, forward differences
-//!   (HNW II §IV.8, increment `sqrt(eps) max(|y_j|, 1e-5)`, as [`super::fd_jacobian`]) over the
-//!   *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`. `f_t`:
+//!   (HNW II §IV.8, [`super::fd_jacobian_columns`], increment `sqrt(eps) max(|y_j|, floor)`
+//!   with `floor = atol / rtol` within `[1e-5, 1]`, the scale below which the error norm
+//!   treats a component as absolute) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`. `f_t`:
 //!   [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
 //!   [`super::Rosenbrock`]. Both are evaluated at the start of every step by default;
 //!   `with_jacobian_reuse(k)` keeps `J` for `k` accepted steps (this loses the order, which
@@ -41,6 +42,7 @@
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
 use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
+use super::jacobian::fd_jacobian_columns;
 use super::lu::{lu_factor, lu_solve};
 use super::{
     dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeJacobian, SettingsError,
@@ -55,6 +57,12 @@ const CONTROLLER: Controller = Controller {
     fac_min: 0.2,
     fac_max: 6.0,
 };
+
+/// The increment floor of the finite-difference Jacobian: `atol / rtol` (the size below which
+/// the error norm treats a component as absolute), within `[1e-5, 1]`.
+fn fd_floor(c: &StepControl) -> f64 {
+    (c.atol / c.rtol).clamp(1e-5, 1.0)
+}
 
 /// Which Rosenbrock tableau a [`Rodas`] stepper runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -231,28 +239,19 @@ impl Rodas {
             .map_err(IntegrateError::Rhs)?;
         if !exact {
             self.jac.fill(0.0);
-            let sqrt_eps = f64::EPSILON.sqrt();
-            self.y_stage.copy_from_slice(&self.y);
-            for j in 0..nc {
-                let yj = self.y[j];
-                let delta = sqrt_eps * yj.abs().max(1e-5);
-                self.y_stage[j] = if yj < 0.0 { yj - delta } else { yj + delta };
-                let d = self.y_stage[j] - yj;
-                let bad = eval(
-                    &mut self.core.stats,
-                    sys,
-                    t,
-                    &self.y_stage,
-                    &mut self.f_stage,
-                )?;
-                self.y_stage[j] = yj;
-                if let Some(i) = bad {
-                    return Err(IntegrateError::NonFiniteState { t, index: i });
-                }
-                for i in 0..n {
-                    self.jac[i * n + j] = (self.f_stage[i] - self.f0[i]) / d;
-                }
-            }
+            self.core.stats.rhs_evals += nc as u64;
+            fd_jacobian_columns(
+                sys,
+                t,
+                &self.y,
+                &self.f0,
+                &mut self.jac,
+                nc,
+                fd_floor(&self.core.control),
+                &mut self.y_stage,
+                &mut self.f_stage,
+            )
+            .map_err(IntegrateError::Rhs)?;
         }
         if let Some(k) = first_non_finite(&self.jac) {
             return Err(IntegrateError::NonFiniteState {

@@ -12,6 +12,10 @@
 //!   approximation (Hairer & Wanner, *Solving ODEs II*, §IV.7), and these terms are not stiff.
 //!   `M_c⁻¹` is computed here from M and J_c of the evaluation, whatever constraint solver the
 //!   scene uses (the Schur and the KKT solve leave different scratch behind).
+//! - For the classical Rosenbrock methods (`Rodas`), which need the exact Jacobian:
+//!   [`OdeJacobian::coupled_dim`] = the q, q̇, i block (the quadratures never feed back, so
+//!   their columns are zero), and no analytic exact Jacobian, so the stepper differences the
+//!   right-hand side over those columns.
 //! - [`SplitSystem`]: the armature circuit `L di/dt = v − R i − K_m q̇` is linear in i with a
 //!   diagonal matrix, so its implicit stage equation `z − γ f_I(z) = r` has the closed form
 //!   `z_i = (r_i + γ (v − K_m q̇)/L) / (1 + γ R/L)` (v and q̇ from the explicit components of r),
@@ -62,6 +66,18 @@ impl ArmSystem<'_> {
 }
 
 impl OdeJacobian for ArmSystem<'_> {
+    /// The structured Jacobian above is an approximation (no Coriolis, no gravity stiffness):
+    /// the classical Rosenbrock methods difference `f` over the coupled columns instead.
+    fn exact_jacobian(&mut self, _t: f64, _y: &[f64], _fy: &[f64], _jac: &mut [f64]) -> Result<bool, RunError> {
+        Ok(false)
+    }
+
+    /// q, q̇ and the currents; the quadratures W, E, E_R, E_D, E_Dm never enter the
+    /// right-hand side.
+    fn coupled_dim(&self) -> usize {
+        self.layout.work().start
+    }
+
     fn jacobian(&mut self, t: f64, y: &[f64], _fy: &[f64], jac: &mut [f64]) -> Result<(), RunError> {
         // the dynamics at (t, y): M and J_c are left in the workspace
         let mut f = std::mem::take(&mut self.ws.jac.f);
