@@ -8,7 +8,7 @@ use schemas::IntegratorInfo;
 
 use crate::error::{short, SceneError};
 use crate::integrate::{
-    integrate_sampled_within, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rosenbrock, SplitSystem, Stats,
+    integrate_sampled_within, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rodas, RodasMethod, Rosenbrock, SplitSystem, Stats,
     StepControl, Stepper,
 };
 use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, RosenbrockSpec};
@@ -27,6 +27,9 @@ pub enum Integrator {
     Rosenbrock { control: StepControl, jacobian_reuse: usize },
     /// ARK4(3)6L[2]SA, the armature circuits implicit.
     Imex(StepControl),
+    /// RODAS5P or RODAS4 with the exact Jacobian (finite differences over the q, q̇, i block),
+    /// refreshed every `jacobian_reuse` steps.
+    Rodas { method: RodasMethod, control: StepControl, jacobian_reuse: usize },
 }
 
 impl Integrator {
@@ -82,13 +85,19 @@ impl Integrator {
             IntegratorSpec::Imex(AdaptiveSpec { rtol, atol, h_max, max_steps }) => {
                 Integrator::Imex(control(*rtol, *atol, *h_max, *max_steps)?)
             }
-            IntegratorSpec::Rosenbrock(RosenbrockSpec { rtol, atol, h_max, max_steps, jacobian_reuse }) => {
+            IntegratorSpec::Rosenbrock(s) | IntegratorSpec::Rodas5p(s) | IntegratorSpec::Rodas4(s) => {
+                let RosenbrockSpec { rtol, atol, h_max, max_steps, jacobian_reuse } = s;
                 let reuse = jacobian_reuse.unwrap_or(1);
                 if reuse == 0 {
                     return Err(err("jacobian_reuse", &reuse, "must be >= 1"));
                 }
                 let jacobian_reuse = usize::try_from(reuse).unwrap_or(usize::MAX);
-                Integrator::Rosenbrock { control: control(*rtol, *atol, *h_max, *max_steps)?, jacobian_reuse }
+                let control = control(*rtol, *atol, *h_max, *max_steps)?;
+                match spec {
+                    IntegratorSpec::Rodas5p(_) => Integrator::Rodas { method: RodasMethod::Rodas5P, control, jacobian_reuse },
+                    IntegratorSpec::Rodas4(_) => Integrator::Rodas { method: RodasMethod::Rodas4, control, jacobian_reuse },
+                    _ => Integrator::Rosenbrock { control, jacobian_reuse },
+                }
             }
         })
     }
@@ -100,6 +109,8 @@ impl Integrator {
             Integrator::Dopri45(_) => "dopri45",
             Integrator::Rosenbrock { .. } => "rosenbrock",
             Integrator::Imex(_) => "imex",
+            Integrator::Rodas { method: RodasMethod::Rodas5P, .. } => "rodas5p",
+            Integrator::Rodas { method: RodasMethod::Rodas4, .. } => "rodas4",
         }
     }
 
@@ -122,6 +133,16 @@ impl Integrator {
                 ..info("rosenbrock (ROS34PW2, structured Jacobian)", Some(control))
             },
             Integrator::Imex(c) => info("imex (ARK4(3)6L[2]SA, armature circuits implicit)", Some(c)),
+            Integrator::Rodas { method, control, jacobian_reuse } => IntegratorInfo {
+                jacobian_reuse: Some(*jacobian_reuse as u64),
+                ..info(
+                    match method {
+                        RodasMethod::Rodas5P => "rodas5p (RODAS5P, exact Jacobian by differences)",
+                        RodasMethod::Rodas4 => "rodas4 (RODAS4, exact Jacobian by differences)",
+                    },
+                    Some(control),
+                )
+            },
         }
     }
 
@@ -144,6 +165,7 @@ impl Integrator {
             Integrator::Dopri45(c) => Box::new(DormandPrince45::new(dim, c)),
             Integrator::Rosenbrock { control, jacobian_reuse } => Box::new(Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse)),
             Integrator::Imex(c) => Box::new(ArkImex::new(dim, c)),
+            Integrator::Rodas { method, control, jacobian_reuse } => Box::new(Rodas::new(dim, control).with_method(method).with_jacobian_reuse(jacobian_reuse)),
         };
         integrate_sampled_within(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, deadline, on_sample)
     }
@@ -165,6 +187,12 @@ mod tests {
         let i = Integrator::from_spec(&spec(r#"{"method":"rosenbrock","rtol":1e-5,"atol":1e-7,"h_max":0.5}"#), "s.json", 5.0, 1e-3).unwrap();
         assert!(matches!(i, Integrator::Rosenbrock { jacobian_reuse: 1, control } if control.h_max == 0.5));
         assert_eq!(i.describe().phrase(), "rosenbrock (ROS34PW2, structured Jacobian) rtol 1e-5 atol 1e-7 h_max 5e-1 jacobian_reuse 1");
+        let i = Integrator::from_spec(&spec(r#"{"method":"rodas5p","rtol":1e-6,"atol":1e-8}"#), "s.json", 5.0, 1e-3).unwrap();
+        assert!(matches!(i, Integrator::Rodas { method: RodasMethod::Rodas5P, jacobian_reuse: 1, control } if control.h_max == 1e-3));
+        assert_eq!(i.method(), "rodas5p");
+        assert_eq!(i.describe().phrase(), "rodas5p (RODAS5P, exact Jacobian by differences) rtol 1e-6 atol 1e-8 h_max 1e-3 jacobian_reuse 1");
+        let i = Integrator::from_spec(&spec(r#"{"method":"rodas4","rtol":1e-6,"atol":1e-8,"jacobian_reuse":3}"#), "s.json", 5.0, 1e-3).unwrap();
+        assert!(matches!(i, Integrator::Rodas { method: RodasMethod::Rodas4, jacobian_reuse: 3, .. }));
     }
 
     #[test]
@@ -187,8 +215,10 @@ mod tests {
         assert!(msg(r#"{"method":"dopri45","rtol":1e-6,"atol":-1}"#).contains("integrator.atol` = -1"));
         assert!(msg(r#"{"method":"imex","rtol":1e-6,"atol":1e-8,"max_steps":0}"#).contains("integrator.max_steps` = 0"));
         assert!(msg(r#"{"method":"rosenbrock","rtol":1e-6,"atol":1e-8,"jacobian_reuse":0}"#).contains("jacobian_reuse` = 0"));
+        assert!(msg(r#"{"method":"rodas5p","rtol":1e-6,"atol":1e-8,"jacobian_reuse":0}"#).contains("jacobian_reuse` = 0"));
+        assert!(msg(r#"{"method":"rodas4","rtol":2,"atol":1e-8}"#).contains("integrator.rtol` = 2"));
         assert!(msg(r#"{"method":"rk4","step":6}"#).contains("integrator.step` = 6"));
-        for method in ["dopri45", "imex", "rosenbrock"] {
+        for method in ["dopri45", "imex", "rosenbrock", "rodas5p", "rodas4"] {
             let m = msg(&format!(r#"{{"method":"{method}","rtol":1e-6,"atol":1e-8,"max_steps":0}}"#));
             assert!(m.contains("integrator.max_steps` = 0: must be >= 1"), "{m}");
         }

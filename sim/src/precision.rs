@@ -6,6 +6,13 @@
 //!
 //! All runs share the output grid, so errors are compared sample by sample; wall time is the
 //! best of `repeats` runs without recording (the simulation itself).
+//!
+//! A run that finished but left the physics is marked `diverged` ([`Row::status`], with the
+//! reason): a non-finite hand or energy, a max hand error above the reach of the reference
+//! hand (the largest |r_hand| of the reference run: an error that large means the simulated
+//! arm is anywhere in its workspace), or a max energy error above the largest electric energy
+//! the reference motors took in (`max_j max_t |E_j,ref|`, at least 1 J): the energy balance no
+//! longer means anything. [`recommend`] picks the cheapest `ok` run within a requested error.
 
 use std::time::Instant;
 
@@ -46,6 +53,8 @@ pub struct Row {
     pub max_link_energy_error_j: f64,
     /// max over samples and contacts of |C|, m.
     pub max_drift_m: f64,
+    /// Largest |r_hand| of the reference, m: the hand error above which the run is `diverged`.
+    pub reach_m: f64,
     /// Simulated time / wall time.
     pub speed_vs_real_time: f64,
 }
@@ -122,6 +131,7 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
         max_hand_error_m: f64::NAN,
         max_link_energy_error_j: f64::NAN,
         max_drift_m: f64::NAN,
+        reach_m: reference.reach_m(),
         speed_vs_real_time: f64::NAN,
     };
     // timing: the simulation alone, best of `repeats`
@@ -155,7 +165,57 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
         }
         Err(e) => row.status = format!("failed: {e}"),
     }
+    if row.status == "ok" {
+        if let Some(why) = divergence(row.max_hand_error_m, row.max_link_energy_error_j, reference) {
+            row.status = format!("diverged: {why}");
+        }
+    }
     row
+}
+
+impl Reference {
+    /// Largest |r_hand| over the reference samples, m.
+    pub fn reach_m(&self) -> f64 {
+        self.hand.iter().map(|h| h.norm()).fold(0.0, f64::max)
+    }
+
+    /// Largest |E_j| or |W_j| of the reference, J, at least 1 J.
+    pub fn energy_scale_j(&self) -> f64 {
+        self.energies.iter().flatten().fold(1.0, |m, e| m.max(e.abs()))
+    }
+}
+
+/// Why a run with these max errors against `reference` has diverged, or `None` (module docs).
+pub fn divergence(hand_error_m: f64, energy_error_j: f64, reference: &Reference) -> Option<String> {
+    if !hand_error_m.is_finite() || !energy_error_j.is_finite() {
+        return Some("non-finite hand or energy".into());
+    }
+    let reach = reference.reach_m();
+    if hand_error_m > reach {
+        return Some(format!("hand error {hand_error_m:.1e} m > reach {reach:.2} m"));
+    }
+    let e = reference.energy_scale_j();
+    if energy_error_j > e {
+        return Some(format!("energy error {energy_error_j:.1e} J > {e:.2e} J"));
+    }
+    None
+}
+
+/// The recommendation for a requested max hand error: the cheapest `ok` run within it by wall
+/// time, and the one with the fewest right-hand sides (work that does not depend on the load).
+#[derive(Clone, Debug)]
+pub struct Recommendation<'r> {
+    pub by_wall: &'r Row,
+    pub by_rhs: &'r Row,
+}
+
+/// The cheapest `ok` runs with `max_hand_error_m <= accuracy_m` (see [`Recommendation`]);
+/// `None` if no run reaches it.
+pub fn recommend(rows: &[Row], accuracy_m: f64) -> Option<Recommendation<'_>> {
+    let within = || rows.iter().filter(|r| r.status == "ok" && r.max_hand_error_m <= accuracy_m);
+    let by_wall = within().min_by(|a, b| a.wall_s.total_cmp(&b.wall_s))?;
+    let by_rhs = within().min_by_key(|r| r.rhs_evals)?;
+    Some(Recommendation { by_wall, by_rhs })
 }
 
 /// The default ladder for a scene: RK4 over steps, Dormand–Prince over tolerances, the
@@ -184,6 +244,15 @@ pub fn default_ladder(scene: &Scene) -> Result<Vec<Variant>, SceneError> {
     }
     for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9] {
         push("rosenbrock (structured J)", format!("rtol {tol:.0e}"), adaptive("rosenbrock", tol, h_long), Crba, Schur, none)?;
+    }
+    for tol in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10] {
+        push("rodas5p (exact J)", format!("rtol {tol:.0e}"), adaptive("rodas5p", tol, h_long), Crba, Schur, none)?;
+    }
+    for tol in [1e-4, 1e-6, 1e-8] {
+        push("rodas5p (h_max = output interval)", format!("rtol {tol:.0e}"), adaptive("rodas5p", tol, h_out), Crba, Schur, none)?;
+    }
+    for tol in [1e-4, 1e-6, 1e-8] {
+        push("rodas4 (exact J)", format!("rtol {tol:.0e}"), adaptive("rodas4", tol, h_long), Crba, Schur, none)?;
     }
     for tol in [1e-4, 1e-6, 1e-8] {
         push("imex (circuits implicit)", format!("rtol {tol:.0e}"), adaptive("imex", tol, h_long), Crba, Schur, none)?;
@@ -219,4 +288,71 @@ pub fn cheapest_within<'r>(rows: &'r [Row], target_m: f64) -> Vec<&'r Row> {
     }
     best.sort_by(|a, b| a.wall_s.total_cmp(&b.wall_s));
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(series: &str, status: &str, wall_s: f64, rhs_evals: u64, hand: f64) -> Row {
+        Row {
+            series: series.into(),
+            setting: "s".into(),
+            status: status.into(),
+            wall_s,
+            rhs_evals,
+            steps: 0,
+            rejected: 0,
+            max_hand_error_m: hand,
+            max_link_energy_error_j: 0.0,
+            max_drift_m: 0.0,
+            reach_m: 2.0,
+            speed_vs_real_time: 1.0,
+        }
+    }
+
+    /// A reference hand at 1.5 m and 2.0 m from the origin, energies up to 40 J.
+    fn reference() -> Reference {
+        Reference {
+            hand: vec![Vector3::new(1.5, 0.0, 0.0), Vector3::new(0.0, 2.0, 0.0)],
+            energies: vec![vec![1.0, -40.0], vec![3.0, 12.0]],
+        }
+    }
+
+    // The bounds of the module docs: the reach (2 m here) and the energy scale (40 J here);
+    // a run at the bounds is not diverged, one just past either is, and so is a NaN.
+    #[test]
+    fn divergence_bounds_are_the_reach_and_the_energy_scale() {
+        let r = reference();
+        assert_eq!(r.reach_m(), 2.0);
+        assert_eq!(r.energy_scale_j(), 40.0);
+        assert_eq!(divergence(2.0, 40.0, &r), None);
+        assert_eq!(divergence(1e-6, 1e-3, &r), None);
+        let hand = divergence(4.9, 1.0, &r).unwrap();
+        assert!(hand.contains("hand error 4.9e0 m > reach 2.00 m"), "{hand}");
+        let energy = divergence(1e-3, 4.5e9, &r).unwrap();
+        assert!(energy.contains("energy error 4.5e9 J"), "{energy}");
+        assert!(divergence(f64::NAN, 0.0, &r).unwrap().contains("non-finite"));
+        assert!(divergence(0.0, f64::INFINITY, &r).unwrap().contains("non-finite"));
+    }
+
+    // The recommendation: among ok runs within the request, the fastest and the fewest RHS
+    // (here different runs); diverged or failed runs never, even when "within"; nothing
+    // within the request -> None.
+    #[test]
+    fn recommendation_is_the_cheapest_ok_run_within_the_request() {
+        let rows = vec![
+            row("a", "ok", 0.010, 900, 5e-7),
+            row("b", "ok", 0.008, 1200, 9e-7),
+            row("c", "ok", 0.001, 100, 2e-6),
+            row("d", "diverged: hand error", 0.0001, 10, 1e-9),
+            row("e", "failed: x", 0.0001, 10, 1e-9),
+        ];
+        let rec = recommend(&rows, 1e-6).unwrap();
+        assert_eq!(rec.by_wall.series, "b");
+        assert_eq!(rec.by_rhs.series, "a");
+        let rec = recommend(&rows, 1e-5).unwrap();
+        assert_eq!((rec.by_wall.series.as_str(), rec.by_rhs.series.as_str()), ("c", "c"));
+        assert!(recommend(&rows, 1e-7).is_none());
+    }
 }

@@ -337,7 +337,7 @@ fn run_bounded(scene: &Scene, pick: usize, counts: &mut RunCounts, case: usize, 
     // the step budget: the scene's max_steps lowered (the validation may then refuse it)
     let scene = match scene.vary(|s| match &mut s.integrator {
         IntegratorSpec::Dopri45(a) | IntegratorSpec::Imex(a) => a.max_steps = Some(a.max_steps.unwrap_or(u64::MAX).min(RUN_MAX_STEPS)),
-        IntegratorSpec::Rosenbrock(r) => r.max_steps = Some(r.max_steps.unwrap_or(u64::MAX).min(RUN_MAX_STEPS)),
+        IntegratorSpec::Rosenbrock(r) | IntegratorSpec::Rodas5p(r) | IntegratorSpec::Rodas4(r) => r.max_steps = Some(r.max_steps.unwrap_or(u64::MAX).min(RUN_MAX_STEPS)),
         IntegratorSpec::Rk4(_) => {}
     }) {
         Ok(s) => s,

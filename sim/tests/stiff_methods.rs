@@ -235,7 +235,7 @@ fn hand_path(scene: &Scene) -> (Vec<nalgebra::Vector3<f64>>, f64) {
     (hand, res / rep.last.electric_energy.iter().sum::<f64>())
 }
 
-/// Rosenbrock-W (rtol 1e-8) and IMEX (rtol 1e-8) follow the Dormand–Prince (rtol 1e-11) hand
+/// Rosenbrock-W, IMEX, RODAS5P and RODAS4 (rtol 1e-8) follow the Dormand–Prince (rtol 1e-11) hand
 /// path over 1 s, with the motors' inductance (L di/dt) and without it (L = 0: the quasi-static
 /// current and the Jacobian's L = 0 branch), and close the energy balance to 1e-6 of E.
 /// The bound is what the tolerance asks for, rtol × |x| (|x| ≈ 2.2 m, the size of the hand's
@@ -254,7 +254,7 @@ fn stiff_methods_agree_with_the_reference() {
         let with = |integrator: IntegratorSpec| paper.vary(|s| s.integrator = integrator).unwrap();
         let (reference, _) = hand_path(&with(IntegratorSpec::Dopri45(AdaptiveSpec { rtol: 1e-11, atol: 1e-13, h_max: Some(1e-3), max_steps: None })));
         let scale = reference.iter().map(|x| x.norm()).fold(0.0, f64::max);
-        for method in ["rosenbrock", "imex"] {
+        for method in ["rosenbrock", "imex", "rodas5p", "rodas4"] {
             let integrator = IntegratorSpec::adaptive(method, rtol, Some(0.1)).unwrap();
             let (hand, res) = hand_path(&with(integrator.clone()));
             let err = hand.iter().zip(&reference).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);

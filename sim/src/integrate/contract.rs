@@ -16,7 +16,7 @@ use super::test_problems::{
 };
 use super::testutil::{local_dense_err, run_exact, Checks, Problem};
 use super::{
-    ArkImex, DormandPrince45, OdeSystem, Rk4, Rosenbrock, SettingsError, Stats, StepControl,
+    ArkImex, DormandPrince45, OdeSystem, Rk4, Rodas, Rosenbrock, SettingsError, Stats, StepControl,
     Stepper,
 };
 
@@ -74,7 +74,7 @@ const NO_COUNTS: Counts = Counts {
 };
 
 /// The methods, in the column order of the tables below.
-pub(super) const METHODS: [Method; 4] = [
+pub(super) const METHODS: [Method; 5] = [
     Method {
         name: "Rk4",
         needs: "OdeSystem",
@@ -153,6 +153,28 @@ pub(super) const METHODS: [Method; 4] = [
         },
         h_local: 0.1,
     },
+    Method {
+        name: "Rodas5P",
+        needs: "OdeJacobian",
+        build: Build::Adaptive(|n, c| Rodas::try_new(n, c).map(|s| Box::new(s) as Dyn)),
+        order: 5.0,
+        dense_order: 5.0, // order-4 interpolant: local error O(h^5)
+        expo: 0.2,
+        stability: None,
+        // analytic (exact) J and f_t: 1 (init) + 7 per attempt + 1 per accepted step (f at
+        // the new point); one J per accepted step, one LU per attempt, as Rosenbrock
+        counts: |s, guess| {
+            let attempts = s.steps + s.rejected;
+            let n = 1 + u64::from(guess) + 7 * attempts + s.steps;
+            Counts {
+                rhs: (n, n),
+                jacobian_evals: s.steps,
+                lu_decompositions: attempts,
+                implicit_solves: 0,
+            }
+        },
+        h_local: 0.1,
+    },
 ];
 
 impl Method {
@@ -227,51 +249,53 @@ fn slope(coarse: f64, fine: f64) -> f64 {
 
 /// Order test cases: problem, end time, and per method (columns of [`METHODS`]) the step
 /// count of the coarsest of three runs (n, 2n, 4n steps; chosen in the asymptotic range and
-/// above rounding); `None`: not run (a stiff problem on an explicit method).
-fn order_cases() -> [(&'static str, Problem, f64, [Option<u32>; 4]); 7] {
+/// above rounding); `None`: not run (a stiff problem on an explicit method; for Rodas5P the
+/// linear problems decay and oscillator, where its end error falls like h^6 (measured slopes
+/// 5.95-6.14: its stability function matches e^z beyond order 5) or reaches rounding).
+fn order_cases() -> [(&'static str, Problem, f64, [Option<u32>; 5]); 7] {
     [
         // DormandPrince45 is still pre-asymptotic here when its error reaches rounding
         (
             "rational",
             Problem::Rational(RationalDecay),
             3.0,
-            [Some(30), None, Some(60), Some(30)],
+            [Some(30), None, Some(60), Some(30), Some(30)],
         ),
         (
             "decay",
             decay(),
             3.0,
-            [Some(30), Some(40), Some(60), Some(30)],
+            [Some(30), Some(40), Some(60), Some(30), None],
         ),
         (
             "oscillator",
             oscillator(1.0),
             TAU,
-            [Some(50), Some(40), Some(100), Some(50)],
+            [Some(50), Some(40), Some(100), Some(50), None],
         ),
         (
             "oscillator w=2",
             oscillator(2.0),
             10.0,
-            [Some(200), Some(100), Some(400), Some(200)],
+            [Some(200), Some(100), Some(400), Some(200), None],
         ),
         (
             "kepler e=0.3",
             kepler(0.3),
             TAU,
-            [Some(400), Some(160), Some(800), Some(400)],
+            [Some(400), Some(160), Some(800), Some(400), Some(160)],
         ),
         (
             "stiff kepler k=1e4",
             stiff_kepler(0.3, 1e4),
             TAU,
-            [None, None, Some(800), Some(200)],
+            [None, None, Some(800), Some(200), Some(200)],
         ),
         (
             "stiff kepler k=1e6",
             stiff_kepler(0.3, 1e6),
             TAU,
-            [None, None, Some(800), Some(200)],
+            [None, None, Some(800), Some(200), Some(200)],
         ),
     ]
 }
@@ -367,7 +391,7 @@ fn dense_output_local_order_and_exact_ends() {
 }
 
 /// A tolerance test case: name, problem, end time, stiff, C per method.
-type TolCase = (&'static str, Problem, f64, bool, [Option<f64>; 4]);
+type TolCase = (&'static str, Problem, f64, bool, [Option<f64>; 5]);
 
 /// Tolerance test cases: problem, end time, stiff, and per method the error constant C
 /// (global and dense error <= C tol), `None` for Rk4 (fixed step) and the stiff problems on
@@ -375,7 +399,10 @@ type TolCase = (&'static str, Problem, f64, bool, [Option<f64>; 4]);
 /// measured worst err/tol over tol = 1e-5 .. 1e-10 with a margin of 2-4x (measured, DOPRI5 /
 /// Rosenbrock / ArkImex: decay 0.15 / 0.5 / 7.3, oscillator 7.0 / 10.3 / 223, rational 2.4 /
 /// 0.9 / 16, Kepler e = 0.5 233 / 108 / 507, e = 0.9 17400 / 693 / 57400; PR - / 2.5 / 4.8,
-/// PR y0 = 2 - / 2.5 / 11, motor - / 6.5 / 43, stiff Kepler - / 213 / 233). Kepler's are large
+/// PR y0 = 2 - / 2.5 / 11, motor - / 6.5 / 43, stiff Kepler - / 213 / 233; Rodas5P: decay
+/// 0.2, oscillator 1.4, rational 11.7 (dense, tol 1e-10), Kepler 120 / 22300, PR 88 and
+/// PR y0 = 2 68 (dense: its interpolant on the stiff component; end error <= 0.2 tol), motor
+/// 0.9, stiff Kepler 39). Kepler's are large
 /// for a physical reason, not a numerical one: the period depends on the energy, so every
 /// local error in the energy becomes a phase error that grows along the orbit (much more at
 /// e = 0.9, where the pericentre passage is fast; ArkImex's explicit part, built for its
@@ -388,63 +415,63 @@ pub(super) fn tolerance_cases() -> [TolCase; 9] {
             decay(),
             5.0,
             false,
-            [None, Some(0.5), Some(2.0), Some(20.0)],
+            [None, Some(0.5), Some(2.0), Some(20.0), Some(2.0)],
         ),
         (
             "oscillator w=2",
             oscillator(2.0),
             10.0,
             false,
-            [None, Some(20.0), Some(30.0), Some(500.0)],
+            [None, Some(20.0), Some(30.0), Some(500.0), Some(30.0)],
         ),
         (
             "rational",
             Problem::Rational(RationalDecay),
             5.0,
             false,
-            [None, Some(10.0), Some(2.0), Some(40.0)],
+            [None, Some(10.0), Some(2.0), Some(40.0), Some(15.0)],
         ),
         (
             "kepler e=0.5",
             kepler(0.5),
             TAU,
             false,
-            [None, Some(500.0), Some(300.0), Some(1500.0)],
+            [None, Some(500.0), Some(300.0), Some(1500.0), Some(300.0)],
         ),
         (
             "kepler e=0.9",
             kepler(0.9),
             TAU,
             false,
-            [None, Some(5e4), Some(2e3), Some(1.5e5)],
+            [None, Some(5e4), Some(2e3), Some(1.5e5), Some(5e4)],
         ),
         (
             "PR -1e4",
             pr(-1e4, 1.0),
             3.0,
             true,
-            [None, None, Some(7.0), Some(10.0)],
+            [None, None, Some(7.0), Some(10.0), Some(100.0)],
         ),
         (
             "PR -1e4 y0=2",
             pr(-1e4, 2.0),
             3.0,
             true,
-            [None, None, Some(7.0), Some(25.0)],
+            [None, None, Some(7.0), Some(25.0), Some(100.0)],
         ),
         (
             "motor oscillator",
             motor(),
             5.0,
             true,
-            [None, None, Some(20.0), Some(80.0)],
+            [None, None, Some(20.0), Some(80.0), Some(20.0)],
         ),
         (
             "stiff kepler",
             stiff_kepler(0.3, 1e4),
             TAU,
             true,
-            [None, None, Some(500.0), Some(500.0)],
+            [None, None, Some(500.0), Some(500.0), Some(500.0)],
         ),
     ]
 }
@@ -535,7 +562,15 @@ fn stiff_problem_steps_set_by_accuracy_or_stability() {
                     r.err_end / tol,
                     r.err_dense / tol
                 );
-                let c_dense = if lambda < -1e3 { 5.0 } else { 25.0 };
+                // RODAS5P's order-4 interpolant is the weak part on stiff PR: its end error is
+                // 0.03 tol, its dense error 10-74 tol (measured at -1e4, -1e6)
+                let c_dense = if m.name == "Rodas5P" {
+                    100.0
+                } else if lambda < -1e3 {
+                    5.0
+                } else {
+                    25.0
+                };
                 checks.check(
                     r.err_end <= 7.0 * tol && r.err_dense <= c_dense * tol,
                     || {

@@ -178,6 +178,17 @@ impl Rodas {
         self
     }
 
+    /// Keeps each Jacobian for `k` accepted steps (see [`Rodas::try_with_jacobian_reuse`]).
+    ///
+    /// # Panics
+    /// If `k == 0`; use [`Rodas::try_with_jacobian_reuse`] for user input.
+    pub fn with_jacobian_reuse(self, k: usize) -> Self {
+        match self.try_with_jacobian_reuse(k) {
+            Ok(s) => s,
+            Err(e) => panic!("Rodas::with_jacobian_reuse: {e}"),
+        }
+    }
+
     /// Keeps each Jacobian for `k` accepted steps (`k >= 1`; default 1). Unlike
     /// [`super::Rosenbrock`] (a W-method) this costs order: the method is then only of order 2
     /// or so in the terms `J` enters, and the error control shortens the steps.

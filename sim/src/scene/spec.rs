@@ -243,6 +243,12 @@ pub enum IntegratorSpec {
     /// IMEX additive Runge–Kutta ARK4(3)6L[2]SA: the armature circuits implicit (closed form),
     /// the mechanics explicit.
     Imex(AdaptiveSpec),
+    /// Rosenbrock RODAS5P (Steinebach 2023; order 5(4), L-stable, dense output of order 4),
+    /// adaptive, with the exact Jacobian of the q, q̇, i block by finite differences.
+    Rodas5p(RosenbrockSpec),
+    /// Rosenbrock RODAS4 (Hairer & Wanner; order 4(3), L-stable, dense output of order 3),
+    /// otherwise as `rodas5p`.
+    Rodas4(RosenbrockSpec),
 }
 
 /// `rk4`'s settings.
@@ -269,7 +275,7 @@ pub struct AdaptiveSpec {
     pub max_steps: Option<u64>,
 }
 
-/// `rosenbrock`'s settings: the step control of [`AdaptiveSpec`] and the Jacobian's reuse.
+/// `rosenbrock`'s, `rodas5p`'s and `rodas4`'s settings: the step control of [`AdaptiveSpec`] and the Jacobian's reuse.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RosenbrockSpec {
@@ -294,6 +300,8 @@ impl IntegratorSpec {
             "dopri45" => IntegratorSpec::Dopri45(a),
             "imex" => IntegratorSpec::Imex(a),
             "rosenbrock" => IntegratorSpec::Rosenbrock(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None }),
+            "rodas5p" => IntegratorSpec::Rodas5p(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None }),
+            "rodas4" => IntegratorSpec::Rodas4(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None }),
             _ => return None,
         })
     }

@@ -16,7 +16,9 @@ use sim::precision::Row;
 #[command(after_help = "\
 Output: DIR/precision.csv, precision.json and the diagram work-precision.svg/.png (max hand
 error against wall time, log-log); on stdout the table (-f json|csv: every row) and the cheapest
-setting per method within 1 um.
+setting per method within --accuracy (default 1e-6 m) and the recommended setting. A run that
+finished but left the physics (hand error above the arm's reach, energy error above the electric
+energy, NaN) has the status \"diverged\".
 
 Examples:
   sim precision                                   the paper's two-elbow run, 5 s
@@ -38,12 +40,22 @@ pub struct PrecisionArgs {
     /// Timed repetitions of each run; the best is kept.
     #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeats: u32,
+    /// A requested max hand error, m: print the recommended setting (the cheapest measured
+    /// method and tolerance within it, by wall time and by right-hand sides) and the cheapest
+    /// run per method within it.
+    #[arg(long, value_name = "METRES", default_value_t = 1e-6, value_parser = positive_metres)]
+    pub accuracy: f64,
     #[command(flatten)]
     pub format: TableFormat,
 }
 
-/// The error bound of the summary's "cheapest setting per method", m.
-const TARGET_M: f64 = 1e-6;
+/// A positive, finite length in metres.
+fn positive_metres(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
+        _ => Err(format!("{s:?} is not a positive number of metres")),
+    }
+}
 
 pub fn run(a: &PrecisionArgs, v: Verbosity) -> Result<u8> {
     let scene = crate::load_scene(a.scene.as_deref())?;
@@ -85,7 +97,7 @@ pub fn run(a: &PrecisionArgs, v: Verbosity) -> Result<u8> {
     let text = match a.format.format {
         Format::Json => serde_json::to_string_pretty(&rows)? + "\n",
         Format::Csv => csv(&rows)?,
-        Format::Table => table(&rows, &scene.spec().name, &run.name, scene.duration())?,
+        Format::Table => table(&rows, &scene.spec().name, &run.name, scene.duration(), a.accuracy)?,
     };
     print_out(&text)?;
     if !v.quiet {
@@ -103,15 +115,15 @@ fn csv(rows: &[Row]) -> Result<String> {
     Ok(String::from_utf8(w.into_inner().context("writing the precision table")?)?)
 }
 
-fn table(rows: &[Row], scene: &str, run: &str, duration: f64) -> Result<String> {
+fn table(rows: &[Row], scene: &str, run: &str, duration: f64, accuracy: f64) -> Result<String> {
     let mut o = String::new();
     writeln!(o, "Speed against error: scene `{scene}`, run `{run}`, {duration} s simulated; reference dopri45 rtol 1e-12")?;
-    let head = ["method", "setting", "wall [ms]", "RHS", "steps", "rejected", "hand [m]", "energy [J]", "drift [m]", "x real"];
+    let head = ["method", "setting", "wall [ms]", "RHS", "steps", "rejected", "hand [m]", "energy [J]", "drift [m]", "x real", "status"];
     let cells: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
             let mut c = vec![r.series.clone(), r.setting.clone()];
-            if r.status == "ok" {
+            if r.status == "ok" || r.status.starts_with("diverged") {
                 c.extend([
                     format!("{:.2}", r.wall_s * 1e3),
                     r.rhs_evals.to_string(),
@@ -121,6 +133,7 @@ fn table(rows: &[Row], scene: &str, run: &str, duration: f64) -> Result<String> 
                     format!("{:.2e}", r.max_link_energy_error_j),
                     format!("{:.1e}", r.max_drift_m),
                     format!("{:.0}", r.speed_vs_real_time),
+                    r.status.clone(),
                 ]);
             } else {
                 c.push(r.status.clone());
@@ -132,12 +145,25 @@ fn table(rows: &[Row], scene: &str, run: &str, duration: f64) -> Result<String> 
     t.left = 2;
     t.rows = cells;
     o.push_str(&t.aligned());
-    let best = sim::precision::cheapest_within(rows, TARGET_M);
+    let best = sim::precision::cheapest_within(rows, accuracy);
     let baseline = best.iter().find(|r| r.series.starts_with("paper baseline")).map(|r| r.wall_s);
-    writeln!(o, "\nCheapest run per method with max hand error <= {TARGET_M:.0e} m:")?;
+    writeln!(o, "\nCheapest run per method with max hand error <= {accuracy:.0e} m:")?;
     for r in &best {
         let ratio = baseline.map_or(String::from("-"), |b| format!("{:.1}x faster than the paper baseline", b / r.wall_s));
         writeln!(o, "  {:<42} {:<12} {:>9.2} ms  {:>6.0}x real time  {ratio}", r.series, r.setting, r.wall_s * 1e3, r.speed_vs_real_time)?;
+    }
+    match sim::precision::recommend(rows, accuracy) {
+        Some(rec) => {
+            let (w, n) = (rec.by_wall, rec.by_rhs);
+            writeln!(o, "\nRecommended for max hand error <= {accuracy:.0e} m: {} {} ({:.2} ms, {} RHS, hand error {:.1e} m)", w.series, w.setting, w.wall_s * 1e3, w.rhs_evals, w.max_hand_error_m)?;
+            if !std::ptr::eq(w, n) {
+                writeln!(o, "Fewest right-hand sides within it: {} {} ({:.2} ms, {} RHS, hand error {:.1e} m)", n.series, n.setting, n.wall_s * 1e3, n.rhs_evals, n.max_hand_error_m)?;
+            }
+        }
+        None => {
+            let best = rows.iter().filter(|r| r.status == "ok").map(|r| r.max_hand_error_m).fold(f64::INFINITY, f64::min);
+            writeln!(o, "\nNo measured setting reaches max hand error <= {accuracy:.0e} m (the smallest was {best:.1e} m).")?;
+        }
     }
     Ok(o)
 }
