@@ -11,7 +11,7 @@ use nalgebra::UnitQuaternion;
 use schemas::{
     frame_transform, hand_points, to_log_time, topics, ConstraintState, EnergyState, FrameTransforms, HandState,
     JointState, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
-    SceneRecord, Setup, UrdfRecord, Vec3,
+    SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
 
 use crate::error::RunError;
@@ -52,8 +52,14 @@ impl<'a> Recorder<'a> {
     /// Open `path` (written under a temporary name until `finish`) and write the metadata and
     /// the robot description.
     pub fn create(path: &Path, scene: &'a Scene, run: &Run) -> Result<Self, RunError> {
+        Self::create_tapped(path, scene, run, None)
+    }
+
+    /// [`Recorder::create`], every record also fed to `tap` (see
+    /// [`RecordingWriter::create_tapped`]); [`Recorder::finish`] returns what it saw.
+    pub fn create_tapped(path: &Path, scene: &'a Scene, run: &Run, tap: Option<Tap>) -> Result<Self, RunError> {
         let err = |source| RunError::Recording { path: path.to_path_buf(), source };
-        let mut writer = RecordingWriter::create(path).map_err(err)?;
+        let mut writer = RecordingWriter::create_tapped(path, WriterOptions::default(), tap).map_err(err)?;
         let joint_names = scene.model.joint_names();
         let contact_names: Vec<String> = run.contacts.iter().map(|&k| scene.contacts[k].name.clone()).collect();
         writer.write_record(&RecordingInfo::new(TOOL)).map_err(err)?;
@@ -169,8 +175,8 @@ impl<'a> Recorder<'a> {
 
     /// Close the file with a result record, then rename it into place. `outcome` is `Ok` with
     /// the solver statistics, or the error that stopped the run (the file then holds every
-    /// sample up to the failure and says when and why).
-    pub fn finish(mut self, outcome: Result<&crate::integrate::Stats, &RunError>) -> Result<PathBuf, RunError> {
+    /// sample up to the failure and says when and why). With a tap, what it saw.
+    pub fn finish(mut self, outcome: Result<&crate::integrate::Stats, &RunError>) -> Result<(PathBuf, Option<Tapped>), RunError> {
         let result = match outcome {
             Ok(stats) => RunResult::complete(stats.rhs_evals, stats.steps, stats.rejected),
             Err(e) => RunResult::failed(e.to_string(), e.time()),
@@ -178,6 +184,6 @@ impl<'a> Recorder<'a> {
         let path = self.path.clone();
         let err = |source| RunError::Recording { path: path.clone(), source };
         self.writer.write_record(&result).map_err(err)?;
-        self.writer.finish().map_err(err)
+        self.writer.finish_tapped().map_err(err)
     }
 }
