@@ -50,11 +50,11 @@ pub use meta::{
 pub use reader::{
     read_recording, read_recording_bytes, read_recording_bytes_topics, read_recording_recover,
     read_recording_recover_bytes, read_recording_topics, stream_recording, stream_recording_recover,
-    ArraySizes, ChannelInfo, DecodedMessage, Recording, RecoverReport, Visitor, MAX_RECORD_BYTES,
+    ArraySizes, ChannelInfo, DecodedMessage, Recording, RecoverReport, Tap, Tapped, Visitor, MAX_RECORD_BYTES,
     NOT_SELECTED,
 };
 pub use value::Value;
-pub use writer::RecordingWriter;
+pub use writer::{Compression, RecordingWriter, WriterOptions};
 
 /// Foxglove's generated message types (all of them, e.g. `SceneUpdate`).
 pub use foxglove::messages as foxglove_messages;

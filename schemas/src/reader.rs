@@ -41,10 +41,12 @@ use crate::value::Value;
 mod decode;
 mod input;
 mod recover;
+mod tap;
 mod typed;
 mod visit;
 use crate::Error;
 pub use recover::{read_recording_recover, read_recording_recover_bytes, stream_recording_recover, RecoverReport};
+pub use tap::{Tap, Tapped};
 pub use typed::ArraySizes;
 pub use visit::{DecodedMessage, Visitor};
 pub(crate) use visit::{decode_typed, Collect};
@@ -175,7 +177,7 @@ pub fn read_recording_bytes_topics(
 }
 
 /// The text of a caught panic.
-fn panic_text(panic: &(dyn std::any::Any + Send)) -> String {
+pub(crate) fn panic_text(panic: &(dyn std::any::Any + Send)) -> String {
     panic
         .downcast_ref::<&str>()
         .map(|s| s.to_string())

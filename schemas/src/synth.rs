@@ -107,11 +107,16 @@ impl Synth {
 
     /// Writes the recording at `path`; returns it. Panics on an I/O error (a test helper).
     pub fn write(&self, path: &Path) -> PathBuf {
-        let mut w = match self.chunk_size {
+        let w = match self.chunk_size {
             Some(n) => RecordingWriter::create_with_chunk_size(path, n),
             None => RecordingWriter::create(path),
         }
         .expect("creating the synthetic recording");
+        self.write_with(w).0
+    }
+
+    /// [`Synth::write`] through `w` (any options, a tap); returns the path and what the tap saw.
+    pub fn write_with(&self, mut w: RecordingWriter) -> (PathBuf, Option<crate::Tapped>) {
         if let Some(tool) = &self.tool {
             w.write_record(&RecordingInfo::new(tool)).expect("recording record");
         }
@@ -154,7 +159,7 @@ impl Synth {
         if let Some(r) = &self.result {
             w.write_record(r).expect("result record");
         }
-        w.finish().expect("finishing the synthetic recording")
+        w.finish_tapped().expect("finishing the synthetic recording")
     }
 }
 

@@ -9,10 +9,11 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::UnitQuaternion;
 use schemas::{
-    frame_transform, hand_points, to_log_time, topics, ConstraintState, EnergyState, FrameTransforms, HandState,
+    frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, EnergyState, FrameTransforms, HandState,
     JointState, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
-    SceneRecord, Setup, UrdfRecord, Vec3,
+    SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
+use schemas::{Quaternion, Vector3};
 
 use crate::error::RunError;
 use crate::scene::{Run, Scene};
@@ -46,14 +47,28 @@ pub struct Recorder<'a> {
     constraints: ConstraintState,
     energy: EnergyState,
     joint_state: JointState,
+    /// `/tf`, built once (frame names), its poses and stamps updated every sample.
+    tf: FrameTransforms,
 }
 
 impl<'a> Recorder<'a> {
     /// Open `path` (written under a temporary name until `finish`) and write the metadata and
     /// the robot description.
     pub fn create(path: &Path, scene: &'a Scene, run: &Run) -> Result<Self, RunError> {
+        Self::create_tapped(path, scene, run, None)
+    }
+
+    /// [`Recorder::create`], every record also fed to `tap` (see
+    /// [`RecordingWriter::create_tapped`]); [`Recorder::finish`] returns what it saw.
+    pub fn create_tapped(path: &Path, scene: &'a Scene, run: &Run, tap: Option<Tap>) -> Result<Self, RunError> {
+        Self::create_with(path, scene, run, WriterOptions::default(), tap)
+    }
+
+    /// [`Recorder::create_tapped`] with the writer's `options` (compression, chunks, thread:
+    /// the bench `record` compares them).
+    pub fn create_with(path: &Path, scene: &'a Scene, run: &Run, options: WriterOptions, tap: Option<Tap>) -> Result<Self, RunError> {
         let err = |source| RunError::Recording { path: path.to_path_buf(), source };
-        let mut writer = RecordingWriter::create(path).map_err(err)?;
+        let mut writer = RecordingWriter::create_tapped(path, options, tap).map_err(err)?;
         let joint_names = scene.model.joint_names();
         let contact_names: Vec<String> = run.contacts.iter().map(|&k| scene.contacts[k].name.clone()).collect();
         writer.write_record(&RecordingInfo::new(TOOL)).map_err(err)?;
@@ -88,9 +103,16 @@ impl<'a> Recorder<'a> {
         writer
             .write(topics::ROBOT_DESCRIPTION, 0, &RosString { data: scene.urdf_xml.clone() })
             .map_err(err)?;
+        // world -> root, then every URDF joint (fixed ones too), in this order every sample
+        let mut tf = FrameTransforms { transforms: Vec::with_capacity(scene.model.urdf_joints.len() + 1) };
+        tf.transforms.push(frame_transform(0, WORLD_FRAME, &scene.model.root_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+        for j in &scene.model.urdf_joints {
+            tf.transforms.push(frame_transform(0, &j.parent_link, &j.child_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+        }
         Ok(Self {
             scene,
             writer,
+            tf,
             path: path.to_path_buf(),
             joint_state: JointState { name: joint_names, ..Default::default() },
             motors: MotorState::default(),
@@ -114,19 +136,23 @@ impl<'a> Recorder<'a> {
         set(&mut js.effort, &o.tau_motor);
         self.writer.write(topics::JOINT_STATES, t_ns, &self.joint_state).map_err(&err)?;
 
-        // transforms: world -> root, then every URDF joint (fixed ones too)
-        let mut tf = FrameTransforms { transforms: Vec::with_capacity(model.urdf_joints.len() + 1) };
-        tf.transforms.push(frame_transform(t_ns, WORLD_FRAME, &model.root_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
-        for j in &model.urdf_joints {
+        // transforms: world -> root (identity), then every URDF joint (fixed ones too); the
+        // frame names were set by `create` (no allocation per sample)
+        let stamp = Some(timestamp(t_ns));
+        let (root, joints) = self.tf.transforms.split_at_mut(1);
+        root[0].timestamp = stamp;
+        for (j, tr) in model.urdf_joints.iter().zip(joints) {
             let x = match j.dof {
                 Some(d) => j.origin * UnitQuaternion::from_axis_angle(&model.bodies[d].axis, o.q[d]),
                 None => j.origin,
             };
             let t = x.translation.vector;
             let r = x.rotation.coords;
-            tf.transforms.push(frame_transform(t_ns, &j.parent_link, &j.child_link, [t.x, t.y, t.z], [r.x, r.y, r.z, r.w]));
+            tr.timestamp = stamp;
+            tr.translation = Some(Vector3 { x: t.x, y: t.y, z: t.z });
+            tr.rotation = Some(Quaternion { x: r.x, y: r.y, z: r.z, w: r.w });
         }
-        self.writer.write(topics::TF, t_ns, &tf).map_err(&err)?;
+        self.writer.write(topics::TF, t_ns, &self.tf).map_err(&err)?;
 
         let m = &mut self.motors;
         m.time = o.t;
@@ -169,8 +195,8 @@ impl<'a> Recorder<'a> {
 
     /// Close the file with a result record, then rename it into place. `outcome` is `Ok` with
     /// the solver statistics, or the error that stopped the run (the file then holds every
-    /// sample up to the failure and says when and why).
-    pub fn finish(mut self, outcome: Result<&crate::integrate::Stats, &RunError>) -> Result<PathBuf, RunError> {
+    /// sample up to the failure and says when and why). With a tap, what it saw.
+    pub fn finish(mut self, outcome: Result<&crate::integrate::Stats, &RunError>) -> Result<(PathBuf, Option<Tapped>), RunError> {
         let result = match outcome {
             Ok(stats) => RunResult::complete(stats.rhs_evals, stats.steps, stats.rejected),
             Err(e) => RunResult::failed(e.to_string(), e.time()),
@@ -178,6 +204,6 @@ impl<'a> Recorder<'a> {
         let path = self.path.clone();
         let err = |source| RunError::Recording { path: path.clone(), source };
         self.writer.write_record(&result).map_err(err)?;
-        self.writer.finish().map_err(err)
+        self.writer.finish_tapped().map_err(err)
     }
 }

@@ -134,17 +134,32 @@ pub fn run_to_file_within(
     run: &Run,
     path: &std::path::Path,
     budget: Budget,
-    mut progress: impl FnMut(f64),
+    progress: impl FnMut(f64),
 ) -> Result<FileReport, RunError> {
-    let mut rec = crate::record::Recorder::create(path, scene, run)?;
+    run_to_file_tapped(scene, run, path, budget, None, progress).map(|(report, _)| report)
+}
+
+/// [`run_to_file_within`], every record written also fed to `tap` ([`schemas::Tap`]: the
+/// messages reach its visitor as a read of the finished file would hand them over); what the
+/// tap saw comes back with a complete run.
+#[allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `run_to_file`
+pub fn run_to_file_tapped(
+    scene: &Scene,
+    run: &Run,
+    path: &std::path::Path,
+    budget: Budget,
+    tap: Option<schemas::Tap>,
+    mut progress: impl FnMut(f64),
+) -> Result<(FileReport, Option<schemas::Tapped>), RunError> {
+    let mut rec = crate::record::Recorder::create_tapped(path, scene, run, tap)?;
     let result = simulate_within(scene, run, budget, |o| {
         progress(o.t);
         rec.record(o)
     });
     match result {
         Ok(report) => {
-            let path = rec.finish(Ok(&report.stats))?;
-            Ok(FileReport { path, report })
+            let (path, tapped) = rec.finish(Ok(&report.stats))?;
+            Ok((FileReport { path, report }, tapped))
         }
         Err(e @ RunError::Recording { .. }) => Err(e),
         Err(e) => {

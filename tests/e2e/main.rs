@@ -15,6 +15,7 @@ mod sampled_energy;
 mod sim_bad_input;
 mod sim_output;
 mod sim_sweep;
+mod sim_table;
 
 /// Runs `analyze` with `args`.
 fn run_analyze<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> std::process::Output {

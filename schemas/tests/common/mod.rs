@@ -143,7 +143,11 @@ pub fn tf(t: u64, k: usize) -> FrameTransforms {
 }
 
 pub fn write_all(path: &Path, c: &Content) -> std::path::PathBuf {
-    let mut w = RecordingWriter::create(path).unwrap();
+    write_all_with(path, c, RecordingWriter::create(path).unwrap())
+}
+
+/// [`write_all`] through the writer `w` (created for `path` with any options or tap).
+pub fn write_all_with(_path: &Path, c: &Content, mut w: RecordingWriter) -> std::path::PathBuf {
     let mut rec = BTreeMap::new();
     rec.insert("scene".to_string(), "two_link".to_string());
     rec.insert("integrator".to_string(), "rk4".to_string());

@@ -1,17 +1,21 @@
 //! `sim run` (and `sim` with no command): run the selected runs of a scene in parallel, each to
-//! its recording, then read the recordings back and print the comparison of the runs.
+//! its recording, and print the comparison of the runs.
 //!
-//! The comparison is made by the `analyze` library from the files just written, so the numbers
-//! shown are those any reader of the recordings gets (the `sim` library never depends on
-//! `analyze`; this binary composes the two).
+//! The comparison is made by the `analyze` library from what each run wrote, without reading
+//! the files back: the writer feeds every record it writes to the reader's own record consumer
+//! ([`schemas::Tap`]), which hands the metric topics to `analyze`'s running reductions
+//! ([`analyze::metrics::Reductions`]) exactly as `analyze compare` on the files does (the same
+//! decoders, checks and reductions; tests/e2e/sim_table.rs checks the two tables equal). The
+//! `sim` library never depends on `analyze`; this binary composes the two.
 
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use cli::{exit, print_out, Jobs, TableFormat, Verbosity};
 use rayon::prelude::*;
-use sim::run::{run_to_file_within, Budget};
+use sim::run::{run_to_file_tapped, Budget};
 use sim::scene::{Run, Scene};
 
 /// The options of a run, with `sim` alone or `sim run`.
@@ -122,6 +126,46 @@ pub struct Done {
     pub error: Option<String>,
     /// The failure is an I/O error (the recording could not be written), not a numerical one.
     pub io_error: bool,
+    /// The metrics of a complete run, from what it wrote ([`MetricsTap`]).
+    pub metrics: Option<Result<analyze::RunMetrics, analyze::Error>>,
+}
+
+/// `analyze`'s running reductions fed by the writer of a recording ([`schemas::Tap`]) with the
+/// messages of the metric topics as it writes them: the metrics of a run without reading its
+/// file back, by the code `analyze` runs on the file.
+#[derive(Clone, Default)]
+pub struct MetricsTap(Arc<Mutex<analyze::metrics::Reductions>>);
+
+impl schemas::Visitor for MetricsTap {
+    fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner).message(m)
+    }
+}
+
+impl MetricsTap {
+    /// The tap for the recording at `path` (labelled as a reader labels it), and the handle
+    /// that [`MetricsTap::metrics`] reads.
+    pub fn new(path: &Path) -> (schemas::Tap, MetricsTap) {
+        let acc = MetricsTap::default();
+        let tap = schemas::Tap::new(path.display().to_string(), Some(&analyze::metrics::METRIC_TOPICS), Box::new(acc.clone()));
+        (tap, acc)
+    }
+
+    /// The metrics, once the writer finished and gave back `tapped` (what
+    /// [`analyze::metrics::stream_run_metrics`] computes from the file).
+    pub fn metrics(self, tapped: Option<schemas::Tapped>) -> Result<analyze::RunMetrics, analyze::Error> {
+        let Some(tapped) = tapped else {
+            return Err(schemas::Error::Stopped { file: "(no tap)".into() }.into());
+        };
+        drop(tapped.visitor); // the other handle of the reductions
+        let acc = match Arc::try_unwrap(self.0) {
+            Ok(m) => m.into_inner().unwrap_or_else(PoisonError::into_inner),
+            Err(shared) => std::mem::take(&mut *shared.lock().unwrap_or_else(PoisonError::into_inner)),
+        };
+        let mut acc = acc;
+        let rec = tapped.recording.map_err(|e| acc.take_error(e))?;
+        acc.finish(&rec, None)
+    }
 }
 
 /// Runs `runs` of `scene` on `jobs` threads, run `r` to `path(r)`, with a progress bar each.
@@ -137,7 +181,8 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
                 let target = path(run);
                 let t0 = Instant::now();
                 let mut count = 0u32;
-                let res = run_to_file_within(scene, run, &target, budget, |t| {
+                let (tap, metrics) = MetricsTap::new(&target);
+                let res = run_to_file_tapped(scene, run, &target, budget, Some(tap), |t| {
                     count += 1;
                     if count % 64 == 0 {
                         cli::progress::set_time(bar, t);
@@ -145,7 +190,7 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
                 });
                 let wall = t0.elapsed().as_secs_f64();
                 match res {
-                    Ok(r) => {
+                    Ok((r, tapped)) => {
                         bar.finish_with_message(format!("{:.3} s", scene.duration()));
                         if v.verbose > 0 {
                             let s = r.report.stats;
@@ -157,13 +202,13 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
                                 )
                             });
                         }
-                        Done { path: Some(r.path), error: None, io_error: false }
+                        Done { path: Some(r.path), error: None, io_error: false, metrics: Some(metrics.metrics(tapped)) }
                     }
                     Err(e) => {
                         bar.abandon_with_message(format!("failed at {}", e.time().map_or("?".into(), |t| format!("{t:.3} s"))));
                         // a numerical failure still leaves a recording that says when and why
                         let written = e.time().is_some() && target.is_file();
-                        Done { path: written.then_some(target), error: Some(format!("run `{}`: {e}", run.name)), io_error: e.is_io() }
+                        Done { path: written.then_some(target), error: Some(format!("run `{}`: {e}", run.name)), io_error: e.is_io(), metrics: None }
                     }
                 }
             })
@@ -188,7 +233,7 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
 /// recording could not be written (an I/O error: its run's result is lost), else 1 if a run
 /// failed numerically (its recording says when and why), else 0.
 pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>) -> Result<u8> {
-    let complete: Vec<&Path> = done.iter().filter(|d| d.error.is_none()).filter_map(|d| d.path.as_deref()).collect();
+    let complete: Vec<&Done> = done.iter().filter(|d| d.error.is_none() && d.path.is_some()).collect();
     if !complete.is_empty() {
         print_comparison(&complete, format.format, baseline)?;
     }
@@ -205,11 +250,17 @@ pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>) -> Res
     })
 }
 
-/// Reads the recordings back and prints the comparison of the runs.
-fn print_comparison(paths: &[&Path], format: analyze::Format, baseline: Option<&str>) -> Result<()> {
-    let metrics = paths
+/// Prints the comparison of the runs, from the metrics computed as they were written (a run
+/// without them, which no caller makes, is read back).
+fn print_comparison(done: &[&Done], format: analyze::Format, baseline: Option<&str>) -> Result<()> {
+    let metrics = done
         .iter()
-        .map(|p| analyze::read_run_metrics(p).with_context(|| format!("reading back {}", p.display())))
+        .filter_map(|d| d.path.as_deref().map(|p| (p, d.metrics.as_ref())))
+        .map(|(p, m)| match m {
+            Some(Ok(m)) => Ok(m.clone()),
+            Some(Err(e)) => Err(anyhow::anyhow!("{e}")).with_context(|| format!("the metrics of {}", p.display())),
+            None => analyze::read_run_metrics(p).with_context(|| format!("reading back {}", p.display())),
+        })
         .collect::<Result<Vec<_>>>()?;
     let cmp = analyze::Comparison::new(&metrics, baseline)?;
     print_out(&analyze::render_comparison(&cmp, format)?)

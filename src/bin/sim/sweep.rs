@@ -12,7 +12,9 @@ use cli::{exit, print_out, Jobs, TableFormat, Verbosity};
 use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::Value;
-use sim::run::run_to_file_within;
+use sim::run::run_to_file_tapped;
+
+use crate::run::MetricsTap;
 use sim::sweep::{compact, Shard, Sweep, Variant};
 
 /// Run a grid of scene variations in parallel (optionally one shard of it, for job arrays).
@@ -162,8 +164,13 @@ pub fn run(args: &SweepArgs, v: Verbosity) -> Result<u8> {
         let run = scene.run(run_name).expect("runs checked when the variant was validated");
         bar.set_message(format!("{} {run_name}", var.name));
         let path = out.join(Sweep::file_name(var, run_name));
-        let done = match run_to_file_within(scene, run, &path, budget, |_| {}) {
-            Ok(rep) => Done { metrics: Some(read_metrics(&rep.path)), path: Some(rep.path), error: None, io_error: false },
+        let (tap, metrics) = MetricsTap::new(&path);
+        let done = match run_to_file_tapped(scene, run, &path, budget, Some(tap), |_| {}) {
+            // the metrics from what the run wrote (as `analyze` reads them from the file)
+            Ok((rep, tapped)) => {
+                let metrics = metrics.metrics(tapped).map_err(|e| format!("the metrics of {}: {e}", rep.path.display()));
+                Done { metrics: Some(metrics), path: Some(rep.path), error: None, io_error: false }
+            }
             Err(e) => {
                 // a numerical failure still leaves a recording that says when and why
                 let written = e.time().is_some() && path.is_file();
@@ -287,6 +294,7 @@ fn manifest_name(shard: Shard) -> String {
     }
 }
 
+/// The metrics of a failed run's recording (a complete run's come from its writer).
 fn read_metrics(p: &Path) -> Result<analyze::RunMetrics, String> {
     analyze::read_run_metrics(p).map_err(|e| format!("reading back {}: {e}", p.display()))
 }
