@@ -15,7 +15,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use analyze::metrics::METRIC_TOPICS;
-use analyze::summary::{self, Query};
+use analyze::summary;
+#[cfg(feature = "tables")]
+use analyze::summary::Query;
 
 fn main() {
     // `cargo bench` passes `--bench`; take the first other argument as the folder
@@ -54,6 +56,7 @@ fn main() {
             .fold(f64::INFINITY, f64::min)
     };
     let params = vec!["controller.kp".to_string(), "controller.kd".to_string()];
+    #[cfg(feature = "tables")]
     let query = Query {
         sort: vec!["E_j".into()],
         ..Query::default()
@@ -80,7 +83,11 @@ fn main() {
                     .count()
             }),
         ),
+        ("summary rows, 1 thread", Box::new(|| rows(&paths, &params, 1))),
+        ("summary rows, all cores", Box::new(|| rows(&paths, &params, 0))),
+        #[cfg(feature = "tables")]
         ("summary, 1 thread (+ polars table, sort)", Box::new(|| summarise(&paths, &params, 1, &query))),
+        #[cfg(feature = "tables")]
         ("summary, all cores (+ polars table, sort)", Box::new(|| summarise(&paths, &params, 0, &query))),
     ];
     let mut base = None;
@@ -92,6 +99,11 @@ fn main() {
     }
 }
 
+fn rows(paths: &[PathBuf], params: &[String], threads: usize) -> usize {
+    summary::read_rows(paths, params, threads, &|| {}).into_iter().map(Result::unwrap).count()
+}
+
+#[cfg(feature = "tables")]
 fn summarise(paths: &[PathBuf], params: &[String], threads: usize, query: &Query) -> usize {
     let rows: Vec<_> = summary::read_rows(paths, params, threads, &|| {})
         .into_iter()

@@ -316,6 +316,12 @@ impl Reductions {
 /// An error of [`Reductions::add`] stops the reader ([`schemas::Error::Stopped`]) and is kept
 /// in [`Reductions::error`], to be returned as it is.
 impl schemas::Visitor for Reductions {
+    /// The metric messages typed when their schema is `schemas`' own (the same numbers, no
+    /// generic tree).
+    fn typed(&self) -> bool {
+        true
+    }
+
     fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), schemas::Error> {
         match self.add(&m) {
             Ok(()) => Ok(()),
