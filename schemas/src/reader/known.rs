@@ -153,40 +153,70 @@ fn vec3(w: Option<Vec3Wire>) -> Vec3 {
     w.map_or_else(Vec3::default, |w| Vec3 { x: w.x, y: w.y, z: w.z })
 }
 
+/// Decoders' scratch messages, one per kind and thread: a repeated field decoded into a `Vec`
+/// that grows one value at a time reallocates several times per message; decoding into kept
+/// storage and copying out allocates each array once, at its size.
+#[derive(Default)]
+struct Scratch {
+    motors: MotorWire,
+    constraints: ConstraintWire,
+    energy: EnergyWire,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
+}
+
 /// Decodes one message of a channel of `kind`; the error is the protobuf decoder's.
 pub(crate) fn decode(kind: KnownKind, data: &[u8]) -> Result<Known, String> {
     use prost::Message as _;
     let err = |e: prost::DecodeError| e.to_string();
-    Ok(match kind {
-        KnownKind::Hand => {
-            let w = HandWire::decode(data).map_err(err)?;
-            Known::Hand(HandState { time: w.time, actual: vec3(w.actual), desired: vec3(w.desired), error: vec3(w.error), error_norm: w.error_norm })
-        }
-        KnownKind::Motors => {
-            let w = MotorWire::decode(data).map_err(err)?;
-            Known::Motors(MotorState { time: w.time, current: w.current, voltage: w.voltage, back_emf: w.back_emf, electric_power: w.electric_power, torque: w.torque })
-        }
-        KnownKind::Constraints => {
-            let w = ConstraintWire::decode(data).map_err(err)?;
-            Known::Constraints(ConstraintState { time: w.time, normal_force: w.normal_force, position: w.position, velocity: w.velocity })
-        }
-        KnownKind::Energy => {
-            let w = EnergyWire::decode(data).map_err(err)?;
-            Known::Energy(EnergyState {
-                time: w.time,
-                link_work: w.link_work,
-                electric_energy: w.electric_energy,
-                link_work_total: w.link_work_total,
-                electric_energy_total: w.electric_energy_total,
-                kinetic: w.kinetic,
-                potential: w.potential,
-                magnetic: w.magnetic,
-                resistive_loss: w.resistive_loss,
-                friction_loss: w.friction_loss,
-                balance_residual: w.balance_residual,
-                gear_friction_loss: w.gear_friction_loss,
-            })
-        }
+    SCRATCH.with_borrow_mut(|s| {
+        Ok(match kind {
+            KnownKind::Hand => {
+                // no arrays: nothing to keep
+                let w = HandWire::decode(data).map_err(err)?;
+                Known::Hand(HandState { time: w.time, actual: vec3(w.actual), desired: vec3(w.desired), error: vec3(w.error), error_norm: w.error_norm })
+            }
+            KnownKind::Motors => {
+                let w = &mut s.motors;
+                w.clear();
+                w.merge(data).map_err(err)?;
+                Known::Motors(MotorState {
+                    time: w.time,
+                    current: w.current.clone(),
+                    voltage: w.voltage.clone(),
+                    back_emf: w.back_emf.clone(),
+                    electric_power: w.electric_power.clone(),
+                    torque: w.torque.clone(),
+                })
+            }
+            KnownKind::Constraints => {
+                let w = &mut s.constraints;
+                w.clear();
+                w.merge(data).map_err(err)?;
+                Known::Constraints(ConstraintState { time: w.time, normal_force: w.normal_force.clone(), position: w.position.clone(), velocity: w.velocity.clone() })
+            }
+            KnownKind::Energy => {
+                let w = &mut s.energy;
+                w.clear();
+                w.merge(data).map_err(err)?;
+                Known::Energy(EnergyState {
+                    time: w.time,
+                    link_work: w.link_work.clone(),
+                    electric_energy: w.electric_energy.clone(),
+                    link_work_total: w.link_work_total,
+                    electric_energy_total: w.electric_energy_total,
+                    kinetic: w.kinetic,
+                    potential: w.potential,
+                    magnetic: w.magnetic,
+                    resistive_loss: w.resistive_loss,
+                    friction_loss: w.friction_loss,
+                    balance_residual: w.balance_residual,
+                    gear_friction_loss: w.gear_friction_loss,
+                })
+            }
+        })
     })
 }
 
@@ -290,22 +320,31 @@ impl Known {
         }
     }
 
-    /// The message as `M` when `M` is its struct (moved, not copied).
-    pub(crate) fn into_typed<M: 'static>(self) -> Option<M> {
-        let mut slot: Option<M> = None;
-        let any = &mut slot as &mut dyn Any;
-        match self {
-            Known::Hand(x) => put(any, x),
-            Known::Motors(x) => put(any, x),
-            Known::Constraints(x) => put(any, x),
-            Known::Energy(x) => put(any, x),
-        }
-        slot
+    /// Its arrays, `(field, length)` in field order: the first `n` of the array returned.
+    pub(crate) fn lists(&self) -> ([(&'static str, usize); 5], usize) {
+        let mut out = [("", 0); 5];
+        let mut n = 0;
+        let _ = self.fields(|name, field| {
+            if let Field::List(xs) = field {
+                if n < out.len() {
+                    out[n] = (name, xs.len());
+                    n += 1;
+                }
+            }
+            ControlFlow::<()>::Continue(())
+        });
+        (out, n)
     }
-}
 
-fn put<T: 'static>(slot: &mut dyn Any, x: T) {
-    if let Some(s) = slot.downcast_mut::<Option<T>>() {
-        *s = Some(x);
+    /// The message as a `&M` when `M` is its struct.
+    pub(crate) fn as_typed<M: 'static>(&self) -> Option<&M> {
+        let any: &dyn Any = match self {
+            Known::Hand(x) => x,
+            Known::Motors(x) => x,
+            Known::Constraints(x) => x,
+            Known::Energy(x) => x,
+        };
+        any.downcast_ref::<M>()
     }
+
 }

@@ -9,7 +9,6 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::ops::ControlFlow;
 
 use crate::messages::TopicMessage;
 use crate::meta::RunDescription;
@@ -18,7 +17,6 @@ use crate::value::{from_value, Value};
 use crate::{from_log_time, ArraySizes, Error};
 
 pub use super::known::Known;
-use super::known::Field;
 
 /// A decoded message's content.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,15 +89,15 @@ impl DecodedMessage<'_> {
     pub fn arrays(&self) -> impl Iterator<Item = (&str, ArrayIndex, usize)> + '_ {
         let keep = |field: &str, len: usize| len > 0 || array_required(self.topic, field);
         let (fields, known) = match &self.body {
-            Body::Value(Value::Struct(fields)) => (fields.as_slice(), Vec::new()),
-            Body::Value(_) => (&[][..], Vec::new()),
-            Body::Known(k) => (&[][..], known_arrays(self.topic, k)),
+            Body::Value(Value::Struct(fields)) => (fields.as_slice(), None),
+            Body::Value(_) => (&[][..], None),
+            Body::Known(k) => (&[][..], Some(known_arrays(self.topic, k))),
         };
         let generic = fields.iter().filter_map(move |(field, v)| match (array_index(self.topic, field), v) {
             (Some(kind), Value::List(items)) if keep(field, items.len()) => Some((field.as_str(), kind, items.len())),
             _ => None,
         });
-        generic.chain(known.into_iter().filter(move |&(field, _, len)| keep(field, len)))
+        generic.chain(known.into_iter().flatten().filter(move |&(field, _, len)| keep(field, len)))
     }
 
     /// The per-joint and per-contact array sizes of [`DecodedMessage::run`].
@@ -115,9 +113,14 @@ impl DecodedMessage<'_> {
     /// The message as `M` (by field name); with `sizes`, every per-joint and per-contact array
     /// must have that many entries (see [`Recording::read_sized`]). Errors name the file, the
     /// topic, the message and the field.
-    pub fn decode<M: TopicMessage + 'static>(&self, sizes: Option<ArraySizes>) -> Result<M, Error> {
+    pub fn decode<M: TopicMessage + Clone + 'static>(&self, sizes: Option<ArraySizes>) -> Result<M, Error> {
+        self.decode_ref::<M>(sizes).map(Cow::into_owned)
+    }
+
+    /// [`DecodedMessage::decode`], borrowed from a [`Body::Known`] (no copy).
+    pub fn decode_ref<M: TopicMessage + Clone + 'static>(&self, sizes: Option<ArraySizes>) -> Result<Cow<'_, M>, Error> {
         match &self.body {
-            Body::Value(v) => decode_typed(self.file, self.topic, self.index, self.log_time_ns, v, sizes),
+            Body::Value(v) => decode_typed(self.file, self.topic, self.index, self.log_time_ns, v, sizes).map(Cow::Owned),
             Body::Known(k) => {
                 if let Some(sizes) = sizes {
                     for (field, kind, len) in known_arrays(self.topic, k) {
@@ -131,22 +134,16 @@ impl DecodedMessage<'_> {
                     log_time_ns: self.log_time_ns,
                     detail: format!("the message is a {}, not a {}", known_name(k), std::any::type_name::<M>()),
                 };
-                k.clone().into_typed::<M>().ok_or_else(wrong)
+                k.as_typed::<M>().map(Cow::Borrowed).ok_or_else(wrong)
             }
         }
     }
 }
 
 /// The per-joint and per-contact arrays of a known message on `topic`: `(field, kind, length)`.
-fn known_arrays(topic: &str, k: &Known) -> Vec<(&'static str, ArrayIndex, usize)> {
-    let mut out = Vec::new();
-    let _ = k.fields(|name, field| {
-        if let (Field::List(xs), Some(kind)) = (field, array_index(topic, name)) {
-            out.push((name, kind, xs.len()));
-        }
-        ControlFlow::<()>::Continue(())
-    });
-    out
+fn known_arrays<'a>(topic: &'a str, k: &Known) -> impl Iterator<Item = (&'a str, ArrayIndex, usize)> + use<'a> {
+    let (lists, n) = k.lists();
+    lists.into_iter().take(n).filter_map(move |(name, len): (&'a str, usize)| array_index(topic, name).map(|kind| (name, kind, len)))
 }
 
 fn known_name(k: &Known) -> &'static str {
