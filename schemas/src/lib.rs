@@ -50,9 +50,11 @@ pub use meta::{
 pub use reader::{
     read_recording, read_recording_bytes, read_recording_bytes_topics, read_recording_recover,
     read_recording_recover_bytes, read_recording_topics, stream_recording, stream_recording_recover,
-    ArraySizes, ChannelInfo, DecodedMessage, Recording, RecoverReport, Tap, Tapped, Visitor, MAX_RECORD_BYTES,
+    ArraySizes, Body, ChannelInfo, DecodedMessage, Known, Recording, RecoverReport, Tap, Tapped, Visitor, MAX_RECORD_BYTES,
     NOT_SELECTED,
 };
+#[cfg(feature = "synth")]
+pub use reader::regroup_chunks;
 pub use value::Value;
 pub use writer::{Compression, RecordingWriter, WriterOptions};
 

@@ -38,17 +38,23 @@ use crate::meta::{MetadataRecord, RunDescription};
 use crate::topics::{array_index, ArrayIndex};
 use crate::value::Value;
 
+mod chunks;
 mod decode;
 mod input;
+mod known;
 mod recover;
 mod tap;
+#[cfg(feature = "synth")]
+mod regroup;
 mod typed;
 mod visit;
 use crate::Error;
 pub use recover::{read_recording_recover, read_recording_recover_bytes, stream_recording_recover, RecoverReport};
 pub use tap::{Tap, Tapped};
 pub use typed::ArraySizes;
-pub use visit::{DecodedMessage, Visitor};
+#[cfg(feature = "synth")]
+pub use regroup::regroup_chunks;
+pub use visit::{Body, DecodedMessage, Known, Visitor};
 pub(crate) use visit::{decode_typed, Collect};
 use decode::{decoder_for, message_to_value, Decoder, SchemaRec};
 
@@ -84,6 +90,8 @@ pub struct Recording {
     pub(crate) first_joint_array_len: Option<usize>,
     /// Whether the first `/energy` message decoded has `gear_friction_loss` (format ≥ 2).
     pub(crate) energy_has_gear_friction: bool,
+    /// Chunks that were not decompressed: they hold none of the topics read.
+    pub(crate) chunks_skipped: usize,
 }
 
 /// Reads and decodes the MCAP file at `path`, keeping every message; errors name the file.
@@ -112,19 +120,28 @@ pub fn read_recording_topics(path: &Path, topics: Option<&[&str]>) -> Result<Rec
 /// result says the whole file was read and checked.
 pub fn stream_recording(path: &Path, topics: Option<&[&str]>, visitor: &mut dyn Visitor) -> Result<Recording, Error> {
     let (mut file, len, label) = input::open(path)?;
-    Ok(read_state(&mut file, len, label, topics, visitor)?.into_recording())
+    let summary = topics.and_then(|_| chunks::summary_of_file(&mut file, len));
+    Ok(read_state(&mut file, len, label, topics, summary.as_deref(), visitor)?.into_recording())
 }
 
 /// Reads a whole MCAP input of `len` bytes into the state (messages to `visitor`) and checks
 /// that it is complete and consistent.
+///
+/// With `summary` (the file's summary section, read first) and `topics`, the chunks that hold
+/// none of `topics` are not decompressed ([`chunks`]).
 fn read_state(
     input: &mut dyn Read,
     len: u64,
     label: String,
     topics: Option<&[&str]>,
+    summary: Option<&[u8]>,
     visitor: &mut dyn Visitor,
 ) -> Result<State, Error> {
     let mut state = State::new(label, topics);
+    state.typed = visitor.typed();
+    if let (Some(summary), Some(_)) = (summary, topics) {
+        state.skip = chunks::prefeed(&mut state, summary);
+    }
     feed(input, reader_options(), &mut state, visitor)?;
     state.check_read_all(len)?;
     state.check_complete()?;
@@ -171,7 +188,8 @@ pub fn read_recording_bytes_topics(
     }
     let mut all = Collect::default();
     let mut input = bytes;
-    let mut rec = read_state(&mut input, bytes.len() as u64, source.to_string(), topics, &mut all)?.into_recording();
+    let summary = topics.and_then(|_| chunks::summary_of_bytes(bytes));
+    let mut rec = read_state(&mut input, bytes.len() as u64, source.to_string(), topics, summary, &mut all)?.into_recording();
     rec.messages = all.0;
     Ok(rec)
 }
@@ -223,13 +241,42 @@ fn feed_records(
     state: &mut State,
     visitor: &mut dyn Visitor,
 ) -> Result<(), Error> {
+    let file = state.file.clone();
+    let mut bytes = 0;
+    // skipping chunks: the reader yields them whole, and the skipper decides
+    let mut skipper = state.skip.then(chunks::Skipper::default);
+    let options = options.with_emit_chunks(skipper.is_some());
+    let fed = pump(input, options, &file, &mut bytes, &mut |opcode, data| {
+        let mcap_err = |source| Error::McapRead { file: file.clone(), source };
+        if let Some(sk) = skipper.as_mut() {
+            if sk.take(opcode, data, state, visitor)? {
+                return Ok(());
+            }
+        }
+        state.record(mcap::parse_record(opcode, data).map_err(mcap_err)?, visitor)
+    });
+    state.bytes_read += bytes;
+    fed?;
+    if let Some(mut sk) = skipper {
+        sk.resolve(state, visitor)?;
+        state.chunks_skipped += sk.skipped;
+    }
+    Ok(())
+}
+
+/// Runs `input` through a linear reader with `options`, handing each record (opcode, content)
+/// to `on_record`; `bytes` counts the bytes read.
+fn pump(
+    input: &mut dyn Read,
+    options: mcap::sans_io::LinearReaderOptions,
+    file: &str,
+    bytes: &mut u64,
+    on_record: &mut dyn FnMut(u8, &[u8]) -> Result<(), Error>,
+) -> Result<(), Error> {
     use mcap::sans_io::{LinearReadEvent, LinearReader};
     let mut reader = LinearReader::new_with_options(options);
     while let Some(event) = reader.next_event() {
-        let event = event.map_err(|source| Error::McapRead {
-            file: state.file.clone(),
-            source,
-        })?;
+        let event = event.map_err(|source| Error::McapRead { file: file.to_string(), source })?;
         match event {
             LinearReadEvent::ReadRequest(need) => {
                 let buf = reader.insert(need);
@@ -238,21 +285,14 @@ fn feed_records(
                         Ok(n) => break n,
                         Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
                         Err(source) => {
-                            return Err(Error::Io { file: state.file.clone(), op: "reading", source });
+                            return Err(Error::Io { file: file.to_string(), op: "reading", source });
                         }
                     }
                 };
-                state.bytes_read += n as u64;
+                *bytes += n as u64;
                 reader.notify_read(n);
             }
-            LinearReadEvent::Record { opcode, data } => {
-                let record =
-                    mcap::parse_record(opcode, data).map_err(|source| Error::McapRead {
-                        file: state.file.clone(),
-                        source,
-                    })?;
-                state.record(record, visitor)?;
-            }
+            LinearReadEvent::Record { opcode, data } => on_record(opcode, data)?,
         }
     }
     Ok(())
@@ -264,7 +304,7 @@ struct Pending {
     channel_id: u16,
     index: usize,
     log_time_ns: u64,
-    value: Value,
+    body: Body,
 }
 
 /// What has been read so far.
@@ -273,6 +313,8 @@ struct State {
     file: String,
     /// Topics whose messages are decoded (`None`: all).
     only: Option<std::collections::BTreeSet<String>>,
+    /// Decode this crate's metric messages typed when their schema is ours ([`Visitor::typed`]).
+    typed: bool,
     schemas: BTreeMap<u16, SchemaRec>,
     channels: BTreeMap<u16, ChannelInfo>,
     decoders: BTreeMap<u16, Decoder>,
@@ -293,6 +335,10 @@ struct State {
     footer: bool,
     /// Bytes handed to the MCAP reader.
     bytes_read: u64,
+    /// Skip the chunks without decoded channels (the summary's channels were read first).
+    skip: bool,
+    /// Chunks not decompressed ([`chunks`]).
+    chunks_skipped: usize,
 }
 
 impl State {
@@ -408,10 +454,11 @@ impl State {
             return Ok(()); // the summary section repeats channels
         }
         let selected = self.only.as_ref().is_none_or(|only| only.contains(&info.topic));
-        let decoder = if selected {
-            decoder_for(&self.file, &info, schema)?
-        } else {
-            Decoder::Skip(NOT_SELECTED.to_string())
+        let known = schema.and_then(|s| known::known_kind(&info.topic, &info.message_encoding, &s.encoding, &s.name, &s.data));
+        let decoder = match known {
+            Some(kind) if selected && self.typed => Decoder::Known(kind),
+            _ if selected => decoder_for(&self.file, &info, schema)?,
+            _ => Decoder::Skip(NOT_SELECTED.to_string()),
         };
         if let Decoder::Skip(why) = &decoder {
             info.undecoded = Some(why.clone());
@@ -427,31 +474,17 @@ impl State {
         data: &[u8],
         visitor: &mut dyn Visitor,
     ) -> Result<(), Error> {
-        let (Some(info), Some(decoder)) = (
-            self.channels.get_mut(&header.channel_id),
-            self.decoders.get(&header.channel_id),
-        ) else {
-            return Err(self.malformed(format!(
-                "message on unknown channel id {}",
-                header.channel_id
-            )));
+        let Some(decoder) = self.decoders.get(&header.channel_id) else {
+            return Err(self.malformed(format!("message on unknown channel id {}", header.channel_id)));
         };
-        let index = info.message_count;
-        if let Some(&previous_ns) = self.last_time.get(&header.channel_id) {
-            if header.log_time < previous_ns {
-                return Err(Error::TimeBackwards {
-                    file: self.file.clone(),
-                    topic: info.topic.clone(),
-                    index,
-                    log_time_ns: header.log_time,
-                    previous_ns,
-                });
-            }
+        let skip = matches!(decoder, Decoder::Skip(_));
+        let index = self.count(header.channel_id, header.log_time)?;
+        let (Some(info), Some(decoder)) = (self.channels.get(&header.channel_id), self.decoders.get(&header.channel_id)) else {
+            return Ok(()); // (known: counted above)
+        };
+        if skip {
+            return Ok(());
         }
-        self.last_time.insert(header.channel_id, header.log_time);
-        self.t_end_ns = Some(self.t_end_ns.map_or(header.log_time, |t| t.max(header.log_time)));
-        info.message_count += 1;
-        self.total += 1;
         let decode_err = |detail: String| Error::Decode {
             file: self.file.clone(),
             topic: info.topic.clone(),
@@ -462,36 +495,61 @@ impl State {
         };
         let value = match decoder {
             Decoder::Skip(_) => return Ok(()),
-            Decoder::Protobuf(desc) => DynamicMessage::decode(desc.clone(), data)
+            Decoder::Known(kind) => Body::Known(known::decode(*kind, data).map_err(decode_err)?),
+            Decoder::Protobuf(desc) => Body::Value(DynamicMessage::decode(desc.clone(), data)
                 .map(|m| message_to_value(&m))
-                .map_err(|e| decode_err(e.to_string()))?,
-            Decoder::Ros2(schema) => crate::cdr::decode(schema, data).map_err(decode_err)?,
-            Decoder::Json => serde_json::from_slice::<serde_json::Value>(data)
+                .map_err(|e| decode_err(e.to_string()))?),
+            Decoder::Ros2(schema) => Body::Value(crate::cdr::decode(schema, data).map_err(decode_err)?),
+            Decoder::Json => Body::Value(serde_json::from_slice::<serde_json::Value>(data)
                 .map(|j| Value::from_json(&j))
-                .map_err(|e| decode_err(e.to_string()))?,
+                .map_err(|e| decode_err(e.to_string()))?),
         };
         if self.first_joint_array_len.is_none() {
-            if let Value::Struct(fields) = &value {
-                let topic = &info.topic;
-                self.first_joint_array_len = fields.iter().find_map(|(field, v)| match (array_index(topic, field), v) {
+            let topic = &info.topic;
+            self.first_joint_array_len = match &value {
+                Body::Known(k) => k.first_joint_array_len(topic),
+                Body::Value(Value::Struct(fields)) => fields.iter().find_map(|(field, v)| match (array_index(topic, field), v) {
                     (Some(ArrayIndex::Joint), Value::List(items)) => Some(items.len()),
                     _ => None,
-                });
-                if self.first_joint_array_len.is_some() && self.run.as_ref().is_some_and(|r| r.joint_names.is_empty()) {
-                    self.update_run(); // format 0 names its joints after this length
-                }
+                }),
+                Body::Value(_) => None,
+            };
+            if self.first_joint_array_len.is_some() && self.run.as_ref().is_some_and(|r| r.joint_names.is_empty()) {
+                self.update_run(); // format 0 names its joints after this length
             }
         }
         let topic = &self.channels[&header.channel_id].topic;
         if topic == crate::topics::ENERGY && self.energy_has_gear_friction.is_none() {
-            self.energy_has_gear_friction = Some(value.get("gear_friction_loss").is_some());
+            self.energy_has_gear_friction = Some(match &value {
+                Body::Value(v) => v.get("gear_friction_loss").is_some(),
+                Body::Known(_) => true, // this crate's schema has the field
+            });
         }
         let channel_id = header.channel_id;
         match &mut self.pending {
-            Some(pending) => pending.push(Pending { channel_id, index, log_time_ns: header.log_time, value }),
-            None => visitor.message(DecodedMessage { file: &self.file, topic, index, log_time_ns: header.log_time, value, run: self.run.as_ref() })?,
+            Some(pending) => pending.push(Pending { channel_id, index, log_time_ns: header.log_time, body: value }),
+            None => visitor.message(DecodedMessage { file: &self.file, topic, index, log_time_ns: header.log_time, body: value, run: self.run.as_ref() })?,
         }
         Ok(())
+    }
+
+    /// Counts a message of the known channel `channel_id` logged at `log_time` (ns), which must
+    /// not be before the channel's previous one; its index in the channel.
+    fn count(&mut self, channel_id: u16, log_time: u64) -> Result<usize, Error> {
+        let Some(info) = self.channels.get_mut(&channel_id) else {
+            return Err(Error::Malformed { file: self.file.clone(), detail: format!("message on unknown channel id {channel_id}") });
+        };
+        let index = info.message_count;
+        if let Some(&previous_ns) = self.last_time.get(&channel_id) {
+            if log_time < previous_ns {
+                return Err(Error::TimeBackwards { file: self.file.clone(), topic: info.topic.clone(), index, log_time_ns: log_time, previous_ns });
+            }
+        }
+        self.last_time.insert(channel_id, log_time);
+        self.t_end_ns = Some(self.t_end_ns.map_or(log_time, |t| t.max(log_time)));
+        info.message_count += 1;
+        self.total += 1;
+        Ok(index)
     }
 
     /// [`State::run`] from the metadata read so far (`None` while it does not read: the typed
@@ -506,6 +564,7 @@ impl State {
             messages: BTreeMap::new(),
             first_joint_array_len: self.first_joint_array_len,
             energy_has_gear_friction: false,
+            chunks_skipped: 0,
         };
         self.run = view.run_opt().ok().flatten();
     }
@@ -515,7 +574,7 @@ impl State {
         let Some(pending) = self.pending.as_mut() else { return Ok(()) };
         for p in pending.drain(..) {
             let topic = &self.channels[&p.channel_id].topic;
-            visitor.message(DecodedMessage { file: &self.file, topic, index: p.index, log_time_ns: p.log_time_ns, value: p.value, run: self.run.as_ref() })?;
+            visitor.message(DecodedMessage { file: &self.file, topic, index: p.index, log_time_ns: p.log_time_ns, body: p.body, run: self.run.as_ref() })?;
         }
         Ok(())
     }
@@ -555,11 +614,18 @@ impl State {
             messages: BTreeMap::new(),
             first_joint_array_len: self.first_joint_array_len,
             energy_has_gear_friction: self.energy_has_gear_friction.unwrap_or(false),
+            chunks_skipped: self.chunks_skipped,
         }
     }
 }
 
 impl Recording {
+    /// How many chunks the reader did not decompress because they hold none of the topics read
+    /// (0 when read for every topic, or from a file without a summary section).
+    pub fn chunks_skipped(&self) -> usize {
+        self.chunks_skipped
+    }
+
     /// The channel of `topic` (the first one, if several share the topic).
     pub fn channel(&self, topic: &str) -> Option<&ChannelInfo> {
         self.channels.iter().find(|c| c.topic == topic)

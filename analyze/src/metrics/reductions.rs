@@ -316,6 +316,12 @@ impl Reductions {
 /// An error of [`Reductions::add`] stops the reader ([`schemas::Error::Stopped`]) and is kept
 /// in [`Reductions::error`], to be returned as it is.
 impl schemas::Visitor for Reductions {
+    /// The metric messages typed when their schema is `schemas`' own (the same numbers, no
+    /// generic tree).
+    fn typed(&self) -> bool {
+        true
+    }
+
     fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), schemas::Error> {
         match self.add(&m) {
             Ok(()) => Ok(()),
@@ -338,7 +344,7 @@ impl Reductions {
         check(m, &mut self.joints, &mut self.n_contacts)?;
         match m.topic {
             topics::HAND => {
-                let h: HandState = m.decode(sizes)?;
+                let h = m.decode_ref::<HandState>(sizes)?;
                 let e = [h.error.x, h.error.y, h.error.z, h.error_norm];
                 let t = Self::sample(&mut self.hand_samples, m)?;
                 for (axis, e) in self.hand.iter_mut().zip(e) {
@@ -346,7 +352,7 @@ impl Reductions {
                 }
             }
             topics::MOTORS => {
-                let motor: MotorState = m.decode(sizes)?;
+                let motor = m.decode_ref::<MotorState>(sizes)?;
                 let t = Self::sample(&mut self.motor_samples, m)?;
                 self.motor_peaks.resize(motor.current.len(), Peak::default());
                 for (p, &i) in self.motor_peaks.iter_mut().zip(&motor.current) {
@@ -354,7 +360,7 @@ impl Reductions {
                 }
             }
             topics::CONSTRAINTS => {
-                let c: ConstraintState = m.decode(sizes)?;
+                let c = m.decode_ref::<ConstraintState>(sizes)?;
                 let t = Self::sample(&mut self.contact_samples, m)?;
                 self.contacts.resize(c.normal_force.len(), Contact::default());
                 for (k, acc) in self.contacts.iter_mut().enumerate() {
@@ -372,13 +378,13 @@ impl Reductions {
                 }
             }
             topics::ENERGY => {
-                let e: EnergyState = m.decode(sizes)?;
+                let e = m.decode_ref::<EnergyState>(sizes)?;
                 let t = Self::sample(&mut self.energy_samples, m)?;
                 self.residual.add(t, e.balance_residual);
                 if self.energy_first.is_none() {
-                    self.energy_first = Some(e.clone());
+                    self.energy_first = Some(e.clone().into_owned());
                 }
-                self.energy_last = Some(e);
+                self.energy_last = Some(e.into_owned());
             }
             _ => {}
         }

@@ -15,6 +15,8 @@ pub(super) struct SchemaRec {
 }
 
 pub(super) enum Decoder {
+    /// One of this crate's metric messages with this crate's schema, decoded typed.
+    Known(super::known::KnownKind),
     Protobuf(MessageDescriptor),
     Ros2(ros2msg::MsgSchema),
     Json,

@@ -164,11 +164,11 @@ fn recover_from<'a>(
     visitor: &mut dyn Visitor,
 ) -> Result<(Recording, RecoverReport), Error> {
     let (mut input, len, label) = open()?;
-    let checked = read_state(&mut input, len, label, Some(&[]), &mut Null);
+    let checked = read_state(&mut input, len, label, Some(&[]), None, &mut Null);
     let (state, report) = match checked {
         Ok(_) => {
             let (mut input, len, label) = open()?;
-            let state = read_state(&mut input, len, label, topics, visitor)?;
+            let state = read_state(&mut input, len, label, topics, None, visitor)?;
             let report = complete_report(&state, len);
             (state, report)
         }
@@ -257,6 +257,7 @@ fn scan(
     normal: &Error,
 ) -> Result<(State, RecoverReport), Error> {
     let mut state = State::new(source.to_string(), topics);
+    state.typed = visitor.typed();
     state.pending = Some(Vec::new());
     // one record at a time: no magic before it, none expected after it
     let options = reader_options()

@@ -148,7 +148,7 @@ impl Recording {
         let run = self.run_opt()?;
         for &topic in topics {
             for (index, (log_time_ns, value)) in self.topic_messages(topic)?.iter().enumerate() {
-                let m = crate::DecodedMessage { file: &self.source, topic, index, log_time_ns: *log_time_ns, value: value.clone(), run: run.as_ref() };
+                let m = crate::DecodedMessage { file: &self.source, topic, index, log_time_ns: *log_time_ns, body: crate::Body::Value(value.clone()), run: run.as_ref() };
                 visitor.message(m)?;
             }
         }

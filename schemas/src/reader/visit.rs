@@ -1,7 +1,13 @@
 //! What a streamed read hands out: each decoded message ([`DecodedMessage`], with the `run`
 //! record read so far) to a [`Visitor`], and its typed reading with the array checks of
 //! [`crate::Recording::read_sized`] ([`decode_typed`], one routine for both).
+//!
+//! A message's [`Body`] is the generic tree ([`Value`]) or, for a visitor that asks for it
+//! ([`Visitor::typed`]) and a channel with this crate's own schema, the struct decoded straight
+//! from the bytes ([`Known`]); every method of [`DecodedMessage`] gives the same answer for
+//! both.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 
 use crate::messages::TopicMessage;
@@ -9,6 +15,17 @@ use crate::meta::RunDescription;
 use crate::topics::{array_index, array_required, ArrayIndex};
 use crate::value::{from_value, Value};
 use crate::{from_log_time, ArraySizes, Error};
+
+pub use super::known::Known;
+
+/// A decoded message's content.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Body {
+    /// The generic tree, decoded through the schema stored in the file.
+    Value(Value),
+    /// One of this crate's metric messages, decoded typed ([`Visitor::typed`]).
+    Known(Known),
+}
 
 /// One decoded message, handed to a [`Visitor`].
 #[derive(Debug, Clone)]
@@ -19,7 +36,7 @@ pub struct DecodedMessage<'a> {
     /// Its index among the messages of its channel (0-based, file order).
     pub index: usize,
     pub log_time_ns: u64,
-    pub value: Value,
+    pub body: Body,
     /// What ran (the `run` record), when the file has given it before this message (`sim`
     /// writes it first): the array sizes and the output grid to check the message against.
     pub run: Option<&'a RunDescription>,
@@ -29,6 +46,10 @@ impl DecodedMessage<'_> {
     /// The first value of the message that is NaN or infinite, with its field path (`error.x`,
     /// `current[2]`), in field order; `None` when every number is finite.
     pub fn non_finite(&self) -> Option<(String, f64)> {
+        let value = match &self.body {
+            Body::Value(v) => v,
+            Body::Known(k) => return k.non_finite(),
+        };
         fn walk(v: &Value, path: &mut String) -> Option<(String, f64)> {
             match v {
                 Value::F64(x) if !x.is_finite() => Some((path.clone(), *x)),
@@ -52,20 +73,31 @@ impl DecodedMessage<'_> {
                 _ => None,
             }
         }
-        walk(&self.value, &mut String::new())
+        walk(value, &mut String::new())
+    }
+
+    /// The message as the generic tree (built from the struct for a [`Body::Known`]).
+    pub fn value(&self) -> Cow<'_, Value> {
+        match &self.body {
+            Body::Value(v) => Cow::Borrowed(v),
+            Body::Known(k) => Cow::Owned(k.to_value()),
+        }
     }
 
     /// The per-joint and per-contact arrays of the message: `(field, kind, length)`, leaving out
     /// an optional array recorded empty ([`crate::topics::array_required`]).
     pub fn arrays(&self) -> impl Iterator<Item = (&str, ArrayIndex, usize)> + '_ {
-        let fields = match &self.value {
-            Value::Struct(fields) => fields.as_slice(),
-            _ => &[],
+        let keep = |field: &str, len: usize| len > 0 || array_required(self.topic, field);
+        let (fields, known) = match &self.body {
+            Body::Value(Value::Struct(fields)) => (fields.as_slice(), None),
+            Body::Value(_) => (&[][..], None),
+            Body::Known(k) => (&[][..], Some(known_arrays(self.topic, k))),
         };
-        fields.iter().filter_map(|(field, v)| match (array_index(self.topic, field), v) {
-            (Some(kind), Value::List(items)) if !items.is_empty() || array_required(self.topic, field) => Some((field.as_str(), kind, items.len())),
+        let generic = fields.iter().filter_map(move |(field, v)| match (array_index(self.topic, field), v) {
+            (Some(kind), Value::List(items)) if keep(field, items.len()) => Some((field.as_str(), kind, items.len())),
             _ => None,
-        })
+        });
+        generic.chain(known.into_iter().flatten().filter(move |&(field, _, len)| keep(field, len)))
     }
 
     /// The per-joint and per-contact array sizes of [`DecodedMessage::run`].
@@ -81,15 +113,82 @@ impl DecodedMessage<'_> {
     /// The message as `M` (by field name); with `sizes`, every per-joint and per-contact array
     /// must have that many entries (see [`Recording::read_sized`]). Errors name the file, the
     /// topic, the message and the field.
-    pub fn decode<M: TopicMessage>(&self, sizes: Option<ArraySizes>) -> Result<M, Error> {
-        decode_typed(self.file, self.topic, self.index, self.log_time_ns, &self.value, sizes)
+    pub fn decode<M: TopicMessage + Clone + 'static>(&self, sizes: Option<ArraySizes>) -> Result<M, Error> {
+        self.decode_ref::<M>(sizes).map(Cow::into_owned)
     }
+
+    /// [`DecodedMessage::decode`], borrowed from a [`Body::Known`] (no copy).
+    pub fn decode_ref<M: TopicMessage + Clone + 'static>(&self, sizes: Option<ArraySizes>) -> Result<Cow<'_, M>, Error> {
+        match &self.body {
+            Body::Value(v) => decode_typed(self.file, self.topic, self.index, self.log_time_ns, v, sizes).map(Cow::Owned),
+            Body::Known(k) => {
+                if let Some(sizes) = sizes {
+                    for (field, kind, len) in known_arrays(self.topic, k) {
+                        check_length(self.file, self.topic, self.index, self.log_time_ns, field, kind, len, sizes)?;
+                    }
+                }
+                let wrong = || Error::Field {
+                    file: self.file.to_string(),
+                    topic: self.topic.into(),
+                    index: self.index,
+                    log_time_ns: self.log_time_ns,
+                    detail: format!("the message is a {}, not a {}", known_name(k), std::any::type_name::<M>()),
+                };
+                k.as_typed::<M>().map(Cow::Borrowed).ok_or_else(wrong)
+            }
+        }
+    }
+}
+
+/// The per-joint and per-contact arrays of a known message on `topic`: `(field, kind, length)`.
+fn known_arrays<'a>(topic: &'a str, k: &Known) -> impl Iterator<Item = (&'a str, ArrayIndex, usize)> + use<'a> {
+    let (lists, n) = k.lists();
+    lists.into_iter().take(n).filter_map(move |(name, len): (&'a str, usize)| array_index(topic, name).map(|kind| (name, kind, len)))
+}
+
+fn known_name(k: &Known) -> &'static str {
+    match k {
+        Known::Hand(_) => "HandState",
+        Known::Motors(_) => "MotorState",
+        Known::Constraints(_) => "ConstraintState",
+        Known::Energy(_) => "EnergyState",
+    }
+}
+
+/// An array of `len` entries of `kind` on `topic` has the length `sizes` requires (an optional
+/// array may be empty).
+#[allow(clippy::too_many_arguments)]
+fn check_length(file: &str, topic: &str, index: usize, log_time_ns: u64, field: &str, kind: ArrayIndex, len: usize, sizes: ArraySizes) -> Result<(), Error> {
+    let (expected, per) = match kind {
+        ArrayIndex::Joint => (sizes.joints, "joint"),
+        ArrayIndex::Contact => (sizes.contacts, "contact"),
+    };
+    if len != expected && (array_required(topic, field) || len != 0) {
+        return Err(Error::WrongLength {
+            file: file.to_string(),
+            topic: topic.into(),
+            field: field.to_string(),
+            index,
+            t_s: from_log_time(log_time_ns),
+            found: len,
+            expected,
+            per,
+        });
+    }
+    Ok(())
 }
 
 /// Receives each decoded message of a [`stream_recording`], per channel in log-time order.
 /// An error stops the reading and is returned.
 pub trait Visitor {
     fn message(&mut self, message: DecodedMessage<'_>) -> Result<(), Error>;
+
+    /// Whether this visitor takes the metric messages typed ([`Body::Known`]) when their schema
+    /// is this crate's own (faster: no generic tree); `false` (the default): always a
+    /// [`Body::Value`].
+    fn typed(&self) -> bool {
+        false
+    }
 }
 
 impl<F: FnMut(DecodedMessage<'_>) -> Result<(), Error>> Visitor for F {
@@ -104,7 +203,11 @@ pub(crate) struct Collect(pub(crate) BTreeMap<String, Vec<(u64, Value)>>);
 
 impl Visitor for Collect {
     fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), Error> {
-        self.0.entry(m.topic.to_string()).or_default().push((m.log_time_ns, m.value));
+        let value = match m.body {
+            Body::Value(v) => v,
+            Body::Known(k) => k.to_value(),
+        };
+        self.0.entry(m.topic.to_string()).or_default().push((m.log_time_ns, value));
         Ok(())
     }
 }
@@ -121,22 +224,7 @@ pub(crate) fn decode_typed<M: TopicMessage>(
     if let (Some(sizes), Value::Struct(fields)) = (sizes, v) {
         for (field, value) in fields {
             let (Some(kind), Value::List(items)) = (array_index(topic, field), value) else { continue };
-            let (expected, per) = match kind {
-                ArrayIndex::Joint => (sizes.joints, "joint"),
-                ArrayIndex::Contact => (sizes.contacts, "contact"),
-            };
-            if items.len() != expected && (array_required(topic, field) || !items.is_empty()) {
-                return Err(Error::WrongLength {
-                    file: file.to_string(),
-                    topic: topic.into(),
-                    field: field.clone(),
-                    index,
-                    t_s: from_log_time(log_time_ns),
-                    found: items.len(),
-                    expected,
-                    per,
-                });
-            }
+            check_length(file, topic, index, log_time_ns, field, kind, items.len(), sizes)?;
         }
     }
     from_value(v).map_err(|e| Error::Field {
