@@ -6,7 +6,8 @@
 //
 // usage: mj_ladder MODEL.xml INTEGRATOR DURATION SAMPLE REPEATS SITE OUT.bin DT [DT ...]
 //   INTEGRATOR: euler | rk4 | implicit | implicitfast
-// stdout: one line per DT, "dt wall_s nsamples steps_per_sample finite(0/1)".
+// stdout: one line per DT, "dt wall_s nsamples steps_per_sample finite(0/1)"; finite is 0 when a
+// sample is not finite or MuJoCo flagged a bad qacc/qvel/qpos (it then resets the state).
 // OUT.bin: for each DT in order, nsamples x 3 float64 (the hand path, samples at 0, SAMPLE, ...).
 #include <math.h>
 #include <stdio.h>
@@ -74,6 +75,8 @@ int main(int argc, char** argv) {
       }
       double wall = now() - t0;
       if (wall < best) best = wall;
+      // on a non-finite or huge state MuJoCo warns and resets the data (and goes on): count it
+      if (d->warning[mjWARN_BADQACC].number || d->warning[mjWARN_BADQVEL].number || d->warning[mjWARN_BADQPOS].number) finite = 0;
       for (long s = 0; s < 3 * nsamples; s++) {
         if (!isfinite(hand[s])) { finite = 0; break; }
       }

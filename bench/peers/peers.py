@@ -257,7 +257,7 @@ def mujoco_ladder(exe: Path, xml_path: Path, dump: dict, reference: np.ndarray, 
                 break
             reps = repeats if predicted < MJ_ONCE_S else 1
             with tempfile.NamedTemporaryFile(suffix=".bin") as f:
-                line = run([str(exe), str(xml_path), integ, repr(duration), repr(sample), str(reps), "hand", f.name, repr(dt)])
+                line = run([str(exe), str(xml_path), integ, repr(duration), repr(sample), str(reps), "hand", f.name, repr(dt)], cwd=xml_path.parent)
                 hand = np.fromfile(f.name, dtype=np.float64).reshape(-1, 3)
             dt_, wall, n, _, finite = line.split()
             if len(hand) != len(reference):
@@ -273,8 +273,8 @@ def mujoco_ladder(exe: Path, xml_path: Path, dump: dict, reference: np.ndarray, 
 
 def project_ladder(sim: Path, scene: Path, run_name: str, repeats: int) -> list[dict]:
     with tempfile.TemporaryDirectory() as out:
-        text = run([str(sim), "precision", str(scene), "--run", run_name, "--repeats", str(repeats), "-o", out, "-f", "json", "-q"])
-    rows = json.loads(text)
+        run([str(sim), "precision", str(scene), "--run", run_name, "--repeats", str(repeats), "-o", out, "-f", "json"])
+        rows = json.loads((Path(out) / "precision.json").read_text())
     if isinstance(rows, dict):  # tolerate a wrapped table
         rows = rows.get("rows", rows)
     res = []
@@ -343,7 +343,7 @@ def best_at(rows: list[dict], level: float) -> tuple[float | None, str | None]:
 # Pinocchio
 
 
-def pinocchio_check(urdf: Path, dump: dict, rhs_exe: Path | None, quick: bool) -> dict:
+def pinocchio_check(urdf: Path, dump: dict, rhs_exe: Path | None, pin_exe: Path | None, pin_input: Path | None, quick: bool) -> dict:
     import pinocchio as pin
 
     model = pin.buildModelFromUrdf(str(urdf))
@@ -429,16 +429,102 @@ def pinocchio_check(urdf: Path, dump: dict, rhs_exe: Path | None, quick: bool) -
         pin.initConstraintDynamics(model, data, cms, cds)
         timings["constraintDynamics_3d_s"] = best_of(lambda: pin.constraintDynamics(model, data, q, v, tau, cms, cds))
     timings["aba_s"] = best_of(lambda: pin.aba(model, data, q, v, tau))
-    if rhs_exe is not None:
-        rounds = []
-        for _ in range(5):
-            out = run([str(rhs_exe), str(200000 if not quick else 20000)])
-            rounds.append(float(out.split()[0]) * 1e-6)
-        timings["project_rhs_two_elbow_s"] = min(rounds)
-        timings["ratio_rhs_vs_forwardDynamics_J"] = timings["project_rhs_two_elbow_s"] / timings["forwardDynamics_J_gamma_s"]
-        if "constraintDynamics_3d_s" in timings:
-            timings["ratio_rhs_vs_constraintDynamics_3d"] = timings["project_rhs_two_elbow_s"] / timings["constraintDynamics_3d_s"]
-    return {"check": worst, "timing": timings}
+    result = {"check": worst, "python_timing": timings}
+    if rhs_exe is None:
+        return result
+    calls = 20000 if quick else 100000
+    # C++ Pinocchio (pin_kernels.cpp) and our RHS (rhs_profile) in interleaved rounds; the
+    # median of the per-round ratios (the machine is shared: rounds see different loads)
+    rounds = []
+    for _ in range(3 if quick else 7):
+        ours = float(run([str(rhs_exe), str(calls)]).split()[0])
+        row = {"project_rhs_two_elbow_us": ours, "python_constraintDynamics_3d_us": None}
+        if pin_exe is not None:
+            for line in run([str(pin_exe), str(pin_input), str(calls)]).splitlines():
+                if line.startswith("#ddq"):
+                    cpp_ddq = np.array([float(x) for x in line.split()[1:]])
+                    continue
+                k, v_ = line.split()
+                row[f"pin_{k}_us"] = float(v_)
+            # the C++ model is the Python one rebuilt joint by joint: same accelerations
+            py_ddq = pin.constraintDynamics(model, data, q, v, tau, cms, cds) if len(cms) else pin.aba(model, data, q, v, tau)
+            worst["cpp_vs_python_ddq_rel"] = max(worst.get("cpp_vs_python_ddq_rel", 0.0), float(np.abs(cpp_ddq - py_ddq).max() / max(1.0, np.abs(py_ddq).max())))
+        rounds.append(row)
+    result["rounds"] = rounds
+    med = lambda xs: float(np.median(xs))
+    result["project_rhs_two_elbow_us"] = med([r["project_rhs_two_elbow_us"] for r in rounds])
+    result["ratio_rhs_vs_python_forwardDynamics_J"] = result["project_rhs_two_elbow_us"] * 1e-6 / timings["forwardDynamics_J_gamma_s"]
+    if pin_exe is not None:
+        for k in [k for k in rounds[0] if k.startswith("pin_")]:
+            result[k] = med([r[k] for r in rounds])
+        if "pin_constraintDynamics_3d_us" in rounds[0]:
+            result["ratio_rhs_vs_cpp_constraintDynamics_3d"] = med([r["project_rhs_two_elbow_us"] / r["pin_constraintDynamics_3d_us"] for r in rounds])
+    return result
+
+
+def pin_kernels_input(urdf: Path, dump: dict, path: Path) -> None:
+    """The model Pinocchio's Python bindings parse from the URDF, joint by joint, for pin_kernels."""
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(str(urdf))
+    lines = []
+    units = {"JointModelRX": (1, 0, 0), "JointModelRY": (0, 1, 0), "JointModelRZ": (0, 0, 1)}
+    for i in range(1, model.njoints):
+        jm = model.joints[i]
+        short = jm.shortname()
+        if short in units:
+            axis = units[short]
+        elif short == "JointModelRevoluteUnaligned":
+            axis = tuple(jm.extract().axis)
+        else:
+            raise PeerError(f"pin_kernels: joint type {short} is not supported")
+        pl, it = model.jointPlacements[i], model.inertias[i]
+        ii = it.inertia
+        vals = [model.parents[i], *axis, *pl.rotation.reshape(-1), *pl.translation, it.mass, *it.lever,
+                ii[0, 0], ii[0, 1], ii[1, 1], ii[0, 2], ii[1, 2], ii[2, 2]]
+        lines.append(f"joint {model.names[i]} " + " ".join(repr(float(x)) if not isinstance(x, int) else str(x) for x in vals))
+    s = dump["dynamics"][0]
+    lines += [f"gravity {fmt(dump['gravity'])}", f"armature {fmt(dump['drives']['jm'])}",
+              f"q {fmt(s['q'])}", f"v {fmt(s['qd'])}", f"tau {fmt(s['tau_drive'])}"]
+    lines += [f"contact {c['joint']}" for c in dump["contacts"]]
+    path.write_text("\n".join(lines) + "\n")
+
+
+CACHE = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "elbow-sim" / "peers-build"
+
+
+def cached_exe(name: str, sources: list[Path], flags: list[str]) -> Path:
+    """Where a helper built from `sources` with `flags` is kept between runs (Pinocchio's C++
+    takes minutes to compile): the name carries a hash of both."""
+    import hashlib
+
+    h = hashlib.sha256("\0".join(flags).encode())
+    for src in sources:
+        h.update(src.read_bytes())
+    CACHE.mkdir(parents=True, exist_ok=True)
+    return CACHE / f"{name}-{h.hexdigest()[:16]}"
+
+
+def build_pin_kernels(cxx: str, work: Path) -> Path | None:
+    """pin_kernels.cpp against the `pin` wheel's headers and libpinocchio_default (Eigen's headers
+    from cmeel-eigen); None, with a note, when they are not there."""
+    import cmeel  # noqa: F401  (the wheels' prefix)
+
+    prefix = Path(sys.prefix) / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / "site-packages" / "cmeel.prefix"
+    if not (prefix / "include/eigen3").exists() or not (prefix / "include/pinocchio").exists():
+        print(f"(no Pinocchio C++ timing: {prefix}/include needs pinocchio and eigen3: pip install cmeel-eigen)")
+        return None
+    exe = cached_exe("pin_kernels", [HERE / "pin_kernels.cpp"], [cxx, str(prefix)])
+    if exe.exists():
+        return exe
+    t0 = time.time()
+    # the compile definitions of Pinocchio's exported CMake targets (lib/cmake/pinocchio)
+    defs = ["-DBOOST_MPL_LIMIT_LIST_SIZE=30", "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30", "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
+            "-DBOOST_FUSION_INVOKE_MAX_ARITY=12", "-DPINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION"]
+    run([cxx, "-O3", "-DNDEBUG", "-std=c++17", *defs, "-o", str(exe), str(HERE / "pin_kernels.cpp"), f"-I{prefix / 'include'}",
+         f"-I{prefix / 'include/eigen3'}", f"-L{prefix / 'lib'}", "-lpinocchio_default", f"-Wl,-rpath,{prefix / 'lib'}"])
+    print(f"(built pin_kernels in {time.time() - t0:.0f} s)")
+    return exe
 
 
 # ---------------------------------------------------------------------------------------------
@@ -460,6 +546,7 @@ def main() -> int:
     ap.add_argument("--no-pinocchio", action="store_true")
     ap.add_argument("--json", type=Path, help="write every row and ratio here")
     ap.add_argument("--cc", default=os.environ.get("CC", "cc"), help="C compiler for mj_ladder.c")
+    ap.add_argument("--cxx", default=os.environ.get("CXX", "c++"), help="C++ compiler for pin_kernels.cpp (Pinocchio's C++ timing)")
     a = ap.parse_args()
     scenes = a.scene or [ROOT / "sim/scenes/peers/mechanical-hold.json", ROOT / "sim/scenes/peers/dcmotor-hold.json"]
     for p, what in [(a.sim, "--sim"), (a.dump, "--dump")]:
@@ -472,7 +559,7 @@ def main() -> int:
     if not libs:
         raise PeerError(f"no libmujoco.so in {mjdir}")
     work = Path(tempfile.mkdtemp(prefix="peers-"))
-    exe = work / "mj_ladder"
+    exe = cached_exe("mj_ladder", [HERE / "mj_ladder.c"], [a.cc, str(libs[0])])
     run([a.cc, "-O2", "-o", str(exe), str(HERE / "mj_ladder.c"), f"-I{mjdir / 'include'}", f"-L{mjdir}", f"-l:{libs[0].name}", f"-Wl,-rpath,{mjdir}", "-lm"])
 
     load = os.getloadavg()
@@ -533,22 +620,31 @@ def main() -> int:
     if not a.no_pinocchio:
         paper = ROOT / "sim/scenes/paper.json"
         dump = json.loads(run([str(a.dump), str(paper), "two-elbow", "--states", "6"]))
-        pc = pinocchio_check((paper.parent / json.loads(paper.read_text())["urdf"]).resolve(), dump, a.rhs if a.rhs.exists() else None, a.quick)
+        urdf = (paper.parent / json.loads(paper.read_text())["urdf"]).resolve()
+        pin_exe, pin_input = build_pin_kernels(a.cxx, work), work / "pin_input.txt"
+        if pin_exe is not None:
+            pin_kernels_input(urdf, dump, pin_input)
+        pc = pinocchio_check(urdf, dump, a.rhs if a.rhs.exists() else None, pin_exe, pin_input, a.quick)
         import pinocchio as pin
 
         report["pinocchio"] = pc | {"version": pin.__version__}
-        c, t = pc["check"], pc["timing"]
+        c, t = pc["check"], pc["python_timing"]
         print(f"\n## Pinocchio {pin.__version__}: the paper scene, two-elbow run")
         print(f"cross-check at {len(dump['dynamics'])} states: hand {c['hand_m']:.1e} m, M + J_m {c['mass_matrix_rel']:.1e} rel, "
               f"constrained q̈ {c['qdd_rel']:.1e} rel, normal forces {c['normal_force_rel']:.1e} rel")
-        print("| kernel | time per call |")
-        print("|---|---|")
+        print("\n| kernel | time per call | ours / it |")
+        print("|---|---|---|")
+        ours = pc.get("project_rhs_two_elbow_us")
+        if ours is not None:
+            print(f"| ours: the two-elbow right-hand side (rhs_profile: motors, IK, PD, eq 21) | {ours:.2f} µs | 1 |")
+        for k, v in pc.items():
+            if k.startswith("pin_"):
+                r = "" if ours is None else f"{ours / v:.2f}"
+                if k == "pin_constraintDynamics_3d_us" and "ratio_rhs_vs_cpp_constraintDynamics_3d" in pc:
+                    r = f"{pc['ratio_rhs_vs_cpp_constraintDynamics_3d']:.2f} (median of per-round ratios)"
+                print(f"| Pinocchio C++ {k[4:-3]} | {v:.2f} µs | {r} |")
         for k, v in t.items():
-            if k.endswith("_s"):
-                print(f"| {k[:-2]} | {v * 1e6:.2f} µs |")
-        for k, v in t.items():
-            if k.startswith("ratio"):
-                print(f"{k}: {v:.2f} (Pinocchio through Python: its time is an upper bound, so ours/its is a lower bound)")
+            print(f"| Pinocchio via Python {k[:-2]} (upper bound) | {v * 1e6:.2f} µs | {'' if ours is None else f'{ours * 1e-6 / v:.2f}'} |")
         tol = 1e-9
         if max(c.values()) > tol:
             raise PeerError(f"Pinocchio disagrees with the project beyond {tol:g}: {c}")

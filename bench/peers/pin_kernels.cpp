@@ -3,10 +3,14 @@
 // with point contacts (constraintDynamics, CONTACT_3D at each contact joint's origin, frames
 // LOCAL_WORLD_ALIGNED) at one state, in C++ (no Python in the loop).
 //
-// usage: pin_kernels URDF INPUT N
-//   INPUT: lines "gravity gx gy gz", "armature a_1 .. a_nv", "q ..", "v ..", "tau ..",
-//          and one "contact JOINT_NAME" per contact.
-// stdout: one line per kernel, "name microseconds_per_call" (best of 5 batches of N calls).
+// usage: pin_kernels INPUT N
+//   INPUT (written by peers.py from the model Pinocchio's Python bindings parsed from the URDF;
+//   the wheel ships no urdfdom headers, so the model is rebuilt here joint by joint): lines
+//   "joint NAME PARENT_ID AX AY AZ R11 R12 .. R33 PX PY PZ MASS CX CY CZ IXX IXY IYY IXZ IYZ IZZ",
+//   then "gravity gx gy gz", "armature a_1 .. a_nv", "q ..", "v ..", "tau ..", and one
+//   "contact JOINT_NAME" per contact.
+// stdout: one line per kernel, "name microseconds_per_call" (best of 5 batches of N calls), then
+// "#ddq ..": the accelerations of the last call (constraintDynamics, or ABA without contacts).
 #include <chrono>
 #include <fstream>
 #include <iostream>
@@ -18,7 +22,7 @@
 #include "pinocchio/algorithm/constrained-dynamics.hpp"
 #include "pinocchio/algorithm/crba.hpp"
 #include "pinocchio/algorithm/rnea.hpp"
-#include "pinocchio/parsers/urdf.hpp"
+#include "pinocchio/multibody.hpp"
 
 using namespace pinocchio;
 
@@ -34,25 +38,48 @@ template<class F> double best_us(int n, F f) {
 }
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::cerr << "usage: pin_kernels URDF INPUT N\n";
+  if (argc != 3) {
+    std::cerr << "usage: pin_kernels INPUT N\n";
     return 2;
   }
   Model model;
-  pinocchio::urdf::buildModel(argv[1], model);
-  std::ifstream in(argv[2]);
+  std::ifstream in(argv[1]);
   if (!in) {
-    std::cerr << "pin_kernels: cannot read " << argv[2] << "\n";
+    std::cerr << "pin_kernels: cannot read " << argv[1] << "\n";
     return 2;
   }
-  int n = std::atoi(argv[3]);
+  int n = std::atoi(argv[2]);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  for (auto& line : lines) {
+    std::istringstream s(line);
+    std::string key, name;
+    s >> key;
+    if (key != "joint") continue;
+    JointIndex parent;
+    Eigen::Vector3d axis, p, c;
+    Eigen::Matrix3d r;
+    double mass, ixx, ixy, iyy, ixz, iyz, izz;
+    s >> name >> parent >> axis[0] >> axis[1] >> axis[2];
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) s >> r(i, j);
+    s >> p[0] >> p[1] >> p[2] >> mass >> c[0] >> c[1] >> c[2] >> ixx >> ixy >> iyy >> ixz >> iyz >> izz;
+    SE3 placement(r, p);
+    JointIndex id;
+    // the specialised joints for unit axes, as Pinocchio's URDF parser chooses them
+    if (axis == Eigen::Vector3d::UnitX()) id = model.addJoint(parent, JointModelRX(), placement, name);
+    else if (axis == Eigen::Vector3d::UnitY()) id = model.addJoint(parent, JointModelRY(), placement, name);
+    else if (axis == Eigen::Vector3d::UnitZ()) id = model.addJoint(parent, JointModelRZ(), placement, name);
+    else id = model.addJoint(parent, JointModelRevoluteUnaligned(axis), placement, name);
+    Symmetric3 inertia(ixx, ixy, iyy, ixz, iyz, izz);
+    model.appendBodyToJoint(id, Inertia(mass, c, inertia), SE3::Identity());
+  }
   Eigen::VectorXd q(model.nq), v(model.nv), tau(model.nv);
   std::vector<std::string> contacts;
-  std::string line;
   auto read_vec = [](std::istringstream& s, Eigen::VectorXd& x) {
     for (Eigen::Index i = 0; i < x.size(); i++) s >> x[i];
   };
-  while (std::getline(in, line)) {
+  for (auto& line : lines) {
     std::istringstream s(line);
     std::string key;
     s >> key;
@@ -93,5 +120,12 @@ int main(int argc, char** argv) {
     initConstraintDynamics(model, data, cms, cds);
     std::cout << "constraintDynamics_3d " << best_us(n, [&] { constraintDynamics(model, data, q, v, tau, cms, cds); }) << "\n";
   }
+  // the result, for peers.py to check this model against the Python bindings' (not a timing)
+  if (!cms.empty()) constraintDynamics(model, data, q, v, tau, cms, cds);
+  else aba(model, data, q, v, tau);
+  std::cout.precision(17);
+  std::cout << "#ddq";
+  for (Eigen::Index i = 0; i < model.nv; i++) std::cout << " " << data.ddq[i];
+  std::cout << "\n";
   return 0;
 }
