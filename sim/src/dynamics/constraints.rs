@@ -48,7 +48,7 @@ pub fn constraint_jacobian(
     jdqd: &mut DVector<f64>,
 ) {
     assert_eq!(jac.shape(), (contacts.len(), model.nv), "jac: expected nc x nv");
-    jac.fill(0.0);
+    jac.as_mut_slice().fill(0.0);
     for (k, c) in contacts.iter().enumerate() {
         c.point.jacobian_along(model, data, &c.normal_world, &mut jac.row_mut(k));
         jdqd[k] = c.bias(data);
@@ -72,7 +72,7 @@ pub fn constraint_rows(
     let nc = contacts.len();
     assert_eq!(jac.shape(), (nc, model.nv), "jac: expected nc x nv");
     assert!(jdqd.len() == nc && c.len() == nc && cd.len() == nc, "jdqd, c, cd: expected nc");
-    jac.fill(0.0);
+    jac.as_mut_slice().fill(0.0);
     for (k, contact) in contacts.iter().enumerate() {
         let n = &contact.normal_world;
         let p = contact.point.position(data);

@@ -23,7 +23,7 @@ use nalgebra::{Cholesky, DMatrix, DVector, LU};
 
 use super::cholesky;
 use super::constraints::{constraint_rows, PointOnPlane};
-use super::crba::crba_placed;
+use super::crba::crba_world;
 use super::data::Data;
 use super::kinematics::{forward_kinematics, forward_velocities};
 use super::model::Model;
@@ -85,8 +85,10 @@ pub struct ForwardData {
     /// Constraint positions `C` (nc), m, and velocities `Ċ` (nc), m/s.
     pub c: DVector<f64>,
     pub cd: DVector<f64>,
-    /// `Z = L⁻¹ J_cᵀ` (nv x nc), L the Cholesky factor of `M_J` (`Schur` only).
+    /// `[u | Z] = L⁻¹ [b | J_cᵀ]` (nv x (1 + nc)), L the Cholesky factor of `M_J` (`Schur` only).
     pub y: DMatrix<f64>,
+    /// `1 / L_jj` (nv), the factor's reciprocal diagonal (`Schur` only).
+    pub l_inv_diag: Vec<f64>,
     /// Schur complement `J_c M_J^{-1} J_c^T` (nc x nc).
     pub a: DMatrix<f64>,
     /// Its Cholesky factor (nc x nc).
@@ -114,7 +116,8 @@ impl ForwardData {
             jdqd: DVector::zeros(nc),
             c: DVector::zeros(nc),
             cd: DVector::zeros(nc),
-            y: DMatrix::zeros(nv, nc),
+            y: DMatrix::zeros(nv, 1 + nc),
+            l_inv_diag: vec![0.0; nv],
             a: DMatrix::zeros(nc, nc),
             a_factor: DMatrix::zeros(nc, nc),
             regularized: false,
@@ -170,7 +173,8 @@ pub fn forward_dynamics(
     }
     // M_J = M + J_m
     match plant.mass_matrix {
-        MassMatrixMethod::Crba => crba_placed(model, data),
+        // in world coordinates, from the world placements just computed (crba.rs)
+        MassMatrixMethod::Crba => crba_world(model, data),
         MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
     };
     fd.m_j.copy_from(&data.m);
@@ -211,20 +215,21 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
     let nv = plant.model.nv;
     let nc = plant.contacts.len();
     // M_J = L Lᵀ in place (cholesky.rs)
-    if !cholesky::factor_in_place(fd.m_j.as_mut_slice(), nv) {
+    if !cholesky::factor_in_place(fd.m_j.as_mut_slice(), nv, &mut fd.l_inv_diag) {
         return Err(DynamicsError::SingularMassMatrix { t });
     }
-    let l = fd.m_j.as_slice();
-    // u = L⁻¹ b, in q̈
-    fd.qdd.copy_from(&fd.b);
-    cholesky::solve_lower(l, nv, fd.qdd.as_mut_slice());
-    if nc > 0 {
-        // Z = L⁻¹ J_cᵀ (nv x nc), so that A = J_c M_J⁻¹ J_cᵀ = Zᵀ Z and J_c q̈_free = Zᵀ u
-        fd.y.tr_copy_from(&fd.jac);
-        for z in fd.y.as_mut_slice().chunks_exact_mut(nv) {
-            cholesky::solve_lower(l, nv, z);
+    let (l, inv) = (fd.m_j.as_slice(), &fd.l_inv_diag[..]);
+    // [u | Z] = L⁻¹ [b | J_cᵀ]: A = J_c M_J⁻¹ J_cᵀ = Zᵀ Z and J_c M_J⁻¹ b = Zᵀ u
+    fd.y.column_mut(0).copy_from(&fd.b);
+    for k in 0..nc {
+        for j in 0..nv {
+            fd.y[(j, 1 + k)] = fd.jac[(k, j)];
         }
-        let (z, u) = (fd.y.as_slice(), fd.qdd.as_slice());
+    }
+    cholesky::solve_lower(l, inv, nv, fd.y.as_mut_slice());
+    let (u, z) = fd.y.as_slice().split_at(nv);
+    fd.qdd.as_mut_slice().copy_from_slice(u);
+    if nc > 0 {
         for a in 0..nc {
             let z_a = &z[a * nv..(a + 1) * nv];
             for b in 0..=a {
@@ -251,7 +256,7 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
         }
         // L⁻¹ (b + J_cᵀ f_n) = u + Z f_n
         let qdd = fd.qdd.as_mut_slice();
-        for (k, z_k) in fd.y.as_slice().chunks_exact(nv).enumerate() {
+        for (k, z_k) in z.chunks_exact(nv).enumerate() {
             let f = fd.f_n[k];
             for (x, z) in qdd.iter_mut().zip(z_k) {
                 *x += z * f;
@@ -259,7 +264,7 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
         }
     }
     // q̈ = L⁻ᵀ L⁻¹ (b + J_cᵀ f_n) = M_J⁻¹ (b + J_cᵀ f_n)
-    cholesky::solve_upper_transposed(fd.m_j.as_slice(), nv, fd.qdd.as_mut_slice());
+    cholesky::solve_upper_transposed(fd.m_j.as_slice(), &fd.l_inv_diag, nv, fd.qdd.as_mut_slice());
     Ok(())
 }
 
@@ -275,7 +280,7 @@ fn solve_kkt(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynamics
     let nv = plant.model.nv;
     let nc = plant.contacts.len();
     let n = nv + nc;
-    fd.kkt.fill(0.0);
+    fd.kkt.as_mut_slice().fill(0.0);
     fd.kkt.view_mut((0, 0), (nv, nv)).copy_from(&fd.m_j);
     for k in 0..nc {
         for j in 0..nv {
