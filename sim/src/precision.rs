@@ -5,7 +5,8 @@
 //! Hairer & Wanner, *Solving ODEs II*, §IV.10.
 //!
 //! All runs share the output grid, so errors are compared sample by sample; wall time is the
-//! best of `repeats` runs without recording (the simulation itself).
+//! best of `repeats` runs without recording (the simulation itself, with the per-sample
+//! outputs at [`OutputLevel::Kinematic`]: the hand, the quadratures and C, as the errors need).
 //!
 //! A run that finished but left the physics is marked `diverged` ([`Row::status`], with the
 //! reason): a non-finite hand or energy, a max hand error above the reach of the reference
@@ -22,6 +23,7 @@ use serde::Serialize;
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
 use crate::dynamics::motor::Electrical;
 use crate::error::{RunError, SceneError};
+use crate::ode::OutputLevel;
 use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, PerJoint, SceneSpec};
 use crate::scene::{Run, Scene};
 
@@ -68,7 +70,8 @@ pub struct Reference {
 fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Stats, f64), RunError> {
     let mut r = Reference { hand: Vec::new(), energies: Vec::new() };
     let mut drift = 0.0f64;
-    let rep = crate::run::simulate(scene, run, |o| {
+    // the hand, the quadratures and C need forward kinematics only, not a right-hand side
+    let rep = crate::run::simulate_outputs(scene, run, Default::default(), OutputLevel::Kinematic, |o| {
         r.hand.push(o.hand);
         let mut e = o.link_work.clone();
         e.extend_from_slice(&o.electric_energy);
@@ -137,7 +140,7 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
     // timing: the simulation alone, best of `repeats`
     for _ in 0..repeats.max(1) {
         let t0 = Instant::now();
-        match crate::run::simulate(s, run, |_| Ok(())) {
+        match crate::run::simulate_outputs(s, run, Default::default(), OutputLevel::Kinematic, |_| Ok(())) {
             Ok(rep) => {
                 row.wall_s = row.wall_s.min(t0.elapsed().as_secs_f64());
                 row.rhs_evals = rep.stats.rhs_evals;

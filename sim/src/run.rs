@@ -8,7 +8,7 @@ use crate::error::RunError;
 use crate::limits::DEFAULT_MAX_WALL_TIME;
 use crate::integrate::{IntegrateError, Stats};
 use crate::scene::{Run, Scene};
-use crate::ode::{ArmSystem, Outputs};
+use crate::ode::{ArmSystem, OutputLevel, Outputs};
 
 /// What a run reports besides its samples.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -80,6 +80,21 @@ pub fn simulate_within(
     scene: &Scene,
     run: &Run,
     budget: Budget,
+    sink: impl FnMut(&Outputs) -> Result<(), RunError>,
+) -> Result<RunReport, RunError> {
+    simulate_outputs(scene, run, budget, OutputLevel::Full, sink)
+}
+
+/// [`simulate_within`] with the samples' outputs evaluated at `level` only: a consumer that
+/// reads the hand, the quadratures and the drift (`sim precision`) passes
+/// [`OutputLevel::Kinematic`] and pays forward kinematics per sample instead of a right-hand
+/// side (`ode/outputs.rs` says which quantity needs what).
+#[allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `simulate`
+pub fn simulate_outputs(
+    scene: &Scene,
+    run: &Run,
+    budget: Budget,
+    level: OutputLevel,
     mut sink: impl FnMut(&Outputs) -> Result<(), RunError>,
 ) -> Result<RunReport, RunError> {
     let deadline = Instant::now()
@@ -96,7 +111,7 @@ pub fn simulate_within(
     // a second system evaluates the outputs, so the stepper's system keeps its scratch
     let mut probe = ArmSystem::new(scene, run);
     let mut on_sample = |t: f64, y: &[f64]| -> Result<(), RunError> {
-        probe.outputs(t, y, &mut out)?;
+        probe.outputs_at(level, t, y, &mut out)?;
         samples += 1;
         sink(&out)
     };

@@ -48,9 +48,49 @@ pub fn constraint_jacobian(
     jdqd: &mut DVector<f64>,
 ) {
     assert_eq!(jac.shape(), (contacts.len(), model.nv), "jac: expected nc x nv");
-    jac.fill(0.0);
+    jac.as_mut_slice().fill(0.0);
     for (k, c) in contacts.iter().enumerate() {
         c.point.jacobian_along(model, data, &c.normal_world, &mut jac.row_mut(k));
         jdqd[k] = c.bias(data);
+    }
+}
+
+/// [`constraint_jacobian`] plus the constraint positions `C` and velocities `Ċ` (nc each), with
+/// each contact point's world position computed once for its four quantities (the formulas of
+/// `PointOnPlane::{position, velocity, bias}` and `BodyPoint::jacobian_along`, in the same
+/// order of operations, so the values are the same to the last bit). Needs
+/// `forward_kinematics` and `forward_velocities` at the current state.
+pub fn constraint_rows(
+    model: &Model,
+    data: &Data,
+    contacts: &[PointOnPlane],
+    jac: &mut DMatrix<f64>,
+    jdqd: &mut DVector<f64>,
+    c: &mut DVector<f64>,
+    cd: &mut DVector<f64>,
+) {
+    let nc = contacts.len();
+    assert_eq!(jac.shape(), (nc, model.nv), "jac: expected nc x nv");
+    assert!(jdqd.len() == nc && c.len() == nc && cd.len() == nc, "jdqd, c, cd: expected nc");
+    jac.as_mut_slice().fill(0.0);
+    for (k, contact) in contacts.iter().enumerate() {
+        let n = &contact.normal_world;
+        let p = contact.point.position(data);
+        c[k] = n.dot(&p) - contact.offset;
+        let Some(b) = contact.point.body else {
+            cd[k] = n.dot(&Vector3::zeros());
+            jdqd[k] = n.dot(&Vector3::zeros());
+            continue;
+        };
+        let r = p - data.x_world_body[b].translation.vector;
+        let w = data.w_world[b];
+        cd[k] = n.dot(&(data.v_world[b] + w.cross(&r)));
+        jdqd[k] = n.dot(&(data.a_bias_world[b] + data.alpha_bias_world[b].cross(&r) + w.cross(&w.cross(&r))));
+        let mut cur = Some(b);
+        while let Some(j) = cur {
+            let z = data.x_world_body[j].rotation * model.bodies[j].axis.into_inner();
+            jac[(k, j)] = n.dot(&z.cross(&(p - data.x_world_body[j].translation.vector)));
+            cur = model.bodies[j].parent;
+        }
     }
 }

@@ -24,8 +24,11 @@ pub struct Data {
     pub f_body: Vec<Force>,
     /// Joint torques of inverse dynamics (nv), N m; `rnea::rnea`.
     pub tau: DVector<f64>,
-    /// Composite inertias (nv); `crba::crba`.
+    /// Composite inertias (nv): in body coordinates after `crba::crba`, in world coordinates
+    /// about the world origin after `crba::crba_world`.
     pub ic: Vec<Inertia>,
+    /// Joint motion subspaces `(z, o × z)` in world coordinates (nv); `crba::crba_world`.
+    pub s_world: Vec<Motion>,
     /// Joint-space inertia M(q) (nv x nv), both triangles filled; `crba::crba` or `walker_orin::mass_matrix`.
     pub m: DMatrix<f64>,
     /// World-frame angular velocity of body i, rad/s; `kinematics::forward_velocities`.
@@ -56,6 +59,7 @@ impl Data {
             f_body: vec![Force::ZERO; nv],
             tau: DVector::zeros(nv),
             ic: vec![Inertia::zero(); nv],
+            s_world: vec![Motion::ZERO; nv],
             m: DMatrix::zeros(nv, nv),
             w_world: vec![Vector3::zeros(); nv],
             v_world: vec![Vector3::zeros(); nv],

@@ -7,9 +7,13 @@
 //! ```
 //!
 //! Two equivalent solutions are offered ([`ConstraintSolver`]):
-//! - `Schur` (default): Cholesky of `M_J = M + J_m`, then the Schur complement
+//! - `Schur` (default): Cholesky of `M_J = M + J_m = L Lᵀ`, then the Schur complement
 //!   `A = J_c M_J^{-1} J_c^T` (nc x nc, Cholesky), `f_n = A^{-1}(−J̇_c q̇ − J_c M_J^{-1} b)`,
-//!   `q̈ = M_J^{-1}(b + J_c^T f_n)` (Featherstone, RBDA §8.1, eq 8.9–8.10).
+//!   `q̈ = M_J^{-1}(b + J_c^T f_n)` (Featherstone, RBDA §8.1, eq 8.9–8.10). With `Z = L⁻¹ J_cᵀ`
+//!   and `u = L⁻¹ b`: `A = Zᵀ Z` (symmetric by construction), `J_c M_J⁻¹ b = Zᵀ u` and
+//!   `q̈ = L⁻ᵀ (u + Z f_n)`: one forward substitution with 1 + nc columns and one back
+//!   substitution (eqs 8.9–8.10 with `M_J⁻¹ = L⁻ᵀ L⁻¹` substituted; the solves of
+//!   `dynamics/cholesky.rs`).
 //! - `Kkt`: LU of the whole (nv + nc) block system, as the paper does.
 //!
 //! The electrical rows are diagonal and solved directly. The mass matrix comes from the
@@ -17,8 +21,9 @@
 
 use nalgebra::{Cholesky, DMatrix, DVector, LU};
 
-use super::constraints::{constraint_jacobian, PointOnPlane};
-use super::crba::crba_placed;
+use super::cholesky;
+use super::constraints::{constraint_rows, PointOnPlane};
+use super::crba::crba_world;
 use super::data::Data;
 use super::kinematics::{forward_kinematics, forward_velocities};
 use super::model::Model;
@@ -67,7 +72,7 @@ pub enum ConstraintSolver {
 /// Scratch and outputs of [`forward_dynamics`], sized once for (nv, nc).
 #[derive(Clone, Debug)]
 pub struct ForwardData {
-    /// `M + J_m`, then its Cholesky factor (nv x nv).
+    /// `M + J_m`, then its Cholesky factor L in the lower triangle (nv x nv; `Schur` only).
     pub m_j: DMatrix<f64>,
     /// Generalised force `b = K_m i − h − G − (D + D_m) q̇` (nv), N m.
     pub b: DVector<f64>,
@@ -80,8 +85,10 @@ pub struct ForwardData {
     /// Constraint positions `C` (nc), m, and velocities `Ċ` (nc), m/s.
     pub c: DVector<f64>,
     pub cd: DVector<f64>,
-    /// `M_J^{-1} J_c^T` (nv x nc).
+    /// `[u | Z] = L⁻¹ [b | J_cᵀ]` (nv x (1 + nc)), L the Cholesky factor of `M_J` (`Schur` only).
     pub y: DMatrix<f64>,
+    /// `1 / L_jj` (nv), the factor's reciprocal diagonal (`Schur` only).
+    pub l_inv_diag: Vec<f64>,
     /// Schur complement `J_c M_J^{-1} J_c^T` (nc x nc).
     pub a: DMatrix<f64>,
     /// Its Cholesky factor (nc x nc).
@@ -109,7 +116,8 @@ impl ForwardData {
             jdqd: DVector::zeros(nc),
             c: DVector::zeros(nc),
             cd: DVector::zeros(nc),
-            y: DMatrix::zeros(nv, nc),
+            y: DMatrix::zeros(nv, 1 + nc),
+            l_inv_diag: vec![0.0; nv],
             a: DMatrix::zeros(nc, nc),
             a_factor: DMatrix::zeros(nc, nc),
             regularized: false,
@@ -135,7 +143,8 @@ pub struct Plant<'a> {
 
 /// Solve eq 21 at time `t` (used only in error messages) for the state `q` (rad), `qd`
 /// (rad/s), `current` (A) and the motor voltages `voltage` (V), all of length nv.
-/// Outputs in `fd`: `qdd`, `f_n`, `di`, `tau_motor`; `data` holds the kinematics at `q`.
+/// Outputs in `fd`: `qdd`, `f_n`, `di`, `tau_motor`; `data` holds the placements at `q` and,
+/// with contacts, the world velocities and bias accelerations at (`q`, `qd`) (the outputs read them).
 pub fn forward_dynamics(
     plant: &Plant,
     data: &mut Data,
@@ -164,7 +173,8 @@ pub fn forward_dynamics(
     }
     // M_J = M + J_m
     match plant.mass_matrix {
-        MassMatrixMethod::Crba => crba_placed(model, data),
+        // in world coordinates, from the world placements just computed (crba.rs)
+        MassMatrixMethod::Crba => crba_world(model, data),
         MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
     };
     fd.m_j.copy_from(&data.m);
@@ -174,11 +184,7 @@ pub fn forward_dynamics(
     // constraint rows
     if nc > 0 {
         forward_velocities(model, data, qd);
-        constraint_jacobian(model, data, plant.contacts, &mut fd.jac, &mut fd.jdqd);
-        for (k, c) in plant.contacts.iter().enumerate() {
-            fd.c[k] = c.position(data);
-            fd.cd[k] = c.velocity(data);
-        }
+        constraint_rows(model, data, plant.contacts, &mut fd.jac, &mut fd.jdqd, &mut fd.c, &mut fd.cd);
         // Baumgarte: the right-hand side −J̇q̇ becomes −J̇q̇ − 2αĊ − β²C
         if let Stabilization::Baumgarte { alpha, beta } = plant.stabilization {
             for k in 0..nc {
@@ -208,19 +214,34 @@ fn contact_names(plant: &Plant) -> String {
 fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), DynamicsError> {
     let nv = plant.model.nv;
     let nc = plant.contacts.len();
-    // factor M_J in place: the storage moves into the factor and back, no allocation
-    let m_j = std::mem::replace(&mut fd.m_j, DMatrix::zeros(0, 0));
-    let Some(chol) = Cholesky::new(m_j) else {
-        fd.m_j = DMatrix::zeros(nv, nv);
+    // M_J = L Lᵀ in place (cholesky.rs)
+    if !cholesky::factor_in_place(fd.m_j.as_mut_slice(), nv, &mut fd.l_inv_diag) {
         return Err(DynamicsError::SingularMassMatrix { t });
-    };
-    fd.qdd.copy_from(&fd.b);
-    chol.solve_mut(&mut fd.qdd);
+    }
+    let (l, inv) = (fd.m_j.as_slice(), &fd.l_inv_diag[..]);
+    // [u | Z] = L⁻¹ [b | J_cᵀ]: A = J_c M_J⁻¹ J_cᵀ = Zᵀ Z and J_c M_J⁻¹ b = Zᵀ u
+    fd.y.column_mut(0).copy_from(&fd.b);
+    for k in 0..nc {
+        for j in 0..nv {
+            fd.y[(j, 1 + k)] = fd.jac[(k, j)];
+        }
+    }
+    cholesky::solve_lower(l, inv, nv, fd.y.as_mut_slice());
+    let (u, z) = fd.y.as_slice().split_at(nv);
+    fd.qdd.as_mut_slice().copy_from_slice(u);
     if nc > 0 {
-        schur_complement(&chol, &fd.jac, &mut fd.y, &mut fd.a);
-        // f_n = A^{-1} (−J̇q̇ − J q̈_free)
-        fd.f_n.copy_from(&fd.jdqd);
-        fd.f_n.gemv(-1.0, &fd.jac, &fd.qdd, -1.0);
+        for a in 0..nc {
+            let z_a = &z[a * nv..(a + 1) * nv];
+            for b in 0..=a {
+                let z_b = &z[b * nv..(b + 1) * nv];
+                let dot: f64 = z_a.iter().zip(z_b).map(|(x, y)| x * y).sum();
+                fd.a[(a, b)] = dot;
+                fd.a[(b, a)] = dot;
+            }
+            // f_n = A⁻¹ (−J̇q̇ − J q̈_free)
+            let ju: f64 = z_a.iter().zip(u).map(|(x, y)| x * y).sum();
+            fd.f_n[a] = -fd.jdqd[a] - ju;
+        }
         // a redundant set (the same point twice, a rank-deficient J_c) has a singular A:
         // regularised so that q̈ stays unique up to O(ε) (spd.rs)
         let solved = match solve_regularized(&fd.a, &mut fd.a_factor, &mut fd.f_n) {
@@ -231,12 +252,19 @@ fn solve_schur(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynami
             None => false,
         };
         if !solved || fd.f_n.iter().any(|x| !x.is_finite()) {
-            fd.m_j = chol.unpack_dirty();
             return Err(DynamicsError::SingularConstraints { t, constraints: contact_names(plant) });
         }
-        fd.qdd.gemv(1.0, &fd.y, &fd.f_n, 1.0);
+        // L⁻¹ (b + J_cᵀ f_n) = u + Z f_n
+        let qdd = fd.qdd.as_mut_slice();
+        for (k, z_k) in z.chunks_exact(nv).enumerate() {
+            let f = fd.f_n[k];
+            for (x, z) in qdd.iter_mut().zip(z_k) {
+                *x += z * f;
+            }
+        }
     }
-    fd.m_j = chol.unpack_dirty();
+    // q̈ = L⁻ᵀ L⁻¹ (b + J_cᵀ f_n) = M_J⁻¹ (b + J_cᵀ f_n)
+    cholesky::solve_upper_transposed(fd.m_j.as_slice(), &fd.l_inv_diag, nv, fd.qdd.as_mut_slice());
     Ok(())
 }
 
@@ -252,7 +280,7 @@ fn solve_kkt(plant: &Plant, fd: &mut ForwardData, t: f64) -> Result<(), Dynamics
     let nv = plant.model.nv;
     let nc = plant.contacts.len();
     let n = nv + nc;
-    fd.kkt.fill(0.0);
+    fd.kkt.as_mut_slice().fill(0.0);
     fd.kkt.view_mut((0, 0), (nv, nv)).copy_from(&fd.m_j);
     for k in 0..nc {
         for j in 0..nv {

@@ -1,6 +1,7 @@
 //! Rigid-body dynamics of motor-driven arms: the read-only [`Model`], the scratch [`Data`],
 //! and one algorithm per file.
 
+pub mod cholesky;
 pub mod constraints;
 pub mod crba;
 pub mod data;

@@ -30,4 +30,4 @@ mod workspace;
 
 pub use arm::ArmSystem;
 pub use layout::Layout;
-pub use outputs::Outputs;
+pub use outputs::{OutputLevel, Outputs};

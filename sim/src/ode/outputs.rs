@@ -1,10 +1,29 @@
-//! [`Outputs`]: everything recorded at one output time, computed from (t, y) by the same
-//! evaluation as the right-hand side.
+//! [`Outputs`]: everything recorded at one output time, computed from (t, y), at one of two
+//! [`OutputLevel`]s so that a consumer pays per sample only for what it reads.
+//!
+//! What each quantity needs (n = nv joints):
+//!
+//! | quantity | needs |
+//! |---|---|
+//! | t, q, q̇, W_j, E_j, E_R, E_D + E_Dm, i (inductive motors) | the state y alone |
+//! | back EMF `K_m q̇` | the state |
+//! | hand position, constraint positions C, potential energy V | forward kinematics at q (placements) |
+//! | constraint velocities Ċ | forward kinematics and velocities at (q, q̇) |
+//! | desired hand position | the circle at t |
+//! | voltages, electric power `i v`, i (quasi-static motors), ½ L i² then | the IK targets and the PD law (eqs 27–29) |
+//! | q̈, f_n, τ_motor (eq 12, has `J_m q̈`), T (`½ q̇ᵀ M q̇`), balance residual | the full right-hand side (eq 21's solve) |
+//!
+//! [`OutputLevel::Full`] (the recording, every test of the physics) evaluates one right-hand
+//! side per sample and reads the kinematics that evaluation left in the workspace (no second
+//! forward-kinematics pass). [`OutputLevel::Kinematic`] (`sim precision`, which measures hand
+//! error, energy-quadrature error and drift) evaluates forward kinematics (and velocities, with
+//! contacts) only: about a tenth of a right-hand side per sample.
 
 use nalgebra::Vector3;
 
 use crate::dynamics::energy::{magnetic_energy, potential_energy, rotor_kinetic_energy};
 use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
+use crate::dynamics::motor::Electrical;
 use crate::error::DynamicsError;
 
 use super::arm::ArmSystem;
@@ -45,41 +64,54 @@ fn set(dst: &mut Vec<f64>, src: &[f64]) {
     dst.extend_from_slice(src);
 }
 
+/// Which quantities of [`Outputs`] a consumer reads (the module docs give what each needs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OutputLevel {
+    /// Everything: one full right-hand side per sample.
+    #[default]
+    Full,
+    /// The state's quantities (t, q, q̇, W, E, the losses, the currents of inductive motors and
+    /// their ½ L i²), the back EMF, and what forward kinematics gives: the hand, the desired
+    /// hand, C, Ċ and V. The quantities that need the controller or eq 21 are left empty (the
+    /// vectors: q̈, voltage, electric power, τ_motor, f_n, and the currents of quasi-static
+    /// motors) or NaN (T, the balance residual, and ½ L i² of quasi-static motors).
+    Kinematic,
+}
+
 impl ArmSystem<'_> {
     /// Everything recorded at (t, y), written into `out` (whose vectors are reused).
     pub fn outputs(&mut self, t: f64, y: &[f64], out: &mut Outputs) -> Result<(), DynamicsError> {
-        self.evaluate(t, y)?;
+        self.outputs_at(OutputLevel::Full, t, y, out)
+    }
+
+    /// The quantities of `level` at (t, y), written into `out` (whose vectors are reused).
+    pub fn outputs_at(&mut self, level: OutputLevel, t: f64, y: &[f64], out: &mut Outputs) -> Result<(), DynamicsError> {
         let l = self.layout;
         let s = self.scene;
         let d = &s.drives;
         let (q, qd) = (&y[l.q()], &y[l.qd()]);
-        let cur = self.currents(y);
-        let (fd, voltage) = (&self.ws.fd, &self.ws.voltage);
+        match level {
+            // the evaluation leaves the placements at q, and with contacts the world
+            // velocities at (q, q̇), in the workspace (`forward_dynamics`)
+            OutputLevel::Full => self.evaluate(t, y)?,
+            OutputLevel::Kinematic => {
+                forward_kinematics(&s.model, &mut self.ws.data, q);
+                if !self.contacts.is_empty() {
+                    forward_velocities(&s.model, &mut self.ws.data, qd);
+                }
+            }
+        }
         out.t = t;
         set(&mut out.q, q);
         set(&mut out.qd, qd);
-        set(&mut out.qdd, fd.qdd.as_slice());
-        set(&mut out.current, cur);
-        set(&mut out.voltage, voltage);
         out.back_emf.clear();
         out.back_emf.extend((0..l.nv).map(|j| d.back_emf(j, qd[j])));
-        out.electric_power.clear();
-        out.electric_power.extend((0..l.nv).map(|j| cur[j] * voltage[j]));
-        set(&mut out.tau_motor, fd.tau_motor.as_slice());
-        set(&mut out.normal_force, fd.f_n.as_slice());
         set(&mut out.link_work, &y[l.work()]);
         set(&mut out.electric_energy, &y[l.electric()]);
         out.loss_resistance = y[l.loss_r()];
         out.loss_friction = y[l.loss_d()] + y[l.loss_dm()];
         out.loss_gear_friction = y[l.loss_dm()];
-        out.magnetic = magnetic_energy(d, cur);
-        // ½ q̇ᵀ M q̇ from the mass matrix of this evaluation (valid for CRBA and Walker–Orin)
-        let data = &mut self.ws.data;
-        let m_qd: f64 = (0..l.nv).map(|r| qd[r] * (0..l.nv).map(|c| data.m[(r, c)] * qd[c]).sum::<f64>()).sum();
-        out.kinetic = 0.5 * m_qd + rotor_kinetic_energy(d, qd);
-        // kinematics at this state (the dynamics left body velocities of RNEA in `data`)
-        forward_kinematics(&s.model, data, q);
-        forward_velocities(&s.model, data, qd);
+        let data = &self.ws.data;
         out.potential = potential_energy(&s.model, data);
         out.hand = s.hand.position(data);
         out.hand_desired = s.circle.position(t);
@@ -87,9 +119,99 @@ impl ArmSystem<'_> {
         out.constraint_position.extend(self.contacts.iter().map(|c| c.position(data)));
         out.constraint_velocity.clear();
         out.constraint_velocity.extend(self.contacts.iter().map(|c| c.velocity(data)));
+        if level == OutputLevel::Kinematic {
+            for v in [&mut out.qdd, &mut out.voltage, &mut out.electric_power, &mut out.tau_motor, &mut out.normal_force] {
+                v.clear();
+            }
+            match l.electrical {
+                Electrical::Inductive => {
+                    set(&mut out.current, &y[l.current()]);
+                    out.magnetic = magnetic_energy(d, &out.current);
+                }
+                Electrical::QuasiStatic => {
+                    out.current.clear();
+                    out.magnetic = f64::NAN;
+                }
+            }
+            out.kinetic = f64::NAN;
+            out.balance_residual = f64::NAN;
+            return Ok(());
+        }
+        let cur = self.currents(y);
+        let (fd, voltage) = (&self.ws.fd, &self.ws.voltage);
+        set(&mut out.qdd, fd.qdd.as_slice());
+        set(&mut out.current, cur);
+        set(&mut out.voltage, voltage);
+        out.electric_power.clear();
+        out.electric_power.extend((0..l.nv).map(|j| cur[j] * voltage[j]));
+        set(&mut out.tau_motor, fd.tau_motor.as_slice());
+        set(&mut out.normal_force, fd.f_n.as_slice());
+        out.magnetic = magnetic_energy(d, cur);
+        // ½ q̇ᵀ M q̇ from the mass matrix of this evaluation (valid for CRBA and Walker–Orin)
+        let m_qd: f64 = (0..l.nv).map(|r| qd[r] * (0..l.nv).map(|c| data.m[(r, c)] * qd[c]).sum::<f64>()).sum();
+        out.kinetic = 0.5 * m_qd + rotor_kinetic_energy(d, qd);
         let electric: f64 = out.electric_energy.iter().sum();
         out.balance_residual = electric
             - (out.kinetic + out.potential + out.magnetic - self.stored0 + out.loss_resistance + out.loss_friction);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::OdeSystem;
+    use crate::scene::Scene;
+
+    /// At the same (t, y) — a state off the initial one, with velocities and currents — the
+    /// kinematic level gives bit for bit the full level's hand, desired hand, C, Ċ, V, state
+    /// quantities, back EMF and (inductive motors) currents and ½ L i², on every run of the
+    /// paper scene and of its quasi-static variant; what needs the solve is empty or NaN.
+    #[test]
+    fn kinematic_outputs_equal_the_full_ones_where_defined() {
+        let paper = Scene::paper().expect("the built-in scene");
+        let quasi_static = paper
+            .vary(|s| {
+                s.motor.inductance = crate::scene::spec::PerJoint::All(0.0);
+                s.initial.current = crate::scene::spec::PerJoint::All(0.0);
+            })
+            .expect("a valid variation");
+        for scene in [&paper, &quasi_static] {
+            for run in scene.runs() {
+                let mut sys = ArmSystem::new(scene, run);
+                let l = sys.layout();
+                let mut y = sys.initial_state();
+                let mut rng = crate::dynamics::samples::SplitMix64(3);
+                for (k, x) in y.iter_mut().enumerate().skip(l.nv) {
+                    *x += rng.range(-0.5, 0.5) * if k < 2 * l.nv { 1.0 } else { 2.0 };
+                }
+                let t = 0.37;
+                let (mut full, mut kin) = (Outputs::default(), Outputs::default());
+                sys.outputs_at(OutputLevel::Full, t, &y, &mut full).expect("full outputs");
+                // the kinematic level must not read what the full level left in the workspace
+                let mut dydt = vec![0.0; sys.dim()];
+                sys.rhs(t + 0.1, &sys.initial_state(), &mut dydt).expect("rhs");
+                sys.outputs_at(OutputLevel::Kinematic, t, &y, &mut kin).expect("kinematic outputs");
+                let name = &run.name;
+                assert_eq!((kin.t, &kin.q, &kin.qd), (full.t, &full.q, &full.qd), "{name}");
+                assert_eq!((kin.hand, kin.hand_desired, kin.potential), (full.hand, full.hand_desired, full.potential), "{name}");
+                assert_eq!((&kin.constraint_position, &kin.constraint_velocity), (&full.constraint_position, &full.constraint_velocity), "{name}");
+                assert_eq!((&kin.link_work, &kin.electric_energy, &kin.back_emf), (&full.link_work, &full.electric_energy, &full.back_emf), "{name}");
+                assert_eq!(
+                    (kin.loss_resistance, kin.loss_friction, kin.loss_gear_friction),
+                    (full.loss_resistance, full.loss_friction, full.loss_gear_friction),
+                    "{name}"
+                );
+                assert_eq!(full.constraint_position.len(), run.contacts.len(), "{name}");
+                if l.ni() > 0 {
+                    assert_eq!((&kin.current, kin.magnetic), (&full.current, full.magnetic), "{name}");
+                } else {
+                    assert!(kin.current.is_empty() && kin.magnetic.is_nan(), "{name}");
+                }
+                assert!(full.qdd.len() == l.nv && kin.qdd.is_empty() && kin.tau_motor.is_empty() && kin.voltage.is_empty(), "{name}");
+                assert!(kin.normal_force.is_empty() && kin.electric_power.is_empty(), "{name}");
+                assert!(kin.kinetic.is_nan() && kin.balance_residual.is_nan() && full.kinetic.is_finite(), "{name}");
+            }
+        }
     }
 }
