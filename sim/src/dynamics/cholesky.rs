@@ -20,7 +20,7 @@ pub fn factor_in_place(a: &mut [f64], n: usize, inv_diag: &mut [f64]) -> bool {
     debug_assert_eq!(inv_diag.len(), n);
     for j in 0..n {
         let d = a[j + j * n];
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return false;
         }
         let l_jj = d.sqrt();
@@ -50,7 +50,7 @@ pub fn factor_in_place(a: &mut [f64], n: usize, inv_diag: &mut [f64]) -> bool {
 /// that their independent chains overlap.
 pub fn solve_lower(l: &[f64], inv_diag: &[f64], n: usize, cols: &mut [f64]) {
     debug_assert_eq!(cols.len() % n.max(1), 0);
-    let m = if n == 0 { 0 } else { cols.len() / n };
+    let m = cols.len().checked_div(n).unwrap_or(0);
     for j in 0..n {
         let col = &l[j * n..(j + 1) * n];
         for c in 0..m {
