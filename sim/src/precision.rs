@@ -255,6 +255,13 @@ pub fn default_ladder(scene: &Scene) -> Result<Vec<Variant>, SceneError> {
         push("rodas5p (h_max = output interval)", format!("rtol {tol:.0e}"), adaptive("rodas5p", tol, h_out), Crba, Schur, none)?;
     }
     for tol in [1e-4, 1e-6, 1e-8] {
+        let mut spec = adaptive("rodas5p", tol, h_long);
+        if let IntegratorSpec::Rodas5p(r) = &mut spec {
+            r.jacobian_reuse = Some(3);
+        }
+        push("rodas5p (J kept 3 steps)", format!("rtol {tol:.0e}"), spec, Crba, Schur, none)?;
+    }
+    for tol in [1e-4, 1e-6, 1e-8] {
         push("rodas4 (exact J)", format!("rtol {tol:.0e}"), adaptive("rodas4", tol, h_long), Crba, Schur, none)?;
     }
     for tol in [1e-4, 1e-6, 1e-8] {

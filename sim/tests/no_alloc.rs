@@ -9,7 +9,7 @@ use std::cell::Cell;
 
 use std::time::{Duration, Instant};
 
-use sim::integrate::{integrate_sampled_within, ArkImex, Deadline, DormandPrince45, Rk4, Rosenbrock, StepControl, Stepper};
+use sim::integrate::{integrate_sampled_within, ArkImex, Deadline, DormandPrince45, Rk4, Rodas, RodasMethod, Rosenbrock, StepControl, Stepper};
 use sim::scene::Scene;
 use sim::ode::ArmSystem;
 
@@ -66,6 +66,10 @@ fn the_step_loop_does_not_allocate() {
     let st = &mut Rosenbrock::new(dim, control(1e-8, 1e-10));
     assert_eq!(steps_allocate(st, &mut sys), 0, "rosenbrock (with its Jacobian)");
     assert_eq!(steps_allocate(&mut ArkImex::new(dim, control(1e-8, 1e-10)), &mut sys), 0, "imex");
+    let st = &mut Rodas::new(dim, control(1e-8, 1e-10));
+    assert_eq!(steps_allocate(st, &mut sys), 0, "rodas5p (with its finite-difference Jacobian)");
+    let st = &mut Rodas::new(dim, control(1e-8, 1e-10)).with_method(RodasMethod::Rodas4);
+    assert_eq!(steps_allocate(st, &mut sys), 0, "rodas4");
 }
 
 /// Projection after every step (the constraint stabilisation) does not allocate either.

@@ -84,9 +84,11 @@ fn precision_writes_its_table_and_plots() {
         .arg(dir.path()));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let table = String::from_utf8(out.stdout).unwrap();
-    for series in ["dopri45", "rosenbrock", "imex", "rk4", "paper baseline"] {
+    for series in ["dopri45", "rosenbrock", "imex", "rk4", "paper baseline", "rodas5p (exact J)", "rodas4"] {
         assert!(table.contains(series), "{series} missing from\n{table}");
     }
+    // the recommendation for the default --accuracy (1e-6 m), which the tight runs reach
+    assert!(table.contains("Recommended for max hand error <= 1e-6 m: "), "{table}");
     let rows: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.path().join("precision.json")).unwrap()).unwrap();
     let rows = rows.as_array().unwrap();
     assert!(rows.len() >= 20);

@@ -340,10 +340,13 @@ pub struct Stats {
     /// Rejected step attempts (error test failed — for [`ArkImex`] also its interpolation
     /// check —, or a non-finite stage, or a singular iteration matrix).
     pub rejected: u64,
-    /// Calls to [`OdeJacobian::jacobian`] ([`Rosenbrock`]; 0 for the explicit methods).
-    /// Evaluations of `rhs` made inside it (e.g. by [`FdJacobian`]) are not in `rhs_evals`.
+    /// Jacobian evaluations: calls to [`OdeJacobian::jacobian`] ([`Rosenbrock`]) or
+    /// [`OdeJacobian::exact_jacobian`] ([`Rodas`]); 0 for the explicit methods. Evaluations of
+    /// `rhs` made inside the system's own Jacobian (e.g. by [`FdJacobian`]) are not in
+    /// `rhs_evals`; those of [`Rodas`]'s own finite differences (when the system has no exact
+    /// Jacobian) are.
     pub jacobian_evals: u64,
-    /// LU factorisations of the iteration matrix ([`Rosenbrock`]; 0 for the others).
+    /// LU factorisations of the iteration matrix ([`Rosenbrock`], [`Rodas`]; 0 for the others).
     pub lu_decompositions: u64,
     /// Calls to [`SplitSystem::solve_implicit`] ([`ArkImex`]; 0 for the others).
     pub implicit_solves: u64,

@@ -465,14 +465,9 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
         }
 
         // dense output of this step
-        for k in 0..tab.dense {
-            let (w, hk) = (&mut self.w[k], &tab.h[k]);
-            for i in 0..n {
-                let mut v = 0.0;
-                for j in 0..tab.stages {
-                    v += hk[j] * self.u[j][i];
-                }
-                w[i] = v;
+        for (w, hk) in self.w.iter_mut().zip(&tab.h).take(tab.dense) {
+            for (i, wi) in w.iter_mut().enumerate() {
+                *wi = hk[..tab.stages].iter().zip(&self.u).map(|(c, u)| c * u[i]).sum();
             }
         }
         let h_new = self.core.limit_growth(h * fac, h, h_proposed);

@@ -136,6 +136,8 @@ fn table(rows: &[Row], scene: &str, run: &str, duration: f64, accuracy: f64) -> 
                     r.status.clone(),
                 ]);
             } else {
+                // a failed run: no numbers, the reason in the status column
+                c.extend(std::iter::repeat_n(String::from("-"), 8));
                 c.push(r.status.clone());
             }
             c

@@ -5,6 +5,8 @@
 //! finite-difference Jacobian over the coupled columns. The stepper contract (with RODAS5P) is
 //! `contract.rs`.
 
+#![allow(clippy::needless_range_loop)] // the index notation of the order conditions
+
 use nalgebra::Complex;
 
 use super::super::test_problems::{HarmonicOscillator, Kepler, RationalDecay, StiffKepler};
