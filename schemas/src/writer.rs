@@ -28,8 +28,8 @@
 //! - **Chunks per topic** (the default, [`WriterOptions::chunk_per_topic`]): each chunk holds
 //!   the messages of one topic, so a reader of some topics skips the chunks of the others (the
 //!   summary's chunk indexes name the channels of each chunk). See `writer/worker.rs`.
-//! - **Compression** ([`Compression`]): chosen by measurement (`cargo bench -p schemas --bench
-//!   write`): see [`WriterOptions::default`].
+//! - **Compression** ([`Compression`]): chosen by measurement (`cargo bench -p sim --bench
+//!   record`): see [`WriterOptions::default`].
 //! - **A tap** ([`RecordingWriter::create_tapped`]): every record written is also fed, on the
 //!   writer's thread, to the reader's own record consumer ([`crate::Tap`]), which hands the
 //!   messages of the chosen topics to a [`crate::Visitor`] exactly as a read of the finished
@@ -88,14 +88,16 @@ pub struct WriterOptions {
 
 impl WriterOptions {
     /// The writer of format versions up to this change: zstd level 3 in interleaved 1 MiB
-    /// chunks, on the caller's thread (the baseline of `cargo bench -p schemas --bench write`).
+    /// chunks, on the caller's thread (the baseline of `cargo bench -p sim --bench record`).
     pub const INLINE_MIXED_ZSTD3: WriterOptions =
         WriterOptions { compression: Compression::Zstd { level: 3 }, chunk_size: 1 << 20, chunk_per_topic: false, background: false, queue: 0 };
 }
 
 impl Default for WriterOptions {
-    /// zstd level 1 (measured against levels 3, 6, lz4 and none on paper recordings: see the
-    /// bench `write` and the notes of issue 14), 1 MiB chunks, one topic per chunk, on a
+    /// zstd level 1 (on a paper run, `cargo bench -p sim --bench record`: 0.74–0.78x the time
+    /// of level 3 for +2 % size; level 6 2–3x the time for −0.2 %; lz4 +19–28 % size and not
+    /// clearly faster; none 1.9x the size), 1 MiB chunks, one topic per chunk (+7–9 % size:
+    /// the price of chunks a reader can skip), on a
     /// background thread with 1024 messages in flight.
     fn default() -> Self {
         WriterOptions { compression: Compression::Zstd { level: 1 }, chunk_size: 1 << 20, chunk_per_topic: true, background: true, queue: 1024 }

@@ -10,6 +10,9 @@
 //! ratios to today's writer (`inline mixed zstd-3`: zstd level 3, 1 MiB interleaved chunks, on
 //! the caller's thread), computed in the same run. Absolute times depend on the load (`uptime`).
 
+// the sink closure must return `sim::error::RunError`, whose size is the library's choice
+#![allow(clippy::result_large_err)]
+
 use std::path::Path;
 use std::time::Instant;
 

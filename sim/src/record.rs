@@ -60,12 +60,14 @@ impl<'a> Recorder<'a> {
 
     /// [`Recorder::create`], every record also fed to `tap` (see
     /// [`RecordingWriter::create_tapped`]); [`Recorder::finish`] returns what it saw.
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
     pub fn create_tapped(path: &Path, scene: &'a Scene, run: &Run, tap: Option<Tap>) -> Result<Self, RunError> {
         Self::create_with(path, scene, run, WriterOptions::default(), tap)
     }
 
     /// [`Recorder::create_tapped`] with the writer's `options` (compression, chunks, thread:
     /// the bench `record` compares them).
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
     pub fn create_with(path: &Path, scene: &'a Scene, run: &Run, options: WriterOptions, tap: Option<Tap>) -> Result<Self, RunError> {
         let err = |source| RunError::Recording { path: path.to_path_buf(), source };
         let mut writer = RecordingWriter::create_tapped(path, options, tap).map_err(err)?;

@@ -153,6 +153,7 @@ impl MetricsTap {
 
     /// The metrics, once the writer finished and gave back `tapped` (what
     /// [`analyze::metrics::stream_run_metrics`] computes from the file).
+    #[allow(clippy::result_large_err)] // analyze::Error, as analyze::read_run_metrics returns it
     pub fn metrics(self, tapped: Option<schemas::Tapped>) -> Result<analyze::RunMetrics, analyze::Error> {
         let Some(tapped) = tapped else {
             return Err(schemas::Error::Stopped { file: "(no tap)".into() }.into());
@@ -184,7 +185,7 @@ pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Syn
                 let (tap, metrics) = MetricsTap::new(&target);
                 let res = run_to_file_tapped(scene, run, &target, budget, Some(tap), |t| {
                     count += 1;
-                    if count % 64 == 0 {
+                    if count.is_multiple_of(64) {
                         cli::progress::set_time(bar, t);
                     }
                 });
