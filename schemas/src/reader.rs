@@ -264,6 +264,9 @@ fn feed_records(
     Ok(())
 }
 
+/// What [`pump`] does with each record: its opcode and content.
+type OnRecord<'a> = dyn FnMut(u8, &[u8]) -> Result<(), Error> + 'a;
+
 /// Runs `input` through a linear reader with `options`, handing each record (opcode, content)
 /// to `on_record`; `bytes` counts the bytes read.
 fn pump(
@@ -271,7 +274,7 @@ fn pump(
     options: mcap::sans_io::LinearReaderOptions,
     file: &str,
     bytes: &mut u64,
-    on_record: &mut dyn FnMut(u8, &[u8]) -> Result<(), Error>,
+    on_record: &mut OnRecord<'_>,
 ) -> Result<(), Error> {
     use mcap::sans_io::{LinearReadEvent, LinearReader};
     let mut reader = LinearReader::new_with_options(options);

@@ -316,3 +316,39 @@ fn duplicate_joint_or_contact_names_are_refused() {
     let e = read_err(&s);
     assert!(e.contains("run.joint names = \"j\": named twice"), "{e}");
 }
+
+/// The reductions fed generic trees (the reader's path before typed decoding).
+struct Generic(Reductions);
+
+impl schemas::Visitor for Generic {
+    fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        schemas::Visitor::message(&mut self.0, m)
+    }
+}
+
+fn generic_metrics(path: &Path) -> Result<RunMetrics, Error> {
+    let mut acc = Generic(Reductions::default());
+    let rec = schemas::stream_recording(path, Some(&METRIC_TOPICS), &mut acc).map_err(|e| acc.0.take_error(e))?;
+    acc.0.finish(&rec, None)
+}
+
+/// Typed decoding (what `read_run_metrics` uses for `schemas`' own messages) gives the metrics
+/// of the generic trees, number for number, and the same errors.
+#[test]
+fn typed_and_generic_decoding_give_the_same_metrics_and_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut runs = vec![Synth::new("plain", &["elbow"], 2).with_setup(), Synth::new("two", &["left", "right"], 3)];
+    runs[1].motors = Some(currents(|t| vec![t.sin(), -2.0 * t, (3.0 * t).cos()]));
+    runs[1].constraints = Some(contact_forces(|t| vec![[t - 0.5, 1e-9 * t, -1e-6], [0.25 - t, 0.0, 1e-3 * t]]));
+    let mut nan = Synth::new("nan", &["elbow"], 2);
+    nan.motors = Some(currents(|t| vec![1.0, if (t - 0.5).abs() < 1e-9 { f64::NAN } else { t }]));
+    runs.push(nan);
+    for s in &runs {
+        let path = s.write_in(dir.path());
+        match (read_run_metrics(&path), generic_metrics(&path)) {
+            (Ok(typed), Ok(generic)) => assert_eq!(serde_json::to_string(&typed).unwrap(), serde_json::to_string(&generic).unwrap()),
+            (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+            (a, b) => panic!("{}: typed {a:?}, generic {b:?}", path.display()),
+        }
+    }
+}

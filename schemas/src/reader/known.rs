@@ -43,9 +43,12 @@ pub(crate) enum KnownKind {
     Energy,
 }
 
-/// The schema (name, `FileDescriptorSet` bytes) this crate writes for each kind, built once.
-fn schemas() -> &'static [(KnownKind, &'static str, String, Vec<u8>); 4] {
-    static SCHEMAS: OnceLock<[(KnownKind, &'static str, String, Vec<u8>); 4]> = OnceLock::new();
+/// A kind, its topic, and the schema (name, `FileDescriptorSet` bytes) this crate writes for it.
+type OwnSchema = (KnownKind, &'static str, String, Vec<u8>);
+
+/// The schemas this crate writes for each kind, built once.
+fn schemas() -> &'static [OwnSchema; 4] {
+    static SCHEMAS: OnceLock<[OwnSchema; 4]> = OnceLock::new();
     SCHEMAS.get_or_init(|| {
         [
             (KnownKind::Hand, topics::HAND, HandState::schema_name(), HandState::schema_data()),

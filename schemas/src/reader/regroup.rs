@@ -9,6 +9,9 @@ use std::io::Cursor;
 
 use mcap::records::{MessageHeader, Record};
 
+/// A group's buffered bytes and messages.
+type Buffered = (usize, Vec<(MessageHeader, Vec<u8>)>);
+
 /// Rewrites the MCAP bytes `src`: the messages of each group of `groups` (topic names; topics
 /// in no group form one more group) go to chunks of their own, a chunk being closed when its
 /// group has `chunk_bytes` of messages buffered and at the end. `summary`: write the summary
@@ -23,9 +26,9 @@ pub fn regroup_chunks(src: &[u8], groups: &[&[&str]], chunk_bytes: usize, summar
     let mut out = options.create(Cursor::new(Vec::new()))?;
     let mut topic_of = BTreeMap::new();
     let group_of = |topic: &str| groups.iter().position(|g| g.contains(&topic)).unwrap_or(groups.len());
-    let mut buffered: Vec<(usize, Vec<(MessageHeader, Vec<u8>)>)> = vec![(0, Vec::new()); groups.len() + 1];
+    let mut buffered: Vec<Buffered> = vec![(0, Vec::new()); groups.len() + 1];
     let mut known_schemas = BTreeMap::new();
-    let write_group = |out: &mut mcap::Writer<Cursor<Vec<u8>>>, group: &mut (usize, Vec<(MessageHeader, Vec<u8>)>)| -> Result<(), mcap::McapError> {
+    let write_group = |out: &mut mcap::Writer<Cursor<Vec<u8>>>, group: &mut Buffered| -> Result<(), mcap::McapError> {
         if group.1.is_empty() {
             return Ok(());
         }
@@ -37,16 +40,12 @@ pub fn regroup_chunks(src: &[u8], groups: &[&[&str]], chunk_bytes: usize, summar
     };
     for record in mcap::read::ChunkFlattener::new(src)? {
         match record? {
-            Record::Schema { header, data } => {
-                if known_schemas.insert(header.id, ()).is_none() {
-                    out.add_schema_with_id(header.id, &header.name, &header.encoding, &data)?;
-                }
+            Record::Schema { header, data } if known_schemas.insert(header.id, ()).is_none() => {
+                out.add_schema_with_id(header.id, &header.name, &header.encoding, &data)?;
             }
-            Record::Channel(ch) => {
-                if !topic_of.contains_key(&ch.id) {
-                    out.add_channel_with_id(ch.id, ch.schema_id, &ch.topic, &ch.message_encoding, &ch.metadata)?;
-                    topic_of.insert(ch.id, ch.topic);
-                }
+            Record::Channel(ch) if !topic_of.contains_key(&ch.id) => {
+                out.add_channel_with_id(ch.id, ch.schema_id, &ch.topic, &ch.message_encoding, &ch.metadata)?;
+                topic_of.insert(ch.id, ch.topic);
             }
             Record::Message { header, data } => {
                 let g = group_of(topic_of.get(&header.channel_id).map_or("", String::as_str));
