@@ -59,7 +59,7 @@ fn dump() -> Result<(), String> {
         Some(k) => args.get(k + 1).and_then(|v| v.parse().ok()).ok_or(usage)?,
         None => 4,
     };
-    let scene = Scene::load(std::path::Path::new(path)).map_err(|e| format!("{path}: {e}"))?;
+    let scene = Scene::load(std::path::Path::new(path)).map_err(|e| e.to_string())?;
     let run = scene.run(run_name).ok_or_else(|| format!("{path}: no run named {run_name:?}"))?.clone();
     let model = scene.model();
     let nv = model.nv;
