@@ -592,9 +592,9 @@ def main() -> int:
     print(f"# peers: {report['date_utc']} UTC, {cpu}, {os.cpu_count()} cores, load {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}, MuJoCo {mujoco.__version__}")
 
     for scene in scenes:
-        spec = json.loads(scene.read_text())
-        urdf = (scene.parent / spec["urdf"]).resolve()
+        # peers_dump validates the scene (a clear error for a bad file or run name) before it is read here
         dump = json.loads(run([str(a.dump), str(scene), a.run, "--reference"]))
+        urdf = (scene.parent / json.loads(scene.read_text())["urdf"]).resolve()
         reference = np.array(dump["reference_hand"])
         electrical = "quasi-static" if all(x == 0.0 for x in dump["drives"]["l"]) else "inductive"
         if any(abs(x - y) > 0 for x, y in zip(dump["q_des0"], dump["q_des_end"])) and max(abs(x - y) for x, y in zip(dump["q_des0"], dump["q_des_end"])) > 1e-12:

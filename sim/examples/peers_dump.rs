@@ -16,22 +16,9 @@ use serde_json::{json, Value};
 use sim::dynamics::crba::crba;
 use sim::dynamics::forward::{forward_dynamics, ForwardData, Plant};
 use sim::dynamics::kinematics::forward_kinematics;
+use sim::dynamics::samples::SplitMix64;
 use sim::dynamics::Data;
 use sim::scene::Scene;
-
-/// A small deterministic generator (xorshift64*, Vigna 2016) for the sample states: the states
-/// only have to be the same on every run, not random in any strong sense.
-struct XorShift(u64);
-impl XorShift {
-    /// Uniform in [lo, hi).
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let u = (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64;
-        lo + (hi - lo) * u
-    }
-}
 
 fn matrix(m: &DMatrix<f64>) -> Value {
     Value::from((0..m.nrows()).map(|i| (0..m.ncols()).map(|j| m[(i, j)]).collect::<Vec<_>>()).collect::<Vec<_>>())
@@ -59,7 +46,7 @@ fn dump() -> Result<(), String> {
         Some(k) => args.get(k + 1).and_then(|v| v.parse().ok()).ok_or(usage)?,
         None => 4,
     };
-    let scene = Scene::load(std::path::Path::new(path)).map_err(|e| format!("{path}: {e}"))?;
+    let scene = Scene::load(std::path::Path::new(path)).map_err(|e| e.to_string())?;
     let run = scene.run(run_name).ok_or_else(|| format!("{path}: no run named {run_name:?}"))?.clone();
     let model = scene.model();
     let nv = model.nv;
@@ -77,11 +64,12 @@ fn dump() -> Result<(), String> {
     let (q_des_end, _) = targets(scene.duration())?;
 
     // kinematics and inertia at q0 and a few states around it
-    let mut rng = XorShift(0x9E37_79B9_7F4A_7C15);
+    // the sample states: deterministic, the same on every run (the benches' generator)
+    let mut rng = SplitMix64(2024);
     let mut data = Data::new(model);
     let mut qs: Vec<Vec<f64>> = vec![scene.q0().to_vec()];
     for _ in 1..n_states {
-        qs.push(scene.q0().iter().map(|q| q + rng.uniform(-0.5, 0.5)).collect());
+        qs.push(scene.q0().iter().map(|q| q + rng.range(-0.5, 0.5)).collect());
     }
     let mut kin = Vec::new();
     for q in &qs {
@@ -104,8 +92,8 @@ fn dump() -> Result<(), String> {
     let mut fd = ForwardData::new(nv, contacts.len());
     let mut dynamics = Vec::new();
     for q in &qs {
-        let qd: Vec<f64> = (0..nv).map(|_| rng.uniform(-1.0, 1.0)).collect();
-        let current: Vec<f64> = (0..nv).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let qd = rng.vector(nv, -1.0, 1.0);
+        let current = rng.vector(nv, -2.0, 2.0);
         let voltage = vec![0.0; nv];
         forward_dynamics(&plant, &mut data, &mut fd, 0.0, q, &qd, &current, &voltage).map_err(|e| e.to_string())?;
         // the generalised force of the drives: K_m i − (D + D_m) q̇ (eq 12 without the J_m q̈ term)
