@@ -103,7 +103,7 @@ fn collector(seen: &Seen) -> impl FnMut(DecodedMessage<'_>) -> Result<(), schema
     let seen = seen.clone();
     move |m: DecodedMessage<'_>| {
         let run = m.run.map(|r| r.run.clone());
-        seen.lock().unwrap().push((m.topic.to_string(), m.index, m.log_time_ns, m.value, run));
+        seen.lock().unwrap().push((m.topic.to_string(), m.index, m.log_time_ns, m.value().into_owned(), run));
         Ok(())
     }
 }
