@@ -106,7 +106,10 @@ fn regrouped(bytes: &[u8], summary: bool) -> Vec<u8> {
 
 fn fixture() -> (tempfile::TempDir, Vec<u8>) {
     let dir = tempfile::tempdir().unwrap();
-    let path = common::write_all(&dir.path().join("all.mcap"), &common::content(400));
+    // every topic in every chunk (the writer's old layout; its default is now one topic per chunk)
+    let path = dir.path().join("all.mcap");
+    let w = schemas::RecordingWriter::create_with(&path, schemas::WriterOptions::INLINE_MIXED_ZSTD3).unwrap();
+    let path = common::write_all_with(&path, &common::content(400), w);
     let bytes = std::fs::read(path).unwrap();
     (dir, bytes)
 }
