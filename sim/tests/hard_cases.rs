@@ -76,10 +76,10 @@ fn sixty_seconds_with_bounded_drift() {
     assert!(r.max_drift_last <= 10.0 * r.max_drift_first.max(1e-14), "first {:e} last {:e}", r.max_drift_first, r.max_drift_last);
 }
 
-/// 60 s, twelve turns, of the paper scene as it is (Dormand–Prince rtol 1e-10) without
-/// stabilisation: eq 15 alone. Its drift is the integral of the acceleration-level error, so it
-/// can grow at most quadratically in time; from the paper scene's stated bound (|C| < 1e-13 m
-/// over 5 s, `paper.rs`) that gives (60/5)² × 1e-13 m = 1.44e-11 m over 60 s (measured
+/// 60 s, twelve turns, of the paper scene at reference accuracy (Dormand–Prince rtol 1e-10, the
+/// scene file's own setting) without stabilisation: eq 15 alone. Its drift is the integral of the
+/// acceleration-level error, so it can grow at most quadratically in time; from the bound at that
+/// tolerance (|C| < 1e-13 m over 5 s; measured 1.4e-14 m) that gives (60/5)² × 1e-13 m = 1.44e-11 m over 60 s (measured
 /// 1.4e-13 m: it grows about linearly). The balance closes to 1e-11 of E, as on the paper scene
 /// (measured 2.2e-13).
 #[test]

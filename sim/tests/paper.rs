@@ -39,13 +39,13 @@ fn run(scene: &Scene, name: &str) -> Summary {
     s
 }
 
-/// Energy balance (electric in = ΔT + ΔV + Δ½Li² + R and D losses) closes to 1e-11 of the
+/// Energy balance (electric in = ΔT + ΔV + Δ½Li² + R and D losses) closes to 1e-9 of the
 /// electric energy at every sample, in all three runs, and the elbows stay on the table to
-/// |C| <= 1e-13 m — the accuracy the README states for the default integrator (Dormand–Prince at
-/// rtol 1e-10: the residual is the integration error of states of up to ~3000 J, measured
-/// 2.3e-12 of E; the drift is eq 15's second integral of that error, measured 7e-15 m). The
-/// output grid is exactly k/1000 s, 5001 samples. (That the link work W_j is what the links
-/// receive is checked on its own: `physics.rs`.)
+/// |C| <= 2e-12 m — the accuracy the README states for the default integrator (Dormand–Prince at
+/// rtol 1e-8, atol 1e-10: the residual is the integration error of states of up to ~3000 J,
+/// measured 3.1e-10 of E in the two-elbow run; the drift is eq 15's second integral of that
+/// error, measured 3.9e-13 m). The output grid is exactly k/1000 s, 5001 samples. (That the link
+/// work W_j is what the links receive is checked on its own: `physics.rs`.)
 #[test]
 fn energy_balance_closes_and_constraints_hold() {
     let scene = Scene::paper().unwrap();
@@ -55,25 +55,47 @@ fn energy_balance_closes_and_constraints_hold() {
         for (k, t) in s.samples.iter().enumerate() {
             assert_eq!(*t, k as f64 / 1000.0);
         }
-        assert!(s.max_residual <= 1e-11 * s.electric, "{name}: residual {:e} J of {} J", s.max_residual, s.electric);
-        assert!(s.max_drift <= 1e-13, "{name}: drift {:e} m", s.max_drift);
+        assert!(s.max_residual <= 1e-9 * s.electric, "{name}: residual {:e} J of {} J", s.max_residual, s.electric);
+        assert!(s.max_drift <= 2e-12, "{name}: drift {:e} m", s.max_drift);
     }
 }
 
-/// The README's claim for the default integrator: tightening it to rtol 1e-12 (atol 1e-14)
-/// changes the final joint angles of the paper runs by less than 1e-13 rad (the two-elbow run,
-/// whose wrist rings hardest; 5 s).
+/// The default integrator is as accurate as the README (and issue 14) says: against a reference
+/// tightened to rtol 1e-12 (atol 1e-14, steps of at most 1 ms), every run's hand path is within
+/// 1e-8 m at every sample and every link's work W_j and motor's electric energy E_j at 5 s is
+/// within 1e-8 of the reference's, relatively (measured: 2.7e-12 m, and 3.0e-9 for W_5 of the
+/// two-elbow run, 2.5e-3 J, the smallest). The reference itself agrees with an independent
+/// implementation to about 1e-13 m (README).
 #[test]
-fn tightening_the_default_integrator_moves_the_final_angles_by_less_than_1e_13_rad() {
+fn the_default_integrator_agrees_with_a_tight_reference() {
     let scene = Scene::paper().unwrap();
     let tight = scene
         .vary(|s| {
             s.integrator = IntegratorSpec::Dopri45(sim::scene::spec::AdaptiveSpec { rtol: 1e-12, atol: 1e-14, h_max: Some(1e-3), max_steps: None })
         })
         .unwrap();
-    let (a, b) = (run(&scene, "two-elbow").last.q, run(&tight, "two-elbow").last.q);
-    let moved = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
-    assert!(moved < 1e-13, "final angles moved by {moved:e} rad");
+    let path = |scene: &Scene, name: &str| {
+        let run = scene.run(name).unwrap().clone();
+        let mut hand = Vec::new();
+        let rep = sim::run::simulate(scene, &run, |o| {
+            hand.push(o.hand);
+            Ok(())
+        })
+        .unwrap();
+        (hand, rep.last)
+    };
+    for name in ["two-elbow", "one-elbow", "no-elbow"] {
+        let ((a, last_a), (b, last_b)) = (path(&scene, name), path(&tight, name));
+        assert_eq!(a.len(), b.len());
+        let hand = a.iter().zip(&b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max);
+        assert!(hand <= 1e-8, "{name}: hand {hand:e} m from the reference");
+        for (what, x, y) in [("W", &last_a.link_work, &last_b.link_work), ("E", &last_a.electric_energy, &last_b.electric_energy)] {
+            for (j, (u, v)) in x.iter().zip(y.iter()).enumerate() {
+                let rel = (u - v).abs() / v.abs();
+                assert!(rel <= 1e-8, "{name}: {what}_{} = {u} J against {v} J ({rel:e} relative)", j + 1);
+            }
+        }
+    }
 }
 
 /// The paper's conclusions (§5), and what the README adds to them:
@@ -110,7 +132,7 @@ fn more_elbows_use_less_energy_and_track_better() {
     assert!(2 * two.pulled[0] > samples, "elbow 4 pulled at {} of {samples} samples", two.pulled[0]);
 }
 
-/// RK4 at h = 2e-5 s and Dormand–Prince at rtol 1e-10 agree on the final joint angles to
+/// RK4 at h = 2e-5 s and Dormand–Prince at the default rtol 1e-8 agree on the final joint angles to
 /// 1e-8 rad (both are far below that error; RK4's is ~1e-11 here).
 #[test]
 fn rk4_and_dopri_agree() {
