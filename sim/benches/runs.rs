@@ -5,7 +5,7 @@
 //! BENCHMARKS.md.
 //!
 //! Ids `paper_run/<case>`:
-//! - `two-elbow-dopri45`: the scene as it is (CRBA + Schur, Dormand–Prince 5(4), rtol 1e-10).
+//! - `two-elbow-dopri45`: the scene as it is (CRBA + Schur, Dormand–Prince 5(4), rtol 1e-8).
 //! - `two-elbow-rk4`: CRBA + Schur, RK4 with a fixed step of 1e-4 s.
 //! - `two-elbow-paper-baseline`: the paper's method, Walker–Orin mass matrix + KKT (LU of the
 //!   block system) + RK4 1e-4 s.
