@@ -44,6 +44,7 @@ use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, F
 use super::control::Controller;
 use super::jacobian::fd_jacobian_columns;
 use super::lu::{lu_factor, lu_solve};
+use super::rosenbrock::time_derivative;
 use super::{
     dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeJacobian, SettingsError,
     Stats, StepControl, Stepper,
@@ -278,31 +279,12 @@ impl Rodas {
         Ok(())
     }
 
-    /// `f_t` at the current point (as in `Rosenbrock`).
+    /// `f_t` at the current point ([`super::rosenbrock::time_derivative`]).
     fn evaluate_dfdt<S: OdeJacobian>(
         &mut self,
         sys: &mut S,
     ) -> Result<(), IntegrateError<S::Error>> {
-        let (t, n) = (self.core.t, self.dim);
-        if !sys
-            .time_derivative(t, &self.y, &self.f0, &mut self.dfdt)
-            .map_err(IntegrateError::Rhs)?
-        {
-            let delta = (f64::EPSILON * t.abs().max(1e-5)).sqrt();
-            self.dfdt.fill(0.0);
-            for d in [delta, -delta] {
-                if eval(&mut self.core.stats, sys, t + d, &self.y, &mut self.f_stage)?.is_none() {
-                    let dt = (t + d) - t;
-                    for i in 0..n {
-                        self.dfdt[i] = (self.f_stage[i] - self.f0[i]) / dt;
-                    }
-                    break;
-                }
-            }
-        }
-        if let Some(i) = first_non_finite(&self.dfdt) {
-            return Err(IntegrateError::NonFiniteState { t, index: i });
-        }
+        time_derivative(&mut self.core.stats, sys, self.core.t, &self.y, &self.f0, &mut self.dfdt, &mut self.f_stage)?;
         self.dfdt_fresh = true;
         Ok(())
     }

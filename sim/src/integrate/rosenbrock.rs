@@ -244,32 +244,12 @@ impl Rosenbrock {
         Ok(())
     }
 
-    /// Evaluates `f_t` at the current point: analytic, else a forward difference in `t`, else
-    /// a backward one, else 0 (any value keeps the order).
+    /// Evaluates `f_t` at the current point ([`time_derivative`]).
     fn evaluate_dfdt<S: OdeJacobian>(
         &mut self,
         sys: &mut S,
     ) -> Result<(), IntegrateError<S::Error>> {
-        let (t, n) = (self.core.t, self.dim);
-        if !sys
-            .time_derivative(t, &self.y, &self.f0, &mut self.dfdt)
-            .map_err(IntegrateError::Rhs)?
-        {
-            let delta = (f64::EPSILON * t.abs().max(1e-5)).sqrt();
-            self.dfdt.fill(0.0);
-            for d in [delta, -delta] {
-                if eval(&mut self.core.stats, sys, t + d, &self.y, &mut self.f_stage)?.is_none() {
-                    let dt = (t + d) - t;
-                    for i in 0..n {
-                        self.dfdt[i] = (self.f_stage[i] - self.f0[i]) / dt;
-                    }
-                    break;
-                }
-            }
-        }
-        if let Some(i) = first_non_finite(&self.dfdt) {
-            return Err(IntegrateError::NonFiniteState { t, index: i });
-        }
+        time_derivative(&mut self.core.stats, sys, self.core.t, &self.y, &self.f0, &mut self.dfdt, &mut self.f_stage)?;
         self.dfdt_fresh = true;
         Ok(())
     }
@@ -460,6 +440,40 @@ impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
         self.y.copy_from_slice(y);
         eval_finite(&mut self.core.stats, sys, self.core.t, y, &mut self.f0)
     }
+}
+
+
+/// `f_t = ∂f/∂t` at `(t, y)` into `dfdt` (`f0 = f(t, y)`, `scratch` of length `dim`): the
+/// system's own ([`OdeJacobian::time_derivative`]), else a forward difference in `t` with
+/// increment `sqrt(eps max(1e-5, |t|))` (Hairer's `rodas.f`), else a backward one, else 0 (any
+/// value keeps a Rosenbrock-W method's order; the classical RODAS methods need it exact to
+/// O(increment)). Shared by [`Rosenbrock`] and [`super::Rodas`].
+pub(super) fn time_derivative<S: OdeJacobian>(
+    stats: &mut Stats,
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    f0: &[f64],
+    dfdt: &mut [f64],
+    scratch: &mut [f64],
+) -> Result<(), IntegrateError<S::Error>> {
+    if !sys.time_derivative(t, y, f0, dfdt).map_err(IntegrateError::Rhs)? {
+        let delta = (f64::EPSILON * t.abs().max(1e-5)).sqrt();
+        dfdt.fill(0.0);
+        for d in [delta, -delta] {
+            if eval(stats, sys, t + d, y, scratch)?.is_none() {
+                let dt = (t + d) - t;
+                for ((g, f), f0) in dfdt.iter_mut().zip(scratch.iter()).zip(f0) {
+                    *g = (f - f0) / dt;
+                }
+                break;
+            }
+        }
+    }
+    if let Some(i) = first_non_finite(dfdt) {
+        return Err(IntegrateError::NonFiniteState { t, index: i });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
