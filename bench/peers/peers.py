@@ -285,7 +285,8 @@ def merge_best(old: list[dict] | None, new: list[dict]) -> list[dict]:
     out = []
     for r in new:
         o = by_key.get((r["series"], r["setting"]))
-        if o is not None and o["wall_s"] < r["wall_s"]:
+        # a run that failed in a pass has no time (None): the other pass's time, if any, wins
+        if o is not None and o["wall_s"] is not None and (r["wall_s"] is None or o["wall_s"] < r["wall_s"]):
             r = o | {"status": r["status"] if r["status"] != "ok" else o["status"]}
         out.append(r)
     return out
