@@ -644,7 +644,9 @@ def main() -> int:
         print("| tool | series | setting | wall | max hand error [m] | status |")
         print("|---|---|---|---|---|---|")
         for r in mj_rows + pr_rows:
-            print(f"| {r['tool']} | {r['series']} | {r['setting']} | {fmt_t(r['wall_s'])} | {r['max_hand_error_m']:.2e} | {r['status']} |")
+            err = r['max_hand_error_m']
+            err = "-" if err is None else f"{err:.2e}"  # a failed run has no error
+            print(f"| {r['tool']} | {r['series']} | {r['setting']} | {fmt_t(r['wall_s'])} | {err} | {r['status']} |")
         report["scenes"].append({"scene": str(scene), "run": a.run, "electrical": electrical, "mjcf_check": check,
                                  "ratios": ratios, "mujoco": mj_rows, "project": pr_rows, "loads_after_each_pass": loads})
 
