@@ -77,6 +77,8 @@ pub(super) struct Core {
     /// Where the current call of [`step`] must stop (for a stepper's look ahead, e.g. how many
     /// steps remain).
     pub t_stop: f64,
+    /// Singular iteration matrices in a row (the implicit methods; [`Core::reject_singular`]).
+    pub singular_run: u32,
 }
 
 impl Core {
@@ -93,6 +95,7 @@ impl Core {
             stats: Stats::default(),
             initialized: false,
             t_stop: 0.0,
+            singular_run: 0,
         }
     }
 
@@ -119,6 +122,7 @@ impl Core {
         self.h_next = None;
         self.rejected_last = false;
         self.failure = Failure::None;
+        self.singular_run = 0;
         Ok(())
     }
 
@@ -138,6 +142,22 @@ impl Core {
             h * self.controller.fac_min,
             Failure::NonFinite { t: t_bad, index },
         )
+    }
+
+    /// A singular iteration matrix in the attempt with step `h` from `t` (as `rodas.f`): halves
+    /// the step (a rejection), up to 5 times in a row, then [`IntegrateError::SingularMatrix`].
+    /// The implicit steppers set `singular_run = 0` once a matrix factors.
+    pub fn reject_singular<E>(&mut self, h: f64) -> Result<Attempt, IntegrateError<E>> {
+        let t = self.t;
+        self.stats.rejected += 1;
+        self.singular_run += 1;
+        self.rejected_last = true;
+        self.failure = Failure::Singular { t, h };
+        if self.singular_run >= 5 {
+            return Err(IntegrateError::SingularMatrix { t, h });
+        }
+        self.h_next = Some(0.5 * h);
+        Ok(Attempt::Rejected)
     }
 
     /// The controller's proposal `h_new` after an accepted step `h`, limited: no growth right

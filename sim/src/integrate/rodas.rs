@@ -103,7 +103,6 @@ pub struct Rodas {
     f0: Vec<f64>,
     y_prev: Vec<f64>,
     w: [Vec<f64>; 3],
-    singular_run: u32,
     /// Jacobian (row-major `dim x dim`, columns `nc..` zero) and `f_t`; see `Rosenbrock`.
     jac: Vec<f64>,
     dfdt: Vec<f64>,
@@ -154,7 +153,6 @@ impl Rodas {
             f0: z(),
             y_prev: z(),
             w: [z(), z(), z()],
-            singular_run: 0,
             jac: vec![0.0; dim * dim],
             dfdt: z(),
             jac_valid: false,
@@ -319,19 +317,6 @@ impl Rodas {
         }
     }
 
-    /// See `Rosenbrock::reject_singular`.
-    fn reject_singular<E>(&mut self, h: f64) -> Result<Attempt, IntegrateError<E>> {
-        let t = self.core.t;
-        self.core.stats.rejected += 1;
-        self.singular_run += 1;
-        self.core.rejected_last = true;
-        self.core.failure = Failure::Singular { t, h };
-        if self.singular_run >= 5 {
-            return Err(IntegrateError::SingularMatrix { t, h });
-        }
-        self.core.h_next = Some(0.5 * h);
-        Ok(Attempt::Rejected)
-    }
 }
 
 impl<S: OdeJacobian> Adaptive<S> for Rodas {
@@ -373,9 +358,9 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
             self.evaluate_dfdt(sys)?;
         }
         if self.lu_h != h && !self.factor(h) {
-            return self.reject_singular(h);
+            return self.core.reject_singular(h);
         }
-        self.singular_run = 0;
+        self.core.singular_run = 0;
         let (t, n, tab) = (self.core.t, self.dim, self.tab);
         let s_last = tab.stages - 1;
 
@@ -474,7 +459,6 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
         self.core.init("Rodas", self.dim, sys.dim(), t0, y0)?;
         self.nc = sys.coupled_dim();
         assert!(self.nc <= self.dim, "Rodas::init: coupled_dim {} > dim {}", self.nc, self.dim);
-        self.singular_run = 0;
         self.jac_valid = false;
         self.jac_fresh = false;
         self.dfdt_fresh = false;

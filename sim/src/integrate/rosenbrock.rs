@@ -86,7 +86,6 @@ pub struct Rosenbrock {
     /// `y`, `f` at the start of the last accepted step (the Hermite data at the left end).
     y_prev: Vec<f64>,
     f_prev: Vec<f64>,
-    singular_run: u32,
     /// Jacobian (row-major) and `f_t`; `jac_valid`: evaluated since `init`; `jac_fresh`:
     /// evaluated at the current `(t, y)`; accepted steps since the evaluation; `max |J_ij|`.
     jac: Vec<f64>,
@@ -139,7 +138,6 @@ impl Rosenbrock {
             f0: z(),
             y_prev: z(),
             f_prev: z(),
-            singular_run: 0,
             jac: vec![0.0; dim * dim],
             dfdt: z(),
             jac_valid: false,
@@ -270,20 +268,6 @@ impl Rosenbrock {
         ok
     }
 
-    /// A singular iteration matrix in the attempt with step `h` from `t`: halves the step
-    /// (a rejection), up to 5 times in a row, then [`IntegrateError::SingularMatrix`].
-    fn reject_singular<E>(&mut self, h: f64) -> Result<Attempt, IntegrateError<E>> {
-        let t = self.core.t;
-        self.core.stats.rejected += 1;
-        self.singular_run += 1;
-        self.core.rejected_last = true;
-        self.core.failure = Failure::Singular { t, h };
-        if self.singular_run >= 5 {
-            return Err(IntegrateError::SingularMatrix { t, h });
-        }
-        self.core.h_next = Some(0.5 * h);
-        Ok(Attempt::Rejected)
-    }
 }
 
 impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
@@ -325,9 +309,9 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
             self.evaluate_dfdt(sys)?;
         }
         if self.lu_h != h && !self.factor(h) {
-            return self.reject_singular(h);
+            return self.core.reject_singular(h);
         }
-        self.singular_run = 0;
+        self.core.singular_run = 0;
         let (t, n, tab) = (self.core.t, self.dim, self.tab);
 
         for s in 0..4 {
@@ -417,7 +401,6 @@ impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
     /// Evaluates `f(t0, y0)` once; the Jacobian is evaluated by the first step.
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.core.init("Rosenbrock", self.dim, sys.dim(), t0, y0)?;
-        self.singular_run = 0;
         self.jac_valid = false;
         self.jac_fresh = false;
         self.dfdt_fresh = false;
