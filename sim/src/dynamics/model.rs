@@ -31,6 +31,39 @@ pub struct Body {
     pub axis: Unit<Vector3<f64>>,
     /// Inertia about the body origin in body coordinates, fixed children merged.
     pub inertia: Inertia,
+    /// The joint's URDF `<limit>` and `<dynamics>`, as read.
+    pub limits: JointLimits,
+}
+
+/// A joint's URDF `<limit>` and `<dynamics>` elements (ROS URDF spec, `joint` element), as
+/// read; nothing here enters the dynamics unless a scene asks for it. urdf-rs fills an absent
+/// `<limit>` with zeros: a zero range, speed or effort means "not given" and reads as `None`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointLimits {
+    /// `(lower, upper)`, rad; `None` for a continuous joint or when `lower = upper`.
+    pub position: Option<(f64, f64)>,
+    /// Largest |q̇|, rad/s (`velocity`); `None` when not given.
+    pub velocity: Option<f64>,
+    /// Largest |τ|, N m (`effort`); `None` when not given.
+    pub effort: Option<f64>,
+    /// `<dynamics damping>`, N m s/rad (0 when absent).
+    pub damping: f64,
+    /// `<dynamics friction>`, Coulomb friction, N m (0 when absent).
+    pub friction: f64,
+}
+
+impl JointLimits {
+    fn from_urdf(joint: &urdf_rs::Joint) -> Self {
+        let l = &joint.limit;
+        let given = |x: f64| (x.is_finite() && x > 0.0).then_some(x);
+        let position = (joint.joint_type != urdf_rs::JointType::Continuous
+            && l.lower.is_finite()
+            && l.upper.is_finite()
+            && l.lower < l.upper)
+            .then_some((l.lower, l.upper));
+        let (damping, friction) = joint.dynamics.as_ref().map_or((0.0, 0.0), |d| (d.damping, d.friction));
+        JointLimits { position, velocity: given(l.velocity), effort: given(l.effort), damping, friction }
+    }
 }
 
 /// A named URDF link frame, attached to a body (or the world for `None`).
@@ -196,6 +229,7 @@ impl Model {
                         x_parent_joint: x_body_joint,
                         axis: Unit::new_normalize(Vector3::from(joint.axis.xyz.0)),
                         inertia: Inertia::zero(),
+                        limits: JointLimits::from_urdf(joint),
                     });
                     (Some(idx), Isometry3::identity())
                 }

@@ -90,6 +90,7 @@ fn random_tree(n: usize, seed: u64, branching: bool) -> Model {
             x_parent_joint: x,
             axis: Unit::new_normalize(rng.unit_vector()),
             inertia: random_inertia(&mut rng),
+            limits: Default::default(),
         });
     }
     Model {

@@ -345,3 +345,28 @@ fn an_immovable_contact_is_reported() {
     assert!(err.to_string().contains("t = 2.5"), "{err}");
     assert!(err.to_string().contains("singular"), "{err}");
 }
+
+/// `<limit>` and `<dynamics>` are read per dof: a range for a revolute joint, none for a
+/// continuous one or an absent `<limit>` (urdf-rs's zeros), speed and effort only when given.
+#[test]
+fn urdf_limits_and_dynamics_are_read_per_dof() {
+    let xml = r#"<robot name="r">
+      <link name="base"/>
+      <link name="a"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <link name="b"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <link name="c"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-1.5" upper="2.5" effort="30" velocity="3.1"/><dynamics damping="0.2" friction="0.4"/></joint>
+      <joint name="j2" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/>
+        <limit effort="12" velocity="0"/></joint>
+      <joint name="j3" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 1 0"/></joint>
+    </robot>"#;
+    let m = Model::from_urdf(xml, "t.urdf", nalgebra::Vector3::zeros()).unwrap();
+    let l = |j: &str| m.bodies[m.dof_of_joint(j).unwrap()].limits;
+    assert_eq!(l("j1").position, Some((-1.5, 2.5)));
+    assert_eq!((l("j1").velocity, l("j1").effort), (Some(3.1), Some(30.0)));
+    assert_eq!((l("j1").damping, l("j1").friction), (0.2, 0.4));
+    assert_eq!(l("j2").position, None);
+    assert_eq!((l("j2").velocity, l("j2").effort), (None, Some(12.0)));
+    assert_eq!(l("j3"), crate::dynamics::model::JointLimits::default());
+}
