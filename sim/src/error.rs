@@ -7,19 +7,22 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ModelError {
-    #[error("{file}: the URDF could not be parsed: {message}")]
-    Parse { file: String, message: String },
-    #[error("{file}: joint `{joint}` is of type `{kind}`, which is not modelled (revolute, continuous and fixed are)")]
-    UnsupportedJoint { file: String, joint: String, kind: String },
-    #[error("{file}: joint `{joint}` refers to link `{link}`, which the URDF does not define")]
-    MissingLink { file: String, joint: String, link: String },
-    #[error("{file}: link `{link}` is the child of both `{first}` and `{second}`: kinematic loops are not modelled")]
-    Loop { file: String, link: String, first: String, second: String },
+    /// The text is not well-formed XML (or not a URDF at all).
+    #[error("{file}:{line}: the URDF could not be parsed: {message}")]
+    Parse { file: String, line: usize, message: String },
+    /// One element is wrong: `element` is written as in the file (`<joint name="j1">`), `why`
+    /// says what is wrong and what to do.
+    #[error("{file}:{line}: {element}: {why}")]
+    At { file: String, line: usize, element: String, why: String },
+    #[error("{file}:{line}: {hint}", hint = crate::dynamics::urdf::XACRO_HINT)]
+    Xacro { file: String, line: usize },
+    /// A loading option of the scene (`robot.locked.<joint>`, ...) that does not fit the URDF:
+    /// `field` is the scene field.
+    #[error("{file}: {field} = {value}: {why}")]
+    Option { file: String, field: String, value: String, why: String },
     #[error("{file}: the links must form one tree with one root; found roots {roots:?}")]
     Roots { file: String, roots: Vec<String> },
-    #[error("{file}: {item} `{name}`: {field} = {value}: {why}")]
-    BadValue { file: String, item: &'static str, name: String, field: &'static str, value: String, why: &'static str },
-    #[error("{file}: the URDF has no movable joint")]
+    #[error("{file}: the URDF has no movable joint (every joint is fixed or locked)")]
     NoJoints { file: String },
     #[error("{file}: elements nested more than {limit} deep (a URDF is about 6 deep); refused before parsing")]
     TooDeep { file: String, limit: usize },

@@ -7,7 +7,6 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::UnitQuaternion;
 use schemas::{
     frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, EnergyState, FrameTransforms, HandState,
     JointState, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
@@ -145,7 +144,7 @@ impl<'a> Recorder<'a> {
         root[0].timestamp = stamp;
         for (j, tr) in model.urdf_joints.iter().zip(joints) {
             let x = match j.dof {
-                Some(d) => j.origin * UnitQuaternion::from_axis_angle(&model.bodies[d].axis, o.q[d]),
+                Some(d) => model.bodies[d].after(&j.origin, o.q[d]),
                 None => j.origin,
             };
             let t = x.translation.vector;

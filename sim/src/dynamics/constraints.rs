@@ -9,7 +9,7 @@ use nalgebra::{DMatrix, DVector, Unit, Vector3};
 
 use super::data::Data;
 use super::kinematics::BodyPoint;
-use super::model::Model;
+use super::model::{JointKind, Model};
 
 /// One point held on a world plane.
 #[derive(Clone, Debug, PartialEq)]
@@ -89,7 +89,10 @@ pub fn constraint_rows(
         let mut cur = Some(b);
         while let Some(j) = cur {
             let z = data.x_world_body[j].rotation * model.bodies[j].axis.into_inner();
-            jac[(k, j)] = n.dot(&z.cross(&(p - data.x_world_body[j].translation.vector)));
+            jac[(k, j)] = match model.bodies[j].kind {
+                JointKind::Revolute => n.dot(&z.cross(&(p - data.x_world_body[j].translation.vector))),
+                JointKind::Prismatic => n.dot(&z),
+            };
             cur = model.bodies[j].parent;
         }
     }

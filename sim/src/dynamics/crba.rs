@@ -11,12 +11,13 @@
 //! quantities in one frame; pinocchio's `crba` likewise accumulates world-frame composite
 //! inertias). The motion subspace of a revolute joint with world axis z through the world
 //! point o is `S = (z, o × z)`: a rotation about z through o moves the body-fixed point at the
-//! world origin with velocity `z × (0 − o) = o × z` (RBDA §2.3's Plücker motion vector).
+//! world origin with velocity `z × (0 − o) = o × z` (RBDA §2.3's Plücker motion vector); that of
+//! a prismatic joint along the world direction z is `S = (0, z)` wherever its origin.
 
 use nalgebra::{DMatrix, Vector3};
 
 use super::data::Data;
-use super::model::Model;
+use super::model::{JointKind, Model};
 use super::spatial::{Motion, Xform};
 
 /// Joint-space inertia of the rigid bodies (nv x nv, kg m^2), stored in `data.m`, symmetric.
@@ -47,14 +48,20 @@ pub fn crba_placed<'d>(model: &Model, data: &'d mut Data) -> &'d DMatrix<f64> {
         }
     }
     for i in 0..nv {
-        let s_i = Motion::new(model.bodies[i].axis.into_inner(), Vector3::zeros());
+        let s_i = model.bodies[i].subspace();
         let mut f = data.ic[i].mul(&s_i);
-        data.m[(i, i)] = s_i.w.dot(&f.n);
+        data.m[(i, i)] = match model.bodies[i].kind {
+            JointKind::Revolute => s_i.w.dot(&f.n),
+            JointKind::Prismatic => s_i.v.dot(&f.f),
+        };
         let mut j = i;
         while let Some(p) = model.bodies[j].parent {
             f = f.to_parent_x(&data.xm_parent_body[j]);
             j = p;
-            let m_ij = model.bodies[j].axis.dot(&f.n);
+            let m_ij = match model.bodies[j].kind {
+                JointKind::Revolute => model.bodies[j].axis.dot(&f.n),
+                JointKind::Prismatic => model.bodies[j].axis.dot(&f.f),
+            };
             data.m[(i, j)] = m_ij;
             data.m[(j, i)] = m_ij;
         }
@@ -72,7 +79,10 @@ pub fn crba_world<'d>(model: &Model, data: &'d mut Data) -> &'d DMatrix<f64> {
         let x = Xform::from(&data.x_world_body[i]);
         data.ic[i] = body.inertia.to_parent_x(&x);
         let z = x.rot * body.axis.into_inner();
-        data.s_world[i] = Motion::new(z, x.trans.cross(&z));
+        data.s_world[i] = match body.kind {
+            JointKind::Revolute => Motion::new(z, x.trans.cross(&z)),
+            JointKind::Prismatic => Motion::new(Vector3::zeros(), z),
+        };
     }
     // composite inertias, leaves first (a parent has a lower index): sums in one frame
     for i in (0..nv).rev() {

@@ -6,12 +6,13 @@
 //! `ω_i = ω_λ + z_i q̇_i`, `v_i = v_λ + ω_λ × (o_i − o_λ)`,
 //! `α_i = α_λ + ω_λ × z_i q̇_i (+ z_i q̈_i)`, `a_i = a_λ + α_λ × r + ω_λ × (ω_λ × r)`, r = o_i − o_λ.
 //! A point p on body b: `v_p = v_b + ω_b × (p − o_b)`, the Jacobian column of an ancestor joint
-//! j is `z_j × (p − o_j)`, and `J̇q̇ = a_b + α_b × r + ω_b × (ω_b × r)` with the bias values.
+//! j is `z_j × (p − o_j)` (`z_j` for a prismatic joint, which adds `z_i q̇_i` to `v_i`, nothing
+//! to `ω_i`, and the Coriolis term `2 ω_λ × z_i q̇_i` to `a_i`), and `J̇q̇ = a_b + α_b × r + ω_b × (ω_b × r)` with the bias values.
 
 use nalgebra::{DMatrix, Vector3};
 
 use super::data::Data;
-use super::model::Model;
+use super::model::{JointKind, Model};
 
 /// Placements of every body, in its parent (`data.x_parent_body`, `data.xm_parent_body`) and
 /// in the world (`data.x_world_body`). `q`: joint angles (nv), rad.
@@ -46,11 +47,24 @@ pub fn forward_velocities(model: &Model, data: &mut Data, qd: &[f64]) {
             None => (Vector3::zeros(), Vector3::zeros(), Vector3::zeros(), Vector3::zeros(), Vector3::zeros()),
         };
         let r = o - o_p;
-        let wz = z_world * qd[i];
-        data.w_world[i] = w_p + wz;
-        data.v_world[i] = v_p + w_p.cross(&r);
-        data.alpha_bias_world[i] = al_p + w_p.cross(&wz);
-        data.a_bias_world[i] = a_p + al_p.cross(&r) + w_p.cross(&w_p.cross(&r));
+        match body.kind {
+            JointKind::Revolute => {
+                let wz = z_world * qd[i];
+                data.w_world[i] = w_p + wz;
+                data.v_world[i] = v_p + w_p.cross(&r);
+                data.alpha_bias_world[i] = al_p + w_p.cross(&wz);
+                data.a_bias_world[i] = a_p + al_p.cross(&r) + w_p.cross(&w_p.cross(&r));
+            }
+            JointKind::Prismatic => {
+                // the origin slides along z at q̇: a relative velocity z q̇ in the parent, whose
+                // Coriolis term is 2 ω_λ × z q̇ (Craig §6.5, eq 6.47 for a prismatic joint)
+                let vz = z_world * qd[i];
+                data.w_world[i] = w_p;
+                data.v_world[i] = v_p + w_p.cross(&r) + vz;
+                data.alpha_bias_world[i] = al_p;
+                data.a_bias_world[i] = a_p + al_p.cross(&r) + w_p.cross(&w_p.cross(&r)) + 2.0 * w_p.cross(&vz);
+            }
+        }
     }
 }
 
@@ -103,7 +117,10 @@ impl BodyPoint {
         let mut cur = self.body;
         while let Some(j) = cur {
             let z = data.x_world_body[j].rotation * model.bodies[j].axis.into_inner();
-            let col = z.cross(&(p - data.x_world_body[j].translation.vector));
+            let col = match model.bodies[j].kind {
+                JointKind::Revolute => z.cross(&(p - data.x_world_body[j].translation.vector)),
+                JointKind::Prismatic => z,
+            };
             jac.fixed_view_mut::<3, 1>(0, j).copy_from(&col);
             cur = model.bodies[j].parent;
         }
@@ -119,7 +136,10 @@ impl BodyPoint {
         let mut cur = self.body;
         while let Some(j) = cur {
             let z = data.x_world_body[j].rotation * model.bodies[j].axis.into_inner();
-            row[j] = n.dot(&z.cross(&(p - data.x_world_body[j].translation.vector)));
+            row[j] = match model.bodies[j].kind {
+                JointKind::Revolute => n.dot(&z.cross(&(p - data.x_world_body[j].translation.vector))),
+                JointKind::Prismatic => n.dot(&z),
+            };
             cur = model.bodies[j].parent;
         }
     }

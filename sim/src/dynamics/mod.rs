@@ -14,6 +14,7 @@ pub mod rnea;
 pub mod samples;
 pub mod spatial;
 pub mod spd;
+pub mod urdf;
 pub mod walker_orin;
 
 pub use data::Data;

@@ -1,12 +1,13 @@
 //! Recursive Newton–Euler inverse dynamics, `τ = M(q) q̈ + C(q, q̇) q̇ + G(q)`, in body
 //! coordinates: Featherstone, *Rigid Body Dynamics Algorithms*, §5.3, Table 5.1; Luh, Walker
 //! and Paul (1980). Gravity enters as a fictitious base acceleration `a_0 = −g`.
-//! O(n) in the number of bodies.
+//! O(n) in the number of bodies. A revolute joint's motion subspace is `S = [a; 0]`, a
+//! prismatic joint's `S = [0; a]` (RBDA Table 4.1).
 
 use nalgebra::{DVector, Vector3};
 
 use super::data::Data;
-use super::model::Model;
+use super::model::{JointKind, Model};
 use super::spatial::Motion;
 
 /// Inverse dynamics of the rigid bodies alone (no motor inertia, no friction).
@@ -51,9 +52,13 @@ pub fn rnea_placed<'d>(
             Some(p) => (data.v_body[p], data.a_body[p]),
             None => (Motion::ZERO, a_world),
         };
-        let vj = Motion::new(axis * qd[i], Vector3::zeros());
+        // S q̇ and S q̈ with S = [a; 0] (revolute) or [0; a] (prismatic)
+        let (vj, aj) = match body.kind {
+            JointKind::Revolute => (Motion::new(axis * qd[i], Vector3::zeros()), Motion::new(axis * qdd[i], Vector3::zeros())),
+            JointKind::Prismatic => (Motion::new(Vector3::zeros(), axis * qd[i]), Motion::new(Vector3::zeros(), axis * qdd[i])),
+        };
         let v = v_parent.to_child_x(x).add(&vj);
-        let a = a_parent.to_child_x(x).add(&Motion::new(axis * qdd[i], Vector3::zeros())).add(&v.cross_motion(&vj));
+        let a = a_parent.to_child_x(x).add(&aj).add(&v.cross_motion(&vj));
         let inertia = &body.inertia;
         data.f_body[i] = inertia.mul(&a).add(&v.cross_force(&inertia.mul(&v)));
         data.v_body[i] = v;
@@ -62,7 +67,11 @@ pub fn rnea_placed<'d>(
     // backward pass: joint torques, inward to the root
     for i in (0..nv).rev() {
         let body = &model.bodies[i];
-        data.tau[i] = body.axis.dot(&data.f_body[i].n);
+        // τ = Sᵀ f: the moment about the axis, or the force along it
+        data.tau[i] = match body.kind {
+            JointKind::Revolute => body.axis.dot(&data.f_body[i].n),
+            JointKind::Prismatic => body.axis.dot(&data.f_body[i].f),
+        };
         if let Some(p) = body.parent {
             let f = data.f_body[i].to_parent_x(&data.xm_parent_body[i]);
             data.f_body[p] = data.f_body[p].add(&f);

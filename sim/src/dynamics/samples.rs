@@ -5,7 +5,7 @@
 
 use nalgebra::{Isometry3, Matrix3, Translation3, Unit, UnitQuaternion, Vector3};
 
-use super::model::{Body, Frame, Model, UrdfJoint};
+use super::model::{Body, Frame, JointKind, Model, UrdfJoint};
 use super::spatial::Inertia;
 
 /// SplitMix64: a tiny, well-mixed, reproducible generator.
@@ -52,9 +52,11 @@ fn random_inertia(rng: &mut SplitMix64) -> Inertia {
     Inertia::from_com(mass, com, r * diag * r.transpose())
 }
 
-/// A random kinematic tree of `n` revolute joints: body i hangs from a random earlier body
-/// (or the root) when `branching`, else from body i − 1 (a chain).
-fn random_tree(n: usize, seed: u64, branching: bool) -> Model {
+/// A random kinematic tree of `n` joints: body i hangs from a random earlier body (or the
+/// root) when `branching`, else from body i − 1 (a chain). With `prismatic`, each joint is
+/// prismatic with probability 1/3 (drawn after everything else, so that the revolute models
+/// of a seed stay the same), else revolute.
+fn random_tree(n: usize, seed: u64, branching: bool, prismatic: bool) -> Model {
     let mut rng = SplitMix64(seed);
     let mut bodies = Vec::with_capacity(n);
     let mut frames = vec![Frame { name: "base".into(), body: None, x_body_frame: Isometry3::identity() }];
@@ -86,6 +88,7 @@ fn random_tree(n: usize, seed: u64, branching: bool) -> Model {
         bodies.push(Body {
             link,
             joint,
+            kind: JointKind::Revolute,
             parent,
             x_parent_joint: x,
             axis: Unit::new_normalize(rng.unit_vector()),
@@ -93,23 +96,44 @@ fn random_tree(n: usize, seed: u64, branching: bool) -> Model {
             limits: Default::default(),
         });
     }
+    if prismatic {
+        let mut kinds = SplitMix64(seed ^ 0x5052_4953_4D41_5449);
+        for b in &mut bodies {
+            if kinds.next_u64() % 3 == 0 {
+                b.kind = JointKind::Prismatic;
+            }
+        }
+    }
     Model {
-        name: format!("random_{}_{}", if branching { "tree" } else { "chain" }, n),
+        name: format!("random_{}{}_{}", if prismatic { "mixed_" } else { "" }, if branching { "tree" } else { "chain" }, n),
         root_link: "base".into(),
         nv: n,
         bodies,
         frames,
         urdf_joints,
         gravity: Vector3::new(0.0, 0.0, -9.81),
+        locked: Vec::new(),
+        mimics: Vec::new(),
+        repaired_inertias: Vec::new(),
     }
 }
 
 /// A random serial chain of `n` revolute joints.
 pub fn random_chain(n: usize, seed: u64) -> Model {
-    random_tree(n, seed, false)
+    random_tree(n, seed, false, false)
+}
+
+/// A random serial chain of `n` joints, about a third of them prismatic.
+pub fn random_mixed_chain(n: usize, seed: u64) -> Model {
+    random_tree(n, seed, false, true)
+}
+
+/// A random branching tree of `n` joints, about a third of them prismatic.
+pub fn random_mixed_tree(n: usize, seed: u64) -> Model {
+    random_tree(n, seed, true, true)
 }
 
 /// A random branching tree of `n` revolute joints.
 pub fn random_branching_tree(n: usize, seed: u64) -> Model {
-    random_tree(n, seed, true)
+    random_tree(n, seed, true, false)
 }

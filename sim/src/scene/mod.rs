@@ -13,8 +13,10 @@ use crate::dynamics::constraints::PointOnPlane;
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 use crate::dynamics::kinematics::{body_point, forward_kinematics, forward_velocities, BodyPoint};
 use crate::dynamics::motor::{Drives, Electrical, MotorParams};
+use crate::dynamics::model::UrdfOptions;
+use crate::dynamics::urdf::{resolve_meshes, MeshInfo};
 use crate::dynamics::{Data, Model};
-use crate::error::{short, SceneError};
+use crate::error::{short, ModelError, SceneError};
 use crate::limits::{read_text, MAX_INPUT_BYTES, MAX_SAMPLES};
 pub use spec::SceneSpec;
 use spec::{Branch, Direction, PerJoint, PointSpec};
@@ -61,6 +63,11 @@ pub struct Scene {
     pub(crate) integrator: Integrator,
     pub(crate) duration: f64,
     pub(crate) output_rate: f64,
+    /// The scene file's directory (`None` for text with no file), for `robot.package_paths`.
+    pub(crate) dir: Option<std::path::PathBuf>,
+    /// The URDF's `<mesh>` references and what became of them (`urdf_xml` holds the resolved
+    /// URIs).
+    pub(crate) meshes: Vec<MeshInfo>,
 }
 
 /// Read access (the fields are private to the crate: a scene never changes after validation).
@@ -145,6 +152,11 @@ impl Scene {
     pub fn output_rate(&self) -> f64 {
         self.output_rate
     }
+    /// The URDF's `<mesh>` references: resolved to `file://` URIs in [`Scene::urdf_xml`] or
+    /// not (then the recording's viewers will not find them: say so in its metadata).
+    pub fn meshes(&self) -> &[MeshInfo] {
+        &self.meshes
+    }
 }
 
 /// Tolerance on the initial constraint violation |C(q0)|, m, and |Ċ|, m/s.
@@ -167,13 +179,24 @@ impl Scene {
         let file = path.display().to_string();
         let text = read_text(path, MAX_INPUT_BYTES).map_err(|e| SceneError::new(&file, "(file)", "", e.to_string()))?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        Self::from_json(&text, &file, |name| read_urdf_file(&dir, name))
+        Self::from_json_in(&text, &file, Some(&dir), |name| read_urdf_file(&dir, name))
     }
 
     /// Parse and validate scene JSON. `read_urdf` returns the text of the named URDF.
     pub fn from_json(
         text: &str,
         source: &str,
+        read_urdf: impl Fn(&str) -> Result<String, String>,
+    ) -> Result<Scene, SceneError> {
+        Self::from_json_in(text, source, None, read_urdf)
+    }
+
+    /// [`Scene::from_json`] for a scene file in directory `dir`, against which
+    /// `robot.package_paths` and the URDF's relative mesh paths are resolved.
+    pub fn from_json_in(
+        text: &str,
+        source: &str,
+        dir: Option<&Path>,
         read_urdf: impl Fn(&str) -> Result<String, String>,
     ) -> Result<Scene, SceneError> {
         let de = &mut serde_json::Deserializer::from_str(text);
@@ -195,7 +218,7 @@ impl Scene {
             SceneError::new(source, field, json_literal_at(text, e.inner()), why)
         })?;
         let urdf_xml = read_urdf(&spec.urdf).map_err(|why| SceneError::new(source, "urdf", &spec.urdf, why))?;
-        build(spec, source, urdf_xml)
+        build(spec, source, urdf_xml, dir)
     }
 
     /// A variation of this scene: `edit` changes a copy of its spec, which is validated again
@@ -204,7 +227,7 @@ impl Scene {
     pub fn vary(&self, edit: impl FnOnce(&mut SceneSpec)) -> Result<Scene, SceneError> {
         let mut spec = self.spec.clone();
         edit(&mut spec);
-        build(spec, &self.source, self.urdf_xml.clone())
+        build(spec, &self.source, self.urdf_xml.clone(), self.dir.as_deref())
     }
 
     /// The run called `name`.
@@ -318,13 +341,13 @@ fn non_negative(x: f64) -> bool {
     x >= 0.0
 }
 
-fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneError> {
+fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>) -> Result<Scene, SceneError> {
     let c = Ctx { file };
     if spec.name.is_empty() || !spec.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch)) {
         return Err(c.err("name", format!("{:?}", spec.name), "must be non-empty and use only letters, digits, '-', '_' and '.' (it names output files)"));
     }
     let gravity = c.vec3("gravity", spec.gravity)?;
-    let model = Model::from_urdf(&urdf_xml, &spec.urdf, gravity).map_err(|e| c.err("urdf", &spec.urdf, e.to_string()))?;
+    let (model, urdf_xml, meshes) = load_robot(&c, &spec, urdf_xml, gravity, dir)?;
     let nv = model.nv;
     let duration = c.number("duration", spec.duration, positive, "must be > 0 s")?;
     let output_rate = c.number("output_rate", spec.output_rate, positive, "must be > 0 Hz")?;
@@ -501,8 +524,46 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String) -> Result<Scene, SceneEr
         integrator,
         duration,
         output_rate,
+        dir: dir.map(Path::to_path_buf),
+        meshes,
         spec,
     })
+}
+
+/// The model of the scene's URDF with the scene's `robot` options, and the URDF text with its
+/// meshes resolved (the same text when it has none).
+fn load_robot(
+    c: &Ctx,
+    spec: &SceneSpec,
+    urdf_xml: String,
+    gravity: Vector3<f64>,
+    dir: Option<&Path>,
+) -> Result<(Model, String, Vec<MeshInfo>), SceneError> {
+    let robot = &spec.robot;
+    let options = UrdfOptions { locked: robot.locked.clone(), repair_inertia: robot.repair_inertia, field: "robot".into() };
+    let model = Model::from_urdf_with(&urdf_xml, &spec.urdf, gravity, &options).map_err(|e| match e {
+        ModelError::Option { field, value, why, .. } => c.err(field, value, why),
+        e => c.err("urdf", &spec.urdf, e.to_string()),
+    })?;
+    let mut packages = std::collections::BTreeMap::new();
+    for (pkg, d) in &robot.package_paths {
+        let p = dir.map_or_else(|| Path::new(d).to_path_buf(), |base| base.join(d));
+        let p = std::path::absolute(&p).unwrap_or(p);
+        if !p.is_dir() {
+            return Err(c.err(format!("robot.package_paths.{pkg}"), d, format!("no directory {} (relative to the scene file)", p.display())));
+        }
+        packages.insert(pkg.clone(), p);
+    }
+    let urdf_dir = dir.map(|d| {
+        let p = d.join(&spec.urdf);
+        let p = p.parent().map(Path::to_path_buf).unwrap_or_default();
+        std::path::absolute(&p).unwrap_or(p)
+    });
+    let (text, meshes) = resolve_meshes(&urdf_xml, &spec.urdf, &packages, urdf_dir.as_deref())
+        .map_err(|e| c.err("urdf", &spec.urdf, e.to_string()))?;
+    // the text as read when nothing was rewritten
+    let urdf_xml = if text == urdf_xml { urdf_xml } else { text };
+    Ok((model, urdf_xml, meshes))
 }
 
 #[cfg(test)]

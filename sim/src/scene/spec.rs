@@ -80,6 +80,34 @@ pub struct SceneSpec {
     pub integrator: IntegratorSpec,
     /// The runs of this scene (e.g. the paper's three elbow configurations).
     pub runs: Vec<RunSpec>,
+    /// How the URDF is loaded: locked joints, inertia repair, mesh packages (absent: as is).
+    #[serde(default, skip_serializing_if = "RobotSpec::is_default")]
+    pub robot: RobotSpec,
+}
+
+/// How the URDF is loaded (`"robot": {...}`); every key optional.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobotSpec {
+    /// Joints made fixed at a value (rad, or m for a prismatic joint): their child is welded
+    /// to the parent at that value (a gripper, a joint the task does not use). A `<mimic>`
+    /// joint whose leader is locked is locked with it at `multiplier · value + offset`.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub locked: std::collections::BTreeMap<String, f64>,
+    /// Replace an implausible inertia of a moving link (not positive semi-definite, or
+    /// violating the triangle inequality) by the nearest plausible one; the repaired links
+    /// are listed in the scene's model (`Model::repaired_inertias`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub repair_inertia: bool,
+    /// ROS package name → directory (relative to the scene file) for `package://` mesh URIs.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub package_paths: std::collections::BTreeMap<String, String>,
+}
+
+impl RobotSpec {
+    pub fn is_default(&self) -> bool {
+        *self == RobotSpec::default()
+    }
 }
 
 /// DC motor and gear of each joint (the paper's eqs 1–12); each entry per joint or for all.
