@@ -21,3 +21,5 @@ pub use data::Data;
 pub use model::Model;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod urdf_tests;

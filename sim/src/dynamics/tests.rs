@@ -12,7 +12,7 @@ use super::kinematics::{forward_kinematics, forward_velocities, BodyPoint};
 use super::model::Model;
 use super::motor::{Drives, MotorParams};
 use super::rnea::{bias_forces, rnea};
-use super::samples::{random_branching_tree, random_chain, SplitMix64};
+use super::samples::{random_branching_tree, random_chain, random_mixed_chain, random_mixed_tree, SplitMix64};
 use super::walker_orin;
 
 fn models() -> Vec<Model> {
@@ -20,7 +20,13 @@ fn models() -> Vec<Model> {
     for (k, n) in [1usize, 2, 3, 7, 10, 16].iter().enumerate() {
         v.push(random_chain(*n, 100 + k as u64));
         v.push(random_branching_tree(*n, 200 + k as u64));
+        // revolute and prismatic joints mixed: every identity below holds for them too
+        v.push(random_mixed_chain(*n, 400 + k as u64));
+        v.push(random_mixed_tree(*n, 500 + k as u64));
     }
+    // the mixed samples do hold prismatic joints (a test that cannot fail is no test)
+    let prismatic = v.iter().flat_map(|m| &m.bodies).filter(|b| b.kind == super::model::JointKind::Prismatic).count();
+    assert!(prismatic >= 10, "only {prismatic} prismatic joints in the samples");
     v
 }
 
