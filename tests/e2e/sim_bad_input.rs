@@ -28,9 +28,9 @@ fn cli_rejects_bad_scenes_with_status_2() {
     let truncated = write("truncated", &PAPER_SCENE_JSON[..300], PAPER_URDF);
     let infinite = write("infinite", &PAPER_SCENE_JSON.replace("\"duration\": 5.0", "\"duration\": 1e999"), PAPER_URDF);
     let prismatic = write(
-        "prismatic",
+        "planar",
         PAPER_SCENE_JSON,
-        &PAPER_URDF.replace(r#"<joint name="joint5" type="revolute">"#, r#"<joint name="joint5" type="prismatic">"#),
+        &PAPER_URDF.replace(r#"<joint name="joint5" type="revolute">"#, r#"<joint name="joint5" type="planar">"#),
     );
     let not_xml = write("not-xml", PAPER_SCENE_JSON, "<<<");
     let missing = dir.path().join("missing.json");
@@ -39,7 +39,7 @@ fn cli_rejects_bad_scenes_with_status_2() {
         (&negative_r, &["field `motor.resistance` = -1.1", "must be > 0 ohm"]),
         (&truncated, &["field `(document)`", "EOF while parsing"]),
         (&infinite, &["field `duration` = 1e999", "number out of range"]),
-        (&prismatic, &["paper_arm.urdf: joint `joint5` is of type `prismatic`"]),
+        (&prismatic, &["paper_arm.urdf:53: <joint name=\"joint5\">: type=\"planar\""]),
         (&not_xml, &["the URDF could not be parsed"]),
         (&missing, &["(file)"]),
     ];

@@ -214,6 +214,11 @@ fn pose(p: &UrdfPose) -> Isometry3<f64> {
     Isometry3::from_parts(Translation3::new(x, y, z), UnitQuaternion::from_euler_angles(r, pi, ya))
 }
 
+/// `x y z` as in a URDF attribute.
+fn v3(v: &[f64; 3]) -> String {
+    format!("{} {} {}", v[0], v[1], v[2])
+}
+
 fn finite3(v: &[f64; 3]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
@@ -384,13 +389,13 @@ impl Model {
             children[p].push(ji);
             if !finite3(&joint.origin.xyz) || !finite3(&joint.origin.rpy) {
                 return Err(at(&file, joint.line, joint_elem(joint), format!(
-                    "<origin xyz=\"{:?}\" rpy=\"{:?}\">: must be finite", joint.origin.xyz, joint.origin.rpy
+                    "<origin xyz=\"{}\" rpy=\"{}\">: must be finite", v3(&joint.origin.xyz), v3(&joint.origin.rpy)
                 )));
             }
             let axis = Vector3::from(joint.axis);
             if kind.is_some() && !(finite3(&joint.axis) && axis.norm() > 1e-9) {
                 return Err(at(&file, joint.line, joint_elem(joint), format!(
-                    "<axis xyz=\"{:?}\">: must be a finite non-zero vector", joint.axis
+                    "<axis xyz=\"{}\">: must be a finite non-zero vector", v3(&joint.axis)
                 )));
             }
             let origin = match (kind, locked.get(joint.name.as_str())) {
@@ -538,7 +543,7 @@ fn checked_inertia(file: &str, link: &UrdfLink, repair: bool, field: &str, repai
         return Err(bad(format!("<mass value=\"0\"> with <inertia {written}>: zero mass with a non-zero inertia is not a physical body; give the mass, or zero the inertia")));
     }
     if !finite3(&inertial.origin.xyz) || !finite3(&inertial.origin.rpy) {
-        return Err(bad(format!("<origin xyz=\"{:?}\" rpy=\"{:?}\">: must be finite", inertial.origin.xyz, inertial.origin.rpy)));
+        return Err(bad(format!("<origin xyz=\"{}\" rpy=\"{}\">: must be finite", v3(&inertial.origin.xyz), v3(&inertial.origin.rpy))));
     }
     let i = Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
     let eig = i.symmetric_eigen();
