@@ -208,8 +208,17 @@ impl MetadataRecord for SceneRecord {
 pub struct UrdfRecord {
     /// The file name the scene gives.
     pub file: String,
-    /// Its text.
+    /// Its text (with mesh references resolved to `file://` URIs when the scene gives
+    /// `robot.package_paths`).
     pub xml: String,
+    /// What became of the URDF's `<mesh>` references (absent when it has none): whether they
+    /// are resolved and present, or that the meshes are not embedded and why.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub meshes: Option<String>,
+    /// Links whose implausible inertia the scene's `robot.repair_inertia` replaced, with the
+    /// principal moments before and after (absent when none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repaired_inertias: Option<String>,
 }
 
 impl MetadataRecord for UrdfRecord {

@@ -99,7 +99,14 @@ impl<'a> Recorder<'a> {
         writer.write_record(&run_info).map_err(err)?;
         let source = Path::new(&scene.source).file_name().map_or(scene.source.clone(), |f| f.to_string_lossy().into_owned());
         writer.write_record(&SceneRecord { json: serde_json::to_string_pretty(&scene.spec).unwrap_or_default(), source }).map_err(err)?;
-        writer.write_record(&UrdfRecord { file: scene.spec.urdf.clone(), xml: scene.urdf_xml.clone() }).map_err(err)?;
+        writer
+            .write_record(&UrdfRecord {
+                file: scene.spec.urdf.clone(),
+                xml: scene.urdf_xml.clone(),
+                meshes: crate::dynamics::urdf::mesh_summary(&scene.meshes),
+                repaired_inertias: crate::dynamics::model::repair_summary(&scene.model.repaired_inertias),
+            })
+            .map_err(err)?;
 
         writer
             .write(topics::ROBOT_DESCRIPTION, 0, &RosString { data: scene.urdf_xml.clone() })

@@ -594,3 +594,14 @@ pub fn repair_principal_moments(lam: [f64; 3]) -> [f64; 3] {
     out.sort_by(f64::total_cmp);
     out
 }
+
+/// The repairs as one line for the recording's metadata; `None` when there are none.
+pub fn repair_summary(repairs: &[InertiaRepair]) -> Option<String> {
+    (!repairs.is_empty()).then(|| {
+        repairs
+            .iter()
+            .map(|r| format!("{}: principal moments {:?} -> {:?} kg m^2", r.link, r.before, r.after))
+            .collect::<Vec<_>>()
+            .join("; ")
+    })
+}

@@ -520,3 +520,21 @@ pub fn resolve_meshes(
 fn xml_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('"', "&quot;").replace('<', "&lt;")
 }
+
+/// One sentence on the meshes for the recording's metadata; `None` when there are none.
+pub fn mesh_summary(meshes: &[MeshInfo]) -> Option<String> {
+    if meshes.is_empty() {
+        return None;
+    }
+    let present = meshes.iter().filter(|m| m.exists).count();
+    if present == meshes.len() {
+        return Some(format!("all {} mesh references resolved to file:// URIs of files present when recorded", meshes.len()));
+    }
+    let missing: Vec<String> = meshes.iter().filter(|m| !m.exists).map(|m| format!("{} (link {}): {}", m.filename, m.link, m.note)).collect();
+    Some(format!(
+        "meshes not embedded: {} of {} mesh references do not resolve to a present file (give robot.package_paths in the scene): {}",
+        missing.len(),
+        meshes.len(),
+        missing.join("; ")
+    ))
+}
