@@ -13,13 +13,15 @@
 //!
 //! Why these numbers: the largest scenes in `sim/scenes` are a few kB, the largest URDF
 //! (`hard/chain100.urdf`) 60 kB; a chain of 1000 joints with inertias is 0.3 MB. Parsing a URDF
-//! (`urdf-rs`: an XML tree, written out again and read by serde) peaks at ~55 MB per MB of
-//! text (measured: 220 MB for 4 MiB, 870 MB for 16 MiB, `sim check`), so 4 MiB bounds it. The
+//! with `urdf-rs` (an XML tree, written out again and read by serde) peaked at ~55 MB per MB
+//! of text (measured: 220 MB for 4 MiB, 870 MB for 16 MiB, `sim check`), so 4 MiB bounded it;
+//! the streaming reader that replaced it (`dynamics::urdf`, quick-xml events) keeps only the
+//! elements it reads, and the bound stays. The
 //! mass matrix is dense (nv² doubles) and `rosenbrock`'s Jacobian is (3 nv)², so 1000 joints
 //! is 8 MB and 72 MB; 10 000 joints would be 0.8 GB and 7 GB. A URDF is flat (the tree is
-//! made of references), five or six elements deep; the XML reader under `urdf-rs` (RustyXML)
-//! builds and drops its tree recursively, so deep nesting overflows the stack (an abort, not
-//! an error). 10^8 samples of one run are 10^8 `/joint_states` messages, ~20 GB.
+//! made of references), five or six elements deep; the XML reader once under `urdf-rs` (RustyXML)
+//! built and dropped its tree recursively, so deep nesting overflowed the stack (an abort, not
+//! an error); quick-xml does not recurse, and the depth bound stays as a limit on input. 10^8 samples of one run are 10^8 `/joint_states` messages, ~20 GB.
 //!
 //! The nesting scan follows the grammar of tags in XML 1.0 (W3C, 5th ed., 2008): start-,
 //! end- and empty-element tags (§3.1), comments (§2.5), processing instructions (§2.6), CDATA

@@ -357,7 +357,12 @@ impl Sweep {
             UrdfSource::BuiltIn => Err(format!("the built-in scene has no file `{name}`")),
             UrdfSource::Dir(dir) => crate::scene::read_urdf_file(dir, name),
         };
-        let scene = Scene::from_json(&text, &source, read_urdf).map_err(|source| SweepError::Variant {
+        // the scene's directory: robot.package_paths are relative to it
+        let dir = match &self.urdf {
+            UrdfSource::Dir(dir) => Some(dir.as_path()),
+            UrdfSource::BuiltIn => None,
+        };
+        let scene = Scene::from_json_in(&text, &source, dir, read_urdf).map_err(|source| SweepError::Variant {
             file: self.file.clone(),
             variant: v.name.clone(),
             replacements: v.describe(),

@@ -353,7 +353,7 @@ fn an_immovable_contact_is_reported() {
 }
 
 /// `<limit>` and `<dynamics>` are read per dof: a range for a revolute joint, none for a
-/// continuous one or an absent `<limit>` (urdf-rs's zeros), speed and effort only when given.
+/// continuous one or an absent `<limit>`, speed and effort only when given.
 #[test]
 fn urdf_limits_and_dynamics_are_read_per_dof() {
     let xml = r#"<robot name="r">
