@@ -467,6 +467,22 @@ impl Model {
         if bodies.is_empty() {
             return Err(ModelError::NoJoints { file });
         }
+        // a joint that moves only massless links makes M(q) singular at every q: refuse it at
+        // load, naming the joint (a tool frame on a revolute joint, a link with no <inertial>)
+        let mut massive: Vec<bool> = bodies.iter().map(|b| b.inertia.mass != 0.0 || b.inertia.i_o != Matrix3::zeros()).collect();
+        for i in (0..bodies.len()).rev() {
+            if let (Some(p), true) = (bodies[i].parent, massive[i]) {
+                massive[p] = true;
+            }
+        }
+        if let Some(i) = massive.iter().position(|&m| !m) {
+            let ji = joint_index[bodies[i].joint.as_str()];
+            let j = &doc.joints[ji];
+            return Err(at(&file, j.line, joint_elem(j), format!(
+                "moves only massless links (`{}` and everything after it have no <inertial> mass or inertia), so M(q) would be singular; give the links their <inertial>, or lock the joint in the scene: {}",
+                bodies[i].link, hint(j)
+            )));
+        }
         let urdf_joints = doc
             .joints
             .iter()

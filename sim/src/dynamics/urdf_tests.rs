@@ -235,6 +235,13 @@ fn errors_name_the_line_and_the_element() {
     assert_eq!(Model::from_urdf_with(&floating, "arm.urdf", Vector3::zeros(), &o).unwrap().nv, 2);
     o.locked.insert("to_world".into(), 1.0);
     assert!(err(&floating, &o).contains("robot.locked.to_world = 1: a floating joint is locked at its origin: give 0"));
+    // a revolute tool frame with no inertial: M(q) would be singular; locked, it loads
+    let tool = ARM.replace("</robot>", r#"<link name="tool"/><joint name="tool_spin" type="continuous"><parent link="palm"/><child link="tool"/></joint></robot>"#);
+    let e = err(&tool, &opts);
+    assert!(e.contains("arm.urdf:21: <joint name=\"tool_spin\">: moves only massless links") && e.contains("\"robot\": {\"locked\": {\"tool_spin\": 0.0}}"), "{e}");
+    let mut o = opts.clone();
+    o.locked.insert("tool_spin".into(), 0.0);
+    assert_eq!(Model::from_urdf_with(&tool, "arm.urdf", Vector3::zeros(), &o).unwrap().nv, 2);
     let e = Model::from_urdf(ARM, "arm.xacro", Vector3::zeros()).unwrap_err().to_string();
     assert!(e.contains("run `xacro FILE > robot.urdf` first"), "{e}");
 }
