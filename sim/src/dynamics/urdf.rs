@@ -156,11 +156,13 @@ pub fn element(tag: &str, name: Option<&str>) -> String {
 struct Ctx<'a> {
     file: &'a str,
     line: usize,
+    /// The enclosing `<link name="...">` or `<joint name="...">` (empty at the top level).
+    within: String,
 }
 
 impl Ctx<'_> {
     fn err(&self, element: String, why: impl Into<String>) -> ModelError {
-        ModelError::At { file: self.file.to_string(), line: self.line, element, why: why.into() }
+        ModelError::At { file: self.file.to_string(), line: self.line, element: format!("{}{element}", self.within), why: why.into() }
     }
 }
 
@@ -246,7 +248,7 @@ enum Open {
 /// Parse URDF text. `file` names the file in errors.
 pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
     let lines = Lines::new(text);
-    let at = |line: usize| Ctx { file, line };
+    let at = |line: usize| Ctx { file, line, within: String::new() };
     if file.ends_with(".xacro") {
         return Err(ModelError::Xacro { file: file.to_string(), line: 1 });
     }
@@ -265,7 +267,18 @@ pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
         // the line of the tag's `<` (skip the whitespace before it)
         let tag_at = start + text.get(start..).map_or(0, |s| s.len() - s.trim_start().len());
         let line = lines.of(tag_at.min(text.len()));
-        let c = at(line);
+        // the enclosing link or joint, named in messages about its inner elements
+        let within = stack
+            .iter()
+            .rev()
+            .find_map(|(_, o)| match o {
+                Open::Link(l) => Some(element("link", Some(&doc.links[*l].name))),
+                Open::Inertial(l, ..) => Some(format!("{}<inertial>", element("link", Some(&doc.links[*l].name)))),
+                Open::Joint(j) => Some(element("joint", Some(&doc.joints[*j].name))),
+                Open::Other => None,
+            })
+            .unwrap_or_default();
+        let c = Ctx { file, line, within };
         let (e, empty) = match &ev {
             Event::Start(e) => (e, false),
             Event::Empty(e) => (e, true),
@@ -440,7 +453,7 @@ pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
 fn close(doc: &mut UrdfDoc, open: Open, c: &Ctx) -> Result<(), ModelError> {
     if let Open::Inertial(l, mass, inertia, origin, line) = open {
         let link = &doc.links[l];
-        let here = Ctx { file: c.file, line };
+        let here = Ctx { file: c.file, line, within: String::new() };
         let elem = format!("<link name=\"{}\"><inertial>", link.name);
         let mass = mass.ok_or_else(|| here.err(elem.clone(), "has no <mass value=\"...\"/> (kg); the URDF specification requires one"))?;
         let inertia = inertia.ok_or_else(|| here.err(elem, "has no <inertia .../> (kg m^2); the URDF specification requires one"))?;

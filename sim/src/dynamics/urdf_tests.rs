@@ -213,13 +213,13 @@ fn inertia_checks_and_repair() {
 fn errors_name_the_line_and_the_element() {
     let opts = locked(&[("finger_l_joint", 0.0)]);
     let cases: Vec<(String, &str)> = vec![
-        (ARM.replace(r#"<mass value="1.5"/>"#, r#"<mass/>"#), "arm.urdf:4: <mass>: the attribute `value` (kg) is missing"),
-        (ARM.replace(r#"<mass value="1.5"/>"#, r#"<mass value="1,5"/>"#), "arm.urdf:4: <mass>: value=\"1,5\" is not a number"),
+        (ARM.replace(r#"<mass value="1.5"/>"#, r#"<mass/>"#), "arm.urdf:4: <link name=\"upper\"><inertial><mass>: the attribute `value` (kg) is missing"),
+        (ARM.replace(r#"<mass value="1.5"/>"#, r#"<mass value="1,5"/>"#), "arm.urdf:4: <link name=\"upper\"><inertial><mass>: value=\"1,5\" is not a number"),
         (ARM.replace(r#"type="revolute"><parent link="base"/>"#, r#"type="hinge"><parent link="base"/>"#), "arm.urdf:11: <joint name=\"shoulder\">: unknown joint type `hinge`"),
         (ARM.replace(r#"<child link="palm"/>"#, r#"<child link="hand"/>"#), "arm.urdf:13: <joint name=\"wrist\">: <child link=\"hand\">: the URDF defines no link `hand`"),
         (ARM.replace(r#"<joint name="wrist""#, r#"<joint name="shoulder""#), "arm.urdf:13: <joint name=\"shoulder\">: defined twice (first on line 11)"),
         (ARM.replace(r#"<link name="palm">"#, r#"<link name="upper">"#), "arm.urdf:5: <link name=\"upper\">: defined twice (first on line 4)"),
-        (ARM.replace(r#"<axis xyz="0 0 1"/>"#, r#"<axis xyz="0 0"/>"#), "arm.urdf:13: <axis>: xyz=\"0 0\" must be three numbers"),
+        (ARM.replace(r#"<axis xyz="0 0 1"/>"#, r#"<axis xyz="0 0"/>"#), "arm.urdf:13: <joint name=\"wrist\"><axis>: xyz=\"0 0\" must be three numbers"),
         (ARM.replace(r#"type="fixed"><parent link="world"/>"#, r#"type="floating"><parent link="world"/>"#), "arm.urdf:10: <joint name=\"to_world\">: type=\"floating\": only fixed-base arms"),
         (ARM.replace(r#"<mass value="0.4"/>"#, r#"<mass value="${m}"/>"#), "xacro"),
         (ARM.replace("</link>\n  <link name=\"palm\">", "\n  <link name=\"palm\">"), "arm.urdf:"),
