@@ -180,10 +180,11 @@ impl Attrs {
             let a = a.map_err(|err| c.err(format!("<{tag}>"), format!("malformed attribute: {err}; write attributes as name=\"value\"")))?;
             let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
             let span = match &a.value {
-                std::borrow::Cow::Borrowed(v) => {
-                    let start = v.as_ptr() as usize - text.as_ptr() as usize;
-                    (start + v.len() <= text.len()).then_some(start..start + v.len())
-                }
+                // a value borrowed from `text`: its byte range there (for rewriting mesh URIs)
+                std::borrow::Cow::Borrowed(v) => (v.as_ptr() as usize)
+                    .checked_sub(text.as_ptr() as usize)
+                    .filter(|&start| start + v.len() <= text.len())
+                    .map(|start| start..start + v.len()),
                 _ => None,
             };
             let raw_has_escape = a.value.contains(&b'&');
