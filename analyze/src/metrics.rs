@@ -194,6 +194,10 @@ pub struct RunMetrics {
     /// joint or drive limits; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limits: Option<LimitsMetrics>,
+    /// The energy balance's terms that only some scenes have (metadata `energy_terms`: the
+    /// back-EMF conversion when K_e ≠ K_t, the soft stops' stored energy and loss), at the end.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy_terms: Option<schemas::EnergyTermsRecord>,
 }
 
 /// The `limits` record of a run: limits exceeded and drive saturations, joint and kind each

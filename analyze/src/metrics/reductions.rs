@@ -313,6 +313,7 @@ impl Reductions {
                 Some(l) => Some(super::LimitsMetrics { exceeded: l.exceeded, saturations: l.saturations, resolution_s: l.resolution, events: l.events }),
                 None => None,
             },
+            energy_terms: rec.record_opt::<schemas::EnergyTermsRecord>()?,
         })
     }
 }
