@@ -282,6 +282,53 @@ mod tests {
         assert!((m.dm() - 0.09).abs() < 1e-15);
     }
 
+    fn limited() -> (MotorParams, Drives) {
+        let m = MotorParams {
+            torque_constant: 0.2, resistance: 2.0, inductance: 0.01, rotor_inertia: 1e-4,
+            gear_ratio: 3.0, gear_damping: 0.0,
+        };
+        let spec = DriveSpec { back_emf_constant: Some(0.25), voltage_limit: Some(24.0), current_limit: Some(5.0), passive: false };
+        (m, Drives::new(&[m], &[0.0]).with_real_drives(&[m], &[spec]))
+    }
+
+    /// The current window `|v − K_e k q̇| ≤ R I`, then the supply: at the window's edge the
+    /// inductive current cannot grow past I (di/dt = 0 at i = I), and |v| ≤ V always.
+    #[test]
+    fn the_driver_clips_to_the_current_window_then_the_supply() {
+        let (_, d) = limited();
+        assert_eq!((d.km[0], d.ke[0]), (0.2 * 3.0, 0.25 * 3.0));
+        assert!(d.has_limits && d.has_conversion);
+        for &(v_cmd, qd) in &[(100.0, 0.0), (-100.0, 2.0), (100.0, 20.0), (3.0, 1.0), (-30.0, -40.0)] {
+            let v = d.limited_voltage(0, v_cmd, qd);
+            assert!(v.abs() <= 24.0, "{v}");
+            let emf = 0.75 * qd;
+            // inside the window the command passes when the supply allows it
+            if (v_cmd - emf).abs() <= 10.0 && v_cmd.abs() <= 24.0 {
+                assert_eq!(v, v_cmd);
+            }
+            // eq 11 at i = ±I: the current does not grow beyond the limit
+            assert!(d.current_rate(0, v, 5.0, qd) <= 1e-12 || v == -24.0 || v == 24.0, "{v_cmd} {qd}");
+            assert!(d.current_rate(0, v, -5.0, qd) >= -1e-12 || v == -24.0 || v == 24.0, "{v_cmd} {qd}");
+            // quasi-static: |i| ≤ I exactly when the supply does not cut first
+            let (vq, i) = d.limited_quasi_static(0, v_cmd, qd);
+            assert!(vq.abs() <= 24.0);
+            assert!((i - (vq - emf) / 2.0).abs() <= 1e-15 * (1.0 + i.abs()), "i = {i} is not (v - K_e k q') / R");
+            if (v_cmd - emf).abs() > 10.0 && (emf - 10.0).abs() <= 24.0 && (emf + 10.0).abs() <= 24.0 {
+                assert_eq!(i.abs(), 5.0, "{v_cmd} {qd}");
+            }
+        }
+    }
+
+    /// A passive joint has no motor: nothing reflected, no torque from any current.
+    #[test]
+    fn a_passive_joint_has_no_motor() {
+        let (m, _) = limited();
+        let d = Drives::new(&[m, m], &[0.0, 0.0]).with_real_drives(&[m, m], &[DriveSpec::ideal(), DriveSpec { passive: true, ..DriveSpec::ideal() }]);
+        assert_eq!((d.km[1], d.ke[1], d.jm[1], d.dm[1]), (0.0, 0.0, 0.0, 0.0));
+        assert_eq!(d.link_torque(1, 3.0, 1.0, 1.0), 0.0);
+        assert!(d.km[0] > 0.0 && !d.has_limits && !d.has_conversion);
+    }
+
     /// A stalled motor (q̇ = 0) settles at i = v / R: the current ODE's fixed point, exactly.
     #[test]
     fn stalled_motor_settles_at_v_over_r() {
