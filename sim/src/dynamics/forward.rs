@@ -16,7 +16,9 @@
 //!   `dynamics/cholesky.rs`).
 //! - `Kkt`: LU of the whole (nv + nc) block system, as the paper does.
 //!
-//! The electrical rows are diagonal and solved directly. The mass matrix comes from the
+//! With soft joint stops (`sim/src/joint_limits.rs`), their torques `τ_s` (filled by the caller
+//! into [`ForwardData::tau_joint`]) are added to b; without, b is as above. The electrical rows
+//! are diagonal and solved directly (with the back-EMF constant K_e k of `motor.rs`). The mass matrix comes from the
 //! composite-rigid-body algorithm or from the paper's Walker–Orin method ([`MassMatrixMethod`]).
 
 use nalgebra::{Cholesky, DMatrix, DVector, LU};

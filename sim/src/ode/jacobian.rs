@@ -10,6 +10,12 @@
 //!   `∂q̈/∂q̇ = −M_c⁻¹ (K_m (k_d + K_m)/R + D + D_m)`. Coriolis, gravity stiffness and the
 //!   quadrature rows are left out: a Rosenbrock-W method keeps its order with any bounded
 //!   approximation (Hairer & Wanner, *Solving ODEs II*, §IV.7), and these terms are not stiff.
+//!   With a back-EMF constant K_e ≠ K_t the back-EMF entries use K_e k; k_p, k_d (and an inner
+//!   current loop's k_i, in `∂i̇/∂i = −(R + k_i)/L`) are the controller's diagonal
+//!   linearisation (`Controller::linearized`: the PD gains for `pd` and `pd-gravity`, the
+//!   model-scaled gains for computed torque); the drive's saturation, the feed-forward's slope
+//!   and the soft stops' stiffness are left out (bounded, so the W-method keeps its order; the
+//!   stops' k can make steps shorter while a joint is beyond its limit).
 //!   `M_c⁻¹` is computed here from M and J_c of the evaluation, whatever constraint solver the
 //!   scene uses (the Schur and the KKT solve leave different scratch behind).
 //! - For the classical Rosenbrock methods (`Rodas`), which need the exact Jacobian:
