@@ -261,6 +261,38 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
             r.run, r.t_end_s
         ));
     }
+    for r in runs.iter() {
+        let Some(l) = r.limits.as_ref().filter(|l| !l.events.is_empty()) else { continue };
+        let list: Vec<String> = l
+            .events
+            .iter()
+            .map(|e| {
+                format!(
+                    "{} {} (limit {}, first at {:.3} s, {:.3} s beyond, peak {})",
+                    e.joint,
+                    e.kind,
+                    crate::render::short_num(e.limit),
+                    e.first_time,
+                    e.time_beyond,
+                    crate::render::short_num(e.peak)
+                )
+            })
+            .collect();
+        out.push(format!("{}: {} (sampled every {} s): {}.", r.run, r.status_text(), l.resolution_s, list.join("; ")));
+    }
+    for r in runs.iter() {
+        let Some(t) = &r.energy_terms else { continue };
+        let mut parts = Vec::new();
+        if let Some(c) = t.emf_conversion {
+            parts.push(format!("back-EMF conversion ∫ Σ (K_e − K_t) k i q' dt = {c:.4e} J"));
+        }
+        if let (Some(e), Some(l)) = (t.stop_energy, t.stop_loss) {
+            parts.push(format!("joint stops: stored {e:.4e} J, damping loss {l:.4e} J"));
+        }
+        if !parts.is_empty() {
+            out.push(format!("{}: the energy balance (residual above) also holds {}.", r.run, parts.join("; ")));
+        }
+    }
     for r in runs.iter().filter(|r| r.status == Status::Incomplete) {
         out.push(format!(
             "{} is incomplete (recovered from a damaged recording): its totals stop at t = {:.3} s.",

@@ -47,7 +47,7 @@ pub use diff::{read_input, render_diff, Diff, DiffError, Tolerance};
 pub use error::Error;
 pub use metrics::{
     read_run_metrics, read_run_metrics_recover, run_metrics, run_metrics_recovered,
-    stream_run_metrics, Reductions, RunMetrics, Status,
+    stream_run_metrics, LimitsMetrics, Reductions, RunMetrics, Status,
 };
 pub use render::{render_comparison, render_metrics, Format};
 pub use schemas::RecoverReport;

@@ -190,6 +190,44 @@ pub struct RunMetrics {
     /// One per contact, in `contacts` order.
     pub contact_forces: Vec<ContactMetrics>,
     pub energy: EnergyAudit,
+    /// What the limits monitor found (metadata `limits`), for runs whose scene monitors
+    /// joint or drive limits; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limits: Option<LimitsMetrics>,
+    /// The energy balance's terms that only some scenes have (metadata `energy_terms`: the
+    /// back-EMF conversion when K_e ≠ K_t, the soft stops' stored energy and loss), at the end.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy_terms: Option<schemas::EnergyTermsRecord>,
+}
+
+/// The `limits` record of a run: limits exceeded and drive saturations, joint and kind each
+/// counted once, and every event.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsMetrics {
+    pub exceeded: u64,
+    pub saturations: u64,
+    /// The times' resolution (the output interval), s.
+    pub resolution_s: f64,
+    pub events: Vec<schemas::LimitEventInfo>,
+}
+
+impl RunMetrics {
+    /// The status with what the limits monitor found: "complete", "complete, 3 limits
+    /// exceeded", "complete, 1 saturation" (never silent about a limit).
+    pub fn status_text(&self) -> String {
+        let s = crate::render::status(self.status).to_string();
+        match &self.limits {
+            Some(l) => schemas::RunResult {
+                limits_exceeded: Some(l.exceeded),
+                saturations: Some(l.saturations),
+                ..schemas::RunResult::complete(0, 0, 0)
+            }
+            .status_text()
+            .replacen("complete", &s, 1),
+            None => s,
+        }
+    }
 }
 
 /// The topics [`run_metrics`] reads; [`read_run_metrics`] decodes only these (the transforms

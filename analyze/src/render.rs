@@ -147,6 +147,11 @@ fn union<'a>(names: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
     out
 }
 
+/// A number in at most 4 significant digits.
+pub(crate) fn short_num(x: f64) -> String {
+    format!("{}", format!("{x:.4e}").parse::<f64>().unwrap_or(x))
+}
+
 pub(crate) fn status(s: Status) -> &'static str {
     match s {
         Status::Complete => "complete",

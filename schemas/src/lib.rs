@@ -44,8 +44,8 @@ pub use messages::{
     Message, MotorState, RosString, TopicMessage, Vec3,
 };
 pub use meta::{
-    IntegratorInfo, MetadataRecord, ModelInfo, RecordingInfo, RunDescription, RunInfo, RunNames,
-    RunResult, RunStatus, SceneRecord, Setup, UrdfRecord,
+    EnergyTermsRecord, IntegratorInfo, LimitEventInfo, LimitsRecord, MetadataRecord, ModelInfo, RecordingInfo,
+    RunDescription, RunInfo, RunNames, RunResult, RunStatus, SceneRecord, Setup, UrdfRecord,
 };
 pub use reader::{
     read_recording, read_recording_bytes, read_recording_bytes_topics, read_recording_recover,

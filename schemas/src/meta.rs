@@ -16,6 +16,9 @@
 //! | `urdf` | `file`, `xml` | 1 |
 //! | `result` | `status` (`complete`/`failed`) | 0 |
 //! | `result` | `rhs_evals`, `steps`, `rejected` (complete), `error`, `error_time` (failed) | 1 |
+//! | `result` | `limits_exceeded`, `saturations` (only runs whose scene monitors limits) | 2 |
+//! | `limits` | `monitored`, `resolution`, `exceeded`, `saturations`, `events` (JSON array) — only runs whose scene monitors limits | 2 |
+//! | `energy_terms` | `emf_conversion`, `stop_energy`, `stop_loss` — only the terms a scene has | 2 |
 //!
 //! Readers ignore keys they do not know (a newer writer may add some) and reject a record that
 //! lacks a key its format version must have, naming the record and the key.
@@ -253,17 +256,133 @@ pub struct RunResult {
     /// Simulated time of the failure, s, when known.
     #[serde(rename = "error_time", default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
     pub error_time_s: Option<f64>,
+    /// Joint and drive limits crossed (joint and kind counted once), when limits were
+    /// monitored (the [`LimitsRecord`] has the details).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub limits_exceeded: Option<u64>,
+    /// Drive saturations (voltage, current window), when limits were monitored.
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub saturations: Option<u64>,
+}
+
+impl RunResult {
+    /// "complete", "complete, 3 limits exceeded", "failed, 1 limit exceeded, 2 saturations":
+    /// the status and what the limits monitor found (never silent).
+    pub fn status_text(&self) -> String {
+        let mut s = match self.status {
+            RunStatus::Complete => "complete".to_string(),
+            RunStatus::Failed => "failed".to_string(),
+        };
+        let plural = |n: u64| if n == 1 { "" } else { "s" };
+        if let Some(n) = self.limits_exceeded.filter(|&n| n > 0) {
+            s += &format!(", {n} limit{} exceeded", plural(n));
+        }
+        if let Some(n) = self.saturations.filter(|&n| n > 0) {
+            s += &format!(", {n} saturation{}", plural(n));
+        }
+        s
+    }
+}
+
+/// One joint and kind that went beyond its limit (in [`LimitsRecord::events`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LimitEventInfo {
+    pub joint: String,
+    /// `position`, `velocity`, `effort`, `current`, `voltage-saturation`, `current-limit`.
+    pub kind: String,
+    /// The limit (rad, rad/s, N m, A, V; for positions the bound crossed first).
+    pub limit: f64,
+    /// First sample time beyond, s.
+    pub first_time: f64,
+    /// Samples beyond × the output interval, s.
+    pub time_beyond: f64,
+    /// The most extreme value (q for positions, else a magnitude).
+    pub peak: f64,
+}
+
+/// Record `limits`: what the limits monitor found (only runs whose scene monitors limits).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LimitsRecord {
+    /// What was monitored.
+    pub monitored: String,
+    /// The output interval, s: the resolution of every time.
+    #[serde(with = "sci")]
+    pub resolution: f64,
+    #[serde(with = "text")]
+    pub exceeded: u64,
+    #[serde(with = "text")]
+    pub saturations: u64,
+    /// The events, a JSON array of [`LimitEventInfo`].
+    #[serde(with = "json_events")]
+    pub events: Vec<LimitEventInfo>,
+}
+
+impl MetadataRecord for LimitsRecord {
+    const NAME: &'static str = "limits";
+}
+
+/// Record `energy_terms`: the final values of the energy balance's terms that only some scenes
+/// have (the `/energy` messages keep their layout; their residual includes these terms).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnergyTermsRecord {
+    /// `∫ Σ (K_e − K_t) k i q̇ dt`, J (scenes with K_e ≠ K_t).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub emf_conversion: Option<f64>,
+    /// The soft stops' stored energy at the end, J (scenes with stops).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub stop_energy: Option<f64>,
+    /// The soft stops' damping loss, J (scenes with stops).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub stop_loss: Option<f64>,
+}
+
+impl MetadataRecord for EnergyTermsRecord {
+    const NAME: &'static str = "energy_terms";
+}
+
+/// [`LimitsRecord::events`] as JSON text.
+mod json_events {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    use super::LimitEventInfo;
+
+    pub fn serialize<S: Serializer>(v: &[LimitEventInfo], s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&serde_json::to_string(v).map_err(serde::ser::Error::custom)?)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<LimitEventInfo>, D::Error> {
+        let s = String::deserialize(d)?;
+        serde_json::from_str(&s).map_err(|e| serde::de::Error::custom(format!("{s:?} is not a JSON array of limit events: {e}")))
+    }
 }
 
 impl RunResult {
     /// A complete run and the solver's work.
     pub fn complete(rhs_evals: u64, steps: u64, rejected: u64) -> Self {
-        Self { status: RunStatus::Complete, rhs_evals: Some(rhs_evals), steps: Some(steps), rejected: Some(rejected), error: None, error_time_s: None }
+        Self {
+            status: RunStatus::Complete,
+            rhs_evals: Some(rhs_evals),
+            steps: Some(steps),
+            rejected: Some(rejected),
+            error: None,
+            error_time_s: None,
+            limits_exceeded: None,
+            saturations: None,
+        }
     }
 
     /// A run stopped by `error` at `time_s` (if known).
     pub fn failed(error: String, time_s: Option<f64>) -> Self {
-        Self { status: RunStatus::Failed, rhs_evals: None, steps: None, rejected: None, error: Some(error), error_time_s: time_s }
+        Self {
+            status: RunStatus::Failed,
+            rhs_evals: None,
+            steps: None,
+            rejected: None,
+            error: Some(error),
+            error_time_s: time_s,
+            limits_exceeded: None,
+            saturations: None,
+        }
     }
 }
 

@@ -16,6 +16,7 @@
 pub mod dynamics;
 pub mod error;
 pub mod limits;
+pub mod joint_limits;
 pub mod control;
 pub mod scene;
 pub mod integrate;

@@ -8,13 +8,14 @@
 use std::path::{Path, PathBuf};
 
 use schemas::{
-    frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, EnergyState, FrameTransforms, HandState,
+    frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
     JointState, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
 use schemas::{Quaternion, Vector3};
 
 use crate::error::RunError;
+use crate::joint_limits::LimitMonitor;
 use crate::scene::{Run, Scene};
 use crate::ode::Outputs;
 
@@ -48,6 +49,11 @@ pub struct Recorder<'a> {
     joint_state: JointState,
     /// `/tf`, built once (frame names), its poses and stamps updated every sample.
     tf: FrameTransforms,
+    /// The limits monitor, when the scene monitors limits: its verdict is written at the end
+    /// (record `limits`, and counts in `result`), for failed runs too.
+    monitor: Option<LimitMonitor>,
+    /// The last sample's `E_conv`, `ΣV_s`, `E_s` (record `energy_terms`, scenes that have them).
+    terms: [f64; 3],
 }
 
 impl<'a> Recorder<'a> {
@@ -126,11 +132,17 @@ impl<'a> Recorder<'a> {
             motors: MotorState::default(),
             constraints: ConstraintState::default(),
             energy: EnergyState::default(),
+            monitor: LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, 1.0 / scene.output_rate),
+            terms: [0.0; 3],
         })
     }
 
     /// Write every channel for one sample.
     pub fn record(&mut self, o: &Outputs) -> Result<(), RunError> {
+        if let Some(m) = self.monitor.as_mut() {
+            m.observe(o);
+        }
+        self.terms = [o.loss_conversion, o.stop_energy, o.loss_stop];
         let t_ns = to_log_time(o.t);
         let model = &self.scene.model;
         let path = &self.path;
@@ -205,12 +217,42 @@ impl<'a> Recorder<'a> {
     /// the solver statistics, or the error that stopped the run (the file then holds every
     /// sample up to the failure and says when and why). With a tap, what it saw.
     pub fn finish(mut self, outcome: Result<&crate::integrate::Stats, &RunError>) -> Result<(PathBuf, Option<Tapped>), RunError> {
-        let result = match outcome {
+        let mut result = match outcome {
             Ok(stats) => RunResult::complete(stats.rhs_evals, stats.steps, stats.rejected),
             Err(e) => RunResult::failed(e.to_string(), e.time()),
         };
         let path = self.path.clone();
         let err = |source| RunError::Recording { path: path.clone(), source };
+        if let Some(m) = &self.monitor {
+            let sum = m.summary();
+            let (exceeded, saturations) = (sum.exceeded() as u64, sum.saturated() as u64);
+            result.limits_exceeded = Some(exceeded);
+            result.saturations = Some(saturations);
+            let events = sum
+                .events
+                .iter()
+                .map(|e| LimitEventInfo {
+                    joint: e.joint.clone(),
+                    kind: e.kind.name().into(),
+                    limit: e.limit,
+                    first_time: e.first_time,
+                    time_beyond: e.time_beyond,
+                    peak: e.peak,
+                })
+                .collect();
+            let rec = LimitsRecord { monitored: sum.monitored, resolution: sum.resolution, exceeded, saturations, events };
+            self.writer.write_record(&rec).map_err(err)?;
+        }
+        let (conv, stops) = (self.scene.drives.has_conversion, self.scene.stops.is_some());
+        if conv || stops {
+            let [c, e, l] = self.terms;
+            let rec = EnergyTermsRecord {
+                emf_conversion: conv.then_some(c),
+                stop_energy: stops.then_some(e),
+                stop_loss: stops.then_some(l),
+            };
+            self.writer.write_record(&rec).map_err(err)?;
+        }
         self.writer.write_record(&result).map_err(err)?;
         self.writer.finish_tapped().map_err(err)
     }

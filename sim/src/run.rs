@@ -8,6 +8,7 @@ use crate::error::RunError;
 use crate::limits::DEFAULT_MAX_WALL_TIME;
 use crate::integrate::{IntegrateError, Stats};
 use crate::scene::{Run, Scene};
+use crate::joint_limits::{LimitMonitor, LimitsSummary};
 use crate::ode::{ArmSystem, OutputLevel, Outputs};
 
 /// What a run reports besides its samples.
@@ -17,6 +18,8 @@ pub struct RunReport {
     pub samples: usize,
     /// The last sample.
     pub last: Outputs,
+    /// The limits monitor's verdict (`joint_limits.rs`), when the scene monitors limits.
+    pub limits: Option<LimitsSummary>,
 }
 
 /// What one run may spend besides its steps (`integrator.max_steps`, a setting of the scene):
@@ -110,16 +113,22 @@ pub fn simulate_outputs(
     let mut samples = 0usize;
     // a second system evaluates the outputs, so the stepper's system keeps its scratch
     let mut probe = ArmSystem::new(scene, run);
+    // limits are monitored on the full outputs only (they need τ, i and the command)
+    let mut monitor =
+        if level == OutputLevel::Full { LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, dt_out) } else { None };
     let mut on_sample = |t: f64, y: &[f64]| -> Result<(), RunError> {
         probe.outputs_at(level, t, y, &mut out)?;
         samples += 1;
+        if let Some(m) = monitor.as_mut() {
+            m.observe(&out);
+        }
         sink(&out)
     };
     let stats = scene
         .integrator
         .integrate(&mut sys, &y0, scene.duration, dt_out, deadline, &mut on_sample)
         .map_err(|e| map_err(e, &names, budget, scene.integrator.method()))?;
-    Ok(RunReport { stats, samples, last: out })
+    Ok(RunReport { stats, samples, last: out, limits: monitor.map(|m| m.summary()) })
 }
 
 /// What `run_to_file` reports.

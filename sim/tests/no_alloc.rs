@@ -107,3 +107,40 @@ fn the_driver_with_a_deadline_does_not_allocate_per_step() {
     let (short, long) = (count(0.01), count(0.05));
     assert_eq!(short, long, "100 steps: {short} allocations, 500 steps: {long}");
 }
+
+/// The real drives (K_e, voltage and current limits), the soft joint stops and the controller
+/// laws (PD + gravity with friction, computed torque with its current loop) allocate nothing
+/// in the step loop either, for an explicit, a Rosenbrock-W (structured Jacobian) and a
+/// classical Rosenbrock method.
+#[test]
+fn the_drives_and_controllers_do_not_allocate() {
+    use sim::scene::spec::{JointLimitsSpec, LawSpec, PerJoint, PositionLimitMode};
+    let drives = |s: &mut sim::scene::SceneSpec| {
+        s.motor.back_emf_constant = Some(PerJoint::All(0.21));
+        s.motor.voltage_limit = Some(PerJoint::All(24.0));
+        s.motor.current_limit = Some(PerJoint::All(10.0));
+        s.joint_limits = Some(JointLimitsSpec { position: PositionLimitMode::Stop, stiffness: Some(1e3), damping: Some(1.0) });
+    };
+    let pdg = Scene::paper().unwrap().vary(|s| {
+        drives(s);
+        s.controller.law = Some(LawSpec::PdGravity);
+        s.controller.friction = Some(true);
+    });
+    let ct = Scene::paper().unwrap().vary(|s| {
+        drives(s);
+        s.controller.law = Some(LawSpec::ComputedTorque);
+        s.controller.kp = PerJoint::All(400.0);
+        s.controller.kd = PerJoint::All(40.0);
+        s.controller.current_gain = Some(PerJoint::All(5.0));
+    });
+    for scene in [pdg.unwrap(), ct.unwrap()] {
+        let run = scene.run("two-elbow").unwrap().clone();
+        let mut sys = ArmSystem::new(&scene, &run);
+        let dim = sys.initial_state().len();
+        let control = |rtol, atol| StepControl { h_max: 1e-3, max_steps: 100_000, ..StepControl::new(rtol, atol) };
+        let law = scene.controller().law.name();
+        assert_eq!(steps_allocate(&mut DormandPrince45::new(dim, control(1e-10, 1e-12)), &mut sys), 0, "{law}: dopri45");
+        assert_eq!(steps_allocate(&mut Rosenbrock::new(dim, control(1e-8, 1e-10)), &mut sys), 0, "{law}: rosenbrock");
+        assert_eq!(steps_allocate(&mut Rodas::new(dim, control(1e-8, 1e-10)), &mut sys), 0, "{law}: rodas5p");
+    }
+}

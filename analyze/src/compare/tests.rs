@@ -45,6 +45,8 @@ pub(crate) fn run(name: &str, contacts: &[&str], e: &[f64], w: &[f64], z_rms: f6
         samples: 501,
         t_end_s: 5.0,
         status: Status::Complete,
+        limits: None,
+        energy_terms: None,
         error: None,
         error_time_s: None,
         hand_error: HandError {

@@ -309,6 +309,11 @@ impl Reductions {
             peak_current,
             contact_forces,
             energy: energy_audit,
+            limits: match rec.record_opt::<schemas::LimitsRecord>()? {
+                Some(l) => Some(super::LimitsMetrics { exceeded: l.exceeded, saturations: l.saturations, resolution_s: l.resolution, events: l.events }),
+                None => None,
+            },
+            energy_terms: rec.record_opt::<schemas::EnergyTermsRecord>()?,
         })
     }
 }

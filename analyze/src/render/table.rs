@@ -1,6 +1,6 @@
 //! Aligned text tables in sections, for people.
 
-use super::{contacts, joints, status, TextTable};
+use super::{contacts, joints, TextTable};
 use crate::compare::{Comparison, Ratios};
 use crate::metrics::RunMetrics;
 
@@ -95,7 +95,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
             .map_or(("-".into(), "-".into()), |p| {
                 (f(p.current_a, 3), p.joint.clone())
             });
-        let st = format!("{}{at}", status(r.status));
+        let st = format!("{}{at}", r.status_text());
         t.table.rows.push(vec![
             name(k),
             r.scene.clone(),

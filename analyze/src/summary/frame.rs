@@ -21,7 +21,7 @@ pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<Dat
         Column::new("file".into(), s(&|r| Some(r.metrics.file.clone()))),
         Column::new("scene".into(), s(&|r| Some(r.metrics.scene.clone()))),
         Column::new("run".into(), s(&|r| Some(r.metrics.run.clone()))),
-        Column::new("status".into(), s(&|r| Some(crate::render::status(r.metrics.status).to_string()))),
+        Column::new("status".into(), s(&|r| Some(r.metrics.status_text()))),
         Column::new("contacts".into(), s(&|r| Some(r.metrics.contacts.join(",")))),
         Column::new("n_contacts".into(), rows.iter().map(|r| r.metrics.contacts.len() as u32).collect::<Vec<_>>()),
         Column::new("integrator".into(), s(&|r| r.integrator.clone())),

@@ -16,7 +16,9 @@
 //!   `dynamics/cholesky.rs`).
 //! - `Kkt`: LU of the whole (nv + nc) block system, as the paper does.
 //!
-//! The electrical rows are diagonal and solved directly. The mass matrix comes from the
+//! With soft joint stops (`sim/src/joint_limits.rs`), their torques `τ_s` (filled by the caller
+//! into [`ForwardData::tau_joint`]) are added to b; without, b is as above. The electrical rows
+//! are diagonal and solved directly (with the back-EMF constant K_e k of `motor.rs`). The mass matrix comes from the
 //! composite-rigid-body algorithm or from the paper's Walker–Orin method ([`MassMatrixMethod`]).
 
 use nalgebra::{Cholesky, DMatrix, DVector, LU};
@@ -104,6 +106,11 @@ pub struct ForwardData {
     pub di: DVector<f64>,
     /// Torque delivered to each link by its motor, eq 12 (nv), N m.
     pub tau_motor: DVector<f64>,
+    /// Further joint torques (nv), N m, added to b when `joint_torque` is set (the soft joint
+    /// stops, `sim/src/joint_limits.rs`); the caller fills them before each solve.
+    pub tau_joint: DVector<f64>,
+    /// Whether `tau_joint` enters b (else it is not read: no arithmetic is added).
+    pub joint_torque: bool,
 }
 
 impl ForwardData {
@@ -126,6 +133,8 @@ impl ForwardData {
             kkt_rhs: DVector::zeros(nv + nc),
             di: DVector::zeros(nv),
             tau_motor: DVector::zeros(nv),
+            tau_joint: DVector::zeros(nv),
+            joint_torque: false,
         }
     }
 }
@@ -169,6 +178,11 @@ pub fn forward_dynamics(
     if drives.has_friction {
         for j in 0..nv {
             fd.b[j] -= (drives.d[j] + drives.dm[j]) * qd[j];
+        }
+    }
+    if fd.joint_torque {
+        for j in 0..nv {
+            fd.b[j] += fd.tau_joint[j];
         }
     }
     // M_J = M + J_m

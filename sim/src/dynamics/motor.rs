@@ -6,6 +6,33 @@
 //!
 //! With L = 0 on every joint the current is algebraic (quasi-static): `i = (v − K_m q̇) / R`,
 //! and the motor is a torque source with back-EMF damping; no electrical state is integrated.
+//!
+//! Real drives ([`DriveSpec`], all optional; absent = the paper's ideal drive, same arithmetic):
+//! - a back-EMF constant K_e distinct from the torque constant K_t (datasheets give both, in
+//!   V s/rad and N m/A; equal in SI for an ideal machine). Eq 11 uses `K_e k q̇`, eq 12 uses
+//!   `K_t k i`. The electric power `i v = R i² + d(½ L i²)/dt + K_e k i q̇` then differs from the
+//!   mechanical power `K_t k i q̇` by `(K_e − K_t) k i q̇`, which the energy balance carries as
+//!   its own quadrature `E_conv = ∫ Σ (K_e − K_t) k i q̇ dt` (present only when some K_e ≠ K_t);
+//! - a supply voltage limit V: the amplifier saturates, `v = clamp(v*, −V, V)`; the saturated
+//!   voltage is what the motor sees, what eq 11 integrates and what is recorded (so the
+//!   amplifier's own losses are outside the balance: it is an ideal switch-mode stage);
+//! - a current limit I of the driver, applied by limiting the voltage to the window
+//!   `−R I + K_e k q̇ ≤ v ≤ R I + K_e k q̇`, before the voltage limit (the supply wins when the
+//!   two disagree, and the run then flags the current). With L = 0 this is `|i| ≤ I` exactly
+//!   (the current is clamped and the voltage recomputed from it); with L > 0 it makes `i = ±I`
+//!   a barrier: at `i = I`, `L di/dt = v − R I − K_e k q̇ ≤ 0` (and symmetrically), so `|i| ≤ I`
+//!   up to the integration error (Mohan, Undeland & Robbins, *Power Electronics*, 3rd ed.,
+//!   §13-5: a current-limited drive is a voltage source whose command is clipped);
+//! - passive joints: no motor at all (K_m = K_e k = J_m = D_m = 0, zero voltage, zero current).
+//!
+//! Prismatic joints use the same model with link-side units: the gear ratio (lead screw or
+//! rack) is in rad/m, K_m = K_t k in N/A, J_m = I_m k² in kg, D_m in N s/m, and the back EMF
+//! `K_e k q̇` in V with q̇ in m/s.
+//!
+//! Gear efficiency is not modelled: a constant efficiency η < 1 scales the torque in one power
+//! direction and its inverse in the other, a non-smooth loss `(1 − η)|τ q̇|` that depends on the
+//! sign of the power flow (and on which side drives): a viscous gear loss `D_m q̇²` (eq 12) is
+//! what this model can close the energy balance with exactly, so gear losses belong there.
 
 use nalgebra::DVector;
 
@@ -69,11 +96,44 @@ impl Electrical {
     }
 }
 
+/// The real-drive additions of one joint (see the module docs); [`DriveSpec::ideal`] is the
+/// paper's drive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriveSpec {
+    /// K_e, motor side, V s/rad; `None`: equal to the torque constant.
+    pub back_emf_constant: Option<f64>,
+    /// Supply voltage limit V, V.
+    pub voltage_limit: Option<f64>,
+    /// Driver current limit I, A.
+    pub current_limit: Option<f64>,
+    /// No motor on this joint.
+    pub passive: bool,
+}
+
+impl DriveSpec {
+    /// The paper's drive: K_e = K_t, no limits, a motor.
+    pub const fn ideal() -> Self {
+        Self { back_emf_constant: None, voltage_limit: None, current_limit: None, passive: false }
+    }
+}
+
 /// The drive train of every joint, reflected to the link side, as vectors (nv) for the RHS.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Drives {
-    /// K_m, N m/A.
+    /// K_m = K_t k, N m/A.
     pub km: DVector<f64>,
+    /// K_e k, the back-EMF constant seen at the link, V s/rad (= K_m unless the scene gives K_e).
+    pub ke: DVector<f64>,
+    /// Supply voltage limit per joint, V (+∞: none).
+    pub voltage_limit: Vec<f64>,
+    /// Driver current limit per joint, A (+∞: none).
+    pub current_limit: Vec<f64>,
+    /// Joints without a motor.
+    pub passive: Vec<bool>,
+    /// Some voltage or current limit is finite (else the limiting is skipped).
+    pub has_limits: bool,
+    /// Some K_e ≠ K_t (the energy balance then has its conversion term).
+    pub has_conversion: bool,
     /// R, ohm.
     pub r: DVector<f64>,
     /// L, H.
@@ -93,8 +153,15 @@ pub struct Drives {
 impl Drives {
     pub fn new(motors: &[MotorParams], joint_damping: &[f64]) -> Self {
         assert_eq!(motors.len(), joint_damping.len(), "one motor per joint");
+        let n = motors.len();
         Self {
             km: DVector::from_iterator(motors.len(), motors.iter().map(MotorParams::km)),
+            ke: DVector::from_iterator(motors.len(), motors.iter().map(MotorParams::km)),
+            voltage_limit: vec![f64::INFINITY; n],
+            current_limit: vec![f64::INFINITY; n],
+            passive: vec![false; n],
+            has_limits: false,
+            has_conversion: false,
             r: DVector::from_iterator(motors.len(), motors.iter().map(|m| m.resistance)),
             l: DVector::from_iterator(motors.len(), motors.iter().map(|m| m.inductance)),
             jm: DVector::from_iterator(motors.len(), motors.iter().map(MotorParams::jm)),
@@ -105,10 +172,71 @@ impl Drives {
         }
     }
 
-    /// The quasi-static current of joint j (L = 0), `(v − K_m q̇) / R`, A.
+    /// [`Drives::new`] with the real-drive additions of each joint (one per joint): K_e,
+    /// the limits, passive joints (whose K_m, K_e, J_m and D_m become 0). `motors` must be those
+    /// given to `new`.
+    pub fn with_real_drives(mut self, motors: &[MotorParams], specs: &[DriveSpec]) -> Self {
+        assert_eq!(specs.len(), self.nv(), "one drive per joint");
+        for (j, (s, m)) in specs.iter().zip(motors).enumerate() {
+            if let Some(ke) = s.back_emf_constant {
+                self.ke[j] = ke * m.gear_ratio;
+            }
+            self.voltage_limit[j] = s.voltage_limit.unwrap_or(f64::INFINITY);
+            self.current_limit[j] = s.current_limit.unwrap_or(f64::INFINITY);
+            if s.passive {
+                self.passive[j] = true;
+                self.km[j] = 0.0;
+                self.ke[j] = 0.0;
+                self.jm[j] = 0.0;
+                self.dm[j] = 0.0;
+            }
+        }
+        self.has_limits = self.voltage_limit.iter().chain(&self.current_limit).any(|x| x.is_finite());
+        self.has_conversion = (0..self.nv()).any(|j| self.ke[j] != self.km[j]);
+        self.has_friction = (0..self.nv()).any(|j| self.dm[j] + self.d[j] != 0.0);
+        self
+    }
+
+    /// The quasi-static current of joint j (L = 0), `(v − K_e k q̇) / R`, A.
     #[inline]
     pub fn quasi_static_current(&self, j: usize, v: f64, qd: f64) -> f64 {
-        (v - self.km[j] * qd) / self.r[j]
+        (v - self.ke[j] * qd) / self.r[j]
+    }
+
+    /// The amplifier's output for the command `v_cmd` at joint speed `qd`: the current window
+    /// `|v − K_e k q̇| ≤ R I`, then the supply `|v| ≤ V` (module docs). Only called when
+    /// [`Drives::has_limits`].
+    #[inline]
+    pub fn limited_voltage(&self, j: usize, v_cmd: f64, qd: f64) -> f64 {
+        let mut v = v_cmd;
+        let i_max = self.current_limit[j];
+        if i_max.is_finite() {
+            let emf = self.ke[j] * qd;
+            let w = self.r[j] * i_max;
+            v = v.clamp(emf - w, emf + w);
+        }
+        let v_max = self.voltage_limit[j];
+        v.clamp(-v_max, v_max)
+    }
+
+    /// Quasi-static motors (L = 0) with limits: the voltage and the current for the command
+    /// `v_cmd`, with `|i| ≤ I` exactly when the supply allows it (the current is clamped and
+    /// the voltage follows from it), then `|v| ≤ V` exactly.
+    #[inline]
+    pub fn limited_quasi_static(&self, j: usize, v_cmd: f64, qd: f64) -> (f64, f64) {
+        let emf = self.ke[j] * qd;
+        let i_max = self.current_limit[j];
+        let (mut v, mut i) = (v_cmd, (v_cmd - emf) / self.r[j]);
+        if i_max.is_finite() && i.abs() > i_max {
+            i = i.clamp(-i_max, i_max);
+            v = self.r[j] * i + emf;
+        }
+        let v_max = self.voltage_limit[j];
+        if v.abs() > v_max {
+            v = v.clamp(-v_max, v_max);
+            i = (v - emf) / self.r[j];
+        }
+        (v, i)
     }
 
     pub fn nv(&self) -> usize {
@@ -120,7 +248,7 @@ impl Drives {
     #[inline]
     pub fn current_rate(&self, j: usize, v: f64, i: f64, qd: f64) -> f64 {
         match self.electrical {
-            Electrical::Inductive => (v - self.r[j] * i - self.km[j] * qd) / self.l[j],
+            Electrical::Inductive => (v - self.r[j] * i - self.ke[j] * qd) / self.l[j],
             Electrical::QuasiStatic => 0.0,
         }
     }
@@ -131,10 +259,10 @@ impl Drives {
         self.km[j] * i - self.jm[j] * qdd - self.dm[j] * qd
     }
 
-    /// Back-EMF `K_m q̇` of joint j, V.
+    /// Back-EMF `K_e k q̇` of joint j, V.
     #[inline]
     pub fn back_emf(&self, j: usize, qd: f64) -> f64 {
-        self.km[j] * qd
+        self.ke[j] * qd
     }
 }
 
@@ -152,6 +280,53 @@ mod tests {
         assert!((m.km() - 0.609).abs() < 1e-15);
         assert!((m.jm() - 0.001476).abs() < 1e-15);
         assert!((m.dm() - 0.09).abs() < 1e-15);
+    }
+
+    fn limited() -> (MotorParams, Drives) {
+        let m = MotorParams {
+            torque_constant: 0.2, resistance: 2.0, inductance: 0.01, rotor_inertia: 1e-4,
+            gear_ratio: 3.0, gear_damping: 0.0,
+        };
+        let spec = DriveSpec { back_emf_constant: Some(0.25), voltage_limit: Some(24.0), current_limit: Some(5.0), passive: false };
+        (m, Drives::new(&[m], &[0.0]).with_real_drives(&[m], &[spec]))
+    }
+
+    /// The current window `|v − K_e k q̇| ≤ R I`, then the supply: at the window's edge the
+    /// inductive current cannot grow past I (di/dt = 0 at i = I), and |v| ≤ V always.
+    #[test]
+    fn the_driver_clips_to_the_current_window_then_the_supply() {
+        let (_, d) = limited();
+        assert_eq!((d.km[0], d.ke[0]), (0.2 * 3.0, 0.25 * 3.0));
+        assert!(d.has_limits && d.has_conversion);
+        for &(v_cmd, qd) in &[(100.0, 0.0), (-100.0, 2.0), (100.0, 20.0), (3.0, 1.0), (-30.0, -40.0)] {
+            let v = d.limited_voltage(0, v_cmd, qd);
+            assert!(v.abs() <= 24.0, "{v}");
+            let emf = 0.75 * qd;
+            // inside the window the command passes when the supply allows it
+            if (v_cmd - emf).abs() <= 10.0 && v_cmd.abs() <= 24.0 {
+                assert_eq!(v, v_cmd);
+            }
+            // eq 11 at i = ±I: the current does not grow beyond the limit
+            assert!(d.current_rate(0, v, 5.0, qd) <= 1e-12 || v == -24.0 || v == 24.0, "{v_cmd} {qd}");
+            assert!(d.current_rate(0, v, -5.0, qd) >= -1e-12 || v == -24.0 || v == 24.0, "{v_cmd} {qd}");
+            // quasi-static: |i| ≤ I exactly when the supply does not cut first
+            let (vq, i) = d.limited_quasi_static(0, v_cmd, qd);
+            assert!(vq.abs() <= 24.0);
+            assert!((i - (vq - emf) / 2.0).abs() <= 1e-15 * (1.0 + i.abs()), "i = {i} is not (v - K_e k q') / R");
+            if (v_cmd - emf).abs() > 10.0 && (emf - 10.0).abs() <= 24.0 && (emf + 10.0).abs() <= 24.0 {
+                assert_eq!(i.abs(), 5.0, "{v_cmd} {qd}");
+            }
+        }
+    }
+
+    /// A passive joint has no motor: nothing reflected, no torque from any current.
+    #[test]
+    fn a_passive_joint_has_no_motor() {
+        let (m, _) = limited();
+        let d = Drives::new(&[m, m], &[0.0, 0.0]).with_real_drives(&[m, m], &[DriveSpec::ideal(), DriveSpec { passive: true, ..DriveSpec::ideal() }]);
+        assert_eq!((d.km[1], d.ke[1], d.jm[1], d.dm[1]), (0.0, 0.0, 0.0, 0.0));
+        assert_eq!(d.link_torque(1, 3.0, 1.0, 1.0), 0.0);
+        assert!(d.km[0] > 0.0 && !d.has_limits && !d.has_conversion);
     }
 
     /// A stalled motor (q̇ = 0) settles at i = v / R: the current ODE's fixed point, exactly.

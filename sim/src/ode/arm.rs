@@ -27,8 +27,9 @@ impl<'a> ArmSystem<'a> {
     pub fn new(scene: &'a Scene, run: &Run) -> Self {
         let nv = scene.model.nv;
         let contacts = scene.run_contacts(run);
-        let layout = Layout { nv, electrical: scene.drives.electrical };
-        let ws = Workspace::new(&scene.model, contacts.len(), layout.dim());
+        let layout = Layout { nv, electrical: scene.drives.electrical, conversion: scene.drives.has_conversion, stops: scene.stops.is_some() };
+        let mut ws = Workspace::new(&scene.model, contacts.len(), layout.dim());
+        ws.fd.joint_torque = scene.stops.is_some();
         let mut sys = Self { scene, contacts, layout, ws, stored0: 0.0 };
         sys.stored0 = sys.stored_energy(&scene.q0, &scene.qd0, &scene.current0);
         sys
@@ -51,23 +52,43 @@ impl<'a> ArmSystem<'a> {
         y
     }
 
-    /// T + V + ½ Σ L i², J. Clobbers the kinematics scratch.
+    /// T + V + ½ Σ L i² (+ the stops' ½ k δ² when configured), J. Clobbers the kinematics
+    /// scratch.
     pub(super) fn stored_energy(&mut self, q: &[f64], qd: &[f64], current: &[f64]) -> f64 {
         let s = self.scene;
         let data = &mut self.ws.data;
         crate::dynamics::rnea::bias_forces(&s.model, data, q, qd);
         let t = link_kinetic_energy(&s.model, data) + rotor_kinetic_energy(&s.drives, qd);
         forward_kinematics(&s.model, data, q);
-        t + potential_energy(&s.model, data) + magnetic_energy(&s.drives, current)
+        let e = t + potential_energy(&s.model, data) + magnetic_energy(&s.drives, current);
+        match &s.stops {
+            Some(st) => e + st.energy(q),
+            None => e,
+        }
     }
 
-    /// The IK targets (eqs 28–29) and the PD voltages (eq 27) at (t, q, q̇), into the workspace.
-    pub(super) fn voltage_at(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), DynamicsError> {
+    /// The IK targets (eqs 28–29), the controller's voltages (eq 27 for the paper) and the
+    /// drive's limits at (t, q, q̇; i for a law with a current loop), into the workspace. With
+    /// quasi-static motors and drive limits, also their currents (`current_qs`).
+    pub(super) fn voltage_at(&mut self, t: f64, q: &[f64], qd: &[f64], current: Option<&[f64]>) -> Result<(), DynamicsError> {
         let s = self.scene;
         let ws = &mut self.ws;
         s.ik.solve(&s.circle.position(t), &s.circle.velocity(t), &mut ws.q_des, &mut ws.qd_des)
             .map_err(|why| DynamicsError::Unreachable { t, why })?;
-        s.gains.voltage(q, qd, &ws.q_des, &ws.qd_des, &mut ws.voltage);
+        let input = crate::control::ControlInput { q, qd, current, q_des: &ws.q_des, qd_des: &ws.qd_des, qdd_des: &ws.qdd_des };
+        s.controller.voltage(&s.model, &s.drives, &mut ws.data, &mut ws.ctrl, &input, &mut ws.voltage);
+        let d = &s.drives;
+        if d.has_limits {
+            ws.voltage_cmd.copy_from_slice(&ws.voltage);
+            for j in 0..q.len() {
+                match d.electrical {
+                    Electrical::Inductive => ws.voltage[j] = d.limited_voltage(j, ws.voltage_cmd[j], qd[j]),
+                    Electrical::QuasiStatic => {
+                        (ws.voltage[j], ws.current_qs[j]) = d.limited_quasi_static(j, ws.voltage_cmd[j], qd[j]);
+                    }
+                }
+            }
+        }
         Ok(())
     }
 
@@ -86,8 +107,14 @@ impl<'a> ArmSystem<'a> {
         let l = self.layout;
         let (q, qd) = (&y[l.q()], &y[l.qd()]);
         let s = self.scene;
-        self.voltage_at(t, q, qd)?;
-        if l.electrical == Electrical::QuasiStatic {
+        let current = (l.electrical == Electrical::Inductive).then(|| &y[l.current()]);
+        self.voltage_at(t, q, qd, current)?;
+        if let Some(st) = &s.stops {
+            for j in 0..l.nv {
+                self.ws.fd.tau_joint[j] = st.torque(j, q[j], qd[j]);
+            }
+        }
+        if l.electrical == Electrical::QuasiStatic && !s.drives.has_limits {
             for j in 0..l.nv {
                 self.ws.current_qs[j] = s.drives.quasi_static_current(j, self.ws.voltage[j], qd[j]);
             }
@@ -142,6 +169,12 @@ impl OdeSystem for ArmSystem<'_> {
         dydt[l.loss_r()] = p_r;
         dydt[l.loss_d()] = p_d;
         dydt[l.loss_dm()] = p_dm;
+        if let Some(k) = l.loss_conversion() {
+            dydt[k] = (0..l.nv).map(|j| (d.ke[j] - d.km[j]) * cur[j] * qd[j]).sum();
+        }
+        if let (Some(k), Some(st)) = (l.loss_stop(), &self.scene.stops) {
+            dydt[k] = st.loss_rate(&y[l.q()], qd);
+        }
         Ok(())
     }
 

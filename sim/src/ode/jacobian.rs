@@ -10,6 +10,12 @@
 //!   `∂q̈/∂q̇ = −M_c⁻¹ (K_m (k_d + K_m)/R + D + D_m)`. Coriolis, gravity stiffness and the
 //!   quadrature rows are left out: a Rosenbrock-W method keeps its order with any bounded
 //!   approximation (Hairer & Wanner, *Solving ODEs II*, §IV.7), and these terms are not stiff.
+//!   With a back-EMF constant K_e ≠ K_t the back-EMF entries use K_e k; k_p, k_d (and an inner
+//!   current loop's k_i, in `∂i̇/∂i = −(R + k_i)/L`) are the controller's diagonal
+//!   linearisation (`Controller::linearized`: the PD gains for `pd` and `pd-gravity`, the
+//!   model-scaled gains for computed torque); the drive's saturation, the feed-forward's slope
+//!   and the soft stops' stiffness are left out (bounded, so the W-method keeps its order; the
+//!   stops' k can make steps shorter while a joint is beyond its limit).
 //!   `M_c⁻¹` is computed here from M and J_c of the evaluation, whatever constraint solver the
 //!   scene uses (the Schur and the KKT solve leave different scratch behind).
 //! - For the classical Rosenbrock methods (`Rodas`), which need the exact Jacobian:
@@ -88,7 +94,14 @@ impl OdeJacobian for ArmSystem<'_> {
         let l = self.layout;
         let (nv, dim) = (l.nv, l.dim());
         let scene = self.scene;
-        let (d, g) = (&scene.drives, &scene.gains);
+        let d = &scene.drives;
+        let inductive = l.electrical == Electrical::Inductive;
+        // the law's diagonal linearisation (k_p', k_d', k_i'): the PD gains for the paper
+        let lin = &mut self.ws.jac.lin;
+        for j in 0..nv {
+            lin[j] = scene.controller.linearized(d, j, self.ws.data.m[(j, j)] + d.jm[j], inductive);
+        }
+        let lin = &self.ws.jac.lin;
         jac.fill(0.0);
         let mut set = |row: usize, col: usize, v: f64| jac[row * dim + col] = v;
         for j in 0..nv {
@@ -104,8 +117,9 @@ impl OdeJacobian for ArmSystem<'_> {
                         set(l.qd().start + r, l.qd().start + c, -m * (d.d[c] + d.dm[c]));
                     }
                     Electrical::QuasiStatic => {
-                        set(l.qd().start + r, l.q().start + c, -m * d.km[c] * g.kp[c] / d.r[c]);
-                        set(l.qd().start + r, l.qd().start + c, -m * (d.km[c] * (g.kd[c] + d.km[c]) / d.r[c] + d.d[c] + d.dm[c]));
+                        let (kp, kd, _) = lin[c];
+                        set(l.qd().start + r, l.q().start + c, -m * d.km[c] * kp / d.r[c]);
+                        set(l.qd().start + r, l.qd().start + c, -m * (d.km[c] * (kd + d.ke[c]) / d.r[c] + d.d[c] + d.dm[c]));
                     }
                 }
             }
@@ -113,9 +127,14 @@ impl OdeJacobian for ArmSystem<'_> {
         if l.electrical == Electrical::Inductive {
             for j in 0..nv {
                 let row = l.current().start + j;
-                set(row, l.q().start + j, -g.kp[j] / d.l[j]);
-                set(row, l.qd().start + j, -(g.kd[j] + d.km[j]) / d.l[j]);
-                set(row, l.current().start + j, -d.r[j] / d.l[j]);
+                let (kp, kd, ki) = lin[j];
+                set(row, l.q().start + j, -kp / d.l[j]);
+                set(row, l.qd().start + j, -(kd + d.ke[j]) / d.l[j]);
+                if ki == 0.0 {
+                    set(row, l.current().start + j, -d.r[j] / d.l[j]);
+                } else {
+                    set(row, l.current().start + j, -(d.r[j] + ki) / d.l[j]);
+                }
             }
         }
         Ok(())
@@ -140,13 +159,14 @@ impl SplitSystem for ArmSystem<'_> {
             return Ok(());
         }
         // v(t, q, q̇) from the explicit components, then the closed form per motor
+        // (a law with a current loop is rejected with imex when the scene is built)
         let scene = self.scene;
-        self.voltage_at(t, &r[l.q()], &r[l.qd()])?;
+        self.voltage_at(t, &r[l.q()], &r[l.qd()], Some(&r[l.current()]))?;
         let (d, voltage) = (&scene.drives, &self.ws.voltage);
         for j in 0..l.nv {
             let k = l.current().start + j;
             let qd = r[l.qd().start + j];
-            z[k] = (r[k] + gamma * (voltage[j] - d.km[j] * qd) / d.l[j]) / (1.0 + gamma * d.r[j] / d.l[j]);
+            z[k] = (r[k] + gamma * (voltage[j] - d.ke[j] * qd) / d.l[j]) / (1.0 + gamma * d.r[j] / d.l[j]);
         }
         Ok(())
     }

@@ -8,6 +8,12 @@ pub struct Layout {
     pub nv: usize,
     /// The motors' electrical model: whether the currents are states.
     pub electrical: Electrical,
+    /// The conversion quadrature `E_conv = ∫ Σ (K_e − K_t) k i q̇ dt` is present (some K_e ≠
+    /// K_t); it follows the three losses.
+    pub conversion: bool,
+    /// The stops' damping loss `E_s = ∫ Σ c q̇² [beyond] dt` is present (soft stops
+    /// configured); it comes last.
+    pub stops: bool,
 }
 
 impl Layout {
@@ -16,7 +22,7 @@ impl Layout {
         self.electrical.states(self.nv)
     }
     pub fn dim(&self) -> usize {
-        4 * self.nv + self.ni() + 3
+        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops)
     }
     pub fn q(&self) -> std::ops::Range<usize> {
         0..self.nv
@@ -47,6 +53,14 @@ impl Layout {
     pub fn loss_dm(&self) -> usize {
         4 * self.nv + self.ni() + 2
     }
+    /// `E_conv`, when [`Layout::conversion`].
+    pub fn loss_conversion(&self) -> Option<usize> {
+        self.conversion.then(|| 4 * self.nv + self.ni() + 3)
+    }
+    /// `E_s`, when [`Layout::stops`].
+    pub fn loss_stop(&self) -> Option<usize> {
+        self.stops.then(|| 4 * self.nv + self.ni() + 3 + usize::from(self.conversion))
+    }
     /// A readable name of state component `k`, for error messages.
     pub fn name(&self, k: usize, joints: &[String]) -> String {
         let within = |r: std::ops::Range<usize>| r.contains(&k).then(|| joints[k - r.start].clone());
@@ -64,8 +78,12 @@ impl Layout {
             "resistive loss".into()
         } else if k == self.loss_d() {
             "joint friction loss".into()
-        } else {
+        } else if k == self.loss_dm() {
             "gear friction loss".into()
+        } else if Some(k) == self.loss_conversion() {
+            "back-EMF conversion energy".into()
+        } else {
+            "joint stop damping loss".into()
         }
     }
 }

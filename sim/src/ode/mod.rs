@@ -11,11 +11,20 @@
 //! `W_j = ∫ τ_j q̇_j dt` (work of motor j on link j, τ of eq 12), `E_j = ∫ i_j v_j dt` (electric
 //! energy into motor j), `E_R = ∫ Σ R i² dt`, `E_D = ∫ Σ D q̇² dt` (the joints' viscous friction)
 //! and `E_Dm = ∫ Σ D_m q̇² dt` (the gears', eq 12's d_m term). The quadratures ride along with
-//! the dynamics so that they are integrated to the same accuracy.
+//! the dynamics so that they are integrated to the same accuracy. Two more follow only in the
+//! scenes that have them (so the paper's layout is unchanged): `E_conv = ∫ Σ (K_e − K_t) k i q̇
+//! dt` when some back-EMF constant differs from the torque constant (`dynamics/motor.rs`), and
+//! `E_s = ∫ Σ c q̇² [beyond a limit] dt` when soft joint stops are configured
+//! (`joint_limits.rs`).
 //!
 //! Energy balance (SCENE.md; ideal constraints do no work):
-//! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm`, T including the rotors' `½ Σ J_m q̇²`.
-//! Its residual measures the integration error (and constraint drift, which lets f_n work).
+//! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm [+ E_conv] [+ ΔV_s + E_s]`, T including
+//! the rotors' `½ Σ J_m q̇²`, `V_s = Σ ½ k δ²` the stops' stored energy. The voltage that
+//! enters `E_j = ∫ i v dt` is the one the motor sees, after the drive's current window and
+//! supply saturation (the amplifier is ideal: it neither stores nor loses energy), so the
+//! limits add no term. Passive joints have i = v = 0 and no rotor. The controller law only
+//! chooses v: it adds no term. Its residual measures the integration error (and constraint
+//! drift, which lets f_n work).
 //!
 //! Files: `layout.rs` (state indices), `workspace.rs` (the scratch), `arm.rs` (the system and
 //! its right-hand side), `outputs.rs`, `jacobian.rs` (Rosenbrock's Jacobian, IMEX's split),

@@ -55,8 +55,18 @@ pub struct Outputs {
     pub loss_friction: f64,
     /// Its gear part `∫ Σ D_m q̇² dt`, J.
     pub loss_gear_friction: f64,
-    /// `Σ E_j − (ΔT + ΔV + ΔE_L + E_R + E_D + E_Dm)`, J.
+    /// `Σ E_j − (ΔT + ΔV + ΔE_L + E_R + E_D + E_Dm [+ E_conv + ΔV_s + E_s])`, J (the bracket's
+    /// terms when the scene has them).
     pub balance_residual: f64,
+    /// The controller's command before the drive's limits, V (empty unless the drives have
+    /// voltage or current limits; full level only).
+    pub voltage_command: Vec<f64>,
+    /// `E_conv = ∫ Σ (K_e − K_t) k i q̇ dt`, J (0 unless some K_e ≠ K_t).
+    pub loss_conversion: f64,
+    /// The soft stops' stored energy `Σ ½ k δ²`, J (0 without stops).
+    pub stop_energy: f64,
+    /// The soft stops' damping loss `∫ Σ c q̇² [beyond] dt`, J (0 without stops).
+    pub loss_stop: f64,
 }
 
 fn set(dst: &mut Vec<f64>, src: &[f64]) {
@@ -111,6 +121,9 @@ impl ArmSystem<'_> {
         out.loss_resistance = y[l.loss_r()];
         out.loss_friction = y[l.loss_d()] + y[l.loss_dm()];
         out.loss_gear_friction = y[l.loss_dm()];
+        out.loss_conversion = l.loss_conversion().map_or(0.0, |k| y[k]);
+        out.loss_stop = l.loss_stop().map_or(0.0, |k| y[k]);
+        out.stop_energy = s.stops.as_ref().map_or(0.0, |st| st.energy(q));
         let data = &self.ws.data;
         out.potential = potential_energy(&s.model, data);
         out.hand = s.hand.position(data);
@@ -120,7 +133,7 @@ impl ArmSystem<'_> {
         out.constraint_velocity.clear();
         out.constraint_velocity.extend(self.contacts.iter().map(|c| c.velocity(data)));
         if level == OutputLevel::Kinematic {
-            for v in [&mut out.qdd, &mut out.voltage, &mut out.electric_power, &mut out.tau_motor, &mut out.normal_force] {
+            for v in [&mut out.qdd, &mut out.voltage, &mut out.electric_power, &mut out.tau_motor, &mut out.normal_force, &mut out.voltage_command] {
                 v.clear();
             }
             match l.electrical {
@@ -142,6 +155,11 @@ impl ArmSystem<'_> {
         set(&mut out.qdd, fd.qdd.as_slice());
         set(&mut out.current, cur);
         set(&mut out.voltage, voltage);
+        if d.has_limits {
+            set(&mut out.voltage_command, &self.ws.voltage_cmd);
+        } else {
+            out.voltage_command.clear();
+        }
         out.electric_power.clear();
         out.electric_power.extend((0..l.nv).map(|j| cur[j] * voltage[j]));
         set(&mut out.tau_motor, fd.tau_motor.as_slice());
@@ -151,8 +169,16 @@ impl ArmSystem<'_> {
         let m_qd: f64 = (0..l.nv).map(|r| qd[r] * (0..l.nv).map(|c| data.m[(r, c)] * qd[c]).sum::<f64>()).sum();
         out.kinetic = 0.5 * m_qd + rotor_kinetic_energy(d, qd);
         let electric: f64 = out.electric_energy.iter().sum();
-        out.balance_residual = electric
-            - (out.kinetic + out.potential + out.magnetic - self.stored0 + out.loss_resistance + out.loss_friction);
+        out.balance_residual = if l.conversion || l.stops {
+            electric
+                - (out.kinetic + out.potential + out.magnetic + out.stop_energy - self.stored0
+                    + out.loss_resistance
+                    + out.loss_friction
+                    + out.loss_conversion
+                    + out.loss_stop)
+        } else {
+            electric - (out.kinetic + out.potential + out.magnetic - self.stored0 + out.loss_resistance + out.loss_friction)
+        };
         Ok(())
     }
 }

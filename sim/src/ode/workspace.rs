@@ -5,6 +5,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::control::ControllerScratch;
 use crate::dynamics::forward::ForwardData;
 use crate::dynamics::{Data, Model};
 
@@ -16,8 +17,16 @@ pub(super) struct Workspace {
     /// IK targets q_d, q̇_d (nv); written by `ArmSystem::voltage_at`.
     pub(super) q_des: Vec<f64>,
     pub(super) qd_des: Vec<f64>,
-    /// Motor voltages of eq 27 (nv), V; written by `ArmSystem::voltage_at`.
+    /// q̈_d (nv), rad/s^2, for the controllers that feed it forward; written with q_d.
+    pub(super) qdd_des: Vec<f64>,
+    /// Motor voltages (nv), V, as the motors see them (after the drive's limits); written by
+    /// `ArmSystem::voltage_at`.
     pub(super) voltage: Vec<f64>,
+    /// The controller's command before the drive's limits (nv), V; written by
+    /// `ArmSystem::voltage_at` when the drives have limits.
+    pub(super) voltage_cmd: Vec<f64>,
+    /// The controller's scratch.
+    pub(super) ctrl: ControllerScratch,
     /// Currents of quasi-static motors (computed, not integrated), A; `ArmSystem::evaluate`.
     pub(super) current_qs: Vec<f64>,
     /// The structured Jacobian's own matrices (`jacobian.rs`), computed there from `fd.jac`
@@ -35,7 +44,10 @@ impl Workspace {
             fd: ForwardData::new(nv, nc),
             q_des: vec![0.0; nv],
             qd_des: vec![0.0; nv],
+            qdd_des: vec![0.0; nv],
             voltage: vec![0.0; nv],
+            voltage_cmd: vec![0.0; nv],
+            ctrl: ControllerScratch::new(nv),
             current_qs: vec![0.0; nv],
             jac: JacobianScratch::new(nv, nc, dim),
             projection: ProjectionScratch::new(nv, nc),
@@ -58,6 +70,8 @@ pub(super) struct JacobianScratch {
     pub(super) ayt: DMatrix<f64>,
     /// f(t, y) of the evaluation the Jacobian is taken at (dim).
     pub(super) f: Vec<f64>,
+    /// The controller's diagonal linearisation per joint (k_p', k_d', k_i').
+    pub(super) lin: Vec<(f64, f64, f64)>,
 }
 
 impl JacobianScratch {
@@ -70,6 +84,7 @@ impl JacobianScratch {
             a_factor: DMatrix::zeros(nc, nc),
             ayt: DMatrix::zeros(nc, nv),
             f: vec![0.0; dim],
+            lin: vec![(0.0, 0.0, 0.0); nv],
         }
     }
 }

@@ -8,18 +8,19 @@ use std::path::Path;
 
 use nalgebra::{DVector, Unit, Vector3};
 
-use crate::control::{Circle, PdGains, YawPlanarIk};
+use crate::control::{Circle, Controller, Law, PdGains, YawPlanarIk};
+use crate::joint_limits::JointStops;
 use crate::dynamics::constraints::PointOnPlane;
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 use crate::dynamics::kinematics::{body_point, forward_kinematics, forward_velocities, BodyPoint};
-use crate::dynamics::motor::{Drives, Electrical, MotorParams};
+use crate::dynamics::motor::{DriveSpec, Drives, Electrical, MotorParams};
 use crate::dynamics::model::UrdfOptions;
 use crate::dynamics::urdf::{resolve_meshes, MeshInfo};
 use crate::dynamics::{Data, Model};
 use crate::error::{short, ModelError, SceneError};
 use crate::limits::{read_text, MAX_INPUT_BYTES, MAX_SAMPLES};
 pub use spec::SceneSpec;
-use spec::{Branch, Direction, PerJoint, PointSpec};
+use spec::{Branch, Direction, LawSpec, PerJoint, PointSpec, PositionLimitMode};
 
 use crate::integrator::Integrator;
 
@@ -49,6 +50,12 @@ pub struct Scene {
     pub(crate) model: Model,
     pub(crate) drives: Drives,
     pub(crate) gains: PdGains,
+    /// The controller (its law and gains; `gains` are its k_p, k_d).
+    pub(crate) controller: Controller,
+    /// Soft stops at the URDF position limits, when the scene asks.
+    pub(crate) stops: Option<JointStops>,
+    /// The URDF joint limits are monitored (the scene has `joint_limits`).
+    pub(crate) monitor_joints: bool,
     pub(crate) hand: BodyPoint,
     pub(crate) circle: Circle,
     pub(crate) ik: YawPlanarIk,
@@ -92,9 +99,21 @@ impl Scene {
     pub fn drives(&self) -> &Drives {
         &self.drives
     }
-    /// The PD voltage law (eq 27).
+    /// The controller's k_p and k_d (the PD voltage law of eq 27 for the paper).
     pub fn gains(&self) -> &PdGains {
         &self.gains
+    }
+    /// The controller: law and gains.
+    pub fn controller(&self) -> &Controller {
+        &self.controller
+    }
+    /// The soft joint stops, if configured.
+    pub fn stops(&self) -> Option<&JointStops> {
+        self.stops.as_ref()
+    }
+    /// Whether the URDF joint limits are monitored.
+    pub fn monitors_joint_limits(&self) -> bool {
+        self.monitor_joints
     }
     /// The tracked hand point.
     pub fn hand(&self) -> &BodyPoint {
@@ -390,16 +409,99 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>) -> R
             gear_damping: dmg[j],
         })
         .collect();
-    let drives = Drives::new(&motors, &damping);
+    let mut drives = Drives::new(&motors, &damping);
+    let mut specs = vec![DriveSpec::ideal(); nv];
+    if let Some(p) = &m.back_emf_constant {
+        let ke = c.per_joint("motor.back_emf_constant", p, nv, positive, "must be > 0 V s/rad")?;
+        for (s, x) in specs.iter_mut().zip(ke) {
+            s.back_emf_constant = Some(x);
+        }
+    }
+    if let Some(p) = &m.voltage_limit {
+        let v = c.per_joint("motor.voltage_limit", p, nv, positive, "must be > 0 V")?;
+        for (s, x) in specs.iter_mut().zip(v) {
+            s.voltage_limit = Some(x);
+        }
+    }
+    if let Some(p) = &m.current_limit {
+        let v = c.per_joint("motor.current_limit", p, nv, positive, "must be > 0 A")?;
+        for (s, x) in specs.iter_mut().zip(v) {
+            s.current_limit = Some(x);
+        }
+    }
+    for (k, name) in spec.passive.iter().enumerate() {
+        let j = c.dof(&format!("passive[{k}]"), &model, name)?;
+        if specs[j].passive {
+            return Err(c.err(format!("passive[{k}]"), name, "is listed twice"));
+        }
+        specs[j].passive = true;
+    }
+    if specs.iter().any(|s| *s != DriveSpec::ideal()) {
+        drives = drives.with_real_drives(&motors, &specs);
+    }
+    let cs = &spec.controller;
+    let law = cs.law.unwrap_or(LawSpec::Pd);
+    let (kp_unit, kd_unit) = if law == LawSpec::ComputedTorque { ("1/s^2", "1/s") } else { ("V/rad", "V s/rad") };
     let gains = PdGains {
-        kp: DVector::from_vec(c.per_joint("controller.kp", &spec.controller.kp, nv, non_negative, "must be >= 0 V/rad")?),
-        kd: DVector::from_vec(c.per_joint("controller.kd", &spec.controller.kd, nv, non_negative, "must be >= 0 V s/rad")?),
+        kp: DVector::from_vec(c.per_joint("controller.kp", &cs.kp, nv, non_negative, &format!("must be >= 0 {kp_unit}"))?),
+        kd: DVector::from_vec(c.per_joint("controller.kd", &cs.kd, nv, non_negative, &format!("must be >= 0 {kd_unit}"))?),
+    };
+    if cs.friction.is_some() && law != LawSpec::PdGravity {
+        return Err(c.err("controller.friction", format!("{:?}", cs.friction), "only the law \"pd-gravity\" has a friction feed-forward"));
+    }
+    if cs.current_gain.is_some() && law != LawSpec::ComputedTorque {
+        return Err(c.err("controller.current_gain", "(given)", "only the law \"computed-torque\" has an inner current loop"));
+    }
+    let controller = Controller {
+        law: match law {
+            LawSpec::Pd => Law::Pd,
+            LawSpec::PdGravity => Law::PdGravity { friction: cs.friction.unwrap_or(false) },
+            LawSpec::ComputedTorque => Law::ComputedTorque {
+                current_gain: DVector::from_vec(match &cs.current_gain {
+                    Some(p) => c.per_joint("controller.current_gain", p, nv, non_negative, "must be >= 0 V/A")?,
+                    None => vec![0.0; nv],
+                }),
+            },
+        },
+        gains: gains.clone(),
+    };
+
+    // joint limits: monitored, and the position limits enforced by soft stops when asked
+    let (monitor_joints, stops) = match &spec.joint_limits {
+        None => (false, None),
+        Some(jl) => {
+            let stops = match jl.position {
+                PositionLimitMode::Flag => {
+                    for (f, x) in [("joint_limits.stiffness", jl.stiffness), ("joint_limits.damping", jl.damping)] {
+                        if let Some(x) = x {
+                            return Err(c.err(f, x, "only with \"position\": \"stop\" (soft stops)"));
+                        }
+                    }
+                    None
+                }
+                PositionLimitMode::Stop => {
+                    let Some(k) = jl.stiffness else {
+                        return Err(c.err("joint_limits.stiffness", "(absent)", "soft stops need a stiffness, N m/rad (> 0)"));
+                    };
+                    let k = c.number("joint_limits.stiffness", k, positive, "must be > 0 N m/rad")?;
+                    let d = c.number("joint_limits.damping", jl.damping.unwrap_or(0.0), non_negative, "must be >= 0 N m s/rad")?;
+                    if model.bodies.iter().all(|b| b.limits.position.is_none()) {
+                        return Err(c.err("joint_limits.position", "stop", "the URDF gives no position limit to any joint (<limit lower upper>)"));
+                    }
+                    Some(JointStops::new(&model, k, d))
+                }
+            };
+            (true, stops)
+        }
     };
 
     // initial state
     let q0 = c.per_joint("initial.q", &spec.initial.q, nv, |_| true, "")?;
     let qd0 = c.per_joint("initial.qd", &spec.initial.qd, nv, |_| true, "")?;
     let current0 = c.per_joint("initial.current", &spec.initial.current, nv, |_| true, "")?;
+    if let Some(j) = (0..nv).find(|&j| drives.passive[j] && current0[j] != 0.0) {
+        return Err(c.err(format!("initial.current[{j}]"), current0[j], "a passive joint has no motor: its current is 0"));
+    }
     if drives.electrical == Electrical::QuasiStatic && current0.iter().any(|&i| i != 0.0) {
         return Err(c.err("initial.current", format!("{current0:?}"), "quasi-static motors (L = 0) have no current state: leave it 0"));
     }
@@ -504,12 +606,22 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>) -> R
     }
 
     let integrator = Integrator::from_spec(&spec.integrator, file, duration, 1.0 / output_rate)?;
+    if integrator.method() == "imex" && drives.electrical == Electrical::Inductive && controller.reads_current() {
+        return Err(c.err(
+            "controller.current_gain",
+            "(non-zero)",
+            "the imex method solves the armature circuits implicitly with a voltage independent of the current; an inner current loop makes it depend on i: use another integrator or current_gain 0",
+        ));
+    }
     Ok(Scene {
         source: file.to_string(),
         urdf_xml,
         model,
         drives,
         gains,
+        controller,
+        stops,
+        monitor_joints,
         hand,
         circle,
         ik,

@@ -68,6 +68,13 @@ pub struct SceneSpec {
     pub joint_damping: PerJoint,
     pub motor: MotorSpec,
     pub controller: ControllerSpec,
+    /// Joints without a motor (URDF joint names): no current, voltage or rotor.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub passive: Vec<String>,
+    /// Monitor the URDF's joint limits (and enforce the position limits by soft stops when
+    /// asked); absent: limits are not looked at (the paper's behaviour).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_limits: Option<JointLimitsSpec>,
     /// The hand point whose path is tracked.
     pub hand: PointSpec,
     pub target: TargetSpec,
@@ -126,16 +133,69 @@ pub struct MotorSpec {
     pub gear_ratio: PerJoint,
     /// d_m, N m s/rad (motor side).
     pub gear_damping: PerJoint,
+    /// K_e, V s/rad (motor side); absent: equal to `torque_constant`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub back_emf_constant: Option<PerJoint>,
+    /// Supply voltage limit, V: the amplifier saturates at ±limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub voltage_limit: Option<PerJoint>,
+    /// The driver's current limit, A.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub current_limit: Option<PerJoint>,
 }
 
-/// PD on the motor voltage (eq 27).
+/// The controller's law (`sim/src/control/controller.rs` gives each equation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LawSpec {
+    Pd,
+    PdGravity,
+    ComputedTorque,
+}
+
+/// What the monitor does at a joint's position limit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PositionLimitMode {
+    /// Flag the crossing (first time, time beyond, peak); nothing pushes back.
+    #[default]
+    Flag,
+    /// A soft stop: a spring-damper beyond the limit (`stiffness`, `damping`), and flagged.
+    Stop,
+}
+
+/// `"joint_limits"`: the URDF `<limit>`s are monitored at every output sample (position,
+/// velocity, effort), and the position limits optionally enforced by soft stops.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointLimitsSpec {
+    #[serde(default)]
+    pub position: PositionLimitMode,
+    /// The stops' stiffness, N m/rad (`stop` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<f64>,
+    /// The stops' damping, N m s/rad (`stop` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
+}
+
+/// The controller: the paper's PD on the motor voltage (eq 27) when `law` is absent or `pd`;
+/// `pd-gravity` (with `friction`) or `computed-torque` (with `current_gain`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ControllerSpec {
-    /// k_p, V/rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub law: Option<LawSpec>,
+    /// k_p: V/rad (`pd`, `pd-gravity`), 1/s^2 (`computed-torque`).
     pub kp: PerJoint,
-    /// k_d, V s/rad.
+    /// k_d: V s/rad (`pd`, `pd-gravity`), 1/s (`computed-torque`).
     pub kd: PerJoint,
+    /// `pd-gravity`: also feed forward the viscous friction (D + D_m) q'_d.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<bool>,
+    /// `computed-torque`: the inner current loop's gain k_i, V/A (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub current_gain: Option<PerJoint>,
 }
 
 /// A point fixed on the robot: the origin of a joint, or a point in a link's frame.

@@ -1,0 +1,318 @@
+//! Joint limits (a scene's `"joint_limits"`) and drive limits: the soft stops that enforce the
+//! URDF position limits when a scene asks, and the monitor that flags every limit crossed.
+//!
+//! **Soft stops** (`"position": "stop"`): beyond a limit a linear spring-damper acts on the
+//! joint, `τ_s = −k (q − q_hi) − c q̇` for `q > q_hi` (and with `q_lo` for `q < q_lo`), zero
+//! inside — the penalty (compliant) method of joint-limit enforcement (Featherstone, *Rigid Body
+//! Dynamics Algorithms*, §11.2, compliant contact; a unilateral-constraint solve is not used).
+//! It stores `V_s = ½ k (q − q_hi)²` (part of the energy balance as a stored energy) and
+//! dissipates `c q̇²` while beyond (a new quadrature `E_s = ∫ Σ c q̇² [beyond] dt`, present only
+//! when stops are configured). The damper acts over the whole penetration (it can pull while
+//! the joint leaves the stop; the energy account is exact either way).
+//!
+//! **Monitor** (on when the scene has `"joint_limits"` or a voltage or current limit): at every
+//! output sample — the resolution of every time below is the output interval `1 / output_rate`
+//! — per joint and kind: the first sample time beyond, the time spent beyond (samples beyond ×
+//! interval), and the peak. Kinds: `position` (q outside the URDF `lower..upper`), `velocity`
+//! (|q̇| > URDF `velocity`), `effort` (|τ| of eq 12 > URDF `effort`), `current` (|i| > the
+//! driver's limit by more than 1e-6 relative — the integration error of inductive motors at
+//! their barrier is below that), and the drive's saturations, which are not limits crossed but
+//! are reported: `voltage-saturation` (the commanded |v*| above the supply) and `current-limit`
+//! (the driver clipped the command, |v* − K_e k q̇| > R I).
+
+use crate::dynamics::Model;
+use crate::dynamics::motor::Drives;
+use crate::ode::Outputs;
+
+/// Soft stops at the URDF position limits (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointStops {
+    /// Lower and upper limit per joint, rad (∓∞ where the URDF gives none).
+    pub lower: Vec<f64>,
+    pub upper: Vec<f64>,
+    /// k, N m/rad.
+    pub stiffness: f64,
+    /// c, N m s/rad.
+    pub damping: f64,
+}
+
+impl JointStops {
+    /// From the URDF limits of `model`.
+    pub fn new(model: &Model, stiffness: f64, damping: f64) -> Self {
+        let lim = |f: fn((f64, f64)) -> f64, none: f64| model.bodies.iter().map(|b| b.limits.position.map_or(none, f)).collect();
+        Self { lower: lim(|p| p.0, f64::NEG_INFINITY), upper: lim(|p| p.1, f64::INFINITY), stiffness, damping }
+    }
+
+    /// Penetration beyond the limits of joint j, rad (positive above, negative below, 0 inside).
+    #[inline]
+    fn beyond(&self, j: usize, q: f64) -> f64 {
+        if q > self.upper[j] {
+            q - self.upper[j]
+        } else if q < self.lower[j] {
+            q - self.lower[j]
+        } else {
+            0.0
+        }
+    }
+
+    /// The stop torque on joint j, N m.
+    #[inline]
+    pub fn torque(&self, j: usize, q: f64, qd: f64) -> f64 {
+        let d = self.beyond(j, q);
+        if d == 0.0 {
+            0.0
+        } else {
+            -self.stiffness * d - self.damping * qd
+        }
+    }
+
+    /// `Σ ½ k δ²`, J.
+    pub fn energy(&self, q: &[f64]) -> f64 {
+        q.iter().enumerate().map(|(j, &x)| 0.5 * self.stiffness * self.beyond(j, x).powi(2)).sum()
+    }
+
+    /// `Σ c q̇² [beyond]`, W.
+    #[inline]
+    pub fn loss_rate(&self, q: &[f64], qd: &[f64]) -> f64 {
+        let mut p = 0.0;
+        for j in 0..q.len() {
+            if self.beyond(j, q[j]) != 0.0 {
+                p += self.damping * qd[j] * qd[j];
+            }
+        }
+        p
+    }
+}
+
+/// What is monitored ([`LimitMonitor`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum LimitKind {
+    Position,
+    Velocity,
+    Effort,
+    Current,
+    VoltageSaturation,
+    CurrentLimit,
+}
+
+impl LimitKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            LimitKind::Position => "position",
+            LimitKind::Velocity => "velocity",
+            LimitKind::Effort => "effort",
+            LimitKind::Current => "current",
+            LimitKind::VoltageSaturation => "voltage-saturation",
+            LimitKind::CurrentLimit => "current-limit",
+        }
+    }
+
+    /// A limit crossed (else a saturation of the drive, which is its designed behaviour).
+    pub fn is_exceeded(self) -> bool {
+        !matches!(self, LimitKind::VoltageSaturation | LimitKind::CurrentLimit)
+    }
+}
+
+/// One joint and kind, as monitored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitEvent {
+    pub joint: String,
+    pub kind: LimitKind,
+    /// The limit, in the quantity's unit (rad, rad/s, N m, A, V; the crossed bound for
+    /// positions).
+    pub limit: f64,
+    /// First sample time beyond, s.
+    pub first_time: f64,
+    /// Samples beyond × the output interval, s.
+    pub time_beyond: f64,
+    /// The most extreme value seen: q for positions, else the magnitude (|q̇|, |τ|, |i|, |v*|,
+    /// and |v* − K_e k q̇| / R for `current-limit`, the current asked for).
+    pub peak: f64,
+}
+
+/// The monitor's verdict on one run.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LimitsSummary {
+    /// One per joint and kind that happened, in joint then kind order.
+    pub events: Vec<LimitEvent>,
+    /// The output interval, s: the resolution of the times.
+    pub resolution: f64,
+    /// What was monitored, for the record.
+    pub monitored: String,
+}
+
+impl LimitsSummary {
+    /// Limits crossed (position, velocity, effort, current), joint and kind counted once.
+    pub fn exceeded(&self) -> usize {
+        self.events.iter().filter(|e| e.kind.is_exceeded()).count()
+    }
+    /// Saturations of the drives (voltage, current window), joint and kind counted once.
+    pub fn saturated(&self) -> usize {
+        self.events.len() - self.exceeded()
+    }
+    /// "complete", "complete, 3 limits exceeded", "complete, 1 limit exceeded, 2 saturations".
+    pub fn status(&self, status: &str) -> String {
+        status_text(status, Some(self.exceeded() as u64), Some(self.saturated() as u64))
+    }
+}
+
+/// The status line of a run: `status`, then the limits exceeded and saturations when non-zero.
+pub fn status_text(status: &str, exceeded: Option<u64>, saturated: Option<u64>) -> String {
+    let mut s = status.to_string();
+    let plural = |n: u64| if n == 1 { "" } else { "s" };
+    if let Some(n) = exceeded.filter(|&n| n > 0) {
+        s += &format!(", {n} limit{} exceeded", plural(n));
+    }
+    if let Some(n) = saturated.filter(|&n| n > 0) {
+        s += &format!(", {n} saturation{}", plural(n));
+    }
+    s
+}
+
+#[derive(Clone, Debug)]
+struct Slot {
+    joint: usize,
+    kind: LimitKind,
+    limit: f64,
+    first_time: Option<f64>,
+    samples: u64,
+    peak: f64,
+    /// Which bound a position crossed first (for the record).
+    bound: f64,
+}
+
+/// Watches every output sample of a run (module docs). Slots are made once; `observe` does not
+/// allocate.
+#[derive(Clone, Debug)]
+pub struct LimitMonitor {
+    joints: Vec<String>,
+    slots: Vec<Slot>,
+    position: Vec<Option<(f64, f64)>>,
+    dt: f64,
+    ke: Vec<f64>,
+    r: Vec<f64>,
+    monitored: String,
+}
+
+impl LimitMonitor {
+    /// The monitor of a scene: joints' limits when `joints` (the scene has `"joint_limits"`),
+    /// the drives' when they have limits; `None` when neither (nothing is monitored).
+    pub fn new(model: &Model, drives: &Drives, joints: bool, dt: f64) -> Option<Self> {
+        if !joints && !drives.has_limits {
+            return None;
+        }
+        let mut slots = Vec::new();
+        let mut what = Vec::new();
+        let slot = |joint, kind, limit| Slot { joint, kind, limit, first_time: None, samples: 0, peak: 0.0, bound: 0.0 };
+        for (j, b) in model.bodies.iter().enumerate() {
+            if joints {
+                if let Some((lo, hi)) = b.limits.position {
+                    slots.push(Slot { peak: f64::NAN, ..slot(j, LimitKind::Position, hi.max(lo)) });
+                }
+                if let Some(v) = b.limits.velocity {
+                    slots.push(slot(j, LimitKind::Velocity, v));
+                }
+                if let Some(e) = b.limits.effort {
+                    slots.push(slot(j, LimitKind::Effort, e));
+                }
+            }
+            if drives.passive[j] {
+                continue;
+            }
+            if drives.current_limit[j].is_finite() {
+                slots.push(slot(j, LimitKind::Current, drives.current_limit[j]));
+                slots.push(slot(j, LimitKind::CurrentLimit, drives.current_limit[j]));
+            }
+            if drives.voltage_limit[j].is_finite() {
+                slots.push(slot(j, LimitKind::VoltageSaturation, drives.voltage_limit[j]));
+            }
+        }
+        if joints {
+            what.push("URDF position, velocity and effort limits");
+        }
+        if drives.has_limits {
+            what.push("drive voltage and current limits");
+        }
+        Some(Self {
+            joints: model.joint_names(),
+            slots,
+            position: model.bodies.iter().map(|b| b.limits.position).collect(),
+            dt,
+            ke: drives.ke.iter().copied().collect(),
+            r: drives.r.iter().copied().collect(),
+            monitored: what.join("; "),
+        })
+    }
+
+    /// Look at one sample (full outputs: q, q̇, τ, i, and the commanded voltage when the drives
+    /// have limits).
+    pub fn observe(&mut self, o: &Outputs) {
+        for s in &mut self.slots {
+            let j = s.joint;
+            let (beyond, value) = match s.kind {
+                LimitKind::Position => {
+                    let (lo, hi) = self.position[j].unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+                    let q = o.q[j];
+                    let beyond = q > hi || q < lo;
+                    if beyond && s.first_time.is_none() {
+                        s.bound = if q > hi { hi } else { lo };
+                    }
+                    // the peak is the q farthest beyond its bound
+                    let excess = |x: f64| if x > hi { x - hi } else if x < lo { lo - x } else { 0.0 };
+                    if beyond && (s.peak.is_nan() || excess(q) > excess(s.peak)) {
+                        s.peak = q;
+                    }
+                    (beyond, None)
+                }
+                LimitKind::Velocity => (o.qd[j].abs() > s.limit, Some(o.qd[j].abs())),
+                LimitKind::Effort => match o.tau_motor.get(j) {
+                    Some(t) => (t.abs() > s.limit, Some(t.abs())),
+                    None => (false, None),
+                },
+                LimitKind::Current => match o.current.get(j) {
+                    Some(i) => (i.abs() > s.limit * (1.0 + 1e-6), Some(i.abs())),
+                    None => (false, None),
+                },
+                LimitKind::VoltageSaturation => match o.voltage_command.get(j) {
+                    Some(v) => (v.abs() > s.limit, Some(v.abs())),
+                    None => (false, None),
+                },
+                LimitKind::CurrentLimit => match o.voltage_command.get(j) {
+                    Some(v) => {
+                        let asked = (v - self.ke[j] * o.qd[j]).abs() / self.r[j];
+                        (asked > s.limit, Some(asked))
+                    }
+                    None => (false, None),
+                },
+            };
+            if beyond {
+                s.first_time.get_or_insert(o.t);
+                s.samples += 1;
+                if let Some(v) = value {
+                    s.peak = s.peak.max(v);
+                }
+            }
+        }
+    }
+
+    /// What happened, one event per joint and kind that was beyond at some sample.
+    pub fn summary(&self) -> LimitsSummary {
+        let events = self
+            .slots
+            .iter()
+            .filter_map(|s| {
+                let first_time = s.first_time?;
+                let limit = if s.kind == LimitKind::Position { s.bound } else { s.limit };
+                Some(LimitEvent {
+                    joint: self.joints[s.joint].clone(),
+                    kind: s.kind,
+                    limit,
+                    first_time,
+                    time_beyond: s.samples as f64 * self.dt,
+                    peak: s.peak,
+                })
+            })
+            .collect();
+        LimitsSummary { events, resolution: self.dt, monitored: self.monitored.clone() }
+    }
+}
