@@ -61,11 +61,13 @@ impl<'a> ArmSystem<'a> {
         t + potential_energy(&s.model, data) + magnetic_energy(&s.drives, current)
     }
 
-    /// The IK targets (eqs 28–29) and the PD voltages (eq 27) at (t, q, q̇), into the workspace.
+    /// The targets (the paper's: eqs 28–29) and the PD voltages (eq 27) at (t, q, q̇), into
+    /// the workspace.
     pub(super) fn voltage_at(&mut self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), DynamicsError> {
         let s = self.scene;
         let ws = &mut self.ws;
-        s.ik.solve(&s.circle.position(t), &s.circle.velocity(t), &mut ws.q_des, &mut ws.qd_des)
+        let qdd_des = if ws.want_qdd { Some(&mut ws.qdd_des[..]) } else { None };
+        s.target.eval(t, &s.model, &s.hand, &mut ws.target, &mut ws.q_des, &mut ws.qd_des, qdd_des)
             .map_err(|why| DynamicsError::Unreachable { t, why })?;
         s.gains.voltage(q, qd, &ws.q_des, &ws.qd_des, &mut ws.voltage);
         Ok(())

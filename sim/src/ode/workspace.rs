@@ -5,6 +5,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::control::TargetScratch;
 use crate::dynamics::forward::ForwardData;
 use crate::dynamics::{Data, Model};
 
@@ -13,9 +14,16 @@ pub(super) struct Workspace {
     pub(super) data: Data,
     /// Eq 21's scratch and outputs (q̈, f_n, di/dt, τ); written by `ArmSystem::evaluate`.
     pub(super) fd: ForwardData,
-    /// IK targets q_d, q̇_d (nv); written by `ArmSystem::voltage_at`.
+    /// Targets q_d, q̇_d (nv); written by `ArmSystem::voltage_at`.
     pub(super) q_des: Vec<f64>,
     pub(super) qd_des: Vec<f64>,
+    /// Target q̈_d (nv), rad/s^2; written by `ArmSystem::voltage_at` when `want_qdd`.
+    pub(super) qdd_des: Vec<f64>,
+    /// Whether the controller reads q̈_d (the paper's PD does not; the paper target then
+    /// skips computing it). Set once in `Workspace::new`.
+    pub(super) want_qdd: bool,
+    /// The target's own scratch (`Target::eval`, `Target::hand_desired`).
+    pub(super) target: TargetScratch,
     /// Motor voltages of eq 27 (nv), V; written by `ArmSystem::voltage_at`.
     pub(super) voltage: Vec<f64>,
     /// Currents of quasi-static motors (computed, not integrated), A; `ArmSystem::evaluate`.
@@ -35,6 +43,9 @@ impl Workspace {
             fd: ForwardData::new(nv, nc),
             q_des: vec![0.0; nv],
             qd_des: vec![0.0; nv],
+            qdd_des: vec![0.0; nv],
+            want_qdd: false,
+            target: TargetScratch::new(model),
             voltage: vec![0.0; nv],
             current_qs: vec![0.0; nv],
             jac: JacobianScratch::new(nv, nc, dim),
