@@ -185,6 +185,7 @@ fn general_ik_reproduces_the_closed_form_on_the_paper_arm() {
     });
     let s = scene_from(&v, None).unwrap();
     let stats = *s.target().track_stats().unwrap();
+    eprintln!("paper circle, general IK on joints 1, 9, 10: {stats:?}");
     assert!(stats.between_knots <= 1e-9 && stats.at_knots <= 1e-12, "{stats:?}");
     let nv = 10;
     let (circle, ik) = (paper.circle().unwrap(), paper.ik().unwrap());
@@ -243,7 +244,9 @@ fn cartesian_target_keeps_the_elbows_on_the_table() {
         "ik": {"solver": "dls", "keep_contacts": ["elbow4", "elbow7"]}
     });
     v["duration"] = json!(0.3);
+    let built = std::time::Instant::now();
     let s = scene_from(&v, None).unwrap();
+    eprintln!("paper circle, all joints, elbows kept: {:?}, built in {:?}", s.target().track_stats().unwrap(), built.elapsed());
     let mut data = Data::new(s.model());
     for k in 0..=30 {
         let t = 0.01 * k as f64 + 0.0013;
@@ -387,10 +390,35 @@ fn track_a_tilted_circle_on_the_seven_dof_arm() {
     assert!((path.position(0.0) - start).norm() < 1e-15);
     let ik = GeneralIk { hand, orientation: None, contacts: vec![], active: vec![true; 7], posture: q0.to_vec() };
     let (q, stats) = track(&ik, &model, &path, &q0, 2.0, 0.002).unwrap();
+    eprintln!("7-DoF tilted circle: {stats:?}");
     assert!(stats.between_knots <= 1e-9 && stats.at_knots <= 1e-12, "{stats:?}");
     let (mut qq, mut qd, mut qdd) = ([0.0; 7], [0.0; 7], [0.0; 7]);
     q.eval(0.0, &mut qq, &mut qd, &mut qdd);
     // q_d(0) is the posture's nearest solution: the start point is q0's hand, so q_d(0) = q0
     assert!(qq.iter().zip(&q0).all(|(a, b)| (a - b).abs() < 1e-6), "{qq:?}");
     let _ = Target::Cartesian { path, q, stats };
+}
+
+/// The example scenes in sim/scenes/targets load (the Cartesian ones with their spline within
+/// 1e-9 m of the path between knots) and run 0.2 s of their two-elbow case without failure,
+/// the elbows staying on the table to 1e-6 m (the runs are unstabilised, as the paper's).
+#[test]
+fn example_target_scenes_load_and_run() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/targets");
+    for name in ["tilted-circle", "square-lines", "joint-spline"] {
+        let s = Scene::load(&dir.join(format!("{name}.json"))).unwrap_or_else(|e| panic!("{e}"));
+        if let Some(st) = s.target().track_stats() {
+            assert!(st.between_knots <= 1e-9, "{name}: {st:?}");
+        }
+        assert!(!s.target().describe(s.model()).is_empty());
+        let s = s.vary(|spec| spec.duration = 0.2).unwrap();
+        let run = s.run("two-elbow").unwrap().clone();
+        let mut worst = 0.0f64;
+        sim::run::simulate(&s, &run, |out| {
+            worst = out.constraint_position.iter().fold(worst, |w, c| w.max(c.abs()));
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(worst < 1e-6, "{name}: elbows off the table by {worst} m");
+    }
 }

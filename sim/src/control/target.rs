@@ -97,6 +97,29 @@ impl Target {
         }
     }
 
+    /// One phrase for people (`sim check` may print it): what is tracked and how q_d is made.
+    pub fn describe(&self, model: &Model) -> String {
+        let names = |dofs: &[usize]| dofs.iter().map(|&j| model.bodies[j].joint.as_str()).collect::<Vec<_>>().join(", ");
+        match self {
+            Target::Paper { circle, ik } => format!(
+                "the paper's circle (centre {:?} m, radius {} m, {} s per turn), closed-form IK on {}",
+                circle.center.as_slice(), circle.radius, circle.period,
+                names(&[ik.yaw_dof, ik.planar_dofs[0], ik.planar_dofs[1]])
+            ),
+            Target::Joint(JointSpline::Cubic(s)) => format!("joint-space cubic spline (C², at rest at the ends) through {} knots", s.knots().len()),
+            Target::Joint(JointSpline::Quintic(_)) => "joint-space minimum-jerk quintics, at rest at each waypoint".to_string(),
+            Target::Cartesian { path, stats, .. } => format!(
+                "hand {} tracked by the general IK (damped least squares): {} knots every {} s, task error <= {:.1e} at the knots, <= {:.1e} between",
+                match path {
+                    CartesianPath::Circle(_) => "circle",
+                    CartesianPath::Lines(_) => "line segments",
+                    CartesianPath::Waypoints(_) => "waypoint spline",
+                },
+                stats.knots, stats.step, stats.at_knots, stats.between_knots
+            ),
+        }
+    }
+
     /// The paper's circle, if this is the paper target.
     pub fn circle(&self) -> Option<&Circle> {
         match self {
