@@ -365,8 +365,11 @@ fn target_errors_name_the_field() {
         (json!({"kind": "cartesian", "path": {"shape": "circle", "center": [3.5, 3.5, 0.4], "normal": [0, 0, 1], "radius": 0.1, "period": 5.0}}), "target.path` = t = 0.0000 s: the general IK cannot follow the path there: task residual"),
         (json!({"kind": "cartesian", "path": {"shape": "spiral"}}), "unknown variant `spiral`"),
         (json!({"kind": "joint-spline", "waypoints": [{"t": 0, "q": [0, 1]}]}), "target.waypoints[0].q"),
-        (json!({"kind": "joint-spline", "waypoints": [{"t": 0, "q": [0,0,0,0,0,0,0,0,0,0], "qq": 1}]}), "unknown field `qq`"),
+        (json!({"kind": "joint-spline", "waypoints": [{"t": 0, "q": [0,0,0,0,0,0,0,0,0,0], "qq": 1}]}), "target.waypoints[0]"),
         (json!({"kind": "teleport"}), "unknown variant `teleport`"),
+        (json!({"kind": "cartesian", "path": {"shape": "circle", "center": [1.5, 1.5, 0.4], "normal": [0, 0, 1], "radius": 0.1, "period": 5.0}, "ik": {"solver": "jt"}}), "field `target.ik.solver`: unknown variant `jt`, expected `dls`"),
+        (json!({"kind": "cartesian", "path": {"shape": "circle", "center": [1.5, 1.5, 0.4], "normal": [0, 0, 1], "radiuss": 0.1, "period": 5.0}}), "field `target.path.radiuss` = 0.1: unknown field `radiuss`"),
+        (json!({"circle": {"center": [1.5, 1.5, 0.4], "radius": "big", "period": 5.0, "phase": 0.0, "direction": "counter-clockwise"}, "ik": {}}), "field `target.circle.radius`: invalid type: string \"big\", expected f64"),
         (json!({"kind": "cartesian", "path": {"shape": "circle", "center": [1.5, 1.5, 0.4], "normal": [0, 0, 1], "radius": 0.1, "period": 5.0}, "ik": {"keep_contacts": ["knee"]}}), "target.ik.keep_contacts[0]` = knee"),
     ];
     for (target, want) in cases {
@@ -421,4 +424,18 @@ fn example_target_scenes_load_and_run() {
         .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(worst < 1e-6, "{name}: elbows off the table by {worst} m");
     }
+}
+
+/// An unknown key is named once in the field path (`contacts[1].plane.normale`, not
+/// `…normale.normale`), inside the target as elsewhere.
+#[test]
+fn unknown_keys_are_named_once() {
+    let mut v = paper_json();
+    v["contacts"][1]["plane"]["normale"] = json!([0, 0, 1]);
+    let e = scene_from(&v, None).unwrap_err().to_string();
+    assert!(e.contains("field `contacts[1].plane.normale` = [0,0,1]: unknown field `normale`"), "{e}");
+    let mut v = paper_json();
+    v["target"]["circle"]["radiuss"] = json!(0.1);
+    let e = scene_from(&v, None).unwrap_err().to_string();
+    assert!(e.contains("field `target.circle.radiuss` = 0.1: unknown field `radiuss`"), "{e}");
 }

@@ -190,12 +190,25 @@ impl Scene {
             let path = e.path().to_string();
             let path = path.trim_end_matches('?').trim_end_matches('.');
             let why = e.inner().to_string();
+            // a value read whole (the target) says where inside it: "at `path.inside`: why"
+            let (path, why) = match why.strip_prefix("at `").and_then(|r| r.split_once("`: ")) {
+                Some((inside, rest)) => (format!("{path}.{inside}"), rest.to_string()),
+                None => (path.to_string(), why),
+            };
+            let path = path.as_str();
             // a tagged value (the integrator) is read whole: name the unknown key inside it
             if let Some(key) = why.strip_prefix("unknown field `").and_then(|r| r.split('`').next()) {
-                let field = if path.is_empty() { key.to_string() } else { format!("{path}.{key}") };
+                // serde_path_to_error's path already ends in the unknown key; a tagged value's does not
+                let field = if path.is_empty() {
+                    key.to_string()
+                } else if path == key || path.ends_with(&format!(".{key}")) {
+                    path.to_string()
+                } else {
+                    format!("{path}.{key}")
+                };
                 let value = serde_json::from_str::<serde_json::Value>(text)
                     .ok()
-                    .and_then(|doc| doc.pointer(&format!("/{}", field.replace('.', "/"))).map(|v| v.to_string()))
+                    .and_then(|doc| doc.pointer(&format!("/{}", field.replace('.', "/").replace('[', "/").replace(']', ""))).map(|v| v.to_string()))
                     .unwrap_or_default();
                 return SceneError::new(source, field, value, why);
             }

@@ -195,22 +195,67 @@ impl Serialize for TargetSpec {
 
 impl<'de> Deserialize<'de> for TargetSpec {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use serde::de::Error;
         let v = serde_json::Value::deserialize(d)?;
-        let kinded = v.as_object().is_some_and(|o| o.contains_key("kind"));
-        // name the path inside the target in the message (the outer path ends at `target`)
-        let inner = |e: serde_path_to_error::Error<serde_json::Error>| {
-            let path = e.path().to_string();
-            if path == "." || path.is_empty() {
-                D::Error::custom(e.inner().to_string())
-            } else {
-                D::Error::custom(format!("{path}: {}", e.inner()))
-            }
-        };
-        if kinded {
-            serde_path_to_error::deserialize(v).map(TargetSpec::Kinded).map_err(inner)
+        if v.as_object().is_some_and(|o| o.contains_key("kind")) {
+            read_inner(v).map(TargetSpec::Kinded)
         } else {
-            serde_path_to_error::deserialize(v).map(TargetSpec::Paper).map_err(inner)
+            read_inner(v).map(TargetSpec::Paper)
+        }
+    }
+}
+
+/// Read a value that was taken whole (a JSON value), keeping the path of an error inside it:
+/// the message becomes "at `path.inside`: why", which `Scene::from_json` appends to the
+/// field's path (serde's own tagged enums buffer their content and lose that path).
+fn read_inner<T: serde::de::DeserializeOwned, E: serde::de::Error>(v: serde_json::Value) -> Result<T, E> {
+    serde_path_to_error::deserialize(v).map_err(|e| {
+        let path = e.path().to_string();
+        let path = if path == "." { String::new() } else { path };
+        let msg = e.inner().to_string();
+        let (path, msg) = match msg.strip_prefix("at `").and_then(|r| r.split_once("`: ")) {
+            Some((inside, rest)) if path.is_empty() => (inside.to_string(), rest.to_string()),
+            Some((inside, rest)) => (format!("{path}.{inside}"), rest.to_string()),
+            None => (path, msg),
+        };
+        if path.is_empty() {
+            E::custom(msg)
+        } else {
+            E::custom(format!("at `{path}`: {msg}"))
+        }
+    })
+}
+
+/// Take the string tag `tag` out of the object `v`; it must name one of `variants`.
+fn take_tag<E: serde::de::Error>(v: &mut serde_json::Value, tag: &'static str, variants: &'static [&'static str]) -> Result<String, E> {
+    let Some(obj) = v.as_object_mut() else {
+        return Err(E::custom(format!("expected an object with `{tag}`")));
+    };
+    match obj.remove(tag) {
+        Some(serde_json::Value::String(s)) if variants.contains(&s.as_str()) => Ok(s),
+        Some(serde_json::Value::String(s)) => Err(E::unknown_variant(&s, variants)),
+        Some(other) => Err(E::custom(format!("at `{tag}`: expected one of {variants:?}, found {other}"))),
+        None => Err(E::missing_field(tag)),
+    }
+}
+
+impl<'de> Deserialize<'de> for KindedTarget {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut v = serde_json::Value::deserialize(d)?;
+        match take_tag::<D::Error>(&mut v, "kind", &["joint-spline", "joint-csv", "cartesian"])?.as_str() {
+            "joint-spline" => read_inner(v).map(KindedTarget::JointSpline),
+            "joint-csv" => read_inner(v).map(KindedTarget::JointCsv),
+            _ => read_inner(v).map(KindedTarget::Cartesian),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PathSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut v = serde_json::Value::deserialize(d)?;
+        match take_tag::<D::Error>(&mut v, "shape", &["circle", "lines", "waypoints"])?.as_str() {
+            "circle" => read_inner(v).map(PathSpec::Circle),
+            "lines" => read_inner(v).map(PathSpec::Lines),
+            _ => read_inner(v).map(PathSpec::Waypoints),
         }
     }
 }
@@ -223,8 +268,8 @@ pub struct PaperTargetSpec {
     pub ik: IkSpec,
 }
 
-/// The targets selected by `kind`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// The targets selected by `kind` (read by hand, so that errors keep their path inside).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum KindedTarget {
     /// Joint-space waypoints joined by a named spline.
@@ -285,8 +330,8 @@ pub struct CartesianSpec {
     pub ik: GeneralIkSpec,
 }
 
-/// A hand path, world frame, selected by `shape`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A hand path, world frame, selected by `shape` (read by hand, as [`KindedTarget`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "shape", rename_all = "kebab-case")]
 pub enum PathSpec {
     Circle(CirclePathSpec),
