@@ -54,10 +54,12 @@ fn dump() -> Result<(), String> {
     let gains = scene.gains();
 
     // joint targets (eqs 28-29) at t = 0 and at the end (equal for a constant target)
-    let circle = scene.circle();
+    let (Some(circle), Some(ik)) = (scene.circle(), scene.ik()) else {
+        return Err(format!("{path}: the peers compare the paper's circle target only"));
+    };
     let targets = |t: f64| -> Result<(Vec<f64>, Vec<f64>), String> {
         let (mut q_des, mut qd_des) = (vec![0.0; nv], vec![0.0; nv]);
-        scene.ik().solve(&circle.position(t), &circle.velocity(t), &mut q_des, &mut qd_des).map_err(|why| format!("the target at t = {t} s: {why}"))?;
+        ik.solve(&circle.position(t), &circle.velocity(t), &mut q_des, &mut qd_des).map_err(|why| format!("the target at t = {t} s: {why}"))?;
         Ok((q_des, qd_des))
     };
     let (q_des, qd_des0) = targets(0.0)?;

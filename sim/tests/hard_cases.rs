@@ -100,7 +100,7 @@ fn sixty_seconds_without_stabilisation() {
 #[test]
 fn near_the_reach_limit() {
     let s = hard("reach-limit").unwrap();
-    let (model, ik, circle) = (s.model(), s.ik(), s.circle());
+    let (model, ik, circle) = (s.model(), s.ik().unwrap(), s.circle().unwrap());
     let mut data = sim::dynamics::Data::new(model);
     let (mut q, mut qd) = (vec![0.0; model.nv], vec![0.0; model.nv]);
     let joint9 = model.bodies.iter().position(|b| b.joint == "joint9").unwrap();

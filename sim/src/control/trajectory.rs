@@ -42,6 +42,13 @@ impl Circle {
         let w = self.direction * 2.0 * std::f64::consts::PI / self.period;
         Vector3::new(-a.sin(), a.cos(), 0.0) * (self.radius * w)
     }
+
+    /// `r̈_d(t)`, world frame, m/s² (the step's derivatives left out, as in ṙ_d).
+    pub fn acceleration(&self, t: f64) -> Vector3<f64> {
+        let a = self.angle(t);
+        let w = self.direction * 2.0 * std::f64::consts::PI / self.period;
+        Vector3::new(a.cos(), a.sin(), 0.0) * (-self.radius * w * w)
+    }
 }
 
 #[cfg(test)]

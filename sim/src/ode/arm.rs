@@ -30,6 +30,7 @@ impl<'a> ArmSystem<'a> {
         let layout = Layout { nv, electrical: scene.drives.electrical, conversion: scene.drives.has_conversion, stops: scene.stops.is_some() };
         let mut ws = Workspace::new(&scene.model, contacts.len(), layout.dim());
         ws.fd.joint_torque = scene.stops.is_some();
+        ws.want_qdd = matches!(scene.controller.law, crate::control::Law::ComputedTorque { .. });
         let mut sys = Self { scene, contacts, layout, ws, stored0: 0.0 };
         sys.stored0 = sys.stored_energy(&scene.q0, &scene.qd0, &scene.current0);
         sys
@@ -67,13 +68,14 @@ impl<'a> ArmSystem<'a> {
         }
     }
 
-    /// The IK targets (eqs 28–29), the controller's voltages (eq 27 for the paper) and the
+    /// The targets (the paper's: eqs 28–29), the controller's voltages (eq 27 for the paper) and the
     /// drive's limits at (t, q, q̇; i for a law with a current loop), into the workspace. With
     /// quasi-static motors and drive limits, also their currents (`current_qs`).
     pub(super) fn voltage_at(&mut self, t: f64, q: &[f64], qd: &[f64], current: Option<&[f64]>) -> Result<(), DynamicsError> {
         let s = self.scene;
         let ws = &mut self.ws;
-        s.ik.solve(&s.circle.position(t), &s.circle.velocity(t), &mut ws.q_des, &mut ws.qd_des)
+        let qdd_des = if ws.want_qdd { Some(&mut ws.qdd_des[..]) } else { None };
+        s.target.eval(t, &s.model, &s.hand, &mut ws.target, &mut ws.q_des, &mut ws.qd_des, qdd_des)
             .map_err(|why| DynamicsError::Unreachable { t, why })?;
         let input = crate::control::ControlInput { q, qd, current, q_des: &ws.q_des, qd_des: &ws.qd_des, qdd_des: &ws.qdd_des };
         s.controller.voltage(&s.model, &s.drives, &mut ws.data, &mut ws.ctrl, &input, &mut ws.voltage);

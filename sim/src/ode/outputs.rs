@@ -9,7 +9,7 @@
 //! | back EMF `K_m q̇` | the state |
 //! | hand position, constraint positions C, potential energy V | forward kinematics at q (placements) |
 //! | constraint velocities Ċ | forward kinematics and velocities at (q, q̇) |
-//! | desired hand position | the circle at t |
+//! | desired hand position | the target's hand path at t (for a joint target: FK of q_d(t)) |
 //! | voltages, electric power `i v`, i (quasi-static motors), ½ L i² then | the IK targets and the PD law (eqs 27–29) |
 //! | q̈, f_n, τ_motor (eq 12, has `J_m q̈`), T (`½ q̇ᵀ M q̇`), balance residual | the full right-hand side (eq 21's solve) |
 //!
@@ -127,7 +127,7 @@ impl ArmSystem<'_> {
         let data = &self.ws.data;
         out.potential = potential_energy(&s.model, data);
         out.hand = s.hand.position(data);
-        out.hand_desired = s.circle.position(t);
+        out.hand_desired = s.target.hand_desired(t, &s.model, &s.hand, &mut self.ws.target);
         out.constraint_position.clear();
         out.constraint_position.extend(self.contacts.iter().map(|c| c.position(data)));
         out.constraint_velocity.clear();

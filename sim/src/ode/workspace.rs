@@ -5,7 +5,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::control::ControllerScratch;
+use crate::control::{ControllerScratch, TargetScratch};
 use crate::dynamics::forward::ForwardData;
 use crate::dynamics::{Data, Model};
 
@@ -14,11 +14,17 @@ pub(super) struct Workspace {
     pub(super) data: Data,
     /// Eq 21's scratch and outputs (q̈, f_n, di/dt, τ); written by `ArmSystem::evaluate`.
     pub(super) fd: ForwardData,
-    /// IK targets q_d, q̇_d (nv); written by `ArmSystem::voltage_at`.
+    /// Targets q_d, q̇_d (nv); written by `ArmSystem::voltage_at`.
     pub(super) q_des: Vec<f64>,
     pub(super) qd_des: Vec<f64>,
-    /// q̈_d (nv), rad/s^2, for the controllers that feed it forward; written with q_d.
+    /// Target q̈_d (nv), rad/s^2, for the controllers that feed it forward; written by
+    /// `ArmSystem::voltage_at` when `want_qdd`.
     pub(super) qdd_des: Vec<f64>,
+    /// Whether the controller reads q̈_d (computed torque; the paper's PD does not, and the
+    /// paper target then skips computing it). Set once in `ArmSystem::new`.
+    pub(super) want_qdd: bool,
+    /// The target's own scratch (`Target::eval`, `Target::hand_desired`).
+    pub(super) target: TargetScratch,
     /// Motor voltages (nv), V, as the motors see them (after the drive's limits); written by
     /// `ArmSystem::voltage_at`.
     pub(super) voltage: Vec<f64>,
@@ -45,6 +51,8 @@ impl Workspace {
             q_des: vec![0.0; nv],
             qd_des: vec![0.0; nv],
             qdd_des: vec![0.0; nv],
+            want_qdd: false,
+            target: TargetScratch::new(model),
             voltage: vec![0.0; nv],
             voltage_cmd: vec![0.0; nv],
             ctrl: ControllerScratch::new(nv),

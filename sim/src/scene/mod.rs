@@ -3,12 +3,13 @@
 //! field and the value. The paper's scene is built in ([`Scene::paper`]).
 
 pub mod spec;
+mod target;
 
 use std::path::Path;
 
 use nalgebra::{DVector, Unit, Vector3};
 
-use crate::control::{Circle, Controller, Law, PdGains, YawPlanarIk};
+use crate::control::{Circle, Controller, Law, PdGains, Target, YawPlanarIk};
 use crate::joint_limits::JointStops;
 use crate::dynamics::constraints::PointOnPlane;
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
@@ -20,7 +21,8 @@ use crate::dynamics::{Data, Model};
 use crate::error::{short, ModelError, SceneError};
 use crate::limits::{read_text, MAX_INPUT_BYTES, MAX_SAMPLES};
 pub use spec::SceneSpec;
-use spec::{Branch, Direction, LawSpec, PerJoint, PointSpec, PositionLimitMode};
+use spec::{KindedTarget, LawSpec, PerJoint, PointSpec, PositionLimitMode, TargetSpec};
+pub use target::{parse_joint_csv, MAX_BETWEEN_KNOTS};
 
 use crate::integrator::Integrator;
 
@@ -57,8 +59,10 @@ pub struct Scene {
     /// The URDF joint limits are monitored (the scene has `joint_limits`).
     pub(crate) monitor_joints: bool,
     pub(crate) hand: BodyPoint,
-    pub(crate) circle: Circle,
-    pub(crate) ik: YawPlanarIk,
+    /// What the arm is asked to do (`target`).
+    pub(crate) target: Target,
+    /// The text of the target's CSV file (`joint-csv`), kept for [`Scene::vary`].
+    pub(crate) target_csv: Option<String>,
     pub(crate) q0: Vec<f64>,
     pub(crate) qd0: Vec<f64>,
     pub(crate) current0: Vec<f64>,
@@ -119,13 +123,17 @@ impl Scene {
     pub fn hand(&self) -> &BodyPoint {
         &self.hand
     }
-    /// The target path.
-    pub fn circle(&self) -> &Circle {
-        &self.circle
+    /// The target (joint or hand path, and how q_d follows from it).
+    pub fn target(&self) -> &Target {
+        &self.target
     }
-    /// The inverse kinematics of the targets.
-    pub fn ik(&self) -> &YawPlanarIk {
-        &self.ik
+    /// The paper's circle, when the target is the paper's.
+    pub fn circle(&self) -> Option<&Circle> {
+        self.target.circle()
+    }
+    /// The paper's closed-form inverse kinematics, when the target is the paper's.
+    pub fn ik(&self) -> Option<&YawPlanarIk> {
+        self.target.paper_ik()
     }
     /// Initial joint angles, rad.
     pub fn q0(&self) -> &[f64] {
@@ -224,12 +232,25 @@ impl Scene {
             let path = e.path().to_string();
             let path = path.trim_end_matches('?').trim_end_matches('.');
             let why = e.inner().to_string();
+            // a value read whole (the target) says where inside it: "at `path.inside`: why"
+            let (path, why) = match why.strip_prefix("at `").and_then(|r| r.split_once("`: ")) {
+                Some((inside, rest)) => (format!("{path}.{inside}"), rest.to_string()),
+                None => (path.to_string(), why),
+            };
+            let path = path.as_str();
             // a tagged value (the integrator) is read whole: name the unknown key inside it
             if let Some(key) = why.strip_prefix("unknown field `").and_then(|r| r.split('`').next()) {
-                let field = if path.is_empty() { key.to_string() } else { format!("{path}.{key}") };
+                // serde_path_to_error's path already ends in the unknown key; a tagged value's does not
+                let field = if path.is_empty() {
+                    key.to_string()
+                } else if path == key || path.ends_with(&format!(".{key}")) {
+                    path.to_string()
+                } else {
+                    format!("{path}.{key}")
+                };
                 let value = serde_json::from_str::<serde_json::Value>(text)
                     .ok()
-                    .and_then(|doc| doc.pointer(&format!("/{}", field.replace('.', "/"))).map(|v| v.to_string()))
+                    .and_then(|doc| doc.pointer(&format!("/{}", field.replace('.', "/").replace('[', "/").replace(']', ""))).map(|v| v.to_string()))
                     .unwrap_or_default();
                 return SceneError::new(source, field, value, why);
             }
@@ -237,7 +258,14 @@ impl Scene {
             SceneError::new(source, field, json_literal_at(text, e.inner()), why)
         })?;
         let urdf_xml = read_urdf(&spec.urdf).map_err(|why| SceneError::new(source, "urdf", &spec.urdf, why))?;
-        build(spec, source, urdf_xml, dir)
+        // a joint CSV is read like the URDF: next to the scene, bounded in size
+        let csv = match &spec.target {
+            TargetSpec::Kinded(KindedTarget::JointCsv(cs)) => {
+                Some(read_urdf(&cs.file).map_err(|why| SceneError::new(source, "target.file", &cs.file, why))?)
+            }
+            _ => None,
+        };
+        build(spec, source, urdf_xml, dir, csv)
     }
 
     /// A variation of this scene: `edit` changes a copy of its spec, which is validated again
@@ -246,7 +274,7 @@ impl Scene {
     pub fn vary(&self, edit: impl FnOnce(&mut SceneSpec)) -> Result<Scene, SceneError> {
         let mut spec = self.spec.clone();
         edit(&mut spec);
-        build(spec, &self.source, self.urdf_xml.clone(), self.dir.as_deref())
+        build(spec, &self.source, self.urdf_xml.clone(), self.dir.as_deref(), self.target_csv.clone())
     }
 
     /// The run called `name`.
@@ -360,7 +388,7 @@ fn non_negative(x: f64) -> bool {
     x >= 0.0
 }
 
-fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>) -> Result<Scene, SceneError> {
+fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, target_csv: Option<String>) -> Result<Scene, SceneError> {
     let c = Ctx { file };
     if spec.name.is_empty() || !spec.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch)) {
         return Err(c.err("name", format!("{:?}", spec.name), "must be non-empty and use only letters, digits, '-', '_' and '.' (it names output files)"));
@@ -495,8 +523,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>) -> R
         }
     };
 
-    // initial state
-    let q0 = c.per_joint("initial.q", &spec.initial.q, nv, |_| true, "")?;
+    // initial state (initial.q may be "from-target": q0 = q_d(0))
     let qd0 = c.per_joint("initial.qd", &spec.initial.qd, nv, |_| true, "")?;
     let current0 = c.per_joint("initial.current", &spec.initial.current, nv, |_| true, "")?;
     if let Some(j) = (0..nv).find(|&j| drives.passive[j] && current0[j] != 0.0) {
@@ -506,42 +533,9 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>) -> R
         return Err(c.err("initial.current", format!("{current0:?}"), "quasi-static motors (L = 0) have no current state: leave it 0"));
     }
 
-    // hand, target and inverse kinematics
+    // hand and target (`target.rs`)
     let hand = c.point("hand", &model, &spec.hand)?;
-    let cs = &spec.target.circle;
-    let circle = Circle {
-        center: c.vec3("target.circle.center", cs.center)?,
-        radius: c.number("target.circle.radius", cs.radius, positive, "must be > 0 m")?,
-        period: c.number("target.circle.period", cs.period, positive, "must be > 0 s")?,
-        phase: c.number("target.circle.phase", cs.phase, |_| true, "")?,
-        direction: match cs.direction {
-            Direction::CounterClockwise => 1.0,
-            Direction::Clockwise => -1.0,
-        },
-        step: match &cs.step {
-            Some(st) => Some((
-                c.number("target.circle.step.time", st.time, |_| true, "")?,
-                c.vec3("target.circle.step.offset", st.offset)?,
-            )),
-            None => None,
-        },
-    };
-    let iks = &spec.target.ik;
-    let yaw = c.dof("target.ik.yaw_joint", &model, &iks.yaw_joint)?;
-    let p1 = c.dof("target.ik.planar_joints[0]", &model, &iks.planar_joints[0])?;
-    let p2 = c.dof("target.ik.planar_joints[1]", &model, &iks.planar_joints[1])?;
-    let branch = if iks.branch == Branch::Positive { 1.0 } else { -1.0 };
-    let ik = YawPlanarIk::new(&model, &q0, yaw, [p1, p2], &hand, branch)
-        .map_err(|e| c.err("target.ik", format!("{} + {:?}", iks.yaw_joint, iks.planar_joints), e.to_string()))?;
-    // the whole path must be reachable: check it densely before running
-    let mut qdes = vec![0.0; nv];
-    let mut qd_des = vec![0.0; nv];
-    let n_check = 2000;
-    for s in 0..=n_check {
-        let t = duration * s as f64 / n_check as f64;
-        ik.solve(&circle.position(t), &circle.velocity(t), &mut qdes, &mut qd_des)
-            .map_err(|why| c.err("target", format!("t = {t:.4} s"), why))?;
-    }
+    let (target, q0) = target::build_target(&c, &spec, &model, &hand, duration, target_csv.as_deref())?;
 
     // contacts: well-formed, and satisfied by the initial state
     let mut data = Data::new(&model);
@@ -623,8 +617,8 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>) -> R
         stops,
         monitor_joints,
         hand,
-        circle,
-        ik,
+        target,
+        target_csv,
         q0,
         qd0,
         current0,

@@ -49,6 +49,58 @@ impl PerJoint {
     }
 }
 
+/// `initial.q`: angles (one for all joints or one per joint), or `"from-target"` (q_d(0)).
+#[derive(Clone, Debug, PartialEq)]
+pub enum InitialQ {
+    Values(PerJoint),
+    FromTarget,
+}
+
+impl Serialize for InitialQ {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            InitialQ::Values(p) => p.serialize(s),
+            InitialQ::FromTarget => s.serialize_str("from-target"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for InitialQ {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = InitialQ;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number, an array of numbers with one per joint, or \"from-target\"")
+            }
+            fn visit_f64<E>(self, v: f64) -> Result<InitialQ, E> {
+                Ok(InitialQ::Values(PerJoint::All(v)))
+            }
+            fn visit_i64<E>(self, v: i64) -> Result<InitialQ, E> {
+                Ok(InitialQ::Values(PerJoint::All(v as f64)))
+            }
+            fn visit_u64<E>(self, v: u64) -> Result<InitialQ, E> {
+                Ok(InitialQ::Values(PerJoint::All(v as f64)))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<InitialQ, E> {
+                if v == "from-target" {
+                    Ok(InitialQ::FromTarget)
+                } else {
+                    Err(E::invalid_value(serde::de::Unexpected::Str(v), &self))
+                }
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<InitialQ, A::Error> {
+                let mut v = Vec::new();
+                while let Some(x) = seq.next_element::<f64>()? {
+                    v.push(x);
+                }
+                Ok(InitialQ::Values(PerJoint::Each(v)))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSpec {
@@ -211,11 +263,238 @@ pub struct PointSpec {
     pub offset: [f64; 3],
 }
 
+/// The scene's target: the paper's form `{"circle": ..., "ik": ...}` (no `kind`), or a form
+/// tagged by `kind` ([`KindedTarget`]). Read through a JSON value so that the paper's form keeps
+/// its exact syntax and each tagged form rejects unknown keys; written back the same way.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TargetSpec {
+    Paper(PaperTargetSpec),
+    Kinded(KindedTarget),
+}
+
+impl Serialize for TargetSpec {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            TargetSpec::Paper(p) => p.serialize(s),
+            TargetSpec::Kinded(k) => k.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for TargetSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = serde_json::Value::deserialize(d)?;
+        if v.as_object().is_some_and(|o| o.contains_key("kind")) {
+            read_inner(v).map(TargetSpec::Kinded)
+        } else {
+            read_inner(v).map(TargetSpec::Paper)
+        }
+    }
+}
+
+/// Read a value that was taken whole (a JSON value), keeping the path of an error inside it:
+/// the message becomes "at `path.inside`: why", which `Scene::from_json` appends to the
+/// field's path (serde's own tagged enums buffer their content and lose that path).
+fn read_inner<T: serde::de::DeserializeOwned, E: serde::de::Error>(v: serde_json::Value) -> Result<T, E> {
+    serde_path_to_error::deserialize(v).map_err(|e| {
+        let path = e.path().to_string();
+        let path = if path == "." { String::new() } else { path };
+        let msg = e.inner().to_string();
+        let (path, msg) = match msg.strip_prefix("at `").and_then(|r| r.split_once("`: ")) {
+            Some((inside, rest)) if path.is_empty() => (inside.to_string(), rest.to_string()),
+            Some((inside, rest)) => (format!("{path}.{inside}"), rest.to_string()),
+            None => (path, msg),
+        };
+        if path.is_empty() {
+            E::custom(msg)
+        } else {
+            E::custom(format!("at `{path}`: {msg}"))
+        }
+    })
+}
+
+/// Take the string tag `tag` out of the object `v`; it must name one of `variants`.
+fn take_tag<E: serde::de::Error>(v: &mut serde_json::Value, tag: &'static str, variants: &'static [&'static str]) -> Result<String, E> {
+    let Some(obj) = v.as_object_mut() else {
+        return Err(E::custom(format!("expected an object with `{tag}`")));
+    };
+    match obj.remove(tag) {
+        Some(serde_json::Value::String(s)) if variants.contains(&s.as_str()) => Ok(s),
+        Some(serde_json::Value::String(s)) => Err(E::unknown_variant(&s, variants)),
+        Some(other) => Err(E::custom(format!("at `{tag}`: expected one of {variants:?}, found {other}"))),
+        None => Err(E::missing_field(tag)),
+    }
+}
+
+impl<'de> Deserialize<'de> for KindedTarget {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut v = serde_json::Value::deserialize(d)?;
+        match take_tag::<D::Error>(&mut v, "kind", &["joint-spline", "joint-csv", "cartesian"])?.as_str() {
+            "joint-spline" => read_inner(v).map(KindedTarget::JointSpline),
+            "joint-csv" => read_inner(v).map(KindedTarget::JointCsv),
+            _ => read_inner(v).map(KindedTarget::Cartesian),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PathSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut v = serde_json::Value::deserialize(d)?;
+        match take_tag::<D::Error>(&mut v, "shape", &["circle", "lines", "waypoints"])?.as_str() {
+            "circle" => read_inner(v).map(PathSpec::Circle),
+            "lines" => read_inner(v).map(PathSpec::Lines),
+            _ => read_inner(v).map(PathSpec::Waypoints),
+        }
+    }
+}
+
+/// The paper's target: a horizontal circle and the closed-form IK.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct TargetSpec {
+pub struct PaperTargetSpec {
     pub circle: CircleSpec,
     pub ik: IkSpec,
+}
+
+/// The targets selected by `kind` (read by hand, so that errors keep their path inside).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum KindedTarget {
+    /// Joint-space waypoints joined by a named spline.
+    JointSpline(JointSplineSpec),
+    /// Joint-space samples from a CSV file (`t,<joint names>`), joined by the cubic spline.
+    JointCsv(JointCsvSpec),
+    /// A hand path, tracked by the general IK.
+    Cartesian(CartesianSpec),
+}
+
+/// `cubic`: the clamped C² cubic spline at rest at both ends; `quintic`: minimum-jerk
+/// segments at rest at every waypoint.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Interpolation {
+    #[default]
+    Cubic,
+    Quintic,
+}
+
+impl Interpolation {
+    fn is_cubic(&self) -> bool {
+        *self == Interpolation::Cubic
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSplineSpec {
+    #[serde(default, skip_serializing_if = "Interpolation::is_cubic")]
+    pub interpolation: Interpolation,
+    pub waypoints: Vec<JointWaypointSpec>,
+}
+
+/// Joint angles (rad, one per joint in dof order) at time `t` (s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointWaypointSpec {
+    pub t: f64,
+    pub q: Vec<f64>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointCsvSpec {
+    /// CSV file, relative to the scene file.
+    pub file: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CartesianSpec {
+    pub path: PathSpec,
+    /// A constant orientation of the hand frame, held along the path.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<OrientationSpec>,
+    #[serde(default)]
+    pub ik: GeneralIkSpec,
+}
+
+/// A hand path, world frame, selected by `shape` (read by hand, as [`KindedTarget`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "shape", rename_all = "kebab-case")]
+pub enum PathSpec {
+    Circle(CirclePathSpec),
+    Lines(PointsSpec),
+    Waypoints(PointsSpec),
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CirclePathSpec {
+    /// m.
+    pub center: [f64; 3],
+    /// The plane's normal (normalised when read).
+    pub normal: [f64; 3],
+    /// m.
+    pub radius: f64,
+    /// s per turn.
+    pub period: f64,
+    /// Angle at t = 0 from the zero axis, rad.
+    #[serde(default)]
+    pub phase: f64,
+    /// About the normal (right-hand rule).
+    #[serde(default = "ccw")]
+    pub direction: Direction,
+    /// The direction of angle 0, projected onto the plane (default: world x, or world y when
+    /// the normal is along x).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zero_axis: Option<[f64; 3]>,
+}
+
+fn ccw() -> Direction {
+    Direction::CounterClockwise
+}
+
+/// Points (m) reached at times (s).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointsSpec {
+    pub points: Vec<[f64; 3]>,
+    pub times: Vec<f64>,
+}
+
+/// URDF convention: roll about x, pitch about y, yaw about z, fixed axes (R = Rz Ry Rx), rad.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrientationSpec {
+    pub rpy: [f64; 3],
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum IkSolver {
+    /// Damped least squares / Levenberg–Marquardt with a null-space posture task.
+    #[default]
+    Dls,
+}
+
+/// The general IK's settings.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeneralIkSpec {
+    #[serde(default)]
+    pub solver: IkSolver,
+    /// Joints the IK moves (default: all); the others hold their posture angle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joints: Option<Vec<String>>,
+    /// Null-space posture, rad, one per joint (default: initial.q).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub posture: Option<Vec<f64>>,
+    /// Scene contacts whose point must stay on its plane along the path.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keep_contacts: Vec<String>,
+    /// Grid step of the solved trajectory, s (default 0.002).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid_step: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -275,8 +554,8 @@ pub struct IkSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// rad.
-    pub q: PerJoint,
+    /// rad, or `"from-target"`: q_d(0).
+    pub q: InitialQ,
     /// rad/s.
     #[serde(default = "PerJoint::zero")]
     pub qd: PerJoint,

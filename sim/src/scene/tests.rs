@@ -24,12 +24,12 @@ fn paper_scene_matches_scene_md() {
         assert!(c.position(&data).abs() < 1e-15, "{} at z = {}", c.name, c.position(&data));
     }
     // the target: a 0.1 m circle about (1.5, 1.5, 0.4) m, once in 5 s
-    assert_eq!((s.circle.center, s.circle.radius, s.circle.period), (nalgebra::Vector3::new(1.5, 1.5, 0.4), 0.1, 5.0));
+    assert_eq!((s.circle().unwrap().center, s.circle().unwrap().radius, s.circle().unwrap().period), (nalgebra::Vector3::new(1.5, 1.5, 0.4), 0.1, 5.0));
     let hand = s.hand.position(&data);
-    let dist = (hand - s.circle.center).norm();
+    let dist = (hand - s.circle().unwrap().center).norm();
     assert!((dist - 0.056).abs() < 1e-3, "hand starts {dist} m from the centre");
     // and 0.054 m from where the target starts (the README's start-up transient)
-    let offset = (hand - s.circle.position(0.0)).norm();
+    let offset = (hand - s.circle().unwrap().position(0.0)).norm();
     assert!((offset - 0.054).abs() < 1e-3, "hand starts {offset} m from r_d(0)");
     // the hand is in the vertical plane through x = y
     assert!((hand.x - hand.y).abs() < 1e-14);
@@ -50,8 +50,8 @@ fn ik_inverts_forward_kinematics_on_the_circle() {
     let (mut qp, mut qm, mut scratch) = (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]);
     for k in 0..50 {
         let t = 5.0 * k as f64 / 50.0;
-        let r = s.circle.position(t);
-        s.ik.solve(&r, &s.circle.velocity(t), &mut q, &mut qd).unwrap();
+        let r = s.circle().unwrap().position(t);
+        s.ik().unwrap().solve(&r, &s.circle().unwrap().velocity(t), &mut q, &mut qd).unwrap();
         forward_kinematics(&s.model, &mut data, &q);
         assert!((s.hand.position(&data) - r).norm() < 1e-12, "t = {t}");
         assert!(q[9] > 0.0);
@@ -60,8 +60,8 @@ fn ik_inverts_forward_kinematics_on_the_circle() {
             assert_eq!(qd[j], 0.0);
         }
         let h = 1e-6;
-        s.ik.solve(&s.circle.position(t + h), &s.circle.velocity(t + h), &mut qp, &mut scratch).unwrap();
-        s.ik.solve(&s.circle.position(t - h), &s.circle.velocity(t - h), &mut qm, &mut scratch).unwrap();
+        s.ik().unwrap().solve(&s.circle().unwrap().position(t + h), &s.circle().unwrap().velocity(t + h), &mut qp, &mut scratch).unwrap();
+        s.ik().unwrap().solve(&s.circle().unwrap().position(t - h), &s.circle().unwrap().velocity(t - h), &mut qm, &mut scratch).unwrap();
         for j in 0..nv {
             let fd = (qp[j] - qm[j]) / (2.0 * h);
             assert!((fd - qd[j]).abs() < 1e-7, "t = {t} joint {j}: {fd} vs {}", qd[j]);
@@ -75,7 +75,7 @@ fn ik_inverts_forward_kinematics_on_the_circle() {
 fn ik_start_is_near_the_initial_pose() {
     let s = paper();
     let (mut q, mut qd) = (vec![0.0; 10], vec![0.0; 10]);
-    s.ik.solve(&s.circle.position(0.0), &s.circle.velocity(0.0), &mut q, &mut qd).unwrap();
+    s.ik().unwrap().solve(&s.circle().unwrap().position(0.0), &s.circle().unwrap().velocity(0.0), &mut q, &mut qd).unwrap();
     assert!(q[0].abs() < 1e-14);
     assert!((q[8] - s.q0[8]).abs() < 0.5 && (q[9] - s.q0[9]).abs() < 0.5, "{q:?}");
 }
@@ -124,5 +124,5 @@ fn small_scene_is_valid() {
     let s = Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/small/small.json"))).unwrap();
     let mut data = Data::new(&s.model);
     forward_kinematics(&s.model, &mut data, &s.q0);
-    assert!((s.hand.position(&data) - s.circle.position(0.0)).norm() < 1e-12);
+    assert!((s.hand.position(&data) - s.circle().unwrap().position(0.0)).norm() < 1e-12);
 }
