@@ -42,7 +42,8 @@ Examples:
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Scene JSON file [default: the built-in paper scene].
+    /// Scene JSON file, or the name of a built-in scene (`sim list`) [default: the built-in paper
+    /// scene].
     #[arg(long, value_name = "FILE")]
     scene: Option<PathBuf>,
     #[command(flatten)]
