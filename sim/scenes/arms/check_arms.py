@@ -7,7 +7,9 @@ solves the scene's Cartesian task along its whole path by damped least squares w
 posture in the null space and the contacts named in `keep_contacts` held on their planes, and
 reports: the residuals (hand and contacts, m), the joint ranges used against the URDF limits,
 the joint speeds (finite differences of the solutions, rad/s) against the URDF velocity limits,
-and q(0) (the `from-target` initial posture).
+q(0) (the `from-target` initial posture), the lowest hand point against the table, and the
+statics of the free run: the gravity torque of each joint along the path against its effort
+limit, and the motor current and R i it takes against the scene's current and voltage limits.
 
 Usage: python3 check_arms.py [scene.json ...]   (default: every *.json here)
 """
@@ -45,6 +47,12 @@ class Urdf:
         self.child_joint = {}
         self.links = {l.get("name"): l for l in root.findall("link")}
         self.movable = []
+        self.inertials = {}
+        for name, l in self.links.items():
+            i = l.find("inertial")
+            if i is not None:
+                o = i.find("origin")
+                self.inertials[name] = (float(i.find("mass").get("value")), np.array(floats(o.get("xyz") if o is not None else None)))
         for j in root.findall("joint"):
             o = j.find("origin")
             xyz = floats(o.get("xyz") if o is not None else None)
@@ -112,6 +120,42 @@ class Urdf:
             if m <= 0 or ev[0] <= 0 or ev[0] + ev[1] < ev[2] * (1 - 1e-12):
                 bad.append((name, m, ev))
         return bad
+
+
+def holding_torques(u, q, g=9.81, h=1e-6):
+    """The joint torques that hold the arm still against gravity, N m: dV/dq, V = sum m g z_c."""
+    def V(qq):
+        v = 0.0
+        for link, (m, c) in u.inertials.items():
+            if link not in u.child_joint:
+                continue  # the root: welded to the world
+            R, p = u.frame(link, qq)
+            v += m * g * (p + R @ c)[2]
+        return v
+    out = np.zeros(len(q))
+    for k in range(len(q)):
+        dq = np.zeros(len(q)); dq[k] = h
+        out[k] = (V(q + dq) - V(q - dq)) / (2 * h)
+    return out
+
+
+def drive_check(s, u, qs):
+    """Statics of the free run along the path: the holding torque against the URDF effort limit,
+    its motor current tau / (K_t N) against the scene's current limit, and R i against the supply."""
+    m = s["motor"]
+    n = len(u.dofs)
+    per = lambda key, default=None: np.broadcast_to(np.array(m.get(key, default), float), (n,))
+    kt, r, N = per("torque_constant"), per("resistance"), per("gear_ratio")
+    ilim, vlim = per("current_limit", np.inf), per("voltage_limit", np.inf)
+    tau = np.max(np.abs(np.array([holding_torques(u, q) for q in qs[::5]])), axis=0)
+    ok = True
+    for k, name in enumerate(u.dofs):
+        eff = u.joints[name]["effort"]
+        i = tau[k] / (kt[k] * N[k])
+        ok &= tau[k] <= eff and i <= ilim[k] and r[k] * i <= vlim[k]
+        print(f"   {name:22s} gravity {tau[k]:8.4f} N m (effort {eff:g}), current {i:6.3f} A (limit {ilim[k]:g}), R i = {r[k] * i:6.3f} V (supply {vlim[k]:g})")
+    print("   the drives hold the arm without its contact along the path" if ok else "   A DRIVE CANNOT HOLD THE ARM")
+    return ok
 
 
 def circle(path, t):
@@ -216,6 +260,7 @@ def check_scene(path):
         print(f"   plane of {c['name']}: lowest other joint origin {low:+.4f} m, lowest hand point {hand_low:+.4f} m (>= 0: above the table)")
         ok &= hand_low >= -1e-9
     print("   joint limits hold along the path" if ok else "   A LIMIT IS CROSSED")
+    ok &= drive_check(s, u, qs)
     return ok and worst < 1e-9
 
 
