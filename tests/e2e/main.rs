@@ -13,6 +13,7 @@ mod format_ownership;
 mod pipeline;
 mod sampled_energy;
 mod sim_bad_input;
+mod sim_list;
 mod sim_output;
 mod sim_sweep;
 mod sim_table;

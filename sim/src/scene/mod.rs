@@ -2,6 +2,7 @@
 //! runnable [`Scene`] (ripgrep's low-args → high-args split). Every error names the file, the
 //! field and the value. The paper's scene is built in ([`Scene::paper`]).
 
+pub mod builtin;
 pub mod spec;
 mod target;
 

@@ -19,10 +19,12 @@ is not valid.
 
 Examples:
   sim check                            the built-in paper scene
+  sim check hobby-arm                  a built-in scene by name (`sim list`)
   sim check sim/scenes/hard/stiff-motor.json
   sim check my_scene.json -f json")]
 pub struct CheckArgs {
-    /// Scene JSON file [default: the built-in paper scene].
+    /// Scene JSON file, or the name of a built-in scene (`sim list`) [default: the built-in paper
+    /// scene].
     #[arg(value_name = "SCENE")]
     pub scene: Option<PathBuf>,
     /// table: a description for people; json: the same for machines.

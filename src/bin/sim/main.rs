@@ -5,6 +5,7 @@
 
 mod check;
 mod export_scene;
+mod list;
 mod precision;
 mod replay;
 mod run;
@@ -24,6 +25,8 @@ Examples:
   sim --run two-elbow -o /tmp/r         one run of the built-in scene, elsewhere
   sim run my_scene.json -f json         another scene, the table as JSON
   sim check my_scene.json               validate a scene and describe it, without running it
+  sim list                              the built-in scenes: the paper and three real arms
+  sim ur5e-like -o /tmp/ur              a built-in scene by name (as `sim run ur5e-like`)
   sim export-scene -o scenes/           the built-in scene and URDF, to edit
   sim replay out/paper-two-elbow.mcap   re-run a recording from its own metadata
   sim sweep sim/scenes/sweeps/paper-gains.json -j 2
@@ -32,13 +35,15 @@ Examples:
 /// Simulate motor-driven arms that rest their elbows on a table; record every run to MCAP.
 ///
 /// With no command, runs the built-in paper scene (three elbow configurations, 5 s each), writes
-/// out/paper-<run>.mcap and prints a table comparing the configurations (as `sim run`).
+/// out/paper-<run>.mcap and prints a table comparing the configurations (as `sim run`). With the
+/// name of a built-in scene instead of a command (`sim list` shows them), runs that scene.
 #[derive(Debug, Parser)]
 #[command(name = "sim", version = cli::VERSION, after_help = EXAMPLES, args_conflicts_with_subcommands = true, propagate_version = true)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Scene JSON file [default: the built-in paper scene].
+    /// Scene JSON file, or the name of a built-in scene (`sim list`) [default: the built-in paper
+    /// scene].
     #[arg(long, value_name = "FILE")]
     scene: Option<PathBuf>,
     #[command(flatten)]
@@ -55,6 +60,7 @@ enum Command {
     Sweep(sweep::SweepArgs),
     Precision(precision::PrecisionArgs),
     ExportScene(export_scene::ExportSceneArgs),
+    List(list::ListArgs),
     /// Print the shell completion script (bash, zsh, fish, elvish, powershell).
     #[command(after_help = "Example:\n  sim completions bash > ~/.local/share/bash-completion/completions/sim")]
     Completions(CompletionsArgs),
@@ -64,7 +70,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(builtin_as_run(std::env::args_os().collect()));
     let v = cli.verbosity;
     let result = match cli.command {
         None => run::run(cli.scene.as_deref(), &cli.run, v),
@@ -74,6 +80,7 @@ fn main() -> ExitCode {
         Some(Command::Sweep(a)) => sweep::run(&a, v),
         Some(Command::Precision(a)) => precision::run(&a, v),
         Some(Command::ExportScene(a)) => export_scene::run(&a, v),
+        Some(Command::List(a)) => list::run(&a),
         Some(Command::Completions(a)) => cli::extras::completions(Cli::command(), a.shell).map(|()| exit::SUCCESS),
         Some(Command::Man(a)) => cli::extras::man_pages(Cli::command(), &a.out).map(|n| {
             if !v.quiet {
@@ -91,10 +98,29 @@ fn main() -> ExitCode {
     }
 }
 
-/// The scene at `path`, or the built-in paper scene.
+/// `sim NAME ARGS…` for a built-in scene NAME (`sim list`) is `sim run NAME ARGS…`: the
+/// arguments with `run` inserted before the first one when it is a built-in scene's name and no
+/// command's. Anything else is left to clap as it is (so an unknown command is still an error
+/// with suggestions, and `sim` alone still runs the paper).
+fn builtin_as_run(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    let first = args.get(1).and_then(|a| a.to_str()).map(str::to_string);
+    if let Some(first) = first {
+        let is_command = Cli::command().get_subcommands().any(|c| c.get_name() == first || c.get_all_aliases().any(|a| a == first));
+        if !is_command && sim::scene::builtin::find(&first).is_some() {
+            args.insert(1, "run".into());
+        }
+    }
+    args
+}
+
+/// The scene at `path`; a `path` that is no file but a built-in scene's name (`sim list`) is
+/// that scene; no `path` is the built-in paper scene.
 fn load_scene(path: Option<&std::path::Path>) -> anyhow::Result<sim::scene::Scene> {
     Ok(match path {
-        Some(p) => sim::scene::Scene::load(p)?,
+        Some(p) => match p.to_str().and_then(sim::scene::builtin::find) {
+            Some(b) if !p.exists() => b.load()?,
+            _ => sim::scene::Scene::load(p)?,
+        },
         None => sim::scene::Scene::paper()?,
     })
 }
@@ -111,7 +137,7 @@ mod tests {
     /// clap's consistency check, and every example of every `--help` parses as written.
     #[test]
     fn the_command_line_and_its_examples_are_consistent() {
-        cli::examples::check_command_line(Cli::command(), |args| Cli::try_parse_from(args).map(drop));
+        cli::examples::check_command_line(Cli::command(), |args| Cli::try_parse_from(builtin_as_run(args.iter().map(Into::into).collect())).map(drop));
     }
 
     #[test]
@@ -133,6 +159,18 @@ mod tests {
     }
 
     #[test]
+    fn a_builtin_scene_name_runs_that_scene() {
+        let argv = |args: &[&str]| builtin_as_run(std::iter::once("sim").chain(args.iter().copied()).map(Into::into).collect());
+        let Some(Command::Run(r)) = Cli::try_parse_from(argv(&["ur5e-like", "--run", "free", "-o", "/tmp/u"])).unwrap().command else { panic!() };
+        assert_eq!((r.scene, r.run.runs, r.run.out), (Some(PathBuf::from("ur5e-like")), vec!["free".to_string()], PathBuf::from("/tmp/u")));
+        // commands and files are left alone
+        assert_eq!(argv(&["list"]), ["sim", "list"]);
+        assert_eq!(argv(&["run", "paper"]), ["sim", "run", "paper"]);
+        assert_eq!(argv(&[]), ["sim"]);
+        assert!(matches!(parse(&["list", "-f", "csv"]).unwrap().command, Some(Command::List(_))));
+    }
+
+    #[test]
     fn subcommands_are_matched_strictly_with_suggestions() {
         let kind = |args: &[&str]| parse(args).unwrap_err().kind();
         assert_eq!(kind(&["chek", "s.json"]), ErrorKind::InvalidSubcommand);
@@ -140,6 +178,7 @@ mod tests {
         assert_eq!(kind(&["s.json"]), ErrorKind::InvalidSubcommand);
         assert_eq!(kind(&["-f", "xml"]), ErrorKind::InvalidValue);
         assert_eq!(kind(&["--scene", "a.json", "check"]), ErrorKind::ArgumentConflict);
+        assert_eq!(kind(&["ur5e-lik"]), ErrorKind::InvalidSubcommand);
         assert_eq!(kind(&["run", "--duration", "0"]), ErrorKind::ValueValidation);
         assert_eq!(kind(&["run", "--duration=-1"]), ErrorKind::ValueValidation);
         assert!(matches!(parse(&["check", "s.json", "-f", "json"]).unwrap().command, Some(Command::Check(_))));

@@ -25,7 +25,8 @@ Examples:
   sim precision --duration 1 --repeats 1          quicker
   sim precision sim/scenes/hard/mechanical.json --run free -o out/precision-mechanical")]
 pub struct PrecisionArgs {
-    /// Scene JSON file [default: the built-in paper scene].
+    /// Scene JSON file, or the name of a built-in scene (`sim list`) [default: the built-in paper
+    /// scene].
     #[arg(value_name = "SCENE")]
     pub scene: Option<PathBuf>,
     /// The run of the scene to measure [default: its first run].

@@ -74,7 +74,8 @@ Examples:
   sim run sim/scenes/small/small.json -o /tmp/small
   sim run --run two-elbow --duration 1 -f csv")]
 pub struct RunCommand {
-    /// Scene JSON file [default: the built-in paper scene].
+    /// Scene JSON file, or the name of a built-in scene (`sim list`) [default: the built-in paper
+    /// scene].
     #[arg(value_name = "SCENE")]
     pub scene: Option<PathBuf>,
     #[command(flatten)]
