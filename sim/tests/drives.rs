@@ -17,11 +17,26 @@ use std::path::Path;
 
 use schemas::{EnergyState, EnergyTermsRecord, LimitsRecord, MotorState, RunResult};
 use sim::run::RunReport;
-use sim::scene::spec::{JointLimitsSpec, LawSpec, PerJoint, PositionLimitMode, StepSpec};
+use sim::scene::spec::{InitialQ, JointLimitsSpec, LawSpec, PerJoint, PositionLimitMode, StepSpec};
 use sim::scene::{Scene, SceneSpec};
 
 fn small() -> Scene {
     Scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/small/small.json"))).unwrap()
+}
+
+/// The small scene's target: the paper's circle with its closed-form IK.
+fn paper_target(s: &mut SceneSpec) -> &mut sim::scene::spec::PaperTargetSpec {
+    match &mut s.target {
+        sim::scene::spec::TargetSpec::Paper(p) => p,
+        other => panic!("the small scene's target is the paper's circle, not {other:?}"),
+    }
+}
+
+/// q_d and q̇_d of the small scene's closed-form IK at `t`.
+fn paper_q_des(scene: &Scene, t: f64, q: &mut [f64], qd: &mut [f64]) {
+    let c = scene.circle().expect("the small scene tracks the paper's circle");
+    let ik = scene.ik().expect("with the closed-form IK");
+    ik.solve(&c.position(t), &c.velocity(t), q, qd).unwrap();
 }
 
 fn vary(edit: impl FnOnce(&mut SceneSpec)) -> Scene {
@@ -30,7 +45,7 @@ fn vary(edit: impl FnOnce(&mut SceneSpec)) -> Scene {
 
 /// A jump of the target by 10 cm at t = 0.2 s: the PD asks for far more than the drives give.
 fn with_step(s: &mut SceneSpec) {
-    s.target.circle.step = Some(StepSpec { time: 0.2, offset: [-0.1, 0.05, 0.05] });
+    paper_target(s).circle.step = Some(StepSpec { time: 0.2, offset: [-0.1, 0.05, 0.05] });
 }
 
 struct Recorded {
@@ -227,8 +242,9 @@ fn a_passive_joint_has_no_current_no_voltage_and_the_balance_closes() {
 
 /// A target that stands still (a circle of 1 µm run once in 10^9 s): q_d constant to 1e-15.
 fn still(s: &mut SceneSpec) {
-    s.target.circle.radius = 1e-6;
-    s.target.circle.period = 1e9;
+    let t = paper_target(s);
+    t.circle.radius = 1e-6;
+    t.circle.period = 1e9;
     s.duration = 3.0;
 }
 
@@ -236,8 +252,7 @@ fn still(s: &mut SceneSpec) {
 fn pd_gravity_holds_a_static_pose_with_zero_error_where_pd_sags_by_r_g_over_km_kp() {
     let q_des = |scene: &Scene| {
         let (mut q, mut qd) = (vec![0.0; 4], vec![0.0; 4]);
-        let c = scene.circle();
-        scene.ik().solve(&c.position(3.0), &c.velocity(3.0), &mut q, &mut qd).unwrap();
+        paper_q_des(scene, 3.0, &mut q, &mut qd);
         q
     };
     let pd = vary(still);
@@ -283,7 +298,7 @@ fn computed_torque_error_decays_as_its_closed_form() {
         s.controller.law = Some(LawSpec::ComputedTorque);
         s.controller.kp = PerJoint::All(kp);
         s.controller.kd = PerJoint::All(kd);
-        if let PerJoint::Each(q) = &mut s.initial.q {
+        if let InitialQ::Values(PerJoint::Each(q)) = &mut s.initial.q {
             // joints that leave the elbow (joint3's origin) on the table
             q[0] += 0.02;
             q[2] -= 0.05;
@@ -291,7 +306,7 @@ fn computed_torque_error_decays_as_its_closed_form() {
         }
     });
     let (mut q_d, mut qd_d) = (vec![0.0; 4], vec![0.0; 4]);
-    scene.ik().solve(&scene.circle().position(0.0), &scene.circle().velocity(0.0), &mut q_d, &mut qd_d).unwrap();
+    paper_q_des(&scene, 0.0, &mut q_d, &mut qd_d);
     let e0: Vec<f64> = (0..4).map(|j| q_d[j] - scene.q0()[j]).collect();
     let mut worst = 0.0f64;
     sim::run::simulate(&scene, scene.run("free").unwrap(), |o| {
@@ -317,7 +332,7 @@ fn computed_torque_error_decays_as_its_closed_form() {
     let b = balance(&r);
     assert!(b <= 1e-6, "computed torque (inductive): balance {b:.2e}");
     let (mut q_d, mut qd_d) = (vec![0.0; 4], vec![0.0; 4]);
-    ind.ik().solve(&ind.circle().position(1.0), &ind.circle().velocity(1.0), &mut q_d, &mut qd_d).unwrap();
+    paper_q_des(&ind, 1.0, &mut q_d, &mut qd_d);
     for j in 0..4 {
         assert!((q_d[j] - r.report.last.q[j]).abs() < 1e-3, "inductive CT joint {j}: e = {}", q_d[j] - r.report.last.q[j]);
     }
