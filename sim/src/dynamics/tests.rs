@@ -190,11 +190,12 @@ fn paper_like_drives(nv: usize) -> Drives {
 }
 
 /// With contacts, the solved accelerations satisfy J q̈ + J̇ q̇ = 0 (to 1e-9 relative), the
-/// Schur and the full block (eq 21) solutions agree (1e-9), and CRBA and Walker–Orin agree.
+/// Schur and the full block (eq 21) solutions agree (1e-9), and CRBA and Walker–Orin agree,
+/// on revolute chains and on chains with prismatic joints.
 #[test]
 fn constrained_accelerations_satisfy_the_constraints() {
-    for n in [4usize, 7, 10] {
-        let model = random_chain(n, 300 + n as u64);
+    // revolute chains, and chains with prismatic joints mixed in
+    for (n, model) in [4usize, 7, 10].into_iter().flat_map(|n| [(n, random_chain(n, 300 + n as u64)), (n, random_mixed_chain(n, 600 + n as u64))]) {
         let drives = paper_like_drives(n);
         let mut rng = SplitMix64(29);
         let contacts: Vec<PointOnPlane> = (0..2)
