@@ -144,3 +144,37 @@ fn the_drives_and_controllers_do_not_allocate() {
         assert_eq!(steps_allocate(&mut Rodas::new(dim, control(1e-8, 1e-10)), &mut sys), 0, "{law}: rodas5p");
     }
 }
+
+/// The targets of issue 10 (joint-space quintics; a Cartesian path tracked by the general IK,
+/// evaluated through its joint-space spline) do not allocate in the step loop either, nor does
+/// the recorded desired hand (FK of q_d for a joint target) or q̈_d of the paper target.
+#[test]
+fn targets_do_not_allocate() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/targets");
+    for name in ["joint-spline", "square-lines", "tilted-circle"] {
+        let scene = Scene::load(&dir.join(format!("{name}.json"))).unwrap();
+        let run = scene.run("two-elbow").unwrap().clone();
+        let mut sys = ArmSystem::new(&scene, &run);
+        let dim = sys.initial_state().len();
+        let control = StepControl { h_max: 1e-3, max_steps: 100_000, ..StepControl::new(1e-8, 1e-10) };
+        assert_eq!(steps_allocate(&mut DormandPrince45::new(dim, control), &mut sys), 0, "{name}: dopri45");
+        let mut scratch = sim::control::TargetScratch::new(scene.model());
+        let nv = scene.model().nv;
+        let (mut q, mut qd, mut qdd) = (vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]);
+        let before = allocs();
+        for k in 0..100 {
+            let t = k as f64 * 0.05;
+            let _ = scene.target().hand_desired(t, scene.model(), scene.hand(), &mut scratch);
+            scene.target().eval(t, scene.model(), scene.hand(), &mut scratch, &mut q, &mut qd, Some(&mut qdd)).unwrap();
+        }
+        assert_eq!(allocs() - before, 0, "{name}: Target::eval, hand_desired");
+    }
+    let scene = Scene::paper().unwrap();
+    let mut scratch = sim::control::TargetScratch::new(scene.model());
+    let (mut q, mut qd, mut qdd) = (vec![0.0; 10], vec![0.0; 10], vec![0.0; 10]);
+    let before = allocs();
+    for k in 0..100 {
+        scene.target().eval(k as f64 * 0.05, scene.model(), scene.hand(), &mut scratch, &mut q, &mut qd, Some(&mut qdd)).unwrap();
+    }
+    assert_eq!(allocs() - before, 0, "paper target with q̈_d");
+}

@@ -48,6 +48,7 @@ impl Target {
     /// q_d, q̇_d (nv each) at t, and q̈_d when `qdd_des` is given (the paper target computes it
     /// only then: its q_d, q̇_d are the closed form's, whatever is asked). `Err(why)` when the
     /// paper IK cannot reach the target.
+    #[allow(clippy::too_many_arguments)]
     pub fn eval(
         &self,
         t: f64,
