@@ -267,14 +267,19 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
             .events
             .iter()
             .map(|e| {
+                let mut when: Vec<String> = e.intervals.iter().take(3).map(|[a, b]| format!("{a:.3}-{b:.3} s")).collect();
+                if e.interval_count > when.len() as u64 {
+                    when.push(format!("{} intervals in all", e.interval_count));
+                }
                 format!(
-                    "{} {} (limit {}, first at {:.3} s, {:.3} s beyond, peak {})",
+                    "{} {} (limit {}, first at {:.3} s, {:.3} s beyond, peak {}{})",
                     e.joint,
                     e.kind,
                     crate::render::short_num(e.limit),
                     e.first_time,
                     e.time_beyond,
-                    crate::render::short_num(e.peak)
+                    crate::render::short_num(e.peak),
+                    if when.is_empty() { String::new() } else { format!("; beyond {}", when.join(", ")) }
                 )
             })
             .collect();

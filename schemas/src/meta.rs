@@ -298,6 +298,12 @@ pub struct LimitEventInfo {
     pub time_beyond: f64,
     /// The most extreme value (q for positions, else a magnitude).
     pub peak: f64,
+    /// `[first, last]` sample time of each run of samples beyond, s (the first 100).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub intervals: Vec<[f64; 2]>,
+    /// How many such runs there were.
+    #[serde(default)]
+    pub interval_count: u64,
 }
 
 /// Record `limits`: what the limits monitor found (only runs whose scene monitors limits).

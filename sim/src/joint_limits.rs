@@ -13,7 +13,8 @@
 //! **Monitor** (on when the scene has `"joint_limits"` or a voltage or current limit): at every
 //! output sample — the resolution of every time below is the output interval `1 / output_rate`
 //! — per joint and kind: the first sample time beyond, the time spent beyond (samples beyond ×
-//! interval), and the peak. Kinds: `position` (q outside the URDF `lower..upper`), `velocity`
+//! interval), the peak, and the intervals beyond (first and last sample time of each run of
+//! samples beyond; the first 100 kept, their count recorded). Kinds: `position` (q outside the URDF `lower..upper`), `velocity`
 //! (|q̇| > URDF `velocity`), `effort` (|τ| of eq 12 > URDF `effort`), `current` (|i| > the
 //! driver's limit by more than 1e-6 relative — the integration error of inductive motors at
 //! their barrier is below that), and the drive's saturations, which are not limits crossed but
@@ -128,7 +129,16 @@ pub struct LimitEvent {
     /// The most extreme value seen: q for positions, else the magnitude (|q̇|, |τ|, |i|, |v*|,
     /// and |v* − K_e k q̇| / R for `current-limit`, the current asked for).
     pub peak: f64,
+    /// The intervals beyond, `[first, last]` sample time of each run of consecutive samples
+    /// beyond (the first [`MAX_INTERVALS`]), s.
+    pub intervals: Vec<[f64; 2]>,
+    /// How many intervals there were (more than `intervals` holds when it was cut).
+    pub interval_count: u64,
 }
+
+/// At most this many intervals are kept per joint and kind (a chattering saturation would
+/// otherwise grow the record without bound).
+pub const MAX_INTERVALS: usize = 100;
 
 /// The monitor's verdict on one run.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -179,6 +189,10 @@ struct Slot {
     peak: f64,
     /// Which bound a position crossed first (for the record).
     bound: f64,
+    /// Whether the last sample was beyond.
+    inside_interval: bool,
+    intervals: Vec<[f64; 2]>,
+    interval_count: u64,
 }
 
 /// Watches every output sample of a run (module docs). Slots are made once; `observe` does not
@@ -203,7 +217,18 @@ impl LimitMonitor {
         }
         let mut slots = Vec::new();
         let mut what = Vec::new();
-        let slot = |joint, kind, limit| Slot { joint, kind, limit, first_time: None, samples: 0, peak: 0.0, bound: 0.0 };
+        let slot = |joint, kind, limit| Slot {
+            joint,
+            kind,
+            limit,
+            first_time: None,
+            samples: 0,
+            peak: 0.0,
+            bound: 0.0,
+            inside_interval: false,
+            intervals: Vec::new(),
+            interval_count: 0,
+        };
         for (j, b) in model.bodies.iter().enumerate() {
             if joints {
                 if let Some((lo, hi)) = b.limits.position {
@@ -291,7 +316,18 @@ impl LimitMonitor {
                 if let Some(v) = value {
                     s.peak = s.peak.max(v);
                 }
+                if !s.inside_interval {
+                    s.interval_count += 1;
+                    if s.intervals.len() < MAX_INTERVALS {
+                        s.intervals.push([o.t, o.t]);
+                    }
+                } else if s.interval_count as usize <= MAX_INTERVALS {
+                    if let Some(last) = s.intervals.last_mut() {
+                        last[1] = o.t;
+                    }
+                }
             }
+            s.inside_interval = beyond;
         }
     }
 
@@ -310,6 +346,8 @@ impl LimitMonitor {
                     first_time,
                     time_beyond: s.samples as f64 * self.dt,
                     peak: s.peak,
+                    intervals: s.intervals.clone(),
+                    interval_count: s.interval_count,
                 })
             })
             .collect();

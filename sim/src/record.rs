@@ -238,6 +238,8 @@ impl<'a> Recorder<'a> {
                     first_time: e.first_time,
                     time_beyond: e.time_beyond,
                     peak: e.peak,
+                    intervals: e.intervals.clone(),
+                    interval_count: e.interval_count,
                 })
                 .collect();
             let rec = LimitsRecord { monitored: sum.monitored, resolution: sum.resolution, exceeded, saturations, events };

@@ -110,6 +110,15 @@ fn voltage_saturation_bounds_the_recorded_voltage_exactly() {
         assert!(hit >= 1, "{run}: no joint reached the supply; the test does not test");
         let lim = r.limits.as_ref().expect("a limits record");
         assert!(lim.events.iter().any(|e| e.kind == "voltage-saturation" && e.peak > limit), "{run}: {lim:?}");
+        // when: the intervals of saturation, within the run, and the first starts at the first time
+        for e in &lim.events {
+            assert!(e.interval_count >= 1 && !e.intervals.is_empty(), "{e:?}");
+            assert_eq!(e.intervals[0][0], e.first_time);
+            let dt = lim.resolution;
+            let spanned: f64 = e.intervals.iter().map(|[a, b]| b - a + dt).sum();
+            assert!((spanned - e.time_beyond).abs() < 1e-9 || e.interval_count as usize > e.intervals.len(), "{e:?}");
+            assert!(e.intervals.iter().all(|[a, b]| a <= b && *b <= 1.0 + 1e-12));
+        }
         assert_eq!(r.result.saturations, Some(lim.saturations));
         assert!(lim.saturations >= 1);
         assert!(r.result.status_text().contains("saturation"), "{}", r.result.status_text());
