@@ -354,3 +354,66 @@ impl LimitMonitor {
         LimitsSummary { events, resolution: self.dt, monitored: self.monitored.clone() }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::motor::MotorParams;
+
+    fn small() -> (Model, Drives) {
+        let xml = include_str!("../scenes/small/small_arm.urdf").replace(r#"lower="-3.14" upper="3.14" effort="100""#, r#"lower="-1" upper="2" effort="100""#);
+        let model = Model::from_urdf(&xml, "small_arm.urdf", nalgebra::Vector3::new(0.0, 0.0, -9.81)).unwrap();
+        let m = MotorParams { torque_constant: 0.2, resistance: 1.0, inductance: 0.0, rotor_inertia: 0.0, gear_ratio: 1.0, gear_damping: 0.0 };
+        let drives = Drives::new(&[m; 4], &[0.0; 4]);
+        (model, drives)
+    }
+
+    /// The stop's spring is conservative with the stored energy it reports: τ = −∂V_s/∂q
+    /// (central differences, h = 1e-6 rad: exact for a quadratic up to rounding, 1e-6 N m;
+    /// on a limit itself V_s is C¹ but not C², and the difference straddling it is off by
+    /// k h / 4, so the tolerance there is k h), zero inside the limits, and the damper
+    /// dissipates c q̇² only beyond.
+    #[test]
+    fn the_stop_torque_is_minus_the_gradient_of_its_energy() {
+        let (model, _) = small();
+        let st = JointStops::new(&model, 1500.0, 3.0);
+        assert_eq!((st.lower[0], st.upper[0]), (-1.0, 2.0));
+        for &q in &[-1.3, -1.0, 0.0, 1.99, 2.0, 2.2] {
+            let at = |x: f64| st.energy(&[x, 0.0, 0.0, 0.0]);
+            let h = 1e-6;
+            let grad = (at(q + h) - at(q - h)) / (2.0 * h);
+            let tol = if q == -1.0 || q == 2.0 { 1500.0 * h } else { 1e-6 };
+            assert!((st.torque(0, q, 0.0) + grad).abs() < tol, "q = {q}: τ = {}, -dV/dq = {}", st.torque(0, q, 0.0), -grad);
+            let beyond = !(-1.0..=2.0).contains(&q);
+            let damper = st.torque(0, q, 0.7) - st.torque(0, q, 0.0);
+            assert!((damper - if beyond { -3.0 * 0.7 } else { 0.0 }).abs() < 1e-12, "q = {q}: damper {damper}");
+            let loss = st.loss_rate(&[q, 0.0, 0.0, 0.0], &[0.7, 0.0, 0.0, 0.0]);
+            assert!((loss - if beyond { 3.0 * 0.7 * 0.7 } else { 0.0 }).abs() < 1e-12, "q = {q}: loss {loss}");
+        }
+    }
+
+    /// Sample by sample: the first time, the time beyond (samples × interval), the peak and
+    /// the intervals of a joint that crosses its upper limit twice.
+    #[test]
+    fn the_monitor_reports_first_time_duration_peak_and_intervals() {
+        let (model, drives) = small();
+        let mut mon = LimitMonitor::new(&model, &drives, true, 0.1).unwrap();
+        let qs = [1.0, 2.1, 2.3, 1.9, 1.5, 2.05, 1.0];
+        for (k, &q) in qs.iter().enumerate() {
+            let o = Outputs { t: 0.1 * k as f64, q: vec![q, 0.0, 0.0, 0.0], qd: vec![0.0; 4], tau_motor: vec![0.0; 4], ..Outputs::default() };
+            mon.observe(&o);
+        }
+        let s = mon.summary();
+        assert_eq!(s.events.len(), 1, "{s:?}");
+        let e = &s.events[0];
+        assert_eq!((e.joint.as_str(), e.kind, e.limit, e.peak), ("joint1", LimitKind::Position, 2.0, 2.3));
+        assert_eq!(e.first_time, 0.1);
+        assert!((e.time_beyond - 0.3).abs() < 1e-15);
+        assert_eq!(e.intervals, vec![[0.1, 0.2], [0.5, 0.5]]);
+        assert_eq!(e.interval_count, 2);
+        assert_eq!((s.exceeded(), s.saturated()), (1, 0));
+        assert_eq!(s.status("complete"), "complete, 1 limit exceeded");
+        // nothing is monitored without joint limits or drive limits
+        assert!(LimitMonitor::new(&model, &drives, false, 0.1).is_none());
+    }
+}
