@@ -35,6 +35,8 @@ pub enum IkSetupError {
     NotAncestor(String, String),
     #[error("a planar link has zero length")]
     ZeroLink,
+    #[error("joint `{0}` is prismatic: the closed-form IK needs revolute joints (use a cartesian target with the general IK, `\"ik\": {{\"solver\": \"dls\"}}`)")]
+    Prismatic(String),
 }
 
 /// Closed-form IK: yaw joint + two planar joints; all other joints held.
@@ -83,6 +85,11 @@ impl YawPlanarIk {
         branch: f64,
     ) -> Result<Self, IkSetupError> {
         let name = |j: usize| model.bodies[j].joint.clone();
+        for j in [yaw_dof, planar_dofs[0], planar_dofs[1]] {
+            if model.bodies[j].kind == crate::dynamics::model::JointKind::Prismatic {
+                return Err(IkSetupError::Prismatic(name(j)));
+            }
+        }
         if model.bodies[yaw_dof].parent.is_some() {
             return Err(IkSetupError::YawNotAtBase(name(yaw_dof)));
         }
@@ -220,5 +227,31 @@ impl YawPlanarIk {
         qd_des[p1] = q1_dot;
         qd_des[p2] = q2_dot;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::kinematics::body_point;
+
+    /// A yaw joint and two planar joints, the second prismatic: refused by name, not solved
+    /// as if it turned.
+    #[test]
+    fn a_prismatic_planar_joint_is_refused_by_name() {
+        let inertial = r#"<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>"#;
+        let xml = format!(
+            r#"<robot name="r"><link name="base"/>
+            <link name="a">{inertial}</link><link name="b">{inertial}</link><link name="c">{inertial}</link>
+            <joint name="yaw" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+            <joint name="p1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+            <joint name="slide" type="prismatic"><parent link="b"/><child link="c"/><origin xyz="0.3 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.2" effort="10" velocity="1"/></joint>
+            </robot>"#
+        );
+        let model = Model::from_urdf(&xml, "t.urdf", Vector3::new(0.0, 0.0, -9.81)).unwrap();
+        let hand = body_point(&model, "c", Vector3::new(0.1, 0.0, 0.0)).unwrap();
+        let e = YawPlanarIk::new(&model, &[0.0; 3], 0, [1, 2], &hand, 1.0).unwrap_err();
+        assert_eq!(e, IkSetupError::Prismatic("slide".into()));
+        assert!(e.to_string().contains("general IK"), "{e}");
     }
 }
