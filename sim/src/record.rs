@@ -223,8 +223,11 @@ impl<'a> Recorder<'a> {
         };
         let path = self.path.clone();
         let err = |source| RunError::Recording { path: path.clone(), source };
-        if let Some(m) = &self.monitor {
-            let sum = m.summary();
+        // a scene that sets no limits of its own (no `joint_limits`, no drive limits) is still
+        // watched against its URDF's limits, and says so only when one was crossed
+        let configured = self.scene.spec.joint_limits.is_some() || self.scene.drives.has_limits;
+        let summary = self.monitor.as_ref().map(LimitMonitor::summary).filter(|s| configured || s.exceeded() + s.saturated() > 0);
+        if let Some(sum) = summary {
             let (exceeded, saturations) = (sum.exceeded() as u64, sum.saturated() as u64);
             result.limits_exceeded = Some(exceeded);
             result.saturations = Some(saturations);

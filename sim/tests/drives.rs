@@ -197,6 +197,17 @@ fn a_run_crossing_a_joint_limit_is_flagged_and_a_stop_holds_it() {
     assert!(rec.events.iter().any(|e| e.joint == "joint4" && e.kind == "position" && e.peak == ev.peak));
     assert!(balance(&free) <= 1e-6);
 
+    // a scene that sets no `joint_limits` is watched all the same: the crossing is in its
+    // result and its `limits` record, never silent (and a scene that crosses nothing writes
+    // neither: the paper's recordings are unchanged, `recordings/refresh.sh --check`)
+    let dir0 = tempfile::tempdir().unwrap();
+    let unset = tight_limit(dir0.path(), lo, hi, |s| s.joint_limits = None);
+    let silent = record(&unset, "free");
+    assert_eq!(silent.result.limits_exceeded, Some(report.exceeded() as u64), "{}", silent.result.status_text());
+    assert!(silent.limits.as_ref().is_some_and(|r| r.events.iter().any(|e| e.joint == "joint4" && e.kind == "position")));
+    let calm = record(&small(), "free");
+    assert_eq!((calm.result.limits_exceeded, calm.limits.is_some()), (None, false), "{}", calm.result.status_text());
+
     // the same with a soft stop of 2000 N m/rad: the overshoot is bounded by the largest motor
     // torque over the stiffness, and the balance (with ½ k δ² and the damper's loss) closes
     let dir2 = tempfile::tempdir().unwrap();

@@ -57,7 +57,8 @@ pub struct Scene {
     pub(crate) controller: Controller,
     /// Soft stops at the URDF position limits, when the scene asks.
     pub(crate) stops: Option<JointStops>,
-    /// The URDF joint limits are monitored (the scene has `joint_limits`).
+    /// The URDF joint limits are monitored: always (with `joint_limits` absent, a record is
+    /// written only when one is crossed: `record.rs`).
     pub(crate) monitor_joints: bool,
     pub(crate) hand: BodyPoint,
     /// What the arm is asked to do (`target`).
@@ -496,8 +497,9 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     };
 
     // joint limits: monitored, and the position limits enforced by soft stops when asked
+    // (without `joint_limits` the URDF's limits are still watched, as with "flag")
     let (monitor_joints, stops) = match &spec.joint_limits {
-        None => (false, None),
+        None => (true, None),
         Some(jl) => {
             let stops = match jl.position {
                 PositionLimitMode::Flag => {
