@@ -158,14 +158,7 @@ impl CubicSpline {
     /// S, S', S'' at `t` into `y`, `yd`, `ydd` (m each).
     pub fn eval(&self, t: f64, y: &mut [f64], yd: &mut [f64], ydd: &mut [f64]) {
         let m = self.m;
-        let n = self.t.len();
-        let Some(k) = interval(&self.t, t) else {
-            let k = if n > 1 && t > self.t[n - 1] { n - 1 } else { 0 };
-            y.copy_from_slice(&self.y[k * m..(k + 1) * m]);
-            yd.fill(0.0);
-            ydd.fill(0.0);
-            return;
-        };
+        let Some(k) = interval_or_hold(&self.t, &self.y, m, t, y, yd, ydd) else { return };
         let h = self.t[k + 1] - self.t[k];
         let a = (self.t[k + 1] - t) / h;
         let b = (t - self.t[k]) / h;
@@ -179,6 +172,20 @@ impl CubicSpline {
             ydd[j] = a * m0[j] + b * m1[j];
         }
     }
+}
+
+/// The interval of the knots `knots` that holds `t`; outside them (`None`), the end value of
+/// `values` (m channels per knot) held, with zero derivatives, written into `y`, `yd`, `ydd`.
+fn interval_or_hold(knots: &[f64], values: &[f64], m: usize, t: f64, y: &mut [f64], yd: &mut [f64], ydd: &mut [f64]) -> Option<usize> {
+    let k = interval(knots, t);
+    if k.is_none() {
+        let n = knots.len();
+        let end = if n > 1 && t > knots[n - 1] { n - 1 } else { 0 };
+        y.copy_from_slice(&values[end * m..(end + 1) * m]);
+        yd.fill(0.0);
+        ydd.fill(0.0);
+    }
+    k
 }
 
 /// Minimum-jerk quintic segments through waypoints, rest at each, with `m` channels.
@@ -199,14 +206,7 @@ impl MinJerk {
     /// y, y', y'' at `t` (m each).
     pub fn eval(&self, t: f64, y: &mut [f64], yd: &mut [f64], ydd: &mut [f64]) {
         let m = self.m;
-        let n = self.t.len();
-        let Some(k) = interval(&self.t, t) else {
-            let k = if n > 1 && t > self.t[n - 1] { n - 1 } else { 0 };
-            y.copy_from_slice(&self.y[k * m..(k + 1) * m]);
-            yd.fill(0.0);
-            ydd.fill(0.0);
-            return;
-        };
+        let Some(k) = interval_or_hold(&self.t, &self.y, m, t, y, yd, ydd) else { return };
         let h = self.t[k + 1] - self.t[k];
         let (s, sd, sdd) = min_jerk((t - self.t[k]) / h);
         for j in 0..m {
