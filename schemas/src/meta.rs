@@ -13,6 +13,7 @@
 //! | `run` | `scene`, `run`, `contacts` | 0 |
 //! | `run` | `joint_names`, `integrator` and `integrator.*`, `duration`, `output_rate`, `mass_matrix`, `constraint_solver`, `stabilization`, `model.*`, `hand_frame`, `tool` | 1 |
 //! | `scene` | `json` (the scene as run), `source` | 1 |
+//! | `scene` | `target_csv` (the `joint-csv` target's file; only those scenes) | 2 |
 //! | `urdf` | `file`, `xml` | 1 |
 //! | `result` | `status` (`complete`/`failed`) | 0 |
 //! | `result` | `rhs_evals`, `steps`, `rejected` (complete), `error`, `error_time` (failed) | 1 |
@@ -200,6 +201,10 @@ pub struct SceneRecord {
     pub json: String,
     /// Where it came from: a file name, or a label.
     pub source: String,
+    /// The text of the file a `joint-csv` target reads (absent for every other target), so
+    /// that a replay needs nothing but the recording.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_csv: Option<String>,
 }
 
 impl MetadataRecord for SceneRecord {
@@ -211,8 +216,8 @@ impl MetadataRecord for SceneRecord {
 pub struct UrdfRecord {
     /// The file name the scene gives.
     pub file: String,
-    /// Its text (with mesh references resolved to `file://` URIs when the scene gives
-    /// `robot.package_paths`).
+    /// Its text (with `package://` and relative mesh references resolved to `file://` URIs
+    /// when, and only when, the scene gives `robot.package_paths`).
     pub xml: String,
     /// What became of the URDF's `<mesh>` references (absent when it has none): whether they
     /// are resolved and present, or that the meshes are not embedded and why.

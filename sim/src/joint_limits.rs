@@ -8,7 +8,9 @@
 //! It stores `V_s = ½ k (q − q_hi)²` (part of the energy balance as a stored energy) and
 //! dissipates `c q̇²` while beyond (a new quadrature `E_s = ∫ Σ c q̇² [beyond] dt`, present only
 //! when stops are configured). The damper acts over the whole penetration (it can pull while
-//! the joint leaves the stop; the energy account is exact either way).
+//! the joint leaves the stop; the energy account is exact either way). One k and one c serve
+//! every joint, in N m/rad and N m s/rad on revolute joints and in N/m and N s/m on prismatic
+//! ones: on an arm with both kinds, choose them for the kind whose stops matter.
 //!
 //! **Monitor** (on when the scene has `"joint_limits"` or a voltage or current limit): at every
 //! output sample — the resolution of every time below is the output interval `1 / output_rate`
@@ -205,6 +207,8 @@ pub struct LimitMonitor {
     dt: f64,
     ke: Vec<f64>,
     r: Vec<f64>,
+    /// The drivers' current limits, A (infinite where none).
+    i_max: Vec<f64>,
     monitored: String,
 }
 
@@ -265,6 +269,7 @@ impl LimitMonitor {
             dt,
             ke: drives.ke.iter().copied().collect(),
             r: drives.r.iter().copied().collect(),
+            i_max: drives.current_limit.iter().copied().collect(),
             monitored: what.join("; "),
         })
     }
@@ -298,8 +303,13 @@ impl LimitMonitor {
                     Some(i) => (i.abs() > s.limit * (1.0 + 1e-6), Some(i.abs())),
                     None => (false, None),
                 },
+                // the supply clips what the driver's current window leaves of the command
                 LimitKind::VoltageSaturation => match o.voltage_command.get(j) {
-                    Some(v) => (v.abs() > s.limit, Some(v.abs())),
+                    Some(&v) => {
+                        let w = self.r[j] * self.i_max[j];
+                        let v = if w.is_finite() { v.clamp(self.ke[j] * o.qd[j] - w, self.ke[j] * o.qd[j] + w) } else { v };
+                        (v.abs() > s.limit, Some(v.abs()))
+                    }
                     None => (false, None),
                 },
                 LimitKind::CurrentLimit => match o.voltage_command.get(j) {

@@ -41,6 +41,11 @@ pub const MAX_URDF_DEPTH: usize = 100;
 /// Most joints in a URDF (its links may number one more: a tree).
 pub const MAX_URDF_JOINTS: usize = 1000;
 
+/// Most values of a joint-space target held in memory (knots × joints, of a joint CSV or of the
+/// general IK's grid): 10^7, i.e. 80 MB for the values and as much for the spline's second
+/// derivatives, whatever the input's size.
+pub const MAX_TARGET_VALUES: usize = 10_000_000;
+
 /// Most samples of one run (`duration × output_rate + 1`).
 pub const MAX_SAMPLES: f64 = 1e8;
 

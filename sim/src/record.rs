@@ -104,7 +104,8 @@ impl<'a> Recorder<'a> {
         };
         writer.write_record(&run_info).map_err(err)?;
         let source = Path::new(&scene.source).file_name().map_or(scene.source.clone(), |f| f.to_string_lossy().into_owned());
-        writer.write_record(&SceneRecord { json: serde_json::to_string_pretty(&scene.spec).unwrap_or_default(), source }).map_err(err)?;
+        let (json, target_csv) = (serde_json::to_string_pretty(&scene.spec).unwrap_or_default(), scene.target_csv.clone());
+        writer.write_record(&SceneRecord { json, source, target_csv }).map_err(err)?;
         writer
             .write_record(&UrdfRecord {
                 file: scene.spec.urdf.clone(),

@@ -1,5 +1,5 @@
-//! Rebuild a scene from a recording alone: the scene JSON, the URDF text and the run name are
-//! in its metadata (`record.rs`), so an archived run says how to reproduce itself. The rebuilt
+//! Rebuild a scene from a recording alone: the scene JSON, the URDF text, the text of a
+//! `joint-csv` target's file and the run name are in its metadata (`record.rs`), so an archived run says how to reproduce itself. The rebuilt
 //! scene keeps the recorded source name, so a replay by the same version of the tool writes a
 //! byte-identical file.
 
@@ -22,10 +22,10 @@ pub fn scene_from_recording(path: &Path) -> Result<(Scene, String), ReplayError>
     let rec = schemas::read_recording_topics(path, Some(&[]))?;
     let (scene, urdf, run) = (rec.scene()?, rec.urdf()?, rec.run()?.run);
     let scene = Scene::from_json(&scene.json, &scene.source, |name| {
-        if name == urdf.file {
-            Ok(urdf.xml.clone())
-        } else {
-            Err(format!("the recording embeds `{}`, not `{name}`", urdf.file))
+        match &scene.target_csv {
+            _ if name == urdf.file => Ok(urdf.xml.clone()),
+            Some(csv) => Ok(csv.clone()),
+            None => Err(format!("the recording embeds `{}`, not `{name}`", urdf.file)),
         }
     })
     .map_err(|source| ReplayError::Scene { file: path.display().to_string(), source })?;

@@ -201,7 +201,7 @@ fn cases() -> Vec<Case> {
         Case {
             what: "IK joint that does not exist",
             edit: Json(|v| v["target"]["ik"]["planar_joints"][1] = json!("joint11")),
-            want: &["target.ik.planar_joints[1]` = joint11", "no revolute joint"],
+            want: &["target.ik.planar_joints[1]` = joint11", "no movable joint"],
         },
         Case {
             what: "missing URDF file",

@@ -82,3 +82,21 @@ fn package_meshes_are_resolved_in_the_stored_urdf() {
     assert_eq!(s.urdf_xml(), urdf);
     assert!(s.meshes()[0].uri.is_none() && s.meshes()[0].note.contains("not embedded"), "{:?}", s.meshes());
 }
+
+/// A joint that moves only massless links (the paper arm with link10's `<inertial>` removed)
+/// runs when its motor has a rotor (M + J_m is regular), and is refused, naming the joint,
+/// when the rotor inertia is zero (M + J_m would be singular at every q).
+#[test]
+fn a_joint_moving_only_massless_links_needs_a_rotor() {
+    let inertial10 = r#"<inertial><origin xyz="0 0 0.15" rpy="0 0 0"/><mass value="0.1"/><inertia ixx="0.0007525" ixy="0" ixz="0" iyy="0.0007525" iyz="0" izz="5e-06"/></inertial>"#;
+    let (head, tail) = PAPER_URDF.split_at(PAPER_URDF.find(r#"<link name="link10">"#).unwrap());
+    assert!(tail.contains(inertial10));
+    let urdf = format!("{head}{}", tail.replacen(inertial10, "", 1));
+    let read = |name: &str| (name == "paper_arm.urdf").then(|| urdf.clone()).ok_or_else(|| format!("no {name}"));
+    let with_rotor = Scene::from_json(PAPER_SCENE_JSON, "t.json", read).unwrap();
+    assert_eq!(with_rotor.model().massless_dofs(), vec![9]);
+    let mut v: serde_json::Value = serde_json::from_str(PAPER_SCENE_JSON).unwrap();
+    v["motor"]["rotor_inertia"] = json!(0.0);
+    let e = Scene::from_json(&v.to_string(), "t.json", read).unwrap_err().to_string();
+    assert!(e.contains("joint `joint10` moves only massless links") && e.contains("rotor inertia"), "{e}");
+}

@@ -343,7 +343,7 @@ fn joint_csv_targets_and_their_errors() {
     assert_eq!(&q[1..9], &q0[1..9]);
     let cases: [(&'static str, &str); 6] = [
         ("t,joint1\n0,0\n1,x\n", "traj.csv, line 3, column 3: `x` is not a finite number"),
-        ("t,joint1,jointX\n0,0,0\n", "traj.csv, line 1, column 10: `jointX` is not a revolute joint"),
+        ("t,joint1,jointX\n0,0,0\n", "traj.csv, line 1, column 10: `jointX` is not a movable joint"),
         ("t,joint1\n0,0\n0,1\n", "traj.csv, line 3, column 1: t = 0 s is not after"),
         ("time,joint1\n0,0\n", "line 1, column 1: the first column must be `t`"),
         ("t,joint1,joint1\n0,0,0\n", "joint `joint1` is listed twice"),
@@ -464,5 +464,57 @@ fn track_with_a_held_orientation() {
         assert!(data.x_world_body[6].rotation.angle_to(&r_hold) <= 1e-9, "t = {t}");
         assert!((hand.position(&data) - path.position(t)).norm() <= 1e-9, "t = {t}");
         assert!(qq.iter().all(|x| x.abs() <= 2.8 + 1e-12));
+    }
+}
+
+/// A `joint-csv` run replays from its recording alone: the CSV's text is in the `scene`
+/// record, and the replayed run writes the same bytes.
+#[test]
+fn a_joint_csv_run_replays_from_its_recording_alone() {
+    let mut v = paper_json();
+    v["target"] = json!({"kind": "joint-csv", "file": "traj.csv"});
+    v["duration"] = json!(0.5);
+    let csv = "t,joint10,joint1\n0,0.7853981633974483,0.0\n0.25,0.8,0.02\n0.5,0.81,0.03\n";
+    let scene = scene_from(&v, Some(csv)).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    let run = scene.run("no-elbow").unwrap();
+    sim::run::run_to_file(&scene, run, &a, |_| {}).unwrap();
+    let (replayed, name) = sim::replay::scene_from_recording(&a).unwrap();
+    assert_eq!(name, "no-elbow");
+    sim::run::run_to_file(&replayed, replayed.run(&name).unwrap(), &b, |_| {}).unwrap();
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "the replay wrote other bytes");
+}
+
+/// An arm with prismatic joints in the hand's chain (a lift along z and a telescope along the
+/// forearm, between revolute joints): the general IK's Jacobian column of a prismatic joint is
+/// its axis (the hand moves along it without turning), so random reachable targets are reached
+/// to 1e-9 m, within the joints' limits.
+#[test]
+fn general_ik_reaches_targets_through_prismatic_joints() {
+    let inertial = r#"<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>"#;
+    let xml = format!(
+        r#"<robot name="lift"><link name="base"/>
+        <link name="l1">{inertial}</link><link name="l2">{inertial}</link><link name="l3">{inertial}</link><link name="l4">{inertial}</link><link name="hand"/>
+        <joint name="yaw" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+        <joint name="lift" type="prismatic"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.2"/><axis xyz="0 0 1"/><limit lower="0" upper="0.5" effort="100" velocity="1"/></joint>
+        <joint name="shoulder" type="revolute"><parent link="l2"/><child link="l3"/><origin xyz="0.05 0 0"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="10" velocity="1"/></joint>
+        <joint name="telescope" type="prismatic"><parent link="l3"/><child link="l4"/><origin xyz="0.3 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.4" effort="100" velocity="1"/></joint>
+        <joint name="tool" type="fixed"><parent link="l4"/><child link="hand"/><origin xyz="0.1 0 0"/></joint>
+        </robot>"#
+    );
+    let model = Model::from_urdf(&xml, "lift.urdf", Vector3::new(0.0, 0.0, -9.81)).unwrap();
+    let hand = body_point(&model, "hand", Vector3::zeros()).unwrap();
+    let mut rng = Lcg(11);
+    for case in 0..20 {
+        let q_goal = [4.0 * rng.next() - 2.0, 0.1 + 0.3 * rng.next(), 1.6 * rng.next() - 0.8, 0.05 + 0.3 * rng.next()];
+        let r = hand_at(&model, &q_goal);
+        let ik = GeneralIk { hand, orientation: None, contacts: vec![], active: vec![true; 4], posture: vec![0.0, 0.25, 0.0, 0.2] };
+        let mut q = vec![q_goal[0] + 0.3, q_goal[1] - 0.05, q_goal[2] + 0.3, q_goal[3] - 0.04];
+        let mut s = ik.scratch(&model);
+        let st = ik.solve(&model, &mut s, &r, &mut q).unwrap_or_else(|e| panic!("case {case}: {e:?}"));
+        let miss = (hand_at(&model, &q) - r).norm();
+        assert!(miss <= 1e-9, "case {case}: missed by {miss} m ({st:?})");
+        assert!((0.0..=0.5).contains(&q[1]) && (0.0..=0.4).contains(&q[3]), "limits: {q:?}");
     }
 }

@@ -43,6 +43,7 @@ use super::spline::CubicSpline;
 use crate::dynamics::constraints::PointOnPlane;
 use crate::dynamics::kinematics::{forward_kinematics, BodyPoint};
 use crate::dynamics::{Data, Model};
+use crate::dynamics::model::JointKind;
 
 /// Converged task residual, m or rad.
 pub const TASK_TOL: f64 = 1e-12;
@@ -117,9 +118,16 @@ impl GeneralIk {
         let mut cur = self.hand.body;
         while let Some(j) = cur {
             let z = data.x_world_body[j].rotation * model.bodies[j].axis.into_inner();
-            s.jac.fixed_view_mut::<3, 1>(0, j).copy_from(&z.cross(&(p - data.x_world_body[j].translation.vector)));
-            if self.orientation.is_some() {
-                s.jac.fixed_view_mut::<3, 1>(3, j).copy_from(&z);
+            // a revolute joint turns the hand about z through its origin, a prismatic one
+            // moves it along z without turning it (Siciliano et al., *Robotics*, eq 3.30)
+            match model.bodies[j].kind {
+                JointKind::Revolute => {
+                    s.jac.fixed_view_mut::<3, 1>(0, j).copy_from(&z.cross(&(p - data.x_world_body[j].translation.vector)));
+                    if self.orientation.is_some() {
+                        s.jac.fixed_view_mut::<3, 1>(3, j).copy_from(&z);
+                    }
+                }
+                JointKind::Prismatic => s.jac.fixed_view_mut::<3, 1>(0, j).copy_from(&z),
             }
             cur = model.bodies[j].parent;
         }
@@ -163,38 +171,58 @@ impl GeneralIk {
         let mut beta = 1.0;
         let mut last = f64::INFINITY;
         for it in 0..=MAX_ITERATIONS {
+            // joints at a limit are free again each iteration and frozen only while the step
+            // would push them out of their range (an active set, Nocedal & Wright §16.5), so a
+            // joint clamped once by a long early step can come back
+            s.frozen.fill(false);
             self.task(model, s, q, r_d);
             let enorm = s.e.norm();
             if enorm > last && enorm > TASK_TOL {
                 beta = (beta * 0.5f64).max(1.0 / 64.0);
             }
             last = enorm;
-            let z = DVector::from_fn(nv, |j, _| if self.active[j] && !s.frozen[j] { beta * (self.posture[j] - q[j]) } else { 0.0 });
-            let jt = s.jac.transpose();
-            let mut a = &s.jac * &jt;
-            for i in 0..m {
-                a[(i, i)] += 0.5 * enorm * enorm;
-            }
-            // A is singular only when J loses rank at the solution: regularise minimally
-            let chol = match a.clone().cholesky() {
-                Some(c) => c,
-                None => {
-                    for i in 0..m {
-                        a[(i, i)] += 1e-12;
+            let mut dq;
+            loop {
+                let z = DVector::from_fn(nv, |j, _| if self.active[j] && !s.frozen[j] { beta * (self.posture[j] - q[j]) } else { 0.0 });
+                let jt = s.jac.transpose();
+                let mut a = &s.jac * &jt;
+                for i in 0..m {
+                    a[(i, i)] += 0.5 * enorm * enorm;
+                }
+                // A is singular only when J loses rank at the solution: regularise minimally
+                let chol = match a.clone().cholesky() {
+                    Some(c) => c,
+                    None => {
+                        for i in 0..m {
+                            a[(i, i)] += 1e-12;
+                        }
+                        match a.cholesky() {
+                            Some(c) => c,
+                            None => return Err(SolveStats { iterations: it, residual: enorm, stationarity: f64::NAN }),
+                        }
                     }
-                    match a.cholesky() {
-                        Some(c) => c,
-                        None => return Err(SolveStats { iterations: it, residual: enorm, stationarity: f64::NAN }),
+                };
+                let jz = &s.jac * &z;
+                let null_part = &z - &jt * chol.solve(&jz);
+                stats = SolveStats { iterations: it, residual: enorm, stationarity: null_part.norm() / beta };
+                dq = &z + &jt * chol.solve(&(&s.e - &jz));
+                let mut again = false;
+                for j in 0..nv {
+                    if let (true, false, Some((lo, hi))) = (self.active[j], s.frozen[j], model.bodies[j].limits.position) {
+                        if (q[j] >= hi && dq[j] > 0.0) || (q[j] <= lo && dq[j] < 0.0) {
+                            s.frozen[j] = true;
+                            s.jac.column_mut(j).fill(0.0);
+                            again = true;
+                        }
                     }
                 }
-            };
-            let jz = &s.jac * &z;
-            let null_part = &z - &jt * chol.solve(&jz);
-            stats = SolveStats { iterations: it, residual: enorm, stationarity: null_part.norm() / beta };
+                if !again {
+                    break;
+                }
+            }
             if (enorm <= TASK_TOL && stats.stationarity <= POSTURE_TOL) || it == MAX_ITERATIONS {
                 break;
             }
-            let mut dq = &z + &jt * chol.solve(&(&s.e - &jz));
             let big = dq.amax();
             if big > MAX_STEP {
                 dq *= MAX_STEP / big;
@@ -202,10 +230,7 @@ impl GeneralIk {
             for j in 0..nv {
                 q[j] += dq[j];
                 if let (true, Some((lo, hi))) = (self.active[j], model.bodies[j].limits.position) {
-                    if q[j] < lo || q[j] > hi {
-                        q[j] = q[j].clamp(lo, hi);
-                        s.frozen[j] = true;
-                    }
+                    q[j] = q[j].clamp(lo, hi);
                 }
             }
         }

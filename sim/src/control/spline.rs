@@ -1,7 +1,10 @@
 //! Interpolating splines in time with exact derivatives, several channels sharing one knot
 //! vector (a joint-space trajectory: one channel per joint).
 //!
-//! - [`CubicSpline`]: the C² cubic spline through `(t_k, y_k)` with clamped ends
+//! - [`CubicSpline`]: the C² cubic spline through `(t_k, y_k)` with clamped ends (C² between
+//!   the first and the last knot; outside them the end value is held, so where the run goes on
+//!   past the last waypoint q̈_d steps from the end curvature to 0: use `quintic` for a target
+//!   that comes to rest smoothly)
 //!   `S'(t_0) = v_0`, `S'(t_n) = v_n` (Burden & Faires, *Numerical Analysis*, 9th ed., §3.5,
 //!   Alg. 3.5; de Boor, *A Practical Guide to Splines*, ch. IV). The unknowns are the second
 //!   derivatives M_k at the knots, from the tridiagonal system

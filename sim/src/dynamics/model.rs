@@ -99,7 +99,9 @@ fn joint_motion(kind: JointKind, axis: &Unit<Vector3<f64>>, q: f64) -> Isometry3
 }
 
 /// A joint's URDF `<limit>` and `<dynamics>` elements (ROS URDF spec, `joint` element), as
-/// read; nothing here enters the dynamics unless a scene asks for it. A zero range, speed or
+/// read. The limits are watched in every run and enforced only as soft stops when a scene asks
+/// (`joint_limits`); `damping` and `friction` are read but do not enter the dynamics (a scene
+/// gives its joints' viscous friction as `joint_damping`). A zero range, speed or
 /// effort (or an absent attribute) means "not given" and reads as `None`. Units follow the
 /// joint: rad, rad/s, N m for a revolute joint; m, m/s, N for a prismatic one.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -327,6 +329,15 @@ impl Model {
                     changed = true;
                 } else if let Some(&v) = locked.get(m.leader.as_str()) {
                     let value = m.multiplier * v + m.offset;
+                    if let Some((lo, hi)) = JointLimits::from_urdf(j).position {
+                        if value < lo - 1e-12 || value > hi + 1e-12 {
+                            return Err(opt_err(
+                                &m.leader,
+                                crate::error::short(v),
+                                format!("locks its mimic follower `{}` at {} = {} * {v} + {}, outside the follower's <limit> [{lo}, {hi}] (line {})", j.name, crate::error::short(value), m.multiplier, m.offset, j.line),
+                            ));
+                        }
+                    }
                     locked.insert(j.name.as_str(), value);
                     mimics.push(Mimic { follower: j.name.clone(), leader: m.leader.clone(), multiplier: m.multiplier, offset: m.offset, locked_at: value });
                     changed = true;
@@ -467,22 +478,6 @@ impl Model {
         if bodies.is_empty() {
             return Err(ModelError::NoJoints { file });
         }
-        // a joint that moves only massless links makes M(q) singular at every q: refuse it at
-        // load, naming the joint (a tool frame on a revolute joint, a link with no <inertial>)
-        let mut massive: Vec<bool> = bodies.iter().map(|b| b.inertia.mass != 0.0 || b.inertia.i_o != Matrix3::zeros()).collect();
-        for i in (0..bodies.len()).rev() {
-            if let (Some(p), true) = (bodies[i].parent, massive[i]) {
-                massive[p] = true;
-            }
-        }
-        if let Some(i) = massive.iter().position(|&m| !m) {
-            let ji = joint_index[bodies[i].joint.as_str()];
-            let j = &doc.joints[ji];
-            return Err(at(&file, j.line, joint_elem(j), format!(
-                "moves only massless links (`{}` and everything after it have no <inertial> mass or inertia), so M(q) would be singular; give the links their <inertial>, or lock the joint in the scene: {}",
-                bodies[i].link, hint(j)
-            )));
-        }
         let urdf_joints = doc
             .joints
             .iter()
@@ -531,6 +526,19 @@ impl Model {
     pub fn joint_placement(&self, i: usize, q_i: f64) -> Isometry3<f64> {
         let b = &self.bodies[i];
         b.after(&b.x_parent_joint, q_i)
+    }
+
+    /// The dofs that move only massless links (no `<inertial>` mass or inertia on their body
+    /// and every body after it): their row of M(q) is zero at every q, so M + J_m is regular
+    /// only with a rotor on that joint (the scene checks it).
+    pub fn massless_dofs(&self) -> Vec<usize> {
+        let mut massive: Vec<bool> = self.bodies.iter().map(|b| b.inertia.mass != 0.0 || b.inertia.i_o != Matrix3::zeros()).collect();
+        for i in (0..self.bodies.len()).rev() {
+            if let (Some(p), true) = (self.bodies[i].parent, massive[i]) {
+                massive[p] = true;
+            }
+        }
+        (0..self.bodies.len()).filter(|&i| !massive[i]).collect()
     }
 
     /// Total mass of the moving bodies, kg.

@@ -394,12 +394,11 @@ pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
                                 joint.friction = attrs.number("friction", &c)?.unwrap_or(0.0);
                             }
                             "mimic" => {
-                                joint.mimic = Some(UrdfMimic {
-                                    line,
-                                    leader: attrs.required("joint", &c)?.to_string(),
-                                    multiplier: attrs.number("multiplier", &c)?.unwrap_or(1.0),
-                                    offset: attrs.number("offset", &c)?.unwrap_or(0.0),
-                                })
+                                let (multiplier, offset) = (attrs.number("multiplier", &c)?.unwrap_or(1.0), attrs.number("offset", &c)?.unwrap_or(0.0));
+                                if !(multiplier.is_finite() && offset.is_finite()) {
+                                    return Err(c.err(attrs.elem(), format!("multiplier=\"{multiplier}\" offset=\"{offset}\" must be finite numbers")));
+                                }
+                                joint.mimic = Some(UrdfMimic { line, leader: attrs.required("joint", &c)?.to_string(), multiplier, offset })
                             }
                             _ => {}
                         }
@@ -508,7 +507,7 @@ pub fn resolve_meshes(
         } else {
             match urdf_dir {
                 Some(d) => Ok(d.join(&m.filename)),
-                None => Err("a relative path with no URDF directory to resolve it against: left as written".to_string()),
+                None => Err("a relative path, left as written (meshes are resolved when the scene gives robot.package_paths)".to_string()),
             }
         };
         let info = match path {

@@ -22,9 +22,10 @@
 //!   [`OdeJacobian::coupled_dim`] = the q, q̇, i block (the quadratures never feed back, so
 //!   their columns are zero), and no analytic exact Jacobian, so the stepper differences the
 //!   right-hand side over those columns.
-//! - [`SplitSystem`]: the armature circuit `L di/dt = v − R i − K_m q̇` is linear in i with a
-//!   diagonal matrix, so its implicit stage equation `z − γ f_I(z) = r` has the closed form
-//!   `z_i = (r_i + γ (v − K_m q̇)/L) / (1 + γ R/L)` (v and q̇ from the explicit components of r),
+//! - [`SplitSystem`]: the armature circuit `L di/dt = v − R i − K_e k q̇` (K_e k = K_m unless
+//!   the scene gives `back_emf_constant`) is linear in i with a diagonal matrix, so its implicit
+//!   stage equation `z − γ f_I(z) = r` has the closed form
+//!   `z_i = (r_i + γ (v − K_e k q̇)/L) / (1 + γ R/L)` (v and q̇ from the explicit components of r),
 //!   for an IMEX Runge–Kutta method (Ascher, Ruuth & Spiteri 1997; Kennedy & Carpenter 2003).
 
 use nalgebra::{Cholesky, DMatrix};

@@ -6,7 +6,7 @@
 //! | quantity | needs |
 //! |---|---|
 //! | t, q, q̇, W_j, E_j, E_R, E_D + E_Dm, i (inductive motors) | the state y alone |
-//! | back EMF `K_m q̇` | the state |
+//! | back EMF `K_e k q̇` (= `K_m q̇` unless the scene gives K_e) | the state |
 //! | hand position, constraint positions C, potential energy V | forward kinematics at q (placements) |
 //! | constraint velocities Ċ | forward kinematics and velocities at (q, q̇) |
 //! | desired hand position | the target's hand path at t (for a joint target: FK of q_d(t)) |

@@ -374,7 +374,7 @@ impl Ctx<'_> {
 
     fn dof(&self, field: &str, model: &Model, joint: &str) -> Result<usize, SceneError> {
         model.dof_of_joint(joint).ok_or_else(|| {
-            self.err(field, joint, format!("no revolute joint of that name (revolute joints: {})", model.joint_names().join(", ")))
+            self.err(field, joint, format!("no movable joint of that name (movable joints: {})", model.joint_names().join(", ")))
         })
     }
 }
@@ -468,6 +468,18 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     }
     if specs.iter().any(|s| *s != DriveSpec::ideal()) {
         drives = drives.with_real_drives(&motors, &specs);
+    }
+    // a joint that moves only massless links has a zero row in M(q): M + J_m is singular at
+    // every q unless its motor adds a rotor inertia
+    for j in model.massless_dofs() {
+        if drives.jm[j] == 0.0 {
+            let joint = &model.bodies[j].joint;
+            return Err(c.err(
+                "urdf",
+                &spec.urdf,
+                format!("joint `{joint}` moves only massless links (no <inertial> on `{}` or after it) and has no rotor inertia (passive, or motor.rotor_inertia = 0), so M + J_m would be singular: give the links their <inertial>, give the motor a rotor inertia, or lock the joint (\"robot\": {{\"locked\": {{\"{joint}\": 0.0}}}})", model.bodies[j].link),
+            ));
+        }
     }
     let cs = &spec.controller;
     let law = cs.law.unwrap_or(LawSpec::Pd);
@@ -663,7 +675,9 @@ fn load_robot(
         }
         packages.insert(pkg.clone(), p);
     }
-    let urdf_dir = dir.map(|d| {
+    // meshes are resolved (to this machine's absolute paths) only when the scene asks, so that
+    // a scene that does not writes the same recording on every machine
+    let urdf_dir = dir.filter(|_| !packages.is_empty()).map(|d| {
         let p = d.join(&spec.urdf);
         let p = p.parent().map(Path::to_path_buf).unwrap_or_default();
         std::path::absolute(&p).unwrap_or(p)

@@ -10,6 +10,7 @@ use super::spec::{
 };
 use super::{names, positive, Ctx};
 use crate::control::general_ik::{track, GeneralIk, DEFAULT_GRID_STEP, MAX_KNOTS};
+use crate::limits::MAX_TARGET_VALUES;
 use crate::control::path::{CartesianPath, CirclePath};
 use crate::control::spline::{CubicSpline, JointSpline, MinJerk};
 use crate::control::{Circle, Target, TargetScratch, YawPlanarIk};
@@ -158,8 +159,13 @@ pub(super) fn build_target(
                 Some(h) => c.number("target.ik.grid_step", h, |h| h > 0.0 && h <= duration, "must be > 0 s and at most the duration")?,
                 None => DEFAULT_GRID_STEP.min(duration / 2.0),
             };
-            if duration / step + 3.0 > MAX_KNOTS as f64 {
-                return Err(c.err("target.ik.grid_step", step, format!("gives more than {MAX_KNOTS} knots over duration = {duration} s; use a larger step")));
+            if duration / step + 3.0 > MAX_KNOTS as f64 || (duration / step + 3.0) * model.nv as f64 > MAX_TARGET_VALUES as f64 {
+                let knots = (duration / step + 3.0).min(MAX_KNOTS as f64 + 1.0);
+                return Err(c.err(
+                    "target.ik.grid_step",
+                    step,
+                    format!("gives {knots:.0} knots of {} joints over duration = {duration} s, more than {MAX_KNOTS} knots or {MAX_TARGET_VALUES} values (crate::limits::MAX_TARGET_VALUES); use a larger step", model.nv),
+                ));
             }
             let ik = GeneralIk { hand: *hand, orientation, contacts, active, posture };
             let start = q_init.clone().unwrap_or_else(|| ik.posture.clone());
@@ -282,7 +288,7 @@ pub fn parse_joint_csv(text: &str, file: &str, model: &Model, q_init: Option<&[f
     let mut dofs = Vec::with_capacity(head.len() - 1);
     for (col, name) in &head[1..] {
         let Some(j) = model.dof_of_joint(name) else {
-            return Err(at(hl, *col, format!("`{name}` is not a revolute joint of the URDF (joints: {})", model.joint_names().join(", "))));
+            return Err(at(hl, *col, format!("`{name}` is not a movable joint of the URDF (joints: {})", model.joint_names().join(", "))));
         };
         if dofs.contains(&j) {
             return Err(at(hl, *col, format!("joint `{name}` is listed twice")));
@@ -314,6 +320,9 @@ pub fn parse_joint_csv(text: &str, file: &str, model: &Model, q_init: Option<&[f
             if vals[0] <= prev {
                 return Err(at(ln, row[0].0, format!("t = {} s is not after the previous row's t = {prev} s", vals[0])));
             }
+        }
+        if (t.len() + 1) * nv > MAX_TARGET_VALUES {
+            return Err(at(ln, 1, format!("more than {} rows of {nv} joints: a joint target holds at most {MAX_TARGET_VALUES} values (crate::limits::MAX_TARGET_VALUES); thin the file", t.len())));
         }
         t.push(vals[0]);
         let mut q = base.clone();
