@@ -56,6 +56,15 @@ struct Description {
     constraint_solver: String,
     stabilization: String,
     motors: &'static str,
+    /// What the arm is asked to do (`target`).
+    target: String,
+    /// The controller's law.
+    controller: String,
+    /// Drive limits and passive joints, and how the URDF's joint limits are treated.
+    limits: String,
+    /// Locked joints, mimic followers, repaired inertias, meshes (empty when none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    robot_options: Vec<String>,
 }
 
 /// The integrator with every setting that applies, defaults filled in.
@@ -125,7 +134,41 @@ fn describe(s: &Scene) -> Description {
             Stabilization::Projection => "projection onto C = 0, C' = 0 after every step".into(),
         },
         motors: s.drives().electrical.describe(),
+        target: s.target().describe(s.model()),
+        controller: s.controller().law.name().to_string(),
+        limits: limits_phrase(s),
+        robot_options: robot_options(s),
     }
+}
+
+fn limits_phrase(s: &Scene) -> String {
+    let (d, names) = (s.drives(), s.model().joint_names());
+    let mut parts = Vec::new();
+    let finite = |v: &[f64]| v.iter().filter(|x| x.is_finite()).count();
+    if finite(d.voltage_limit.as_slice()) > 0 {
+        parts.push(format!("supply voltage limited on {} joints", finite(d.voltage_limit.as_slice())));
+    }
+    if finite(d.current_limit.as_slice()) > 0 {
+        parts.push(format!("current limited on {} joints", finite(d.current_limit.as_slice())));
+    }
+    let passive: Vec<&str> = names.iter().zip(&d.passive).filter(|(_, &p)| p).map(|(n, _)| n.as_str()).collect();
+    if !passive.is_empty() {
+        parts.push(format!("passive: {}", passive.join(", ")));
+    }
+    parts.push(match s.stops() {
+        Some(_) => "URDF position limits enforced by soft stops, speed and effort limits watched".into(),
+        None => "URDF position, speed and effort limits watched (flagged when crossed)".into(),
+    });
+    parts.join("; ")
+}
+
+fn robot_options(s: &Scene) -> Vec<String> {
+    let m = s.model();
+    let mut out: Vec<String> = m.locked.iter().map(|(j, v)| format!("locked {j} at {v}")).collect();
+    out.extend(m.mimics.iter().map(|x| format!("mimic {} locked at {} with {}", x.follower, x.locked_at, x.leader)));
+    out.extend(sim::dynamics::model::repair_summary(&m.repaired_inertias).map(|r| format!("repaired inertias: {r}")));
+    out.extend(sim::dynamics::urdf::mesh_summary(s.meshes()).map(|r| format!("meshes: {r}")));
+    out
 }
 
 pub fn run(a: &CheckArgs) -> Result<u8> {
@@ -150,6 +193,12 @@ pub fn run(a: &CheckArgs) -> Result<u8> {
             writeln!(o, "  integrator   {}", d.integrator.phrase)?;
             writeln!(o, "  dynamics     mass matrix {}, constraint solver {}, stabilisation {}", d.mass_matrix, d.constraint_solver, d.stabilization)?;
             writeln!(o, "  motors       {}", d.motors)?;
+            writeln!(o, "  target       {}", d.target)?;
+            writeln!(o, "  controller   {}", d.controller)?;
+            writeln!(o, "  limits       {}", d.limits)?;
+            for r in &d.robot_options {
+                writeln!(o, "  urdf         {r}")?;
+            }
             o
         }
     };
