@@ -44,7 +44,7 @@ use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, F
 use super::control::Controller;
 use super::jacobian::fd_jacobian_columns;
 use super::lu::{lu_factor, lu_solve};
-use super::rosenbrock::time_derivative;
+use super::rosenbrock::{stage_argument, stage_rhs, time_derivative};
 use super::{
     dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeJacobian, SettingsError,
     Stats, StepControl, Stepper,
@@ -367,13 +367,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
         for s in 0..tab.stages {
             let ts = if tab.c[s] == 1.0 { t_new } else { t + tab.c[s] * h };
             if s > 0 {
-                for i in 0..n {
-                    let mut v = self.y[i];
-                    for j in 0..s {
-                        v += tab.a[s][j] * self.u[j][i];
-                    }
-                    self.y_stage[i] = v;
-                }
+                stage_argument(&self.y, &self.u[..s], &tab.a[s], &mut self.y_stage);
                 if let Some(i) = eval(
                     &mut self.core.stats,
                     sys,
@@ -386,16 +380,8 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
             } else {
                 self.f_stage.copy_from_slice(&self.f0);
             }
-            let hd = h * tab.d[s];
             let (done, rest) = self.u.split_at_mut(s);
-            let us = &mut rest[0];
-            for i in 0..n {
-                let mut v = self.f_stage[i] + hd * self.dfdt[i];
-                for (j, uj) in done.iter().enumerate() {
-                    v += tab.c_ij[s][j] / h * uj[i];
-                }
-                us[i] = v;
-            }
+            stage_rhs(&self.f_stage, &self.dfdt, h * tab.d[s], done, &tab.c_ij[s], h, &mut rest[0]);
             let mut x = std::mem::take(&mut self.u[s]);
             self.solve(h, &mut x);
             self.u[s] = x;

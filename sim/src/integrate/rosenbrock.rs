@@ -318,13 +318,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
             // stage argument and f at it (stage 0: f0)
             let ts = if s == 3 { t_new } else { t + tab.alpha[s] * h };
             if s > 0 {
-                for i in 0..n {
-                    let mut v = self.y[i];
-                    for j in 0..s {
-                        v += tab.a[s][j] * self.u[j][i];
-                    }
-                    self.y_stage[i] = v;
-                }
+                stage_argument(&self.y, &self.u[..s], &tab.a[s], &mut self.y_stage);
                 if let Some(i) = eval(
                     &mut self.core.stats,
                     sys,
@@ -337,16 +331,9 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
             } else {
                 self.f_stage.copy_from_slice(&self.f0);
             }
-            let hg = h * tab.gamma[s];
             let (done, rest) = self.u.split_at_mut(s);
             let us = &mut rest[0];
-            for i in 0..n {
-                let mut v = self.f_stage[i] + hg * self.dfdt[i];
-                for (j, uj) in done.iter().enumerate() {
-                    v += tab.c[s][j] / h * uj[i];
-                }
-                us[i] = v;
-            }
+            stage_rhs(&self.f_stage, &self.dfdt, h * tab.gamma[s], done, &tab.c[s], h, us);
             lu_solve(&self.lu, n, &self.piv, us);
             if let Some(i) = first_non_finite(us) {
                 return Ok(self.core.reject_non_finite(h, ts, i));
@@ -425,6 +412,32 @@ impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
     }
 }
 
+
+/// The argument of stage s of a Rosenbrock method in the form of HNW II §IV.7 (eq 7.25, with
+/// `u_j = γ k_j`): `y_s = y + Σ_{j<s} a_sj u_j`, `u` holding the stages done. Shared by
+/// [`Rosenbrock`] and [`super::Rodas`].
+pub(super) fn stage_argument(y: &[f64], u: &[Vec<f64>], a_row: &[f64], y_stage: &mut [f64]) {
+    for i in 0..y.len() {
+        let mut v = y[i];
+        for (j, uj) in u.iter().enumerate() {
+            v += a_row[j] * uj[i];
+        }
+        y_stage[i] = v;
+    }
+}
+
+/// The right-hand side of stage s's linear system in the same form: `f(y_s) + h d_s f_t +
+/// Σ_{j<s} (c_sj / h) u_j` into `us`, with `hd = h d_s` (ROS34PW2: `h γ_s`). Shared by
+/// [`Rosenbrock`] and [`super::Rodas`].
+pub(super) fn stage_rhs(f_stage: &[f64], dfdt: &[f64], hd: f64, done: &[Vec<f64>], c_row: &[f64], h: f64, us: &mut [f64]) {
+    for i in 0..us.len() {
+        let mut v = f_stage[i] + hd * dfdt[i];
+        for (j, uj) in done.iter().enumerate() {
+            v += c_row[j] / h * uj[i];
+        }
+        us[i] = v;
+    }
+}
 
 /// `f_t = ∂f/∂t` at `(t, y)` into `dfdt` (`f0 = f(t, y)`, `scratch` of length `dim`): the
 /// system's own ([`OdeJacobian::time_derivative`]), else a forward difference in `t` with
