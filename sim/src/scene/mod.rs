@@ -3,26 +3,29 @@
 //! field and the value. The paper's scene is built in ([`Scene::paper`]).
 
 pub mod builtin;
+mod ctx;
+mod robot;
 pub mod spec;
 mod target;
 
 use std::path::Path;
 
-use nalgebra::{DVector, Unit, Vector3};
+use nalgebra::{DVector, Unit};
 
 use crate::control::{Circle, Controller, Law, PdGains, Target, YawPlanarIk};
 use crate::joint_limits::JointStops;
 use crate::dynamics::constraints::PointOnPlane;
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
-use crate::dynamics::kinematics::{body_point, forward_kinematics, forward_velocities, BodyPoint};
+use crate::dynamics::kinematics::{forward_kinematics, forward_velocities, BodyPoint};
 use crate::dynamics::motor::{DriveSpec, Drives, Electrical, MotorParams};
-use crate::dynamics::model::UrdfOptions;
-use crate::dynamics::urdf::{resolve_meshes, MeshInfo};
+use crate::dynamics::urdf::MeshInfo;
 use crate::dynamics::{Data, Model};
-use crate::error::{short, ModelError, SceneError};
+use crate::error::{short, SceneError};
 use crate::limits::{read_text, MAX_INPUT_BYTES, MAX_SAMPLES};
+use ctx::{names, non_negative, positive, Ctx};
+use robot::load_robot;
 pub use spec::SceneSpec;
-use spec::{KindedTarget, LawSpec, PerJoint, PointSpec, PositionLimitMode, TargetSpec};
+use spec::{KindedTarget, LawSpec, PositionLimitMode, TargetSpec};
 pub use target::{parse_joint_csv, MAX_BETWEEN_KNOTS};
 
 use crate::integrator::Integrator;
@@ -309,87 +312,6 @@ fn json_literal_at(text: &str, e: &serde_json::Error) -> String {
     head[start..].to_string()
 }
 
-struct Ctx<'a> {
-    file: &'a str,
-}
-
-impl Ctx<'_> {
-    fn err(&self, field: impl Into<String>, value: impl std::fmt::Display, why: impl Into<String>) -> SceneError {
-        SceneError::new(self.file, field, value, why)
-    }
-
-    fn number(&self, field: &str, x: f64, ok: impl Fn(f64) -> bool, why: &str) -> Result<f64, SceneError> {
-        if !x.is_finite() {
-            return Err(self.err(field, x, "must be a finite number"));
-        }
-        if !ok(x) {
-            return Err(self.err(field, x, why));
-        }
-        Ok(x)
-    }
-
-    fn per_joint(
-        &self,
-        field: &str,
-        p: &PerJoint,
-        nv: usize,
-        ok: impl Fn(f64) -> bool,
-        why: &str,
-    ) -> Result<Vec<f64>, SceneError> {
-        let v = match p {
-            PerJoint::All(x) => vec![*x; nv],
-            PerJoint::Each(v) if v.len() == nv => v.clone(),
-            PerJoint::Each(v) => {
-                return Err(self.err(field, format!("an array of {}", v.len()), format!("needs one value per joint ({nv})")))
-            }
-        };
-        for (j, &x) in v.iter().enumerate() {
-            let f = if matches!(p, PerJoint::All(_)) { field.to_string() } else { format!("{field}[{j}]") };
-            self.number(&f, x, &ok, why)?;
-        }
-        Ok(v)
-    }
-
-    fn vec3(&self, field: &str, v: [f64; 3]) -> Result<Vector3<f64>, SceneError> {
-        for (k, x) in v.iter().enumerate() {
-            self.number(&format!("{field}[{k}]"), *x, |_| true, "")?;
-        }
-        Ok(Vector3::from(v))
-    }
-
-    fn point(&self, field: &str, model: &Model, p: &PointSpec) -> Result<BodyPoint, SceneError> {
-        let offset = self.vec3(&format!("{field}.offset"), p.offset)?;
-        let link = match (&p.joint, &p.link) {
-            (Some(j), None) => match model.urdf_joints.iter().find(|u| &u.name == j) {
-                Some(u) => u.child_link.clone(),
-                None => return Err(self.err(format!("{field}.joint"), j, format!("no such joint in the URDF (joints: {})", names(model.urdf_joints.iter().map(|u| &u.name))))),
-            },
-            (None, Some(l)) => l.clone(),
-            _ => return Err(self.err(field, "", "give exactly one of `joint` (its origin) or `link`")),
-        };
-        body_point(model, &link, offset).ok_or_else(|| {
-            self.err(format!("{field}.link"), &link, format!("no such link in the URDF (links: {})", names(model.frames.iter().map(|f| &f.name))))
-        })
-    }
-
-    fn dof(&self, field: &str, model: &Model, joint: &str) -> Result<usize, SceneError> {
-        model.dof_of_joint(joint).ok_or_else(|| {
-            self.err(field, joint, format!("no movable joint of that name (movable joints: {})", model.joint_names().join(", ")))
-        })
-    }
-}
-
-fn names<'a>(it: impl Iterator<Item = &'a String>) -> String {
-    it.map(String::as_str).collect::<Vec<_>>().join(", ")
-}
-
-fn positive(x: f64) -> bool {
-    x > 0.0
-}
-fn non_negative(x: f64) -> bool {
-    x >= 0.0
-}
-
 fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, target_csv: Option<String>) -> Result<Scene, SceneError> {
     let c = Ctx { file };
     if spec.name.is_empty() || !spec.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch)) {
@@ -649,44 +571,6 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
         meshes,
         spec,
     })
-}
-
-/// The model of the scene's URDF with the scene's `robot` options, and the URDF text with its
-/// meshes resolved (the same text when it has none).
-fn load_robot(
-    c: &Ctx,
-    spec: &SceneSpec,
-    urdf_xml: String,
-    gravity: Vector3<f64>,
-    dir: Option<&Path>,
-) -> Result<(Model, String, Vec<MeshInfo>), SceneError> {
-    let robot = &spec.robot;
-    let options = UrdfOptions { locked: robot.locked.clone(), repair_inertia: robot.repair_inertia, field: "robot".into() };
-    let model = Model::from_urdf_with(&urdf_xml, &spec.urdf, gravity, &options).map_err(|e| match e {
-        ModelError::Option { field, value, why, .. } => c.err(field, value, why),
-        e => c.err("urdf", &spec.urdf, e.to_string()),
-    })?;
-    let mut packages = std::collections::BTreeMap::new();
-    for (pkg, d) in &robot.package_paths {
-        let p = dir.map_or_else(|| Path::new(d).to_path_buf(), |base| base.join(d));
-        let p = std::path::absolute(&p).unwrap_or(p);
-        if !p.is_dir() {
-            return Err(c.err(format!("robot.package_paths.{pkg}"), d, format!("no directory {} (relative to the scene file)", p.display())));
-        }
-        packages.insert(pkg.clone(), p);
-    }
-    // meshes are resolved (to this machine's absolute paths) only when the scene asks, so that
-    // a scene that does not writes the same recording on every machine
-    let urdf_dir = dir.filter(|_| !packages.is_empty()).map(|d| {
-        let p = d.join(&spec.urdf);
-        let p = p.parent().map(Path::to_path_buf).unwrap_or_default();
-        std::path::absolute(&p).unwrap_or(p)
-    });
-    let (text, meshes) = resolve_meshes(&urdf_xml, &spec.urdf, &packages, urdf_dir.as_deref())
-        .map_err(|e| c.err("urdf", &spec.urdf, e.to_string()))?;
-    // the text as read when nothing was rewritten
-    let urdf_xml = if text == urdf_xml { urdf_xml } else { text };
-    Ok((model, urdf_xml, meshes))
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ use nalgebra::UnitQuaternion;
 use super::spec::{
     Branch, Direction, InitialQ, Interpolation, KindedTarget, PathSpec, PointsSpec, SceneSpec, TargetSpec,
 };
-use super::{names, positive, Ctx};
+use super::ctx::{names, positive, Ctx};
 use crate::control::general_ik::{track, GeneralIk, DEFAULT_GRID_STEP, MAX_KNOTS};
 use crate::limits::MAX_TARGET_VALUES;
 use crate::control::path::{CartesianPath, CirclePath};
