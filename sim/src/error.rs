@@ -68,6 +68,11 @@ pub enum DynamicsError {
     Unreachable { t: f64, why: String },
     #[error("t = {t:.9} s: a non-finite value appeared in {what}")]
     NonFinite { t: f64, what: String },
+    /// A rigid unilateral contact configuration with no consistent solution, or with several
+    /// that accelerate the arm differently (Painlevé's paradox: friction too high for the
+    /// geometry); `contact` names the contact(s).
+    #[error("t = {t:.9} s: contact {contact}: {why}")]
+    InconsistentContact { t: f64, contact: String, why: String },
 }
 
 /// A failure of a whole run.
@@ -90,6 +95,10 @@ pub enum RunError {
     NonFiniteState { t: f64, index: usize, name: String },
     #[error("the integrator stopped at t = {t:.9} s: more than {max_steps} steps (integrator.max_steps) with {method}; {hint}; raise integrator.max_steps if the run needs more", hint = slow_run_hint(method))]
     TooManySteps { t: f64, max_steps: usize, method: &'static str },
+    #[error("the run stopped at t = {t:.9} s: more than {max_events} contact events; a contact chatters, or the run is long (contacts.max_events)")]
+    TooManyEvents { t: f64, max_events: u64 },
+    #[error("the run stopped at t = {t:.9} s: {count} contact events in a row at the same instant (within {window:e} s): the contact modes chatter; {events}")]
+    Chattering { t: f64, count: u32, window: f64, events: String },
     /// The recording could not be written (I/O error, full disk, another writer of the same
     /// path): `source` names the path and the OS reason.
     #[error("writing the recording: {source}")]
@@ -113,7 +122,8 @@ impl DynamicsError {
             DynamicsError::SingularMassMatrix { t }
             | DynamicsError::SingularConstraints { t, .. }
             | DynamicsError::Unreachable { t, .. }
-            | DynamicsError::NonFinite { t, .. } => t,
+            | DynamicsError::NonFinite { t, .. }
+            | DynamicsError::InconsistentContact { t, .. } => t,
         }
     }
 }
@@ -129,7 +139,9 @@ impl RunError {
             | RunError::TooSlow { t, .. }
             | RunError::SingularIterationMatrix { t, .. }
             | RunError::NonFiniteState { t, .. }
-            | RunError::TooManySteps { t, .. } => Some(*t),
+            | RunError::TooManySteps { t, .. }
+            | RunError::TooManyEvents { t, .. }
+            | RunError::Chattering { t, .. } => Some(*t),
             RunError::Recording { .. } => None,
         }
     }

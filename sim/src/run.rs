@@ -59,6 +59,8 @@ fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget:
         IntegrateError::TooManySteps { t, max_steps } => {
             RunError::TooManySteps { t, max_steps: usize::try_from(max_steps).unwrap_or(usize::MAX), method }
         }
+        IntegrateError::TooManyEvents { t, max_events } => RunError::TooManyEvents { t, max_events },
+        IntegrateError::Chattering { t, count, window, events } => RunError::Chattering { t, count, window, events },
         IntegrateError::InvalidOutputGrid { t0, t_end, dt_out } => RunError::Dynamics(crate::error::DynamicsError::NonFinite {
             t: t0,
             what: format!("the output grid (t_end = {t_end}, dt = {dt_out})"),

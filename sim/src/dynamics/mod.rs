@@ -3,6 +3,7 @@
 
 pub mod cholesky;
 pub mod constraints;
+pub mod contact;
 pub mod crba;
 pub mod data;
 pub mod energy;

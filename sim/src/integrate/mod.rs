@@ -108,6 +108,7 @@ mod adaptive;
 mod contract;
 mod control;
 mod dopri5;
+mod events;
 mod imex;
 mod jacobian;
 mod lu;
@@ -121,6 +122,7 @@ mod testutil;
 
 pub use self::control::{SettingsError, StepControl};
 pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
+pub use self::events::{integrate_hybrid, EventSettings, HybridSystem};
 pub use self::imex::ArkImex;
 pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, FdJacobian};
 pub use self::rk4::Rk4;
@@ -271,6 +273,11 @@ pub enum IntegrateError<E> {
     /// step from `t`, still at the last step size tried, `h` (the step is halved up to 5 times
     /// in a row, and not below `h_min`, before giving up).
     SingularMatrix { t: f64, h: f64 },
+    /// [`integrate_hybrid`]: more than [`EventSettings::max_events`] events in the run.
+    TooManyEvents { t: f64, max_events: u64 },
+    /// [`integrate_hybrid`]: more than [`EventSettings::max_events_at_one_time`] events in a
+    /// row within `window` s of each other, at `t`; `events` names the last functions fired.
+    Chattering { t: f64, count: u32, window: f64, events: String },
 }
 
 impl<E: fmt::Display> fmt::Display for IntegrateError<E> {
@@ -311,6 +318,12 @@ impl<E: fmt::Display> fmt::Display for IntegrateError<E> {
             }
             IntegrateError::TooSlow { t, projected_s } => {
                 write!(f, "at t = {t} the pace so far projects {projected_s:.0} s of wall time, more than twice the budget")
+            }
+            IntegrateError::TooManyEvents { t, max_events } => {
+                write!(f, "more than {max_events} events, stopped at t = {t}")
+            }
+            IntegrateError::Chattering { t, count, window, events } => {
+                write!(f, "{count} events in a row within {window:e} s at t = {t} ({events})")
             }
             IntegrateError::SingularMatrix { t, h } => write!(
                 f,

@@ -67,6 +67,10 @@ pub struct Outputs {
     pub stop_energy: f64,
     /// The soft stops' damping loss `∫ Σ c q̇² [beyond] dt`, J (0 without stops).
     pub loss_stop: f64,
+    /// Per contact of the run, in its order: mode, gap, forces, slip and the cumulative contact
+    /// losses. Empty when every contact of the run is bilateral (the paper's runs: their
+    /// recordings carry `/constraints` only).
+    pub contacts: Vec<crate::dynamics::contact::ContactOutput>,
 }
 
 fn set(dst: &mut Vec<f64>, src: &[f64]) {
