@@ -137,6 +137,49 @@ impl<'a> ArmSystem<'a> {
     }
 }
 
+// ---- issue 11 interface (base commit): the arm helper implements these; the run uses them ----
+
+impl ArmSystem<'_> {
+    /// Whether this run is event-driven: it has a non-bilateral contact (then the run uses
+    /// `integrate_hybrid`, records `/contacts` and fills `Outputs::contacts`).
+    pub fn is_hybrid(&self) -> bool {
+        false
+    }
+
+    /// Take over `other`'s discrete contact modes (the run's output probe follows the
+    /// stepper's system before each sample).
+    pub fn copy_modes_from(&mut self, other: &ArmSystem<'_>) {
+        let _ = other;
+    }
+
+    /// Move the logged contact events (in time order) to the end of `into`.
+    pub fn drain_events(&mut self, into: &mut Vec<crate::dynamics::contact::ContactEvent>) {
+        let _ = into;
+    }
+}
+
+impl crate::integrate::HybridSystem for ArmSystem<'_> {
+    fn n_events(&self) -> usize {
+        0
+    }
+
+    fn event_direction(&self, _i: usize) -> i8 {
+        0
+    }
+
+    fn events(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) -> Result<(), RunError> {
+        Ok(())
+    }
+
+    fn init_modes(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool, RunError> {
+        Ok(false)
+    }
+
+    fn handle_events(&mut self, _t: f64, _y: &mut [f64], _fired: &[bool]) -> Result<bool, RunError> {
+        Ok(false)
+    }
+}
+
 impl OdeSystem for ArmSystem<'_> {
     type Error = RunError;
 

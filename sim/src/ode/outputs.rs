@@ -71,6 +71,9 @@ pub struct Outputs {
     /// losses. Empty when every contact of the run is bilateral (the paper's runs: their
     /// recordings carry `/constraints` only).
     pub contacts: Vec<crate::dynamics::contact::ContactOutput>,
+    /// The contact events since the previous sample (at times ≤ t), in time order; the run
+    /// moves them here from the system's log at each sample (always empty for bilateral runs).
+    pub events: Vec<crate::dynamics::contact::ContactEvent>,
 }
 
 fn set(dst: &mut Vec<f64>, src: &[f64]) {
