@@ -399,8 +399,7 @@ mod tests {
     #[test]
     fn drift_counts_only_held_contacts() {
         use crate::dynamics::contact::ContactOutput;
-        let mut o = crate::ode::Outputs::default();
-        o.constraint_position = vec![1e-9, 0.3];
+        let mut o = crate::ode::Outputs { constraint_position: vec![1e-9, 0.3], ..Default::default() };
         assert!(held(&o, 0) && held(&o, 1));
         let c = |mode| ContactOutput { mode, ..Default::default() };
         o.contacts = vec![c(ContactMode::Sticking), c(ContactMode::Separated)];
