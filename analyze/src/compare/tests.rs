@@ -47,6 +47,7 @@ pub(crate) fn run(name: &str, contacts: &[&str], e: &[f64], w: &[f64], z_rms: f6
         status: Status::Complete,
         limits: None,
         energy_terms: None,
+        contact_states: Vec::new(),
         error: None,
         error_time_s: None,
         hand_error: HandError {

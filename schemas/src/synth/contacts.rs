@@ -8,7 +8,7 @@ use crate::{ConstraintState, ContactEventMsg, ContactState};
 /// What [`unilateral`] wrote, in closed form (for exact assertions).
 #[derive(Debug, Clone, PartialEq)]
 pub struct UnilateralTruth {
-    /// Time in contact per contact (mode ≠ separated), s: elbow4 0.305 + 0.295 = 0.6, elbow7 1.
+    /// Time in contact per contact (mode ≠ separated), s: elbow4 0.303 + 0.293 = 0.596 (events off the sample midpoints: the trapezoid rule on the samples would give 0.6), elbow7 1.
     pub time_in_contact: [f64; 2],
     /// Lift-offs, touch-downs, impacts, rests, stick-to-slip, slip-to-stick of elbow4 (elbow7: none).
     pub elbow4_counts: [usize; 6],
@@ -29,13 +29,13 @@ pub struct UnilateralTruth {
 /// | time | mode | event |
 /// |---|---|---|
 /// | 0 ≤ t ≤ 0.30 | sticking, f_n = 10 N, f_t = (2, 0) N | |
-/// | 0.305 | | lift-off |
-/// | 0.31 ≤ t ≤ 0.59 | separated, g = 0.1 (t − 0.305)(0.595 − t) … | |
+/// | 0.303 | | lift-off |
+/// | 0.31 ≤ t ≤ 0.59 | separated, g = 0.01 + 0.1 (t − 0.3), ġ = 0.1 m/s (made up) | |
 /// | 0.595 | | impact, ġ −0.2 → 0.1 m/s, impulse 0.3 N s, 0.05 J lost |
 /// | 0.60 ≤ t ≤ 0.70 | separated | |
-/// | 0.705 | | rest, ġ −0.05 → 0 m/s, impulse 0.1 N s, 0.01 J lost |
+/// | 0.707 | | rest, ġ −0.05 → 0 m/s, impulse 0.1 N s, 0.01 J lost |
 /// | 0.71 ≤ t ≤ 0.80 | sliding, f_n = 10 N, f_t = (−6, 0) N, v_t = (0.01, 0) m/s | |
-/// | 0.805 | | slip-to-stick |
+/// | 0.807 | | slip-to-stick |
 /// | 0.81 ≤ t ≤ 1 | sticking, f_n = 10 N, f_t = (3, 0) N | |
 ///
 /// `/constraints` carries the same `f_n`, `g`, `ġ`; the `energy_terms` record the totals.
@@ -43,11 +43,11 @@ pub fn unilateral() -> (Synth, UnilateralTruth) {
     let mut s = Synth::new("unilateral", &["elbow4", "elbow7"], 3).with_setup();
     // elbow4 at t: (mode, g, ġ, f_n, f_t1, v_t1, impact loss, friction work)
     fn elbow4(t: f64) -> (u32, f64, f64, f64, f64, f64, f64, f64) {
-        let friction_work = 0.06 * (t - 0.705).clamp(0.0, 0.1);
-        let impact_loss = if t < 0.595 { 0.0 } else if t < 0.705 { 0.05 } else { 0.06 };
+        let friction_work = 0.06 * (t - 0.707).clamp(0.0, 0.1);
+        let impact_loss = if t < 0.595 { 0.0 } else if t < 0.707 { 0.05 } else { 0.06 };
         if t <= 0.30 + 1e-9 {
             (1, 0.0, 0.0, 10.0, 2.0, 0.0, impact_loss, friction_work)
-        } else if t < 0.705 {
+        } else if t < 0.707 {
             // a made-up flight: positive gap, rate of either sign
             (0, 0.01 + 0.1 * (t - 0.3), 0.1, 0.0, 0.0, 0.0, impact_loss, friction_work)
         } else if t <= 0.80 + 1e-9 {
@@ -89,10 +89,10 @@ pub fn unilateral() -> (Synth, UnilateralTruth) {
         gap_rate_after: after,
     };
     s.contact_events = vec![
-        event(0.305, "lift-off", 0.0, 0.0, 0.0, 0.0),
+        event(0.303, "lift-off", 0.0, 0.0, 0.0, 0.0),
         event(0.595, "impact", 0.3, 0.05, -0.2, 0.1),
-        event(0.705, "rest", 0.1, 0.01, -0.05, 0.0),
-        event(0.805, "slip-to-stick", 0.0, 0.0, 0.0, 0.0),
+        event(0.707, "rest", 0.1, 0.01, -0.05, 0.0),
+        event(0.807, "slip-to-stick", 0.0, 0.0, 0.0, 0.0),
     ];
     let info = |name: &str| ContactInfo {
         name: name.into(),
@@ -117,7 +117,7 @@ pub fn unilateral() -> (Synth, UnilateralTruth) {
     });
     s.energy_terms = Some(EnergyTermsRecord { impact_loss: Some(0.06), friction_work: Some(0.006), damping_loss: Some(0.0), ..Default::default() });
     let truth = UnilateralTruth {
-        time_in_contact: [0.6, 1.0],
+        time_in_contact: [0.596, 1.0],
         elbow4_counts: [1, 0, 1, 1, 0, 1],
         elbow4_impact_loss: 0.06,
         elbow4_friction_work: 0.006,
