@@ -144,3 +144,14 @@ fn a_bilateral_run_writes_no_contact_channels() {
     assert!(r.record_opt::<ContactsRecord>().unwrap().is_none());
     assert!(r.record_opt::<EnergyTermsRecord>().unwrap().is_none());
 }
+
+/// The event kinds and mode codes of the simulator are the recording format's.
+#[test]
+fn event_kinds_and_mode_codes_are_the_formats() {
+    use ContactEventKind::*;
+    let kinds: Vec<&str> = [LiftOff, TouchDown, Impact, Rest, StickToSlip, SlipToStick].iter().map(|k| k.name()).collect();
+    assert_eq!(kinds, schemas::CONTACT_EVENT_KINDS);
+    for m in [ContactMode::Separated, ContactMode::Sticking, ContactMode::Sliding, ContactMode::Bilateral] {
+        assert_eq!(schemas::contact_mode::name(m.code()), Some(m.name()));
+    }
+}
