@@ -7,6 +7,8 @@ use super::*;
 use schemas::synth::{contact_forces, currents, hand_error, linear_energy, Synth};
 use schemas::{EnergyState, RunResult, RunStatus};
 
+mod contacts;
+
 fn read(s: &Synth) -> (tempfile::TempDir, RunMetrics) {
     let dir = tempfile::tempdir().unwrap();
     let m = read_run_metrics(&s.write_in(dir.path())).unwrap();
@@ -326,7 +328,7 @@ impl schemas::Visitor for Generic {
     }
 }
 
-fn generic_metrics(path: &Path) -> Result<RunMetrics, Error> {
+pub(super) fn generic_metrics(path: &Path) -> Result<RunMetrics, Error> {
     let mut acc = Generic(Reductions::default());
     let rec = schemas::stream_recording(path, Some(&METRIC_TOPICS), &mut acc).map_err(|e| acc.0.take_error(e))?;
     acc.0.finish(&rec, None)
