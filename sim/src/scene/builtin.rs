@@ -1,4 +1,5 @@
-//! The scenes built into the binary, by name: the paper's scene and the real-arm scenes of
+//! The scenes built into the binary, by name: the paper's scene, the paper's arm over a real
+//! table (`paper-unilateral`, issue 11: the table only pushes), and the real-arm scenes of
 //! `sim/scenes/arms/` (issue 10, item 5), each with the URDF it names. They are embedded
 //! (`include_str!`), so a `sim` installed with `cargo install` runs them by name (`sim ur5e-like`)
 //! without the repository; `sim export-scene NAME` writes one out to edit.
@@ -32,6 +33,12 @@ pub struct Builtin {
 /// Every built-in scene, the paper's first.
 pub const BUILTINS: &[Builtin] = &[
     Builtin { name: "paper", file: "paper.json", json: PAPER_SCENE_JSON, files: &[("paper_arm.urdf", PAPER_URDF)] },
+    Builtin {
+        name: "paper-unilateral",
+        file: "paper_unilateral.json",
+        json: include_str!("../../scenes/paper_unilateral.json"),
+        files: &[("paper_arm.urdf", PAPER_URDF)],
+    },
     Builtin {
         name: "ur5e-like",
         file: "ur5e_like.json",

@@ -21,7 +21,8 @@ use cli::Verbosity;
 
 const EXAMPLES: &str = "\
 Examples:
-  sim                                   the paper's three runs -> out/, then the comparison table
+  sim                                   the paper's three runs and the same arm over a real table
+                                        (paper-unilateral) -> out/, then one comparison table
   sim --run two-elbow -o /tmp/r         one run of the built-in scene, elsewhere
   sim run my_scene.json -f json         another scene, the table as JSON
   sim check my_scene.json               validate a scene and describe it, without running it
@@ -34,8 +35,11 @@ Examples:
 
 /// Simulate motor-driven arms that rest their elbows on a table; record every run to MCAP.
 ///
-/// With no command, runs the built-in paper scene (three elbow configurations, 5 s each), writes
-/// out/paper-<run>.mcap and prints a table comparing the configurations (as `sim run`). With the
+/// With no command, runs the built-in paper scene (three elbow configurations, 5 s each, a table
+/// that holds the elbows bilaterally, as the paper) and the same arm over a real table that only
+/// pushes (`paper-unilateral`: the elbows rest unilaterally with friction, and the no-elbow arm
+/// over a table under the whole arm), writes out/<scene>-<run>.mcap and prints one table
+/// comparing the six runs. With a scene (`--scene`, `sim run SCENE`), runs that scene. With the
 /// name of a built-in scene instead of a command (`sim list` shows them), runs that scene.
 #[derive(Debug, Parser)]
 #[command(name = "sim", version = cli::VERSION, after_help = EXAMPLES, args_conflicts_with_subcommands = true, propagate_version = true)]
@@ -73,6 +77,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse_from(builtin_as_run(std::env::args_os().collect()));
     let v = cli.verbosity;
     let result = match cli.command {
+        None if cli.scene.is_none() => run::run_default(&cli.run, v),
         None => run::run(cli.scene.as_deref(), &cli.run, v),
         Some(Command::Run(a)) => run::run(a.scene.as_deref(), &a.run, v),
         Some(Command::Check(a)) => check::run(&a),

@@ -103,6 +103,40 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     finish(&done, a.format, a.baseline.as_deref())
 }
 
+/// `sim` with no scene: the paper's scene and the same arm over a real table
+/// (`paper-unilateral`), one comparison table of all their runs. `--run NAME` picks runs from
+/// either scene (their run names differ).
+pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
+    let mut scenes = Vec::new();
+    for name in ["paper", "paper-unilateral"] {
+        let b = sim::scene::builtin::find(name).with_context(|| format!("the built-in scene `{name}` is missing"))?;
+        let scene = b.load()?;
+        scenes.push(match a.duration {
+            Some(d) => scene.vary(|s| s.duration = d)?,
+            None => scene,
+        });
+    }
+    let mut picked = Vec::new();
+    for scene in &scenes {
+        let names: Vec<String> = a.runs.iter().filter(|n| scene.run(n).is_some()).cloned().collect();
+        if a.runs.is_empty() || !names.is_empty() {
+            picked.push(select_runs(scene, &names)?);
+        } else {
+            picked.push(Vec::new());
+        }
+    }
+    if let Some(n) = a.runs.iter().find(|n| scenes.iter().all(|s| s.run(n).is_none())) {
+        let all: Vec<&str> = scenes.iter().flat_map(|s| s.runs().iter().map(|r| r.name.as_str())).collect();
+        anyhow::bail!("no run `{n}` in the built-in scenes paper and paper-unilateral (runs: {})", all.join(", "));
+    }
+    cli::create_dir(&a.out)?;
+    let mut done = Vec::new();
+    for (scene, runs) in scenes.iter().zip(&picked).filter(|(_, r)| !r.is_empty()) {
+        done.extend(run_all(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, a.wall_time.budget(), v));
+    }
+    finish(&done, a.format, a.baseline.as_deref())
+}
+
 /// The runs called `names` (all when empty), in that order.
 pub fn select_runs(scene: &Scene, names: &[String]) -> Result<Vec<Run>> {
     if names.is_empty() {
