@@ -23,7 +23,7 @@ use schemas::{
 };
 use schemas::{Quaternion, Vector3};
 
-use crate::dynamics::contact::{Contact, ContactEvent, ContactModel, ContactOutput};
+use crate::dynamics::contact::{Contact, ContactEvent, ContactModel, ContactOutput, ContactSettings};
 use crate::error::RunError;
 use crate::joint_limits::LimitMonitor;
 use crate::scene::{Run, Scene};
@@ -54,37 +54,9 @@ fn set_with<T>(dst: &mut Vec<T>, src: &[ContactOutput], f: impl Fn(&ContactOutpu
     dst.extend(src.iter().map(f));
 }
 
-/// The event settings recorded in the `contacts` record (the design's tolerances of issue 11).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ContactSettings {
-    /// Width of the bracket an event time is located to, s.
-    pub time_tolerance: f64,
-    /// A contact is closed when `|g| ≤ gap_tolerance` (m) and `|ġ| ≤ velocity_tolerance` (m/s).
-    pub gap_tolerance: f64,
-    pub velocity_tolerance: f64,
-    /// Impacts slower than this are plastic (the Zeno rule), m/s.
-    pub rest_velocity: f64,
-    /// Most events in a run.
-    pub max_events: u64,
-}
-
-impl Default for ContactSettings {
-    fn default() -> Self {
-        ContactSettings { time_tolerance: 1e-12, gap_tolerance: 1e-9, velocity_tolerance: 1e-9, rest_velocity: 1e-4, max_events: 100_000 }
-    }
-}
-
 /// The contacts of `run`, in its order, with their models.
-// MERGE (issue 11): once `Scene::contacts` holds `dynamics::contact::Contact` (arm branch),
-// this is `run.contacts.iter().map(|&k| scene.contacts[k].clone()).collect()`.
 fn run_contacts(scene: &Scene, run: &Run) -> Vec<Contact> {
-    run.contacts.iter().map(|&k| Contact::new(scene.contacts[k].clone(), ContactModel::Bilateral)).collect()
-}
-
-/// The event settings of `scene`.
-// MERGE (issue 11): read them from the scene's `events` settings (arm branch).
-fn contact_settings(_scene: &Scene) -> ContactSettings {
-    ContactSettings::default()
+    scene.run_contact_models(run)
 }
 
 /// Record `contacts`: every contact of the run (its model and parameters, plane, tangent basis)
@@ -125,9 +97,9 @@ pub fn contacts_record(contacts: &[Contact], settings: &ContactSettings) -> Cont
         .collect();
     ContactsRecord {
         contacts,
-        time_tolerance: settings.time_tolerance,
-        gap_tolerance: settings.gap_tolerance,
-        velocity_tolerance: settings.velocity_tolerance,
+        time_tolerance: settings.time_tol,
+        gap_tolerance: settings.gap_tol,
+        velocity_tolerance: settings.vel_tol,
         rest_velocity: settings.rest_velocity,
         max_events: settings.max_events,
     }
@@ -178,7 +150,7 @@ impl<'a> Recorder<'a> {
     /// the bench `record` compares them).
     #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
     pub fn create_with(path: &Path, scene: &'a Scene, run: &Run, options: WriterOptions, tap: Option<Tap>) -> Result<Self, RunError> {
-        Self::create_described(path, scene, run, options, tap, &run_contacts(scene, run), &contact_settings(scene))
+        Self::create_described(path, scene, run, options, tap, &run_contacts(scene, run), &scene.contact_settings())
     }
 
     /// [`Recorder::create_with`] for the run's `contacts` (in its order, with their models) and
