@@ -367,6 +367,7 @@ impl<'a> Recorder<'a> {
     }
 
     /// One contact event on `/contact_events`, log time = the event time.
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
     fn write_event(&mut self, ev: &ContactEvent) -> Result<(), RunError> {
         let path = &self.path;
         let e = &mut self.contact_event;
