@@ -275,11 +275,7 @@ impl<'a> Recorder<'a> {
         let model = &self.scene.model;
 
         // the contact events since the previous sample, at their own times (≤ t), before it
-        if self.hybrid {
-            for ev in &o.events {
-                self.write_event(ev)?;
-            }
-        }
+        self.record_events(&o.events)?;
         let path = &self.path;
         let err = |source| RunError::Recording { path: path.clone(), source };
 
@@ -362,6 +358,19 @@ impl<'a> Recorder<'a> {
             set_with(&mut cs.damping_loss, &o.contacts, |c| c.damping_loss);
             self.contact_terms = [cs.impact_loss.iter().sum(), cs.friction_work.iter().sum(), cs.damping_loss.iter().sum()];
             self.writer.write(topics::CONTACTS, t_ns, &self.contact_state).map_err(&err)?;
+        }
+        Ok(())
+    }
+
+    /// Contact events outside a sample: those logged after the last sample of a run that then
+    /// failed (drain the system's log and call this before [`Recorder::finish`]), so the file
+    /// says what happened up to the failure. Written only for runs with a non-bilateral contact.
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
+    pub fn record_events(&mut self, events: &[ContactEvent]) -> Result<(), RunError> {
+        if self.hybrid {
+            for ev in events {
+                self.write_event(ev)?;
+            }
         }
         Ok(())
     }
