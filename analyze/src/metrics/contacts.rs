@@ -205,12 +205,11 @@ impl ContactReductions {
         for (k, m) in out.iter_mut().enumerate() {
             let Some(acc) = self.contacts.get(k) else { continue };
             for &(t0, t1, closing) in &acc.changes {
-                let inside = per_contact[k].iter().filter(|(t, _)| *t > t0 && *t <= t1);
+                let mut inside = per_contact[k].iter().filter(|(t, _)| *t > t0 && *t <= t1);
                 let part = if closing {
-                    let closer = inside.filter(|(_, e)| matches!(e.kind.as_str(), kind::TOUCH_DOWN | kind::IMPACT | kind::REST)).last();
+                    let closer = inside.rfind(|(_, e)| matches!(e.kind.as_str(), kind::TOUCH_DOWN | kind::IMPACT | kind::REST));
                     closer.map_or(0.5 * (t1 - t0), |(t, _)| t1 - t)
                 } else {
-                    let mut inside = inside;
                     let opener = inside.find(|(_, e)| e.kind == kind::LIFT_OFF);
                     opener.map_or(0.5 * (t1 - t0), |(t, _)| t - t0)
                 };
