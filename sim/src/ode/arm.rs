@@ -2,6 +2,7 @@
 //! (eqs 27–29), the motors' currents, eq 21, and the quadratures of the energy balance.
 
 use crate::dynamics::constraints::PointOnPlane;
+use crate::dynamics::contact::forward::forward_dynamics_contacts;
 use crate::dynamics::energy::{link_kinetic_energy, magnetic_energy, potential_energy, rotor_kinetic_energy};
 use crate::dynamics::forward::{forward_dynamics, Plant, Stabilization};
 use crate::dynamics::kinematics::forward_kinematics;
@@ -21,18 +22,33 @@ pub struct ArmSystem<'a> {
     pub(super) ws: Workspace,
     /// T + V + ½ L i² at t = 0, J (for the balance residual).
     pub(super) stored0: f64,
+    /// The contacts' models, modes and event log: `Some` when the run has a non-bilateral
+    /// contact (event-driven), `None` for the paper's runs (today's path, untouched).
+    pub(super) hybrid: Option<Box<super::hybrid::Hybrid>>,
 }
 
 impl<'a> ArmSystem<'a> {
     pub fn new(scene: &'a Scene, run: &Run) -> Self {
         let nv = scene.model.nv;
         let contacts = scene.run_contacts(run);
-        let layout = Layout { nv, electrical: scene.drives.electrical, conversion: scene.drives.has_conversion, stops: scene.stops.is_some() };
+        let is_hybrid = scene.run_is_hybrid(run);
+        let layout = Layout {
+            nv,
+            electrical: scene.drives.electrical,
+            conversion: scene.drives.has_conversion,
+            stops: scene.stops.is_some(),
+            contacts: if is_hybrid { contacts.len() } else { 0 },
+        };
         let mut ws = Workspace::new(&scene.model, contacts.len(), layout.dim());
         ws.fd.joint_torque = scene.stops.is_some();
         ws.want_qdd = matches!(scene.controller.law, crate::control::Law::ComputedTorque { .. });
-        let mut sys = Self { scene, contacts, layout, ws, stored0: 0.0 };
+        let hybrid = is_hybrid.then(|| Box::new(super::hybrid::Hybrid::new(scene, run)));
+        let mut sys = Self { scene, contacts, layout, ws, stored0: 0.0, hybrid };
         sys.stored0 = sys.stored_energy(&scene.q0, &scene.qd0, &scene.current0);
+        if sys.hybrid.is_some() {
+            // the compliant contacts' ½ k δ² at t = 0 (kinematics at q0 from stored_energy)
+            sys.stored0 += sys.contact_energy();
+        }
         sys
     }
 
@@ -103,9 +119,9 @@ impl<'a> ArmSystem<'a> {
         }
     }
 
-    /// Targets, voltages and currents at (t, y), then eq 21: everything the right-hand side,
-    /// the outputs and the Jacobian read, into the workspace.
-    pub(super) fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+    /// Targets, voltages, the stops' torques and the quasi-static currents at (t, y), into the
+    /// workspace: the inputs of eq 21.
+    pub(super) fn inputs(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
         let l = self.layout;
         let (q, qd) = (&y[l.q()], &y[l.qd()]);
         let s = self.scene;
@@ -121,6 +137,17 @@ impl<'a> ArmSystem<'a> {
                 self.ws.current_qs[j] = s.drives.quasi_static_current(j, self.ws.voltage[j], qd[j]);
             }
         }
+        Ok(())
+    }
+
+    /// Targets, voltages and currents at (t, y), then eq 21: everything the right-hand side,
+    /// the outputs and the Jacobian read, into the workspace. A hybrid run solves eq 21 with
+    /// its contacts' active rows in the current modes (`dynamics/contact/forward.rs`).
+    pub(super) fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+        self.inputs(t, y)?;
+        let l = self.layout;
+        let (q, qd) = (&y[l.q()], &y[l.qd()]);
+        let s = self.scene;
         let plant = Plant {
             model: &s.model,
             drives: &s.drives,
@@ -133,50 +160,10 @@ impl<'a> ArmSystem<'a> {
             Electrical::Inductive => &y[l.current()],
             Electrical::QuasiStatic => &self.ws.current_qs[..],
         };
-        forward_dynamics(&plant, &mut self.ws.data, &mut self.ws.fd, t, q, qd, current, &self.ws.voltage)
-    }
-}
-
-// ---- issue 11 interface (base commit): the arm helper implements these; the run uses them ----
-
-impl ArmSystem<'_> {
-    /// Whether this run is event-driven: it has a non-bilateral contact (then the run uses
-    /// `integrate_hybrid`, records `/contacts` and fills `Outputs::contacts`).
-    pub fn is_hybrid(&self) -> bool {
-        false
-    }
-
-    /// Take over `other`'s discrete contact modes (the run's output probe follows the
-    /// stepper's system before each sample).
-    pub fn copy_modes_from(&mut self, other: &ArmSystem<'_>) {
-        let _ = other;
-    }
-
-    /// Move the logged contact events (in time order) to the end of `into`.
-    pub fn drain_events(&mut self, into: &mut Vec<crate::dynamics::contact::ContactEvent>) {
-        let _ = into;
-    }
-}
-
-impl crate::integrate::HybridSystem for ArmSystem<'_> {
-    fn n_events(&self) -> usize {
-        0
-    }
-
-    fn event_direction(&self, _i: usize) -> i8 {
-        0
-    }
-
-    fn events(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) -> Result<(), RunError> {
-        Ok(())
-    }
-
-    fn init_modes(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool, RunError> {
-        Ok(false)
-    }
-
-    fn handle_events(&mut self, _t: f64, _y: &mut [f64], _fired: &[bool]) -> Result<bool, RunError> {
-        Ok(false)
+        match &mut self.hybrid {
+            None => forward_dynamics(&plant, &mut self.ws.data, &mut self.ws.fd, t, q, qd, current, &self.ws.voltage),
+            Some(h) => forward_dynamics_contacts(&plant, &h.contacts, &h.state, &mut self.ws.data, &mut self.ws.fd, &mut h.cd, t, q, qd, current, &self.ws.voltage),
+        }
     }
 }
 
@@ -220,11 +207,17 @@ impl OdeSystem for ArmSystem<'_> {
         if let (Some(k), Some(st)) = (l.loss_stop(), &self.scene.stops) {
             dydt[k] = st.loss_rate(&y[l.q()], qd);
         }
+        if self.hybrid.is_some() {
+            self.contact_loss_rates(dydt);
+        }
         Ok(())
     }
 
     fn project(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
         if self.scene.stabilization == Stabilization::Projection {
+            if self.hybrid.is_some() {
+                return Ok(self.project_onto_active_rows(t, y)?);
+            }
             Ok(self.project_onto_constraints(t, y)?)
         } else {
             Ok(false)

@@ -43,7 +43,10 @@ impl ArmSystem<'_> {
     /// Jacobian scratch.
     fn constrained_inverse_inertia(&mut self, t: f64) -> Result<(), RunError> {
         let nv = self.layout.nv;
-        let nc = self.contacts.len();
+        // a hybrid run's rows depend on its modes and are not in fd.jac: the unconstrained
+        // M_J⁻¹ there (a bounded approximation, which the W-methods allow; the classical
+        // Rosenbrock methods difference f instead)
+        let nc = if self.hybrid.is_some() { 0 } else { self.contacts.len() };
         let d = &self.scene.drives;
         let (data, fd, js) = (&self.ws.data, &self.ws.fd, &mut self.ws.jac);
         js.m_j.copy_from(&data.m);

@@ -14,6 +14,10 @@ pub struct Layout {
     /// The stops' damping loss `E_s = ∫ Σ c q̇² [beyond] dt` is present (soft stops
     /// configured); it comes last.
     pub stops: bool,
+    /// Number of contacts with energy quadratures: every contact of a run that has a
+    /// non-bilateral contact (0 otherwise, so the paper's layout is unchanged). Per contact k,
+    /// three follow the stops': impact loss, friction work, damping loss.
+    pub contacts: usize,
 }
 
 impl Layout {
@@ -22,7 +26,7 @@ impl Layout {
         self.electrical.states(self.nv)
     }
     pub fn dim(&self) -> usize {
-        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops)
+        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * self.contacts
     }
     pub fn q(&self) -> std::ops::Range<usize> {
         0..self.nv
@@ -61,6 +65,18 @@ impl Layout {
     pub fn loss_stop(&self) -> Option<usize> {
         self.stops.then(|| 4 * self.nv + self.ni() + 3 + usize::from(self.conversion))
     }
+    /// Contact k's kinetic energy lost in impacts (with the rotors'), J.
+    pub fn impact_loss(&self, k: usize) -> usize {
+        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * k
+    }
+    /// Contact k's friction work `∫ −f_t · v_t dt`, J.
+    pub fn friction_work(&self, k: usize) -> usize {
+        self.impact_loss(k) + 1
+    }
+    /// Contact k's damping loss `∫ (f_n − k δ) δ̇ dt` (compliant contacts), J.
+    pub fn damping_loss(&self, k: usize) -> usize {
+        self.impact_loss(k) + 2
+    }
     /// A readable name of state component `k`, for error messages.
     pub fn name(&self, k: usize, joints: &[String]) -> String {
         let within = |r: std::ops::Range<usize>| r.contains(&k).then(|| joints[k - r.start].clone());
@@ -82,8 +98,12 @@ impl Layout {
             "gear friction loss".into()
         } else if Some(k) == self.loss_conversion() {
             "back-EMF conversion energy".into()
-        } else {
+        } else if Some(k) == self.loss_stop() {
             "joint stop damping loss".into()
+        } else {
+            let first = self.impact_loss(0);
+            let c = (k - first) / 3;
+            ["impact loss", "friction work", "damping loss"][(k - first) % 3].to_string() + &format!(" of contact {c}")
         }
     }
 }

@@ -31,6 +31,7 @@
 //! `projection.rs`.
 
 mod arm;
+mod hybrid;
 mod jacobian;
 mod layout;
 mod outputs;

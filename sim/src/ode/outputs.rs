@@ -155,6 +155,7 @@ impl ArmSystem<'_> {
             }
             out.kinetic = f64::NAN;
             out.balance_residual = f64::NAN;
+            self.contact_outputs(y, false, &mut out.contacts);
             return Ok(());
         }
         let cur = self.currents(y);
@@ -170,7 +171,10 @@ impl ArmSystem<'_> {
         out.electric_power.clear();
         out.electric_power.extend((0..l.nv).map(|j| cur[j] * voltage[j]));
         set(&mut out.tau_motor, fd.tau_motor.as_slice());
-        set(&mut out.normal_force, fd.f_n.as_slice());
+        match &self.hybrid {
+            None => set(&mut out.normal_force, fd.f_n.as_slice()),
+            Some(h) => set(&mut out.normal_force, &h.cd.f_n),
+        }
         out.magnetic = magnetic_energy(d, cur);
         // ½ q̇ᵀ M q̇ from the mass matrix of this evaluation (valid for CRBA and Walker–Orin)
         let m_qd: f64 = (0..l.nv).map(|r| qd[r] * (0..l.nv).map(|c| data.m[(r, c)] * qd[c]).sum::<f64>()).sum();
@@ -186,6 +190,13 @@ impl ArmSystem<'_> {
         } else {
             electric - (out.kinetic + out.potential + out.magnetic - self.stored0 + out.loss_resistance + out.loss_friction)
         };
+        if self.hybrid.is_some() {
+            // the contacts' losses and the compliant contacts' stored ½ k δ² (ΔV_c: stored0 has V_c(0))
+            out.balance_residual -= self.contact_losses(y) + self.contact_energy();
+            self.contact_outputs(y, true, &mut out.contacts);
+        } else {
+            out.contacts.clear();
+        }
         Ok(())
     }
 }

@@ -83,3 +83,70 @@ impl ArmSystem<'_> {
         Ok(changed)
     }
 }
+
+impl ArmSystem<'_> {
+    /// A hybrid run's projection (same method, HLW §IV.4): positions onto g = 0 for the
+    /// contacts in touch (and the bilateral ones), then velocities onto ġ = 0 for those and
+    /// v_t = 0 for the sticking ones; minimum-norm corrections `−Wᵀ (W Wᵀ)⁻¹ r`.
+    pub fn project_onto_active_rows(&mut self, t: f64, y: &mut [f64]) -> Result<bool, DynamicsError> {
+        use crate::dynamics::contact::rows::contact_rows;
+        use crate::dynamics::contact::solve::{solve_active, ActiveRow, RowForce};
+        use crate::dynamics::contact::ContactMode;
+        let l = self.layout;
+        let model = &self.scene.model;
+        let data = &mut self.ws.data;
+        let Some(h) = self.hybrid.as_mut() else { return Ok(false) };
+        let held = |m: ContactMode| matches!(m, ContactMode::Sticking | ContactMode::Sliding | ContactMode::Bilateral);
+        if !h.state.mode.iter().any(|&m| held(m)) {
+            return Ok(false);
+        }
+        let singular = || DynamicsError::SingularConstraints { t, constraints: "projection".into() };
+        let mut changed = false;
+        for pass in 0..6 {
+            let q = &y[l.q()];
+            forward_kinematics(model, data, q);
+            forward_velocities(model, data, &y[l.qd()]);
+            contact_rows(model, data, &h.contacts, &mut h.cd.rows);
+            let r = &h.cd.rows;
+            h.proj_rows.clear();
+            let mut worst = 0.0f64;
+            for k in 0..h.contacts.len() {
+                if held(h.state.mode[k]) {
+                    worst = worst.max(r.gap[k].abs());
+                    h.proj_rows.push(ActiveRow { row: 3 * k, force: RowForce::Same, extra: r.gap[k] - r.bias[3 * k] });
+                }
+            }
+            if worst <= 1e-13 || pass == 5 {
+                break;
+            }
+            solve_active(&h.eye, &h.ones, &h.zeros, r, &h.proj_rows, &mut h.cd.scratch, &mut h.proj_dx).map_err(|_| singular())?;
+            for j in 0..l.nv {
+                y[l.q().start + j] += h.proj_dx[j];
+            }
+            changed = true;
+        }
+        // velocities at the projected positions (rows of the last pass)
+        let r = &h.cd.rows;
+        h.proj_rows.clear();
+        let mut worst = 0.0f64;
+        for k in 0..h.contacts.len() {
+            let m = h.state.mode[k];
+            if held(m) {
+                let axes = if m == ContactMode::Sticking { 0..3 } else { 0..1 };
+                for a in axes {
+                    let v = r.vel[3 * k + a];
+                    worst = worst.max(v.abs());
+                    h.proj_rows.push(ActiveRow { row: 3 * k + a, force: RowForce::Same, extra: v - r.bias[3 * k + a] });
+                }
+            }
+        }
+        if worst > 1e-13 {
+            solve_active(&h.eye, &h.ones, &h.zeros, r, &h.proj_rows, &mut h.cd.scratch, &mut h.proj_dx).map_err(|_| singular())?;
+            for j in 0..l.nv {
+                y[l.qd().start + j] += h.proj_dx[j];
+            }
+            changed = true;
+        }
+        Ok(changed)
+    }
+}

@@ -3,6 +3,7 @@
 //! field and the value. The paper's scene is built in ([`Scene::paper`]).
 
 pub mod builtin;
+mod contacts;
 mod ctx;
 mod robot;
 pub mod spec;
@@ -10,11 +11,12 @@ mod target;
 
 use std::path::Path;
 
-use nalgebra::{DVector, Unit};
+use nalgebra::DVector;
 
 use crate::control::{Circle, Controller, Law, PdGains, Target, YawPlanarIk};
 use crate::joint_limits::JointStops;
 use crate::dynamics::constraints::PointOnPlane;
+use crate::dynamics::contact::{Contact, ContactModel, ContactSettings};
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 use crate::dynamics::kinematics::{forward_kinematics, forward_velocities, BodyPoint};
 use crate::dynamics::motor::{DriveSpec, Drives, Electrical, MotorParams};
@@ -72,6 +74,10 @@ pub struct Scene {
     pub(crate) qd0: Vec<f64>,
     pub(crate) current0: Vec<f64>,
     pub(crate) contacts: Vec<PointOnPlane>,
+    /// The same contacts with their models and tangent bases (same order as `contacts`).
+    pub(crate) contact_models: Vec<Contact>,
+    /// Tolerances and limits of the event-driven contact handling (`events`).
+    pub(crate) contact_settings: ContactSettings,
     pub(crate) runs: Vec<Run>,
     pub(crate) mass_matrix: MassMatrixMethod,
     pub(crate) solver: ConstraintSolver,
@@ -155,6 +161,14 @@ impl Scene {
     /// Every named contact; a run picks some.
     pub fn contacts(&self) -> &[PointOnPlane] {
         &self.contacts
+    }
+    /// Every contact with its model (same order as [`Scene::contacts`]).
+    pub fn contact_models(&self) -> &[Contact] {
+        &self.contact_models
+    }
+    /// The event-driven contact handling's tolerances and limits (`events`).
+    pub fn contact_settings(&self) -> ContactSettings {
+        self.contact_settings
     }
     /// The runs, in the scene's order.
     pub fn runs(&self) -> &[Run] {
@@ -285,6 +299,16 @@ impl Scene {
     /// The run called `name`.
     pub fn run(&self, name: &str) -> Option<&Run> {
         self.runs.iter().find(|r| r.name == name)
+    }
+
+    /// The contacts active in `run` with their models, in its order.
+    pub fn run_contact_models(&self, run: &Run) -> Vec<Contact> {
+        run.contacts.iter().map(|&k| self.contact_models[k].clone()).collect()
+    }
+
+    /// Whether `run` has a non-bilateral contact (then it is integrated event by event).
+    pub fn run_is_hybrid(&self, run: &Run) -> bool {
+        run.contacts.iter().any(|&k| self.contact_models[k].model != ContactModel::Bilateral)
     }
 
     /// The contacts active in `run`, in its order.
@@ -478,34 +502,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     let mut data = Data::new(&model);
     forward_kinematics(&model, &mut data, &q0);
     forward_velocities(&model, &mut data, &qd0);
-    let mut contacts = Vec::with_capacity(spec.contacts.len());
-    for (i, cspec) in spec.contacts.iter().enumerate() {
-        let f = format!("contacts[{i}]");
-        if contacts.iter().any(|p: &PointOnPlane| p.name == cspec.name) {
-            return Err(c.err(format!("{f}.name"), &cspec.name, "is used twice"));
-        }
-        let point = c.point(&format!("{f}.point"), &model, &cspec.point)?;
-        let n = c.vec3(&format!("{f}.plane.normal"), cspec.plane.normal)?;
-        if n.norm() < 1e-12 {
-            return Err(c.err(format!("{f}.plane.normal"), format!("{:?}", cspec.plane.normal), "must be non-zero"));
-        }
-        let offset = c.number(&format!("{f}.plane.offset"), cspec.plane.offset, |_| true, "")?;
-        let contact = PointOnPlane { name: cspec.name.clone(), point, normal_world: Unit::new_normalize(n), offset };
-        if point.body.is_none() {
-            return Err(c.err(format!("{f}.point"), &cspec.name, "is fixed to the base: it cannot be constrained"));
-        }
-        let (pos, vel) = (contact.position(&data), contact.velocity(&data));
-        if pos.abs() > INITIAL_CONSTRAINT_TOL || vel.abs() > INITIAL_CONSTRAINT_TOL {
-            return Err(c.err(
-                format!("{f}"),
-                &cspec.name,
-                format!(
-                    "the initial state violates this contact: C(q0) = {pos:.3e} m, C'(q0, qd0) = {vel:.3e} m/s (tolerance {INITIAL_CONSTRAINT_TOL:e}); move initial.q onto the plane or drop the contact"
-                ),
-            ));
-        }
-        contacts.push(contact);
-    }
+    let (contacts, contact_models, table_contacts, contact_settings) = contacts::build_contacts(&c, &spec, &model, &data)?;
     let mut runs = Vec::with_capacity(spec.runs.len());
     if spec.runs.is_empty() {
         return Err(c.err("runs", "[]", "needs at least one run"));
@@ -526,6 +523,12 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
                 return Err(c.err(format!("runs[{i}].contacts[{k}]"), name, "is listed twice"));
             }
             idx.push(ci);
+        }
+        // the table's contacts belong to every run
+        for &k in &table_contacts {
+            if !idx.contains(&k) {
+                idx.push(k);
+            }
         }
         runs.push(Run { name: rs.name.clone(), contacts: idx });
     }
@@ -560,6 +563,8 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
         qd0,
         current0,
         contacts,
+        contact_models,
+        contact_settings,
         runs,
         mass_matrix: spec.dynamics.mass_matrix,
         solver: spec.dynamics.constraint_solver,

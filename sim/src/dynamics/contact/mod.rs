@@ -180,3 +180,35 @@ pub struct ContactOutput {
     pub friction_work: f64,
     pub damping_loss: f64,
 }
+
+/// Tolerances and limits of the event-driven contact handling (the scene's `events`, with the
+/// closing tolerances fixed here).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactSettings {
+    /// Width of the bracket an event time is located to, s (default 1e-12).
+    pub time_tol: f64,
+    /// A contact is closed when `|g| ≤ gap_tol` (m) and `|ġ| ≤ vel_tol` (m/s); 1e-9 each.
+    pub gap_tol: f64,
+    pub vel_tol: f64,
+    /// Impacts with approach speed below this are plastic (the Zeno rule), m/s (default 1e-4).
+    pub rest_velocity: f64,
+    /// Most contact events in a run (default 100 000).
+    pub max_events: u64,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        ContactSettings { time_tol: 1e-12, gap_tol: 1e-9, vel_tol: 1e-9, rest_velocity: 1e-4, max_events: 100_000 }
+    }
+}
+
+/// Most unilateral contacts closed at one time: the mode problem enumerates 3^n combinations.
+pub const MAX_CLOSED_CONTACTS: usize = 8;
+
+pub mod forward;
+pub mod impact;
+pub mod modes;
+pub mod rows;
+pub mod solve;
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,240 @@
+//! Forward dynamics of the arm with contacts of any model, in the current contact modes: the
+//! general active-row path NEXT TO the untouched bilateral path of `dynamics/forward.rs` (the
+//! paper's runs never come here). Same generalised force b and inertia `M_J = M + J_m` as
+//! eq 21 (the same calls in the same order), then compliant forces added to b
+//! (`J_nᵀ f_n + J_tᵀ f_t`), then the active rows of the modes ([`super::solve`]).
+//!
+//! Compliant model (Hunt–Crossley-like linear spring-damper clipped at zero, Acary & Brogliato,
+//! *Numerical Methods for Nonsmooth Dynamical Systems*, 2008, §2.2): `f_n = max(0, k δ + c δ̇)`
+//! for `δ = −g > 0`, friction `f_t = −μ f_n v_t / sqrt(|v_t|² + v_s²)`.
+
+use super::rows::{contact_rows, ContactRows};
+use super::solve::{solve_active, ActiveRow, ActiveScratch, RowForce, Singular};
+use super::{Contact, ContactMode, ContactModel};
+use crate::dynamics::cholesky;
+use crate::dynamics::crba::crba_world;
+use crate::dynamics::data::Data;
+use crate::dynamics::forward::{ForwardData, MassMatrixMethod, Plant, Stabilization};
+use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
+use crate::dynamics::rnea::bias_forces_placed;
+use crate::dynamics::walker_orin;
+use crate::error::DynamicsError;
+
+/// The discrete state of a run's contacts: the mode of each, and the slip direction
+/// `[s1, s2]` (unit, in the contact's tangent basis) a sliding contact uses while its slip
+/// velocity is below `vel_tol` (at the start of a slip).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactState {
+    pub mode: Vec<ContactMode>,
+    pub slip: Vec<[f64; 2]>,
+}
+
+impl ContactState {
+    /// Bilateral contacts `Bilateral`, the others `Separated` (the mode problem at t0 decides).
+    pub fn new(contacts: &[Contact]) -> Self {
+        ContactState {
+            mode: contacts.iter().map(|c| if c.model == ContactModel::Bilateral { ContactMode::Bilateral } else { ContactMode::Separated }).collect(),
+            slip: vec![[1.0, 0.0]; contacts.len()],
+        }
+    }
+}
+
+/// Scratch and outputs of the contact dynamics, sized once for (nv, nc).
+#[derive(Clone, Debug)]
+pub struct ContactData {
+    pub rows: ContactRows,
+    pub active: Vec<ActiveRow>,
+    pub scratch: ActiveScratch,
+    /// Per contact: normal force f_n (N) and friction force `[t1, t2]` (N) of the last solve.
+    pub f_n: Vec<f64>,
+    pub f_t: Vec<[f64; 2]>,
+}
+
+impl ContactData {
+    pub fn new(nv: usize, nc: usize) -> Self {
+        ContactData {
+            rows: ContactRows::new(nv, nc),
+            active: Vec::with_capacity(3 * nc),
+            scratch: ActiveScratch::new(nv, nc),
+            f_n: vec![0.0; nc],
+            f_t: vec![[0.0; 2]; nc],
+        }
+    }
+}
+
+/// Slip speeds below this use the stored slip direction (m/s).
+pub const SLIP_DIRECTION_SPEED: f64 = 1e-9;
+
+/// The slip direction of a sliding contact: `v_t/|v_t|` when `|v_t|` > [`SLIP_DIRECTION_SPEED`],
+/// else the stored one.
+pub fn slip_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
+    let s = v_t[0].hypot(v_t[1]);
+    if s > SLIP_DIRECTION_SPEED {
+        [v_t[0] / s, v_t[1] / s]
+    } else {
+        stored
+    }
+}
+
+/// Kinematics, b (with compliant forces), `M_J` and its Cholesky factor (in `fd.m_j`,
+/// `fd.l_inv_diag`), the contact rows: everything the mode-dependent solve reads.
+#[allow(clippy::too_many_arguments)]
+pub fn prepare(
+    plant: &Plant,
+    contacts: &[Contact],
+    data: &mut Data,
+    fd: &mut ForwardData,
+    cd: &mut ContactData,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    current: &[f64],
+) -> Result<(), DynamicsError> {
+    let (model, drives) = (plant.model, plant.drives);
+    let nv = model.nv;
+    forward_kinematics(model, data, q);
+    bias_forces_placed(model, data, qd);
+    for j in 0..nv {
+        fd.b[j] = drives.km[j] * current[j] - data.tau[j];
+    }
+    if drives.has_friction {
+        for j in 0..nv {
+            fd.b[j] -= (drives.d[j] + drives.dm[j]) * qd[j];
+        }
+    }
+    if fd.joint_torque {
+        for j in 0..nv {
+            fd.b[j] += fd.tau_joint[j];
+        }
+    }
+    match plant.mass_matrix {
+        MassMatrixMethod::Crba => crba_world(model, data),
+        MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
+    };
+    fd.m_j.copy_from(&data.m);
+    for j in 0..nv {
+        fd.m_j[(j, j)] += drives.jm[j];
+    }
+    forward_velocities(model, data, qd);
+    contact_rows(model, data, contacts, &mut cd.rows);
+    // compliant forces into b
+    for (k, c) in contacts.iter().enumerate() {
+        cd.f_n[k] = 0.0;
+        cd.f_t[k] = [0.0; 2];
+        if let ContactModel::Compliant { stiffness, damping, friction, slip_velocity } = c.model {
+            let (delta, delta_d) = (-cd.rows.gap[k], -cd.rows.vel[3 * k]);
+            if delta > 0.0 {
+                let f_n = (stiffness * delta + damping * delta_d).max(0.0);
+                let v = cd.rows.slip(k);
+                let w = -friction * f_n / (v[0] * v[0] + v[1] * v[1] + slip_velocity * slip_velocity).sqrt();
+                let f_t = [w * v[0], w * v[1]];
+                cd.f_n[k] = f_n;
+                cd.f_t[k] = f_t;
+                let r = &cd.rows;
+                for j in 0..nv {
+                    fd.b[j] += f_n * r.row(3 * k)[j] + f_t[0] * r.row(3 * k + 1)[j] + f_t[1] * r.row(3 * k + 2)[j];
+                }
+            }
+        }
+    }
+    if !cholesky::factor_in_place(fd.m_j.as_mut_slice(), nv, &mut fd.l_inv_diag) {
+        return Err(DynamicsError::SingularMassMatrix { t });
+    }
+    Ok(())
+}
+
+/// The active rows of `state` (with Baumgarte's terms when asked) into `cd.active`.
+pub fn active_rows(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, cd: &mut ContactData) {
+    let (alpha, beta) = match stabilization {
+        Stabilization::Baumgarte { alpha, beta } => (alpha, beta),
+        _ => (0.0, 0.0),
+    };
+    let r = &cd.rows;
+    cd.active.clear();
+    for (k, c) in contacts.iter().enumerate() {
+        let normal_extra = 2.0 * alpha * r.vel[3 * k] + beta * beta * r.gap[k];
+        let normal = |force| ActiveRow { row: 3 * k, force, extra: normal_extra };
+        let mu = match c.model {
+            ContactModel::Unilateral { friction, .. } => friction,
+            _ => 0.0,
+        };
+        match state.mode[k] {
+            ContactMode::Separated => {}
+            ContactMode::Bilateral => cd.active.push(normal(RowForce::Same)),
+            ContactMode::Sticking if mu > 0.0 => {
+                cd.active.push(normal(RowForce::Same));
+                for axis in 1..3 {
+                    cd.active.push(ActiveRow { row: 3 * k + axis, force: RowForce::Same, extra: 2.0 * alpha * r.vel[3 * k + axis] });
+                }
+            }
+            ContactMode::Sticking | ContactMode::Sliding => {
+                let s = slip_direction(r.slip(k), state.slip[k]);
+                cd.active.push(normal(if mu > 0.0 { RowForce::Sliding { mu, s } } else { RowForce::Same }));
+            }
+        }
+    }
+}
+
+/// The mode-dependent solve after [`prepare`]: q̈ into `fd.qdd`, the forces of the rigid
+/// contacts into `cd.f_n`, `cd.f_t` (compliant ones keep theirs).
+pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) -> Result<(), Singular> {
+    active_rows(contacts, state, stabilization, cd);
+    let nv = cd.rows.nv;
+    solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, fd.b.as_slice(), &cd.rows, &cd.active, &mut cd.scratch, &mut fd.qdd.as_mut_slice()[..nv])?;
+    for (k, c) in contacts.iter().enumerate() {
+        if !matches!(c.model, ContactModel::Compliant { .. }) {
+            cd.f_n[k] = 0.0;
+            cd.f_t[k] = [0.0; 2];
+        }
+    }
+    for (i, ar) in cd.active.iter().enumerate() {
+        let (k, axis) = (ar.row / 3, ar.row % 3);
+        let lam = cd.scratch.lambda[i];
+        match (axis, ar.force) {
+            (0, RowForce::Same) => cd.f_n[k] = lam,
+            (0, RowForce::Sliding { mu, s }) => {
+                cd.f_n[k] = lam;
+                cd.f_t[k] = [-mu * lam * s[0], -mu * lam * s[1]];
+            }
+            (a, _) => cd.f_t[k][a - 1] = lam,
+        }
+    }
+    Ok(())
+}
+
+/// Eq 21 with contacts of any model in the modes of `state` (the bilateral path's outputs in
+/// `fd`: `qdd`, `di`, `tau_motor`; the contact forces in `cd`).
+#[allow(clippy::too_many_arguments)]
+pub fn forward_dynamics_contacts(
+    plant: &Plant,
+    contacts: &[Contact],
+    state: &ContactState,
+    data: &mut Data,
+    fd: &mut ForwardData,
+    cd: &mut ContactData,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    current: &[f64],
+    voltage: &[f64],
+) -> Result<(), DynamicsError> {
+    prepare(plant, contacts, data, fd, cd, t, q, qd, current)?;
+    if solve_modes(contacts, state, plant.stabilization, fd, cd).is_err() {
+        let names: Vec<&str> = cd.active.iter().map(|a| contacts[a.row / 3].name()).collect();
+        return Err(DynamicsError::SingularConstraints { t, constraints: names.join(", ") });
+    }
+    finish(plant, fd, t, qd, current, voltage)
+}
+
+/// The electrical rows and the motor torque of eq 12, as in the bilateral path.
+pub fn finish(plant: &Plant, fd: &mut ForwardData, t: f64, qd: &[f64], current: &[f64], voltage: &[f64]) -> Result<(), DynamicsError> {
+    let (model, drives) = (plant.model, plant.drives);
+    for j in 0..model.nv {
+        fd.di[j] = drives.current_rate(j, voltage[j], current[j], qd[j]);
+        fd.tau_motor[j] = drives.link_torque(j, current[j], qd[j], fd.qdd[j]);
+    }
+    if let Some(j) = fd.qdd.iter().position(|x| !x.is_finite()) {
+        return Err(DynamicsError::NonFinite { t, what: format!("the acceleration of {}", model.bodies[j].joint) });
+    }
+    Ok(())
+}

@@ -1,0 +1,193 @@
+//! The mode problem at t0 and at every event: which closed rigid contacts separate, stick or
+//! slide, so that the contact forces and accelerations are consistent (the acceleration-level
+//! complementarity of Pfeiffer & Glocker 1996, §5.2, and of Acary & Brogliato 2008, §5.4), by
+//! EXACT ENUMERATION of the candidate modes of the closed contacts (3^n solves for n ≤
+//! [`MAX_CLOSED_CONTACTS`]; at events only, so the allocations here are at events).
+//!
+//! Candidates per closed contact: separated; sticking (μ > 0 and `|v_t| ≤ vel_tol`); sliding
+//! (along `v_t/|v_t|` when `|v_t| > vel_tol`; from rest along the impending direction
+//! `−f_t/|f_t|` of the same combination with the contact sticking; frictionless: the normal
+//! row alone). Feasibility, with tolerances relative to the solution's scale
+//! (`tol_f = 1e-8 (1 N + max |f|)`, `tol_a = 1e-8 (1 + max |q̈|)`): separated → `g̈ ≥ −tol_a`;
+//! sticking → `f_n ≥ −tol_f`, `|f_t| ≤ μ f_n + tol_f`; sliding → `f_n ≥ −tol_f` and from rest
+//! `a_t · s ≥ −tol_a`. No feasible combination: Painlevé inconsistency (error). Feasible
+//! combinations with different q̈ (beyond `1e-6 (1 + max |q̈|)`): indeterminate (error). Among
+//! those with the same q̈ (f_n = 0 with g̈ = 0, or |f_t| = μ f_n), the rule: the one whose modes
+//! agree with the `preferred` ones (the event's implication: lift-off → separated, touch-down →
+//! closed, stick→slip → sliding, slip→stick → sticking; else the current mode) at the most
+//! contacts, then the first in the order sticking, sliding, separated.
+
+use super::forward::{solve_modes, ContactData, ContactState};
+use super::{Contact, ContactMode, ContactModel, MAX_CLOSED_CONTACTS};
+use crate::dynamics::forward::{ForwardData, Stabilization};
+use crate::error::DynamicsError;
+
+fn mu_of(c: &Contact) -> f64 {
+    match c.model {
+        ContactModel::Unilateral { friction, .. } => friction,
+        _ => 0.0,
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Cand {
+    Stick,
+    /// Sliding; `moving` when |v_t| > vel_tol (direction v_t/|v_t|), else from rest.
+    Slide { moving: bool },
+    Sep,
+}
+
+struct Feasible {
+    mode: Vec<ContactMode>,
+    slip: Vec<[f64; 2]>,
+    qdd: Vec<f64>,
+    score: usize,
+}
+
+/// Choose the modes of the `closed` contacts (indices) after [`super::forward::prepare`] at the
+/// state; the other contacts keep theirs. On return `state` holds the choice and `fd`, `cd` its
+/// solution.
+#[allow(clippy::too_many_arguments)]
+pub fn choose_modes(
+    contacts: &[Contact],
+    state: &mut ContactState,
+    closed: &[usize],
+    preferred: &[ContactMode],
+    vel_tol: f64,
+    stabilization: Stabilization,
+    fd: &mut ForwardData,
+    cd: &mut ContactData,
+    t: f64,
+) -> Result<(), DynamicsError> {
+    let names = || closed.iter().map(|&k| contacts[k].name()).collect::<Vec<_>>().join(", ");
+    if closed.len() > MAX_CLOSED_CONTACTS {
+        return Err(DynamicsError::InconsistentContact {
+            t,
+            contact: names(),
+            why: format!("more than {MAX_CLOSED_CONTACTS} simultaneous rigid contacts ({}): the exact mode enumeration is limited to 3^{MAX_CLOSED_CONTACTS}; use compliant contacts", closed.len()),
+        });
+    }
+    let nv = cd.rows.nv;
+    let cands: Vec<Vec<Cand>> = closed
+        .iter()
+        .map(|&k| {
+            let v = cd.rows.slip(k);
+            let moving = v[0].hypot(v[1]) > vel_tol;
+            if mu_of(&contacts[k]) == 0.0 || moving {
+                vec![Cand::Slide { moving }, Cand::Sep]
+            } else {
+                vec![Cand::Stick, Cand::Slide { moving: false }, Cand::Sep]
+            }
+        })
+        .collect();
+    let mut idx = vec![0usize; closed.len()];
+    let mut feasible: Vec<Feasible> = Vec::new();
+    let mut trial = state.clone();
+    loop {
+        // the combination idx
+        let mut from_rest = false;
+        for (i, &k) in closed.iter().enumerate() {
+            trial.mode[k] = match cands[i][idx[i]] {
+                Cand::Stick => ContactMode::Sticking,
+                Cand::Slide { moving } => {
+                    let v = cd.rows.slip(k);
+                    if moving {
+                        let s = v[0].hypot(v[1]);
+                        trial.slip[k] = [v[0] / s, v[1] / s];
+                    } else if mu_of(&contacts[k]) > 0.0 {
+                        from_rest = true;
+                    }
+                    ContactMode::Sliding
+                }
+                Cand::Sep => ContactMode::Separated,
+            };
+        }
+        let mut ok = true;
+        if from_rest {
+            // the impending slip directions: the same combination with those contacts sticking
+            let mut stick = trial.clone();
+            for (i, &k) in closed.iter().enumerate() {
+                if cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 {
+                    stick.mode[k] = ContactMode::Sticking;
+                }
+            }
+            ok = solve_modes(contacts, &stick, stabilization, fd, cd).is_ok();
+            if ok {
+                for (i, &k) in closed.iter().enumerate() {
+                    if cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 {
+                        let f = cd.f_t[k];
+                        let m = f[0].hypot(f[1]);
+                        // no impending slip: sliding from rest is the sticking solution (not a separate candidate)
+                        if !(m > 1e-12 * (1.0 + cd.f_n[k].abs())) {
+                            ok = false;
+                        } else {
+                            trial.slip[k] = [-f[0] / m, -f[1] / m];
+                        }
+                    }
+                }
+            }
+        }
+        if ok && solve_modes(contacts, &trial, stabilization, fd, cd).is_ok() {
+            let qdd = &fd.qdd.as_slice()[..nv];
+            let qmax = qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let fmax = closed.iter().fold(0.0f64, |m, &k| m.max(cd.f_n[k].abs()).max(cd.f_t[k][0].hypot(cd.f_t[k][1])));
+            let (tol_f, tol_a) = (1e-8 * (1.0 + fmax), 1e-8 * (1.0 + qmax));
+            let mut feasible_here = true;
+            for (i, &k) in closed.iter().enumerate() {
+                let (f_n, f_t) = (cd.f_n[k], cd.f_t[k]);
+                let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
+                feasible_here &= match cands[i][idx[i]] {
+                    Cand::Sep => accel(0) >= -tol_a,
+                    Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= mu_of(&contacts[k]) * f_n + tol_f,
+                    Cand::Slide { moving } => {
+                        f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -tol_a)
+                    }
+                };
+            }
+            if feasible_here {
+                let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();
+                feasible.push(Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), qdd: qdd.to_vec(), score });
+            }
+        }
+        // next combination
+        let mut i = 0;
+        loop {
+            if i == closed.len() {
+                break;
+            }
+            idx[i] += 1;
+            if idx[i] < cands[i].len() {
+                break;
+            }
+            idx[i] = 0;
+            i += 1;
+        }
+        if i == closed.len() {
+            break;
+        }
+    }
+    let mus = closed.iter().map(|&k| format!("{} (mu = {})", contacts[k].name(), mu_of(&contacts[k]))).collect::<Vec<_>>().join(", ");
+    let Some(best) = feasible.iter().enumerate().max_by_key(|(i, f)| (f.score, usize::MAX - i)).map(|(_, f)| f) else {
+        return Err(DynamicsError::InconsistentContact {
+            t,
+            contact: names(),
+            why: format!("no consistent contact forces: Painleve inconsistency ({mus}); try a smaller friction"),
+        });
+    };
+    let qmax = best.qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for f in &feasible {
+        let d = f.qdd.iter().zip(&best.qdd).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        if d > 1e-6 * (1.0 + qmax) {
+            return Err(DynamicsError::InconsistentContact {
+                t,
+                contact: names(),
+                why: format!("indeterminate: several solutions of the contact problem accelerate the arm differently (by {d:.3e} rad/s^2; {mus}); Painleve indeterminacy, try a smaller friction"),
+            });
+        }
+    }
+    for &k in closed {
+        state.mode[k] = best.mode[k];
+        state.slip[k] = best.slip[k];
+    }
+    solve_modes(contacts, state, stabilization, fd, cd).map_err(|_| DynamicsError::SingularConstraints { t, constraints: names() })
+}

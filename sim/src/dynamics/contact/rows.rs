@@ -1,0 +1,64 @@
+//! The rows of each contact: gap `g = n · p − d`, the normal row `J_n = nᵀ J_p` and the
+//! tangential rows `J_t = [t1ᵀ J_p; t2ᵀ J_p]` (J_p the point's world linear-velocity Jacobian),
+//! their biases `J̇ q̇` along n, t1, t2, and the velocities `ġ = J_n q̇`, `v_t = J_t q̇`
+//! (Pfeiffer & Glocker, *Multibody Dynamics with Unilateral Contacts*, 1996, §4; the point
+//! kinematics of `dynamics/kinematics.rs`, Featherstone RBDA §2.7).
+
+use super::Contact;
+use crate::dynamics::{Data, Model};
+
+/// Rows of all contacts of a run, preallocated for nc contacts and nv joints. Row `3k` is
+/// contact k's normal, `3k + 1` and `3k + 2` its tangents t1, t2 (row-major, nv columns).
+#[derive(Clone, Debug)]
+pub struct ContactRows {
+    pub nv: usize,
+    /// `3 nc x nv`, row-major.
+    pub jac: Vec<f64>,
+    /// `J̇ q̇` along n, t1, t2 (3 nc), m/s^2.
+    pub bias: Vec<f64>,
+    /// Gap g (nc), m.
+    pub gap: Vec<f64>,
+    /// `ġ, v_t1, v_t2` (3 nc), m/s.
+    pub vel: Vec<f64>,
+}
+
+impl ContactRows {
+    pub fn new(nv: usize, nc: usize) -> Self {
+        ContactRows { nv, jac: vec![0.0; 3 * nc * nv], bias: vec![0.0; 3 * nc], gap: vec![0.0; nc], vel: vec![0.0; 3 * nc] }
+    }
+
+    /// Row `r` (`3k + axis`).
+    pub fn row(&self, r: usize) -> &[f64] {
+        &self.jac[r * self.nv..(r + 1) * self.nv]
+    }
+
+    /// `row_r · x`.
+    pub fn dot(&self, r: usize, x: &[f64]) -> f64 {
+        self.row(r).iter().zip(x).map(|(a, b)| a * b).sum()
+    }
+
+    /// The slip velocity `[v_t1, v_t2]` of contact k, m/s.
+    pub fn slip(&self, k: usize) -> [f64; 2] {
+        [self.vel[3 * k + 1], self.vel[3 * k + 2]]
+    }
+}
+
+/// Fill `rows` at the state of `data` (needs `forward_kinematics` and `forward_velocities`).
+/// The normal row's formulas are those of `constraints::constraint_rows` (same operations).
+pub fn contact_rows(model: &Model, data: &Data, contacts: &[Contact], rows: &mut ContactRows) {
+    let nv = model.nv;
+    rows.jac.fill(0.0);
+    for (k, c) in contacts.iter().enumerate() {
+        let point = &c.plane.point;
+        let n = c.plane.normal_world.into_inner();
+        rows.gap[k] = c.plane.position(data);
+        let v = point.velocity(data);
+        let a = point.bias_acceleration(data);
+        for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
+            let r = 3 * k + axis;
+            rows.vel[r] = dir.dot(&v);
+            rows.bias[r] = dir.dot(&a);
+            point.jacobian_along(model, data, dir, &mut rows.jac[r * nv..(r + 1) * nv]);
+        }
+    }
+}

@@ -1,0 +1,524 @@
+//! The arm as a hybrid (event-driven) system when its run has a non-bilateral contact
+//! (Pfeiffer & Glocker, *Multibody Dynamics with Unilateral Contacts*, 1996, ch. 5–6; Acary &
+//! Brogliato, *Numerical Methods for Nonsmooth Dynamical Systems*, 2008, ch. 7 on event-driven
+//! schemes): the contacts' modes are discrete state, changed at events located by the driver
+//! (`integrate::events`) as roots of two functions per contact:
+//!
+//! | mode | ev0 (direction) | ev1 (direction) |
+//! |---|---|---|
+//! | separated (unilateral) | g (−1, touch-down) | 1 |
+//! | sticking | f_n (−1, lift-off) | μ f_n − \|f_t\| (−1, stick→slip) |
+//! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick; 1 when μ = 0) |
+//! | compliant | g (0) | k δ + c δ̇ while δ > 0, else 1 (0) |
+//! | bilateral | 1 | 1 |
+//!
+//! `s_ref` is the slip direction at the start of the step (refreshed in `after_step`).
+//! The force-type functions need a full evaluation of eq 21 at the interpolated state.
+//! At an event ([`HybridSystem::handle_events`]): touch-downs with approach speed above
+//! `vel_tol` are impacts (`dynamics/contact/impact.rs`; below `rest_velocity` plastic: the Zeno
+//! rule, kind `rest`); then the mode problem (`dynamics/contact/modes.rs`) over the closed
+//! contacts, preferring the modes the events imply. An impact jumps q̇ (currents continuous),
+//! adds its kinetic-energy loss to the contacts' impact-loss quadratures and the rotors'
+//! impulsive torque work `−J_m (q̇⁺² − q̇⁻²)/2` to the link works W_j. Allocation happens at
+//! events only (the mode enumeration, the impact), not in the step loop.
+
+use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState};
+use crate::dynamics::contact::impact::solve_impact;
+use crate::dynamics::contact::modes::choose_modes;
+use crate::dynamics::contact::{Contact, ContactEvent, ContactEventKind, ContactMode, ContactModel, ContactOutput, ContactSettings};
+use crate::dynamics::forward::Plant;
+use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
+use crate::dynamics::motor::Electrical;
+use crate::error::{DynamicsError, RunError};
+use crate::integrate::HybridSystem;
+use crate::scene::{Run, Scene};
+
+use super::arm::ArmSystem;
+
+/// The hybrid part of an [`ArmSystem`].
+pub(crate) struct Hybrid {
+    pub(crate) contacts: Vec<Contact>,
+    pub(crate) state: ContactState,
+    pub(crate) cd: ContactData,
+    pub(crate) settings: ContactSettings,
+    /// Events since the last drain, in time order.
+    pub(crate) log: Vec<ContactEvent>,
+    /// Events handled in the whole run.
+    pub(crate) count: u64,
+    /// Slip direction of each sliding contact at the start of the step (for ev1).
+    pub(crate) s_ref: Vec<[f64; 2]>,
+    /// The projection's identity "factor" (nv x nv), its unit diagonal, a zero force, its
+    /// rows and correction (nv).
+    pub(crate) eye: Vec<f64>,
+    pub(crate) ones: Vec<f64>,
+    pub(crate) zeros: Vec<f64>,
+    pub(crate) proj_rows: Vec<crate::dynamics::contact::solve::ActiveRow>,
+    pub(crate) proj_dx: Vec<f64>,
+}
+
+impl Hybrid {
+    pub(crate) fn new(scene: &Scene, run: &Run) -> Self {
+        let contacts = scene.run_contact_models(run);
+        let nc = contacts.len();
+        let nv = scene.model.nv;
+        let state = ContactState::new(&contacts);
+        Hybrid {
+            cd: ContactData::new(scene.model.nv, nc),
+            state,
+            settings: scene.contact_settings(),
+            log: Vec::with_capacity(64),
+            count: 0,
+            s_ref: vec![[1.0, 0.0]; nc],
+            eye: (0..nv * nv).map(|i| if i % (nv + 1) == 0 { 1.0 } else { 0.0 }).collect(),
+            ones: vec![1.0; nv],
+            zeros: vec![0.0; nv],
+            proj_rows: Vec::with_capacity(3 * nc),
+            proj_dx: vec![0.0; nv],
+            contacts,
+        }
+    }
+}
+
+fn mu_of(c: &Contact) -> f64 {
+    match c.model {
+        ContactModel::Unilateral { friction, .. } => friction,
+        _ => 0.0,
+    }
+}
+
+fn in_touch(m: ContactMode) -> bool {
+    matches!(m, ContactMode::Sticking | ContactMode::Sliding)
+}
+
+impl ArmSystem<'_> {
+    /// Whether this run is event-driven: it has a non-bilateral contact (then the run uses
+    /// `integrate_hybrid`, records `/contacts` and fills `Outputs::contacts`).
+    pub fn is_hybrid(&self) -> bool {
+        self.hybrid.is_some()
+    }
+
+    /// Take over `other`'s discrete contact modes (the run's output probe follows the
+    /// stepper's system before each sample).
+    pub fn copy_modes_from(&mut self, other: &ArmSystem<'_>) {
+        if let (Some(h), Some(o)) = (&mut self.hybrid, &other.hybrid) {
+            h.state.mode.copy_from_slice(&o.state.mode);
+            h.state.slip.copy_from_slice(&o.state.slip);
+            h.s_ref.copy_from_slice(&o.s_ref);
+        }
+    }
+
+    /// Move the logged contact events (in time order) to the end of `into`.
+    pub fn drain_events(&mut self, into: &mut Vec<ContactEvent>) {
+        if let Some(h) = &mut self.hybrid {
+            into.append(&mut h.log);
+        }
+    }
+
+    /// The contacts' modes (empty for a bilateral run).
+    pub fn contact_modes(&self) -> &[ContactMode] {
+        self.hybrid.as_ref().map_or(&[], |h| &h.state.mode[..])
+    }
+
+    /// `Σ ½ k δ²` of the compliant contacts at the kinematics in the workspace, J.
+    pub(super) fn contact_energy(&self) -> f64 {
+        let Some(h) = &self.hybrid else { return 0.0 };
+        h.contacts
+            .iter()
+            .map(|c| match c.model {
+                ContactModel::Compliant { stiffness, .. } => {
+                    let delta = -c.plane.position(&self.ws.data);
+                    if delta > 0.0 {
+                        0.5 * stiffness * delta * delta
+                    } else {
+                        0.0
+                    }
+                }
+                _ => 0.0,
+            })
+            .sum()
+    }
+
+    /// The contact quadratures' rates after an evaluation: friction work `−f_t · v_t` and a
+    /// compliant contact's damping loss `(f_n − k δ) δ̇` (impact losses change at events only).
+    pub(super) fn contact_loss_rates(&self, dydt: &mut [f64]) {
+        let l = self.layout;
+        let Some(h) = &self.hybrid else { return };
+        let r = &h.cd.rows;
+        for (k, c) in h.contacts.iter().enumerate() {
+            let v = r.slip(k);
+            let f_t = h.cd.f_t[k];
+            dydt[l.impact_loss(k)] = 0.0;
+            dydt[l.friction_work(k)] = -(f_t[0] * v[0] + f_t[1] * v[1]);
+            dydt[l.damping_loss(k)] = match c.model {
+                ContactModel::Compliant { stiffness, .. } => {
+                    let (delta, delta_d) = (-r.gap[k], -r.vel[3 * k]);
+                    if delta > 0.0 {
+                        (h.cd.f_n[k] - stiffness * delta) * delta_d
+                    } else {
+                        0.0
+                    }
+                }
+                _ => 0.0,
+            };
+        }
+    }
+
+    /// `Σ_k (E_imp + E_fric + E_damp)` at y, J.
+    pub(super) fn contact_losses(&self, y: &[f64]) -> f64 {
+        let l = self.layout;
+        (0..l.contacts).map(|k| y[l.impact_loss(k)] + y[l.friction_work(k)] + y[l.damping_loss(k)]).sum()
+    }
+
+    /// The contacts' recorded quantities after a full evaluation at y (forces from it).
+    pub(super) fn contact_outputs(&self, y: &[f64], forces: bool, out: &mut Vec<ContactOutput>) {
+        out.clear();
+        let Some(h) = &self.hybrid else { return };
+        let l = self.layout;
+        let data = &self.ws.data;
+        for (k, c) in h.contacts.iter().enumerate() {
+            let p = &c.plane;
+            let (gap, vel) = (p.position(data), p.point.velocity(data));
+            let slip = [c.t1.dot(&vel), c.t2.dot(&vel)];
+            let (f_n, f_t) = if forces { (h.cd.f_n[k], h.cd.f_t[k]) } else { (f64::NAN, [f64::NAN; 2]) };
+            let mode = match c.model {
+                ContactModel::Compliant { .. } if forces => {
+                    if f_n > 0.0 {
+                        ContactMode::Sliding
+                    } else {
+                        ContactMode::Separated
+                    }
+                }
+                _ => h.state.mode[k],
+            };
+            out.push(ContactOutput {
+                mode,
+                gap,
+                gap_rate: p.normal_world.dot(&vel),
+                normal_force: f_n,
+                friction_force: f_t,
+                slip_velocity: slip,
+                impact_loss: y[l.impact_loss(k)],
+                friction_work: y[l.friction_work(k)],
+                damping_loss: y[l.damping_loss(k)],
+            });
+        }
+    }
+
+    /// Inputs and [`prepare`] at (t, y) for the hybrid path (no mode-dependent solve).
+    fn prepare_at(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+        self.inputs(t, y)?;
+        let l = self.layout;
+        let s = self.scene;
+        let plant = Plant {
+            model: &s.model,
+            drives: &s.drives,
+            contacts: &self.contacts,
+            mass_matrix: s.mass_matrix,
+            solver: s.solver,
+            stabilization: s.stabilization,
+        };
+        let h = self.hybrid.as_mut().expect("hybrid");
+        let current = match l.electrical {
+            Electrical::Inductive => &y[l.current()],
+            Electrical::QuasiStatic => &self.ws.current_qs[..],
+        };
+        prepare(&plant, &h.contacts, &mut self.ws.data, &mut self.ws.fd, &mut h.cd, t, &y[l.q()], &y[l.qd()], current)
+    }
+
+    fn log(&mut self, e: ContactEvent) -> Result<(), RunError> {
+        let h = self.hybrid.as_mut().expect("hybrid");
+        h.count += 1;
+        if h.count > h.settings.max_events {
+            return Err(RunError::TooManyEvents { t: e.t, max_events: h.settings.max_events });
+        }
+        h.log.push(e);
+        Ok(())
+    }
+
+    /// An impact at (t, y): the contacts in touch and the separated unilateral ones at the
+    /// table take part; q̇ jumps, the losses and the rotors' work are booked, events logged.
+    /// Returns the contacts that stay closed (ġ⁺ ≤ vel_tol) and those that separate.
+    fn impact(&mut self, t: f64, y: &mut [f64], approaching: &[usize]) -> Result<(Vec<usize>, Vec<usize>), RunError> {
+        let l = self.layout;
+        let nv = l.nv;
+        self.prepare_at(t, y)?;
+        let h = self.hybrid.as_ref().expect("hybrid");
+        let st = h.settings;
+        let mut uni = Vec::new();
+        let mut bil = Vec::new();
+        for (k, c) in h.contacts.iter().enumerate() {
+            match c.model {
+                ContactModel::Bilateral => bil.push(k),
+                ContactModel::Unilateral { restitution, .. } => {
+                    if in_touch(h.state.mode[k]) || h.cd.rows.gap[k].abs() <= st.gap_tol || approaching.contains(&k) {
+                        let gd = h.cd.rows.vel[3 * k];
+                        let e = if -gd < st.rest_velocity { 0.0 } else { restitution };
+                        uni.push((k, e));
+                    }
+                }
+                ContactModel::Compliant { .. } => {}
+            }
+        }
+        let fd = &self.ws.fd;
+        let imp = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &uni, &bil, t)?;
+        let d = &self.scene.drives;
+        for j in 0..nv {
+            let before = y[l.qd().start + j];
+            let after = before + imp.dqd[j];
+            y[l.work().start + j] += -d.jm[j] * (after * after - before * before) / 2.0;
+            y[l.qd().start + j] = after;
+        }
+        let mut closed = Vec::new();
+        let mut opened = Vec::new();
+        let vel_tol = st.vel_tol;
+        let rest_velocity = st.rest_velocity;
+        for &k in uni.iter().map(|(k, _)| k).chain(bil.iter()) {
+            y[l.impact_loss(k)] += imp.energy_lost[k];
+        }
+        for &(k, _) in &uni {
+            let (before, after) = (imp.gap_rate_before[k], imp.gap_rate_after[k]);
+            if after <= vel_tol {
+                closed.push(k);
+            } else {
+                opened.push(k);
+            }
+            if before < -vel_tol && imp.impulse[k] > 0.0 {
+                let kind = if -before < rest_velocity { ContactEventKind::Rest } else { ContactEventKind::Impact };
+                self.log(ContactEvent { t, contact: k, kind, impulse: imp.impulse[k], energy_lost: imp.energy_lost[k], gap_rate_before: before, gap_rate_after: after })?;
+            }
+        }
+        Ok((closed, opened))
+    }
+
+    /// The mode problem over `closed` at (t, y) with `preferred` modes; logs the mode changes
+    /// not logged yet (`logged`), and refreshes `s_ref`.
+    fn resolve_modes(&mut self, t: f64, y: &[f64], closed: &[usize], preferred: &[ContactMode], logged: &[usize]) -> Result<(), RunError> {
+        self.prepare_at(t, y)?;
+        let stab = self.scene.stabilization;
+        let h = self.hybrid.as_mut().expect("hybrid");
+        let before = h.state.mode.clone();
+        for (k, c) in h.contacts.iter().enumerate() {
+            if matches!(c.model, ContactModel::Unilateral { .. }) && !closed.contains(&k) {
+                h.state.mode[k] = ContactMode::Separated;
+            }
+        }
+        choose_modes(&h.contacts, &mut h.state, closed, preferred, h.settings.vel_tol, stab, &mut self.ws.fd, &mut h.cd, t)?;
+        let mut events = Vec::new();
+        for k in 0..h.contacts.len() {
+            let (a, b) = (before[k], h.state.mode[k]);
+            if b == ContactMode::Sliding {
+                h.s_ref[k] = slip_direction(h.cd.rows.slip(k), h.state.slip[k]);
+            }
+            if a == b || logged.contains(&k) {
+                continue;
+            }
+            let kind = match (a, b) {
+                (ContactMode::Separated, _) => ContactEventKind::TouchDown,
+                (_, ContactMode::Separated) => ContactEventKind::LiftOff,
+                (ContactMode::Sticking, ContactMode::Sliding) => ContactEventKind::StickToSlip,
+                _ => ContactEventKind::SlipToStick,
+            };
+            let gd = h.cd.rows.vel[3 * k];
+            events.push(ContactEvent { t, contact: k, kind, impulse: 0.0, energy_lost: 0.0, gap_rate_before: gd, gap_rate_after: gd });
+        }
+        for e in events {
+            self.log(e)?;
+        }
+        Ok(())
+    }
+
+    /// After an accepted step: the slip directions the next step's ev1 refers to.
+    fn refresh_slip_reference(&mut self, y: &[f64]) {
+        let l = self.layout;
+        let model = &self.scene.model;
+        let Some(h) = &mut self.hybrid else { return };
+        if !h.state.mode.iter().any(|&m| m == ContactMode::Sliding) {
+            return;
+        }
+        forward_kinematics(model, &mut self.ws.data, &y[l.q()]);
+        forward_velocities(model, &mut self.ws.data, &y[l.qd()]);
+        for (k, c) in h.contacts.iter().enumerate() {
+            if h.state.mode[k] == ContactMode::Sliding {
+                let v = c.plane.point.velocity(&self.ws.data);
+                h.s_ref[k] = slip_direction([c.t1.dot(&v), c.t2.dot(&v)], h.state.slip[k]);
+            }
+        }
+    }
+}
+
+impl HybridSystem for ArmSystem<'_> {
+    fn n_events(&self) -> usize {
+        self.hybrid.as_ref().map_or(0, |h| 2 * h.contacts.len())
+    }
+
+    fn event_direction(&self, i: usize) -> i8 {
+        let Some(h) = &self.hybrid else { return 0 };
+        match h.contacts[i / 2].model {
+            ContactModel::Compliant { .. } => 0,
+            _ => -1,
+        }
+    }
+
+    fn events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
+        if self.hybrid.is_none() {
+            return Ok(());
+        }
+        self.evaluate(t, y)?;
+        let h = self.hybrid.as_ref().expect("hybrid");
+        let r = &h.cd.rows;
+        for (k, c) in h.contacts.iter().enumerate() {
+            let (f_n, f_t) = (h.cd.f_n[k], h.cd.f_t[k]);
+            let (e0, e1) = match (c.model, h.state.mode[k]) {
+                (ContactModel::Bilateral, _) => (1.0, 1.0),
+                (ContactModel::Compliant { stiffness, damping, .. }, _) => {
+                    let (delta, delta_d) = (-r.gap[k], -r.vel[3 * k]);
+                    (r.gap[k], if delta > 0.0 { stiffness * delta + damping * delta_d } else { 1.0 })
+                }
+                (_, ContactMode::Separated | ContactMode::Bilateral) => (r.gap[k], 1.0),
+                (_, ContactMode::Sticking) => (f_n, mu_of(c) * f_n - f_t[0].hypot(f_t[1])),
+                (_, ContactMode::Sliding) => {
+                    let v = r.slip(k);
+                    (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
+                }
+            };
+            out[2 * k] = e0;
+            out[2 * k + 1] = e1;
+        }
+        Ok(())
+    }
+
+    fn init_modes(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
+        if self.hybrid.is_none() {
+            return Ok(false);
+        }
+        self.prepare_at(t, y)?;
+        let h = self.hybrid.as_ref().expect("hybrid");
+        let st = h.settings;
+        let mut approaching = Vec::new();
+        let mut closed = Vec::new();
+        for (k, c) in h.contacts.iter().enumerate() {
+            if matches!(c.model, ContactModel::Unilateral { .. }) && h.cd.rows.gap[k].abs() <= st.gap_tol {
+                if h.cd.rows.vel[3 * k] < -st.vel_tol {
+                    approaching.push(k);
+                } else if h.cd.rows.vel[3 * k] <= st.vel_tol {
+                    closed.push(k);
+                }
+            }
+        }
+        let mut moved = false;
+        if !approaching.is_empty() {
+            let (c2, _) = self.impact(t, y, &approaching)?;
+            closed = c2;
+            moved = true;
+        }
+        // a contact at rest on the table at t0 is taken as closed when both are consistent
+        let h = self.hybrid.as_ref().expect("hybrid");
+        let preferred: Vec<ContactMode> = h
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(k, c)| if mu_of(c) > 0.0 && h.cd.rows.slip(k)[0].hypot(h.cd.rows.slip(k)[1]) <= st.vel_tol { ContactMode::Sticking } else { ContactMode::Sliding })
+            .collect();
+        let before_log = self.hybrid.as_ref().map_or(0, |h| h.log.len());
+        self.resolve_modes(t, y, &closed, &preferred, &[])?;
+        // the initial choice is not an event
+        let h = self.hybrid.as_mut().expect("hybrid");
+        let n = h.log.len();
+        let dropped = h.log.drain(before_log..n).filter(|e| e.kind != ContactEventKind::Impact && e.kind != ContactEventKind::Rest).count();
+        h.count -= dropped as u64;
+        Ok(moved)
+    }
+
+    fn handle_events(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> Result<bool, RunError> {
+        if self.hybrid.is_none() {
+            return Ok(false);
+        }
+        // forces and rows at the event in the current modes
+        self.evaluate(t, y)?;
+        let h = self.hybrid.as_mut().expect("hybrid");
+        let st = h.settings;
+        let nc = h.contacts.len();
+        let mut preferred = h.state.mode.clone();
+        let mut closed: Vec<usize> = (0..nc).filter(|&k| in_touch(h.state.mode[k])).collect();
+        let mut approaching = Vec::new();
+        let mut touched = Vec::new();
+        let mut pending = Vec::new();
+        let mut logged = Vec::new();
+        for k in 0..nc {
+            let (f0, f1) = (fired[2 * k], fired[2 * k + 1]);
+            if !(f0 || f1) {
+                continue;
+            }
+            let gd = h.cd.rows.vel[3 * k];
+            let c = &h.contacts[k];
+            match (c.model, h.state.mode[k]) {
+                (ContactModel::Bilateral, _) => {}
+                (ContactModel::Compliant { .. }, _) => {
+                    if f0 {
+                        let kind = if gd < 0.0 { ContactEventKind::TouchDown } else { ContactEventKind::LiftOff };
+                        pending.push(ContactEvent { t, contact: k, kind, impulse: 0.0, energy_lost: 0.0, gap_rate_before: gd, gap_rate_after: gd });
+                    }
+                }
+                (_, ContactMode::Separated | ContactMode::Bilateral) => {
+                    if f0 {
+                        if gd < -st.vel_tol {
+                            approaching.push(k);
+                        } else {
+                            touched.push(k);
+                            preferred[k] = if mu_of(c) > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
+                        }
+                    }
+                }
+                (_, mode) => {
+                    if f0 {
+                        preferred[k] = ContactMode::Separated;
+                    } else if f1 && mode == ContactMode::Sticking {
+                        preferred[k] = ContactMode::Sliding;
+                        let f = h.cd.f_t[k];
+                        let m = f[0].hypot(f[1]);
+                        if m > 0.0 {
+                            h.state.slip[k] = [-f[0] / m, -f[1] / m];
+                        }
+                    } else if f1 {
+                        preferred[k] = ContactMode::Sticking;
+                    }
+                }
+            }
+        }
+        for e in pending {
+            self.log(e)?;
+        }
+        let mut moved = false;
+        if !approaching.is_empty() {
+            let (c2, opened) = self.impact(t, y, &approaching)?;
+            moved = true;
+            for k in c2 {
+                if !closed.contains(&k) {
+                    closed.push(k);
+                }
+                let c = &self.hybrid.as_ref().expect("hybrid").contacts[k];
+                if preferred[k] == ContactMode::Separated && approaching.contains(&k) {
+                    preferred[k] = if mu_of(c) > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
+                }
+                if approaching.contains(&k) {
+                    logged.push(k);
+                }
+            }
+            closed.retain(|k| !opened.contains(k));
+            for k in opened {
+                logged.push(k);
+            }
+        }
+        for k in touched {
+            if !closed.contains(&k) {
+                closed.push(k);
+            }
+        }
+        self.resolve_modes(t, y, &closed, &preferred, &logged)?;
+        Ok(moved)
+    }
+
+    fn after_step(&mut self, _t: f64, y: &[f64]) {
+        self.refresh_slip_reference(y);
+    }
+}

@@ -1,0 +1,160 @@
+//! The scene's contacts: each `contacts[i]` with its model (absent = the paper's bilateral
+//! constraint), the `table` construct (a plane under named points, each a unilateral contact by
+//! default that belongs to every run), and the `events` settings. Errors name
+//! `contacts[i].field` (or `table.field`) and the value.
+
+use nalgebra::Unit;
+
+use super::ctx::{non_negative, positive, Ctx};
+use super::spec::{LawKeys, PlaneSpec, PointSpec, SceneSpec};
+use super::INITIAL_CONSTRAINT_TOL;
+use crate::dynamics::constraints::PointOnPlane;
+use crate::dynamics::contact::{Contact, ContactModel, ContactSettings};
+use crate::dynamics::{Data, Model};
+use crate::error::{short, SceneError};
+
+/// The model of a contact from its keys; `default` when `model` is absent.
+fn contact_model(c: &Ctx, f: &str, k: LawKeys, default: &str) -> Result<ContactModel, SceneError> {
+    let model = k.model.unwrap_or(default);
+    let given = [
+        ("restitution", k.restitution),
+        ("friction", k.friction),
+        ("stiffness", k.stiffness),
+        ("damping", k.damping),
+        ("slip_velocity", k.slip_velocity),
+    ];
+    let allowed: &[&str] = match model {
+        "bilateral" => &[],
+        "unilateral" => &["restitution", "friction"],
+        "compliant" => &["friction", "stiffness", "damping", "slip_velocity"],
+        other => {
+            return Err(c.err(format!("{f}.model"), other, "unknown contact model: use \"bilateral\", \"unilateral\" or \"compliant\""));
+        }
+    };
+    for (key, v) in given {
+        if let Some(v) = v {
+            if !allowed.contains(&key) {
+                return Err(c.err(format!("{f}.{key}"), short(v), format!("does not belong to the {model} model (its keys: {})", if allowed.is_empty() { "none".into() } else { allowed.join(", ") })));
+            }
+        }
+    }
+    let friction = c.number(&format!("{f}.friction"), k.friction.unwrap_or(0.0), non_negative, "must be >= 0")?;
+    Ok(match model {
+        "bilateral" => ContactModel::Bilateral,
+        "unilateral" => {
+            let restitution = c.number(&format!("{f}.restitution"), k.restitution.unwrap_or(0.0), |x| (0.0..=1.0).contains(&x), "must be in [0, 1]")?;
+            ContactModel::Unilateral { restitution, friction }
+        }
+        _ => {
+            let Some(stiffness) = k.stiffness else {
+                return Err(c.err(format!("{f}.stiffness"), "(absent)", "a compliant contact needs a stiffness, N/m (> 0)"));
+            };
+            let stiffness = c.number(&format!("{f}.stiffness"), stiffness, positive, "must be > 0 N/m")?;
+            let damping = c.number(&format!("{f}.damping"), k.damping.unwrap_or(0.0), non_negative, "must be >= 0 N s/m")?;
+            let slip_velocity = c.number(&format!("{f}.slip_velocity"), k.slip_velocity.unwrap_or(1e-3), positive, "must be > 0 m/s")?;
+            ContactModel::Compliant { stiffness, damping, friction, slip_velocity }
+        }
+    })
+}
+
+fn plane(c: &Ctx, f: &str, name: &str, model: &Model, point: &PointSpec, plane: &PlaneSpec) -> Result<PointOnPlane, SceneError> {
+    let point = c.point(&format!("{f}.point"), model, point)?;
+    let n = c.vec3(&format!("{f}.plane.normal"), plane.normal)?;
+    if n.norm() < 1e-12 {
+        return Err(c.err(format!("{f}.plane.normal"), format!("{:?}", plane.normal), "must be non-zero"));
+    }
+    let offset = c.number(&format!("{f}.plane.offset"), plane.offset, |_| true, "")?;
+    if point.body.is_none() {
+        return Err(c.err(format!("{f}.point"), name, "is fixed to the base: it cannot be constrained"));
+    }
+    Ok(PointOnPlane { name: name.to_string(), point, normal_world: Unit::new_normalize(n), offset })
+}
+
+/// The initial state against a contact: bilateral ones must hold (C = 0, Ċ = 0, the paper's
+/// check); a unilateral one must not start inside the plane (g0 ≥ −gap_tol).
+fn check_initial(c: &Ctx, f: &str, contact: &Contact, data: &Data, gap_tol: f64) -> Result<(), SceneError> {
+    let p = &contact.plane;
+    let (pos, vel) = (p.position(data), p.velocity(data));
+    match contact.model {
+        ContactModel::Bilateral => {
+            if pos.abs() > INITIAL_CONSTRAINT_TOL || vel.abs() > INITIAL_CONSTRAINT_TOL {
+                return Err(c.err(
+                    f.to_string(),
+                    &p.name,
+                    format!(
+                        "the initial state violates this contact: C(q0) = {pos:.3e} m, C'(q0, qd0) = {vel:.3e} m/s (tolerance {INITIAL_CONSTRAINT_TOL:e}); move initial.q onto the plane or drop the contact"
+                    ),
+                ));
+            }
+        }
+        ContactModel::Unilateral { .. } => {
+            if pos < -gap_tol {
+                return Err(c.err(
+                    f.to_string(),
+                    &p.name,
+                    format!("the point starts inside the plane: gap g(q0) = {pos:.3e} m < -{gap_tol:e} m; move initial.q or the plane"),
+                ));
+            }
+        }
+        ContactModel::Compliant { .. } => {}
+    }
+    Ok(())
+}
+
+/// Every contact of the scene (the `contacts`, then the table's points) as planes and as
+/// contacts with their models, the indices of the table's contacts (part of every run), and
+/// the event settings. `data` holds the kinematics and velocities at (q0, q̇0).
+pub(super) fn build_contacts(
+    c: &Ctx,
+    spec: &SceneSpec,
+    model: &Model,
+    data: &Data,
+) -> Result<(Vec<PointOnPlane>, Vec<Contact>, Vec<usize>, ContactSettings), SceneError> {
+    let mut settings = ContactSettings::default();
+    if let Some(ev) = &spec.events {
+        if let Some(x) = ev.time_tolerance {
+            settings.time_tol = c.number("events.time_tolerance", x, |x| x > 0.0 && x <= 1e-3, "must be in (0, 1e-3] s")?;
+        }
+        if let Some(x) = ev.rest_velocity {
+            settings.rest_velocity = c.number("events.rest_velocity", x, non_negative, "must be >= 0 m/s")?;
+        }
+        if let Some(x) = ev.max_events {
+            if x == 0 {
+                return Err(c.err("events.max_events", x, "must be >= 1"));
+            }
+            settings.max_events = x;
+        }
+    }
+    let mut planes: Vec<PointOnPlane> = Vec::new();
+    let mut contacts: Vec<Contact> = Vec::new();
+    let mut table_idx = Vec::new();
+    let mut push = |f: &str, name: &str, p: PointOnPlane, m: ContactModel| -> Result<(), SceneError> {
+        if planes.iter().any(|x| x.name == name) {
+            return Err(c.err(format!("{f}.name"), name, "is used twice"));
+        }
+        let contact = Contact::new(p.clone(), m);
+        check_initial(c, f, &contact, data, settings.gap_tol)?;
+        planes.push(p);
+        contacts.push(contact);
+        Ok(())
+    };
+    for (i, cs) in spec.contacts.iter().enumerate() {
+        let f = format!("contacts[{i}]");
+        let m = contact_model(c, &f, cs.law(), "bilateral")?;
+        let p = plane(c, &f, &cs.name, model, &cs.point, &cs.plane)?;
+        push(&f, &cs.name, p, m)?;
+    }
+    if let Some(t) = &spec.table {
+        let m = contact_model(c, "table", t.law(), "unilateral")?;
+        if t.points.is_empty() {
+            return Err(c.err("table.points", "[]", "needs at least one point"));
+        }
+        for (i, tp) in t.points.iter().enumerate() {
+            let f = format!("table.points[{i}]");
+            let p = plane(c, &f, &tp.name, model, &tp.point, &t.plane)?;
+            push(&f, &tp.name, p, m)?;
+            table_idx.push(spec.contacts.len() + i);
+        }
+    }
+    Ok((planes, contacts, table_idx, settings))
+}
