@@ -2,8 +2,58 @@
 //! located as roots of event functions on the stepper's dense output, the system's discrete
 //! mode switched (and its state possibly jumped) at each event, then the stepper restarted.
 //!
-//! INTERFACE ONLY in this base commit (issue 11); the driver is implemented on its branch.
+//! The driver ([`integrate_hybrid`]) follows the event-driven scheme of Pfeiffer & Glocker,
+//! *Multibody Dynamics with Unilateral Contacts* (Wiley 1996, ch. 6) and Acary & Brogliato,
+//! *Numerical Methods for Nonsmooth Dynamical Systems* (Springer 2008, ch. 8 "event-driven
+//! schemes"): integrate a smooth phase with an ordinary (adaptive) method, detect a sign change
+//! of an event function between the ends of an accepted step, locate its root on the step's
+//! dense output (HNW I §II.6), switch the mode at the root, restart the method there.
+//! Root location is the Illinois (modified regula falsi) iteration of SUNDIALS CVODE's
+//! rootfinding (Hindmarsh et al., ACM TOMS 31 (2005) 363–396, §2.4 and `cvRootfind`), on all
+//! functions at once, so the earliest root across the functions is found:
+//!
+//! - an accepted step `[t_lo, t_hi]` has a *sign change* of function `i` when, with the
+//!   function's direction `d_i` ([`HybridSystem::event_direction`]), `g_i(t_lo) > 0 ≥
+//!   g_i(t_hi)` (`d_i = −1`), `g_i(t_lo) < 0 ≤ g_i(t_hi)` (`d_i = +1`) or either (`d_i = 0`).
+//!   A function exactly 0 at the start of a step is thereby *disarmed* for that step: one
+//!   exactly 0 at a (re)start fires only after it has left 0 (at a later step start);
+//! - the bracket `[t_lo, t_hi]` is narrowed by the Illinois secant on the function with the
+//!   largest `|g(t_hi)| / |g(t_hi) − g(t_lo)|` (all functions are evaluated at each trial point;
+//!   a sign change of any function in `[t_lo, t_mid]` keeps that half), to a width
+//!   `≤ time_tol` (default 1e-12 s, or 4 ulp of `t` if larger);
+//! - the event time `t*` is the bracket's upper end (every fired function has changed sign
+//!   there); all functions with a sign change over the final bracket fire together;
+//! - output samples `t_k < t*` come from the pre-event dense output, `y* = y(t*)` from the same;
+//!   [`HybridSystem::handle_events`] switches the modes and may jump `y*`; the state is then
+//!   projected ([`OdeSystem::project`], with the new modes), the stepper restarted at
+//!   `(t*, y*)` with [`Stepper::init`] (its statistics accumulated over the restarts), and
+//!   samples `t_k ≥ t*` come from after the event.
+//!
+//! Guards: more than [`EventSettings::max_events`] events in a run is
+//! [`IntegrateError::TooManyEvents`]; more than [`EventSettings::max_events_at_one_time`]
+//! events in a row, each within `10 time_tol` of the previous one, is
+//! [`IntegrateError::Chattering`] (a handler that does not settle the mode; Zeno accumulation
+//! of impacts is the system's to stop, by a rest rule).
+//!
+//! Fixed-step [`super::Rk4`]: the same procedure on its cubic Hermite interpolant, so event
+//! times are accurate to that interpolant (O(h⁴)), not to `time_tol`; and a function that
+//! changes sign twice within one step (up to the step size) is not seen. The adaptive methods
+//! have the same blind spot within one of their steps; their `h_max` bounds it.
+//!
+//! Cost: each trial point of the root finding evaluates all event functions once (for the arm,
+//! force-type functions need a right-hand side); the functions are also evaluated at the end
+//! of every accepted step and again at its (projected) start, so the next step compares like
+//! with like. Allocation: the buffers are sized once per call; nothing per step; an event
+//! allocates only for an error message.
 
+mod locate;
+#[cfg(test)]
+mod tests;
+#[cfg(test)]
+mod toys;
+
+use self::locate::{crosses, locate_root, Bracket};
+use super::sampled::{OutputGrid, Pace};
 use super::{Deadline, IntegrateError, OdeSystem, Stats, Stepper};
 
 /// A system whose right-hand side depends on a discrete mode that changes at events.
@@ -59,10 +109,27 @@ impl Default for EventSettings {
     }
 }
 
-/// [`super::integrate_sampled_within`] for a [`HybridSystem`]: the same fixed output grid and
-/// projection, plus event location and restarts. `sample(t, y, sys)` gets the system too, so
-/// a caller can read its modes (and drain what it logged) at each output time; samples at
-/// `t_k < t_event` come from before the event, `t_k ≥ t_event` from after it.
+/// [`super::integrate_sampled_within`] for a [`HybridSystem`]: the same fixed output grid,
+/// projection and deadline, plus event location and restarts (the module doc says how).
+/// `sample(t, y, sys)` gets the system too, so a caller can read its modes (and drain what it
+/// logged) at each output time; samples at `t_k < t_event` come from before the event,
+/// `t_k ≥ t_event` from after it.
+///
+/// - [`HybridSystem::init_modes`] is called at `(t0, y0)` before anything else; the first
+///   sample is `y0` bit for bit unless it moved `y0`.
+/// - [`HybridSystem::after_step`] is called after every accepted step that has no event (after
+///   the projection).
+/// - With `sys.n_events() == 0` the samples, the steps and the statistics are those of
+///   `integrate_sampled_within` bit for bit.
+/// - `settings.time_tol` that is not finite and positive means "as fine as `t` resolves"
+///   (4 ulp of `t`).
+///
+/// Returns the [`Stats`] summed over all restarts.
+///
+/// # Errors
+/// Those of `integrate_sampled_within`; the system's errors from `events`, `init_modes`,
+/// `handle_events` as [`IntegrateError::Rhs`]; [`IntegrateError::TooManyEvents`] and
+/// [`IntegrateError::Chattering`] at the event time.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
     stepper: &mut St,
@@ -73,8 +140,138 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
     dt_out: f64,
     deadline: Option<Deadline>,
     settings: EventSettings,
-    sample: impl FnMut(f64, &[f64], &mut S) -> Result<(), S::Error>,
+    mut sample: impl FnMut(f64, &[f64], &mut S) -> Result<(), S::Error>,
 ) -> Result<Stats, IntegrateError<S::Error>> {
-    let _ = (stepper, sys, t0, y0, t_end, dt_out, deadline, settings, sample);
-    unimplemented!("issue 11: the event driver lands on its branch")
+    let grid = OutputGrid::new(t0, t_end, dt_out)?;
+    let n_out = grid.n_out;
+    let n_ev = sys.n_events();
+    let rhs = IntegrateError::Rhs;
+
+    // the modes at t0, then the first sample
+    let mut y_star = y0.to_vec();
+    sys.init_modes(t0, &mut y_star).map_err(rhs)?;
+    stepper.init(sys, t0, &y_star)?;
+    sample(t0, stepper.y(), sys).map_err(|source| IntegrateError::Sample { t: t0, source })?;
+
+    let mut buf = vec![0.0; y0.len()];
+    let mut br = Bracket::new(n_ev);
+    if n_ev > 0 {
+        br.refresh_directions(sys);
+        sys.events(t0, stepper.y(), &mut br.g_lo).map_err(rhs)?;
+    }
+    let mut k = 1;
+    let mut pace = Pace::new(deadline, t0, t_end);
+    let mut done = Stats::default(); // statistics of the segments before the last restart
+    let mut restarted = false; // no step since the last event's restart
+    let mut stepped = false; // a step since the last (re)start
+    let mut n_events = 0u64;
+    let mut in_row = 0u32;
+    let mut t_last_event = f64::NEG_INFINITY;
+    loop {
+        // report every grid point inside the last accepted step [t_prev, t] (or at the restart)
+        while k <= n_out {
+            let t_k = grid.time(k);
+            if t_k > stepper.t() {
+                break;
+            }
+            if t_k == stepper.t() {
+                sample(t_k, stepper.y(), sys)
+            } else {
+                stepper.interpolate(t_k, &mut buf);
+                sample(t_k, &buf, sys)
+            }
+            .map_err(|source| IntegrateError::Sample { t: t_k, source })?;
+            k += 1;
+        }
+        if stepper.t() >= t_end {
+            break;
+        }
+        // projection after an accepted step, as integrate_sampled_within does (after sampling)
+        if !restarted && (k > 1 || stepper.t() > t0) {
+            buf.copy_from_slice(stepper.y());
+            if sys.project(stepper.t(), &mut buf).map_err(rhs)? {
+                stepper.set_state(sys, &buf)?;
+            }
+        }
+        if stepped && n_ev > 0 {
+            // the step had no event: the system may refresh what its functions refer to, and
+            // the next step's start values are taken at the (projected) state
+            sys.after_step(stepper.t(), stepper.y());
+            sys.events(stepper.t(), stepper.y(), &mut br.g_lo).map_err(rhs)?;
+        }
+        let t_before = stepper.t();
+        let t_after = stepper.step(sys, t_end)?;
+        if t_after.is_nan() || t_after <= t_before {
+            // a stepper that stops advancing before t_end would loop forever
+            return Err(IntegrateError::StepSizeTooSmall { t: t_before, h: t_after - t_before });
+        }
+        pace.after_step(t_after)?;
+        restarted = false;
+        stepped = true;
+        if n_ev == 0 {
+            continue;
+        }
+        sys.events(t_after, stepper.y(), &mut br.g_hi).map_err(rhs)?;
+        if !(0..n_ev).any(|i| crosses(br.dir[i], br.g_lo[i], br.g_hi[i])) {
+            continue;
+        }
+
+        // an event in [t_before, t_after]: its time, then the samples before it
+        let tol = time_tolerance(settings.time_tol, t_after);
+        let t_star = locate_root(stepper, sys, &mut br, t_before, t_after, tol, &mut buf)?;
+        while k <= n_out && grid.time(k) < t_star {
+            let t_k = grid.time(k);
+            stepper.interpolate(t_k, &mut buf);
+            sample(t_k, &buf, sys).map_err(|source| IntegrateError::Sample { t: t_k, source })?;
+            k += 1;
+        }
+        n_events += 1;
+        if n_events > settings.max_events {
+            return Err(IntegrateError::TooManyEvents { t: t_star, max_events: settings.max_events });
+        }
+        let window = 10.0 * tol;
+        in_row = if t_star - t_last_event <= window { in_row + 1 } else { 1 };
+        t_last_event = t_star;
+        if in_row > settings.max_events_at_one_time {
+            let fired: Vec<usize> = (0..n_ev).filter(|&i| br.fired[i]).collect();
+            return Err(IntegrateError::Chattering { t: t_star, count: in_row, window, events: format!("event functions {fired:?}") });
+        }
+
+        // switch the modes (and jump the state) at t*, project, restart there
+        stepper.interpolate(t_star, &mut y_star);
+        sys.handle_events(t_star, &mut y_star, &br.fired).map_err(rhs)?;
+        sys.project(t_star, &mut y_star).map_err(rhs)?;
+        done = add_stats(done, stepper.stats());
+        stepper.init(sys, t_star, &y_star)?;
+        br.refresh_directions(sys);
+        sys.events(t_star, stepper.y(), &mut br.g_lo).map_err(rhs)?;
+        restarted = true;
+        stepped = false;
+    }
+    Ok(add_stats(done, stepper.stats()))
+}
+
+/// Width an event time is located to at `t`: `time_tol`, or 4 ulp of `t` if larger (or if
+/// `time_tol` is not a positive number).
+fn time_tolerance(time_tol: f64, t: f64) -> f64 {
+    let a = t.abs();
+    let ulp = if a.is_finite() { f64::from_bits(a.to_bits() + 1) - a } else { 0.0 };
+    let floor = 4.0 * ulp.max(f64::MIN_POSITIVE);
+    if time_tol.is_finite() && time_tol > floor {
+        time_tol
+    } else {
+        floor
+    }
+}
+
+/// `a + b`, counter by counter.
+fn add_stats(a: Stats, b: Stats) -> Stats {
+    Stats {
+        rhs_evals: a.rhs_evals + b.rhs_evals,
+        steps: a.steps + b.steps,
+        rejected: a.rejected + b.rejected,
+        jacobian_evals: a.jacobian_evals + b.jacobian_evals,
+        lu_decompositions: a.lu_decompositions + b.lu_decompositions,
+        implicit_solves: a.implicit_solves + b.implicit_solves,
+    }
 }

@@ -88,28 +88,8 @@ pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
     deadline: Option<Deadline>,
     mut sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
 ) -> Result<Stats, IntegrateError<S::Error>> {
-    // output grid: n intervals, the last one ending exactly on t_end when it fits
-    let invalid = || IntegrateError::InvalidOutputGrid { t0, t_end, dt_out };
-    if !(t0.is_finite() && t_end.is_finite() && dt_out.is_finite() && dt_out > 0.0 && t_end >= t0) {
-        return Err(invalid());
-    }
-    let ratio = (t_end - t0) / dt_out;
-    if ratio > 9.007_199_254_740_992e15 {
-        return Err(invalid());
-    }
-    let nearest = ratio.round();
-    let lands_on_end = (ratio - nearest).abs() <= GRID_REL_TOL * nearest.max(1.0);
-    let n_out = if lands_on_end { nearest } else { ratio.floor() } as u64;
-    let grid_time = |k: u64| {
-        if k == n_out && lands_on_end {
-            t_end
-        } else if lands_on_end {
-            // k (t_end - t0) / N, correctly rounded: 0.009, not 9 * 0.001 = 0.009000000000000001
-            t0 + (k as f64 * (t_end - t0)) / n_out as f64
-        } else {
-            t0 + k as f64 * dt_out
-        }
-    };
+    let grid = OutputGrid::new(t0, t_end, dt_out)?;
+    let n_out = grid.n_out;
 
     // first sample: the initial state exactly
     stepper.init(sys, t0, y0)?;
@@ -117,12 +97,11 @@ pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
 
     let mut buf = vec![0.0; y0.len()];
     let mut k = 1;
-    let mut steps = 0u64;
-    let started = Instant::now();
+    let mut pace = Pace::new(deadline, t0, t_end);
     loop {
         // report every grid point inside the last accepted step [t_prev, t]
         while k <= n_out {
-            let t_k = grid_time(k);
+            let t_k = grid.time(k);
             if t_k > stepper.t() {
                 break;
             }
@@ -158,25 +137,93 @@ pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
                 h: t_after - t_before,
             });
         }
-        steps += 1;
-        if let Some(deadline) = deadline {
-            if steps.is_multiple_of(CLOCK_EVERY) {
+        pace.after_step(t_after)?;
+    }
+    Ok(stepper.stats())
+}
+
+/// The output grid of [`integrate_sampled_within`] (and of the event driver): `n_out`
+/// intervals, the last one ending exactly on `t_end` when the span is a whole number of
+/// output intervals (within [`GRID_REL_TOL`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct OutputGrid {
+    t0: f64,
+    t_end: f64,
+    dt_out: f64,
+    /// Index of the last output time (`k = 0..=n_out`).
+    pub(super) n_out: u64,
+    lands_on_end: bool,
+}
+
+impl OutputGrid {
+    /// The grid, or [`IntegrateError::InvalidOutputGrid`] for a non-finite value, `dt_out <= 0`,
+    /// `t_end < t0` or more than 2^53 samples.
+    pub(super) fn new<E>(t0: f64, t_end: f64, dt_out: f64) -> Result<Self, IntegrateError<E>> {
+        let invalid = || IntegrateError::InvalidOutputGrid { t0, t_end, dt_out };
+        if !(t0.is_finite() && t_end.is_finite() && dt_out.is_finite() && dt_out > 0.0 && t_end >= t0) {
+            return Err(invalid());
+        }
+        let ratio = (t_end - t0) / dt_out;
+        if ratio > 9.007_199_254_740_992e15 {
+            return Err(invalid());
+        }
+        let nearest = ratio.round();
+        let lands_on_end = (ratio - nearest).abs() <= GRID_REL_TOL * nearest.max(1.0);
+        let n_out = if lands_on_end { nearest } else { ratio.floor() } as u64;
+        Ok(OutputGrid { t0, t_end, dt_out, n_out, lands_on_end })
+    }
+
+    /// Output time `k` (by multiplication, no accumulated round-off).
+    pub(super) fn time(&self, k: u64) -> f64 {
+        let OutputGrid { t0, t_end, dt_out, n_out, lands_on_end } = *self;
+        if k == n_out && lands_on_end {
+            t_end
+        } else if lands_on_end {
+            // k (t_end - t0) / N, correctly rounded: 0.009, not 9 * 0.001 = 0.009000000000000001
+            t0 + (k as f64 * (t_end - t0)) / n_out as f64
+        } else {
+            t0 + k as f64 * dt_out
+        }
+    }
+}
+
+/// The wall-clock watch of a run ([`Deadline`]): counts accepted steps and reads the clock
+/// every [`CLOCK_EVERY`] of them.
+pub(super) struct Pace {
+    deadline: Option<Deadline>,
+    t0: f64,
+    t_end: f64,
+    steps: u64,
+    started: Instant,
+}
+
+impl Pace {
+    pub(super) fn new(deadline: Option<Deadline>, t0: f64, t_end: f64) -> Self {
+        Pace { deadline, t0, t_end, steps: 0, started: Instant::now() }
+    }
+
+    /// After an accepted step ending at `t_after`: [`IntegrateError::OutOfTime`] past the
+    /// deadline, [`IntegrateError::TooSlow`] when the pace so far cannot make it.
+    pub(super) fn after_step<E>(&mut self, t_after: f64) -> Result<(), IntegrateError<E>> {
+        self.steps += 1;
+        if let Some(deadline) = self.deadline {
+            if self.steps.is_multiple_of(CLOCK_EVERY) {
                 let now = Instant::now();
                 if now >= deadline.at {
                     return Err(IntegrateError::OutOfTime { t: t_after });
                 }
-                let spent = now.duration_since(started);
-                let done = (t_after - t0) / (t_end - t0);
+                let spent = now.duration_since(self.started);
+                let done = (t_after - self.t0) / (self.t_end - self.t0);
                 if spent >= deadline.judge_pace_after && done > 0.0 {
                     let projected_s = spent.as_secs_f64() / done;
-                    if projected_s > 2.0 * deadline.at.duration_since(started).as_secs_f64() {
+                    if projected_s > 2.0 * deadline.at.duration_since(self.started).as_secs_f64() {
                         return Err(IntegrateError::TooSlow { t: t_after, projected_s });
                     }
                 }
             }
         }
+        Ok(())
     }
-    Ok(stepper.stats())
 }
 
 #[cfg(test)]

@@ -1,0 +1,136 @@
+//! Locating the earliest root of the event functions in an accepted step: the Illinois
+//! (modified regula falsi) iteration of SUNDIALS CVODE's `cvRootfind` (Hindmarsh et al., ACM
+//! TOMS 31 (2005) 363–396, §2.4), on the stepper's dense output (HNW I §II.6).
+
+use super::HybridSystem;
+use crate::integrate::{IntegrateError, Stepper};
+
+/// Most trial points of one root search: far more than the ~log2(h / time_tol) ≈ 40 a
+/// bisection would need, so the bound only stops a search that cannot shrink its bracket
+/// (which the inward adjustment below rules out).
+const MAX_TRIALS: u32 = 400;
+
+/// The event functions at the ends of a bracket, the trial values, the directions and which
+/// functions fired: sized once per run (`n` functions).
+pub(super) struct Bracket {
+    pub(super) g_lo: Vec<f64>,
+    pub(super) g_hi: Vec<f64>,
+    g_mid: Vec<f64>,
+    pub(super) dir: Vec<i8>,
+    pub(super) fired: Vec<bool>,
+}
+
+impl Bracket {
+    pub(super) fn new(n: usize) -> Self {
+        Bracket { g_lo: vec![0.0; n], g_hi: vec![0.0; n], g_mid: vec![0.0; n], dir: vec![0; n], fired: vec![false; n] }
+    }
+
+    /// Reads the directions of the current mode from `sys`.
+    pub(super) fn refresh_directions<S: HybridSystem>(&mut self, sys: &S) {
+        for (i, d) in self.dir.iter_mut().enumerate() {
+            *d = sys.event_direction(i);
+        }
+    }
+}
+
+/// Whether a function of direction `dir` going from `lo` to `g` has changed sign: from `> 0`
+/// to `≤ 0` (`dir = −1`), from `< 0` to `≥ 0` (`+1`), either (`0`). `lo = 0` never (disarmed);
+/// a NaN never.
+#[inline]
+pub(super) fn crosses(dir: i8, lo: f64, g: f64) -> bool {
+    let down = lo > 0.0 && g <= 0.0;
+    let up = lo < 0.0 && g >= 0.0;
+    match dir {
+        d if d < 0 => down,
+        d if d > 0 => up,
+        _ => down || up,
+    }
+}
+
+/// The earliest root in `[t_lo, t_hi]` (an accepted step of `stepper`, whose `br.g_lo`,
+/// `br.g_hi` hold the functions at its ends and have a sign change): narrows the bracket to
+/// `≤ tol` and returns its upper end `t*`, with `br.fired` the functions that changed sign
+/// over the final bracket and `br.g_hi` their values at `t*`. `y` is scratch (length dim).
+pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
+    stepper: &St,
+    sys: &mut S,
+    br: &mut Bracket,
+    mut t_lo: f64,
+    mut t_hi: f64,
+    tol: f64,
+    y: &mut [f64],
+) -> Result<f64, IntegrateError<S::Error>> {
+    let n = br.g_lo.len();
+    // the function to take the secant on: the largest |g_hi| / |g_hi - g_lo| among the crossing
+    let pick = |lo: &[f64], hi: &[f64], dir: &[i8]| -> Option<usize> {
+        let mut best: Option<(usize, f64)> = None;
+        for i in 0..n {
+            if crosses(dir[i], lo[i], hi[i]) {
+                let frac = (hi[i] / (hi[i] - lo[i])).abs();
+                if best.is_none_or(|(_, f)| frac > f) {
+                    best = Some((i, frac));
+                }
+            }
+        }
+        best.map(|(i, _)| i)
+    };
+    let Some(mut imax) = pick(&br.g_lo, &br.g_hi, &br.dir) else {
+        unreachable_bracket(br);
+        return Ok(t_hi);
+    };
+    let mut alpha = 1.0;
+    // side of the last two reductions: 1 = the root was in the low part, 2 = in the high part
+    let (mut side, mut side_prev) = (0u8, 0u8);
+    let mut trials = 0;
+    while t_hi - t_lo > tol && trials < MAX_TRIALS {
+        trials += 1;
+        // Illinois weight: the same side twice in a row -> weight the retained end's value
+        alpha = if trials > 2 && side == side_prev { if side == 2 { alpha * 2.0 } else { alpha * 0.5 } } else { 1.0 };
+        let (glo, ghi) = (br.g_lo[imax], br.g_hi[imax]);
+        let mut t_mid = t_hi - (t_hi - t_lo) * ghi / (ghi - alpha * glo);
+        if !t_mid.is_finite() {
+            t_mid = 0.5 * (t_lo + t_hi);
+        }
+        // keep the trial point at least tol/2 inside the bracket (cvRootfind's adjustment)
+        let width = t_hi - t_lo;
+        let inward = || {
+            let frac_int = width / tol;
+            (if frac_int > 5.0 { 0.1 } else { 0.5 / frac_int }) * width
+        };
+        if t_mid - t_lo < 0.5 * tol {
+            t_mid = t_lo + inward();
+        }
+        if t_hi - t_mid < 0.5 * tol {
+            t_mid = t_hi - inward();
+        }
+        if !(t_mid > t_lo && t_mid < t_hi) {
+            break; // the bracket is down to adjacent floating-point numbers
+        }
+        stepper.interpolate(t_mid, y);
+        sys.events(t_mid, y, &mut br.g_mid).map_err(IntegrateError::Rhs)?;
+        side_prev = side;
+        match pick(&br.g_lo, &br.g_mid, &br.dir) {
+            Some(i) => {
+                // a sign change in [t_lo, t_mid]: the root (the earliest) is there
+                imax = i;
+                t_hi = t_mid;
+                br.g_hi.copy_from_slice(&br.g_mid);
+                side = 1;
+            }
+            None => {
+                t_lo = t_mid;
+                br.g_lo.copy_from_slice(&br.g_mid);
+                side = 2;
+            }
+        }
+    }
+    for i in 0..n {
+        br.fired[i] = crosses(br.dir[i], br.g_lo[i], br.g_hi[i]);
+    }
+    Ok(t_hi)
+}
+
+/// Called without a sign change: fires nothing (the caller checked there is one).
+fn unreachable_bracket(br: &mut Bracket) {
+    br.fired.iter_mut().for_each(|f| *f = false);
+}

@@ -1,0 +1,320 @@
+//! The event driver on abstract hybrid problems with closed-form event times, for every
+//! method (`toys.rs`).
+
+use super::toys::{methods, Ball, LiftOff, Law, Thresholds, Toy};
+use super::*;
+use crate::integrate::test_problems::{HarmonicOscillator, Kepler, RhsFailure, StiffLinear};
+use crate::integrate::{integrate_sampled, ArkImex, DormandPrince45, Rk4, Rodas, Rosenbrock, StepControl};
+
+const G: f64 = 9.81;
+
+/// Runs `toy` from `y0` at 0 to `t_end`, sampling every `dt`; returns the samples.
+fn run<L: Law>(
+    st: &mut dyn Stepper<Toy<L>>,
+    toy: &mut Toy<L>,
+    y0: [f64; 2],
+    t_end: f64,
+    dt: f64,
+    settings: EventSettings,
+) -> Result<(Vec<(f64, [f64; 2])>, Stats), IntegrateError<RhsFailure>> {
+    let mut samples = Vec::new();
+    let stats = integrate_hybrid(st, toy, 0.0, &y0, t_end, dt, None, settings, |t, y, _| {
+        samples.push((t, [y[0], y[1]]));
+        Ok(())
+    })?;
+    Ok((samples, stats))
+}
+
+/// The ball of [`Ball`] dropped from `h0`: impact times `t_1 = sqrt(2 h0 / g)`,
+/// `t_{j+1} = t_j + 2 e u_j / g` with impact speeds `u_1 = g t_1`, `u_{j+1} = e u_j`; the
+/// first impact slower than `v_rest` is the rest. Returns (bounce times, rest time).
+fn ball_closed_form(h0: f64, e: f64, v_rest: f64) -> (Vec<f64>, f64) {
+    let mut t = (2.0 * h0 / G).sqrt();
+    let mut u = G * t;
+    let mut bounces = Vec::new();
+    while u >= v_rest {
+        bounces.push(t);
+        t += 2.0 * e * u / G;
+        u *= e;
+    }
+    (bounces, t)
+}
+
+/// The ball's state at `t` by the closed form (impacts at the closed-form times).
+fn ball_state(h0: f64, e: f64, v_rest: f64, t: f64) -> [f64; 2] {
+    let (bounces, rest) = ball_closed_form(h0, e, v_rest);
+    if t >= rest {
+        return [0.0, 0.0];
+    }
+    // the last impact at or before t, and the upward speed after it
+    let (mut t_j, mut v_j, mut x_j) = (0.0, 0.0, h0);
+    let mut u = G * (2.0 * h0 / G).sqrt();
+    for &tb in &bounces {
+        if tb > t {
+            break;
+        }
+        (t_j, v_j, x_j) = (tb, e * u, 0.0);
+        u *= e;
+    }
+    let s = t - t_j;
+    [x_j + v_j * s - 0.5 * G * s * s, v_j - G * s]
+}
+
+/// Bouncing ball, h0 = 1 m, e = 0.5, v_rest = 1e-3 m/s: u_1 = 4.43 m/s, so 13 bounces (the
+/// smallest n with u_1 eⁿ < v_rest is 13) and a rest at the 14th impact. Every method: the
+/// impact times within 1e-9 relative of the closed form, the count of bounces exact, the rest
+/// time within 1e-9 relative and short of the accumulation time
+/// `t_∞ = t_1 + 2 u_1 e / (g (1 − e))` by exactly the closed-form `2 u_14 e / (g (1 − e))`
+/// (1e-9 relative); and the samples (both sides of each jump) on the closed form within 1e-9.
+/// The solution is piecewise quadratic, which every method (and rk4's cubic Hermite) reproduces,
+/// so these bounds test the event location, not the steps.
+#[test]
+fn bouncing_ball_event_times_match_the_closed_form() {
+    let (h0, e, v_rest) = (1.0, 0.5, 1e-3);
+    let (bounces, rest) = ball_closed_form(h0, e, v_rest);
+    assert_eq!(bounces.len(), 13);
+    let t1 = (2.0 * h0 / G).sqrt();
+    let u1 = G * t1;
+    let n = bounces.len() as i32;
+    assert!(u1 * e.powi(n) < v_rest && u1 * e.powi(n - 1) >= v_rest);
+    let t_inf = t1 + 2.0 * u1 * e / (G * (1.0 - e));
+    // rk4's step (1e-5 s) is shorter than the shortest flight (1.1e-4 s): a flight within
+    // one fixed step is not seen (module doc)
+    for (name, mut st) in methods::<Ball>(1e-5, 1e-10, 1e-12, 0.05) {
+        let mut toy = Toy::new(Ball::new(G, e, v_rest));
+        let (samples, stats) = run(st.as_mut(), &mut toy, [h0, 0.0], 2.0, 1e-3, EventSettings::default()).expect(name);
+        let ball = &toy.law;
+        assert_eq!(ball.bounces.len(), bounces.len(), "{name}: bounces");
+        for (j, (t, t_cf)) in ball.bounces.iter().zip(&bounces).enumerate() {
+            assert!(((t - t_cf) / t_cf).abs() <= 1e-9, "{name}: bounce {j} at {t}, closed form {t_cf}");
+        }
+        let t_rest = ball.rest.expect("rests");
+        assert!(((t_rest - rest) / rest).abs() <= 1e-9, "{name}: rest at {t_rest}, closed form {rest}");
+        let short = 2.0 * u1 * e.powi(n) * e / (G * (1.0 - e));
+        assert!(((t_inf - t_rest) - short).abs() <= 1e-9 * t_inf, "{name}: t_inf - t_rest = {}, closed form {short}", t_inf - t_rest);
+        assert_eq!(samples.len(), 2001, "{name}");
+        let mut worst: f64 = 0.0;
+        for (t, y) in &samples {
+            let ex = ball_state(h0, e, v_rest, *t);
+            worst = worst.max((y[0] - ex[0]).abs()).max((y[1] - ex[1]).abs());
+        }
+        assert!(worst <= 1e-9, "{name}: samples off the closed form by {worst:e}");
+        eprintln!(
+            "{name}: {} events, {} rhs in steps ({} steps), {} event-function evaluations ({:.1} per located event beyond the 2 per step)",
+            toy.log.len(),
+            stats.rhs_evals,
+            stats.steps,
+            toy.event_calls,
+            (toy.event_calls as f64 - 2.0 * stats.steps as f64) / toy.log.len() as f64,
+        );
+    }
+}
+
+/// Without a rest rule (v_rest = 0) the bounces accumulate at t_∞ (Zeno). What the driver
+/// does then, stated: it follows the bounces (closed-form times to 1e-9 relative) until a
+/// flight is shorter than what it can resolve (the restart's first step, or the chattering
+/// window); then either the chattering guard stops the run, or the ball, restarted just below
+/// the table (t* is the bracket's upper end), passes it unseen. Either way the last event is
+/// at t_∞ within 1e-9 s — which is why rigid contacts need the rest rule.
+#[test]
+fn zeno_without_rest_rule_is_followed_to_the_accumulation_time() {
+    let (h0, e) = (1.0, 0.5);
+    let t1 = (2.0 * h0 / G).sqrt();
+    let t_inf = t1 + 2.0 * G * t1 * e / (G * (1.0 - e));
+    for (name, mut st) in methods::<Ball>(1e-3, 1e-10, 1e-12, 0.05).into_iter().skip(1) {
+        let mut toy = Toy::new(Ball::new(G, e, 0.0));
+        let res = run(st.as_mut(), &mut toy, [h0, 0.0], 2.0, 1e-3, EventSettings::default());
+        let times = toy.times();
+        let (bounces, _) = ball_closed_form(h0, e, 1e-6);
+        for (j, (t, t_cf)) in times.iter().zip(&bounces).enumerate() {
+            assert!(((t - t_cf) / t_cf).abs() <= 1e-9, "{name}: bounce {j} at {t}, closed form {t_cf}");
+        }
+        let last = times.last().copied().unwrap_or(0.0);
+        assert!(times.len() >= bounces.len(), "{name}: only {} bounces", times.len());
+        assert!((last - t_inf).abs() <= 1e-9, "{name}: last event at {last}, t_inf = {t_inf}");
+        let how = match res {
+            Err(IntegrateError::Chattering { .. }) => "chattering guard".to_string(),
+            Ok(_) => "ball passed the table".to_string(),
+            other => panic!("{name}: {:?}", other.map(|r| r.1)),
+        };
+        eprintln!("{name}: {} events, last at t_inf - {:.2e} s, then {how}", times.len(), t_inf - last);
+    }
+}
+
+/// g(t) = x(t) − 0.3 with x = t (direction +1): located to 1e-12 s (the methods' x is t up
+/// to round-off, ~1e-15), by every method, with steps far larger than the tolerance.
+#[test]
+fn a_time_linear_event_is_located_to_the_time_tolerance() {
+    for (name, mut st) in methods::<Thresholds>(0.1, 1e-8, 1e-10, 0.25) {
+        let mut toy = Toy::new(Thresholds { c: vec![0.3], dirs: vec![1], shift: None });
+        run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.1, EventSettings::default()).expect(name);
+        let t = toy.times();
+        assert_eq!(t.len(), 1, "{name}: {t:?}");
+        assert!((t[0] - 0.3).abs() <= 1e-12, "{name}: t* - 0.3 = {:e}", t[0] - 0.3);
+    }
+}
+
+/// The mass on the table pushed by F = a t (m = 2 kg, a = 7 N/s): lift-off at t_L = m g / a
+/// within 1e-10 s; afterwards x(t) = a (t − t_L)³ / (6 m) (samples within 1e-9 m).
+#[test]
+fn lift_off_under_a_linear_force_at_the_closed_form_time() {
+    let (m, a) = (2.0, 7.0);
+    let t_l = m * G / a;
+    for (name, mut st) in methods::<LiftOff>(1e-2, 1e-10, 1e-12, 0.05) {
+        let mut toy = Toy::new(LiftOff { m, g: G, a, in_contact: true });
+        let (samples, _) = run(st.as_mut(), &mut toy, [0.0, 0.0], 3.5, 0.01, EventSettings::default()).expect(name);
+        let t = toy.times();
+        assert_eq!(t.len(), 1, "{name}: {t:?}");
+        assert!((t[0] - t_l).abs() <= 1e-10, "{name}: lift-off at {}, closed form {t_l}", t[0]);
+        for (t, y) in &samples {
+            let x = if *t < t_l { 0.0 } else { a * (t - t_l).powi(3) / (6.0 * m) };
+            assert!((y[0] - x).abs() <= 1e-9, "{name}: x({t}) = {}, closed form {x}", y[0]);
+        }
+    }
+}
+
+/// Two thresholds crossed in the same step (0.41 and 0.40, rk4 step 1 and an adaptive h_max
+/// of 1): the earlier (function 1, at 0.40) is handled first, alone, then function 0 at 0.41;
+/// a function exactly 0 at the start (x − 0, direction 0) is never reported.
+#[test]
+fn the_earlier_of_two_events_in_one_step_is_handled_first() {
+    for (name, mut st) in methods::<Thresholds>(1.0, 1e-6, 1e-9, 1.0) {
+        let mut toy = Toy::new(Thresholds { c: vec![0.41, 0.40, 0.0], dirs: vec![1, 1, 0], shift: None });
+        run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.5, EventSettings::default()).expect(name);
+        let fired: Vec<(f64, Vec<bool>)> = toy.log.iter().map(|(t, f, _)| (*t, f.clone())).collect();
+        assert_eq!(fired.len(), 2, "{name}: {fired:?}");
+        assert_eq!(fired[0].1, vec![false, true, false], "{name}");
+        assert_eq!(fired[1].1, vec![true, false, false], "{name}");
+        assert!((fired[0].0 - 0.40).abs() <= 1e-12 && (fired[1].0 - 0.41).abs() <= 1e-12, "{name}: {fired:?}");
+    }
+}
+
+/// Two functions with the same root fire together, in one event.
+#[test]
+fn simultaneous_roots_fire_together() {
+    for (name, mut st) in methods::<Thresholds>(0.1, 1e-8, 1e-10, 0.25) {
+        let mut toy = Toy::new(Thresholds { c: vec![0.5, 0.5], dirs: vec![1, 0], shift: None });
+        run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.5, EventSettings::default()).expect(name);
+        assert_eq!(toy.log.len(), 1, "{name}");
+        assert_eq!(toy.log[0].1, vec![true, true], "{name}");
+    }
+}
+
+/// A handler that moves the threshold 1e-13 s ahead at every event keeps firing at (almost)
+/// the same time: after 32 such events in a row the run stops with Chattering (count 33, at
+/// t ≈ 0.5); one that moves it 0.01 s ahead fires every 0.01 s and, with max_events = 5,
+/// stops with TooManyEvents at the 6th event (t ≈ 0.55).
+#[test]
+fn chattering_and_max_events_are_typed_errors() {
+    for (name, mut st) in methods::<Thresholds>(0.1, 1e-8, 1e-10, 0.25) {
+        let mut toy = Toy::new(Thresholds { c: vec![0.5], dirs: vec![1], shift: Some(1e-13) });
+        match run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.1, EventSettings::default()) {
+            Err(IntegrateError::Chattering { t, count, window, events }) => {
+                assert_eq!(count, 33, "{name}");
+                assert!((t - 0.5).abs() < 1e-10 && window == 1e-11 && events.contains("[0]"), "{name}: {t} {window} {events}");
+            }
+            other => panic!("{name}: expected Chattering, got {:?}", other.map(|r| r.1)),
+        }
+    }
+    for (name, mut st) in methods::<Thresholds>(0.1, 1e-8, 1e-10, 0.25) {
+        let mut toy = Toy::new(Thresholds { c: vec![0.5], dirs: vec![1], shift: Some(0.01) });
+        let settings = EventSettings { max_events: 5, ..EventSettings::default() };
+        match run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.1, settings) {
+            Err(IntegrateError::TooManyEvents { t, max_events: 5 }) => {
+                assert!((t - 0.55).abs() < 1e-9, "{name}: {t}");
+                assert_eq!(toy.log.len(), 5, "{name}");
+            }
+            other => panic!("{name}: expected TooManyEvents, got {:?}", other.map(|r| r.1)),
+        }
+    }
+}
+
+/// Statistics are summed over restarts: a run with events reports at least the steps of its
+/// last segment plus one per event-free segment, and after_step is called once per accepted
+/// step without an event.
+#[test]
+fn statistics_accumulate_over_restarts() {
+    let mut st = DormandPrince45::new(2, StepControl { h_max: 0.05, ..StepControl::new(1e-10, 1e-12) });
+    let mut toy = Toy::new(Ball::new(G, 0.5, 1e-3));
+    let (_, stats) = run(&mut st, &mut toy, [1.0, 0.0], 2.0, 1e-3, EventSettings::default()).unwrap();
+    let n_ev = toy.log.len() as u64;
+    assert_eq!(n_ev, 14);
+    assert!(stats.steps > st.stats().steps + n_ev, "{stats:?} vs last segment {:?}", st.stats());
+    assert_eq!(toy.after_steps, stats.steps - n_ev - 1, "the last step ends the run, each event's step has none");
+    assert!(stats.rhs_evals >= 6 * stats.steps);
+}
+
+/// The test problems as hybrid systems without events.
+impl HybridSystem for crate::integrate::testutil::Problem {
+    fn n_events(&self) -> usize {
+        0
+    }
+    fn event_direction(&self, _i: usize) -> i8 {
+        0
+    }
+    fn events(&mut self, _t: f64, _y: &[f64], _out: &mut [f64]) -> Result<(), RhsFailure> {
+        Ok(())
+    }
+    fn init_modes(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool, RhsFailure> {
+        Ok(false)
+    }
+    fn handle_events(&mut self, _t: f64, _y: &mut [f64], _fired: &[bool]) -> Result<bool, RhsFailure> {
+        Ok(false)
+    }
+}
+
+/// With no event functions, integrate_hybrid is integrate_sampled: the same samples bit for
+/// bit and the same statistics, for every method, on a non-stiff and a stiff problem.
+#[test]
+fn without_events_the_samples_are_integrate_sampled_bit_for_bit() {
+    use crate::integrate::testutil::Problem;
+    let c = StepControl::new(1e-7, 1e-9);
+    let build = |name: &str, dim: usize| -> Box<dyn Stepper<Problem>> {
+        match name {
+            "rk4" => Box::new(Rk4::new(dim, 0.013)),
+            "dopri45" => Box::new(DormandPrince45::new(dim, c)),
+            "rosenbrock" => Box::new(Rosenbrock::new(dim, c)),
+            "rodas5p" => Box::new(Rodas::new(dim, c)),
+            "imex" => Box::new(ArkImex::new(dim, c)),
+            _ => unreachable!(),
+        }
+    };
+    for problem in [Problem::Kepler(Kepler { e: 0.5 }), Problem::Oscillator(HarmonicOscillator::default()), Problem::Pr(StiffLinear::default())] {
+        let stiff = matches!(problem, Problem::Pr(_));
+        for name in ["rk4", "dopri45", "rosenbrock", "rodas5p", "imex"] {
+            if stiff && (name == "rk4" || name == "dopri45") {
+                continue; // explicit methods on λ = -1e4: unstable / stopped as stiff
+            }
+            let mut p = problem;
+            let dim = p.dim();
+            let y0 = crate::integrate::test_problems::ExactSolution::y0(&p);
+            let mut a = Vec::new();
+            let sa = integrate_sampled(build(name, dim).as_mut(), &mut p, 0.0, &y0, 2.0, 0.03, |t, y| {
+                a.push((t, y.to_vec()));
+                Ok(())
+            })
+            .unwrap();
+            let mut p = problem;
+            let mut b = Vec::new();
+            let sb = integrate_hybrid(build(name, dim).as_mut(), &mut p, 0.0, &y0, 2.0, 0.03, None, EventSettings::default(), |t, y, _| {
+                b.push((t, y.to_vec()));
+                Ok(())
+            })
+            .unwrap();
+            assert_eq!(sa, sb, "{name}");
+            assert_eq!(a.len(), b.len(), "{name}");
+            for ((ta, ya), (tb, yb)) in a.iter().zip(&b) {
+                assert_eq!(ta.to_bits(), tb.to_bits(), "{name}");
+                assert!(ya.iter().zip(yb).all(|(x, y)| x.to_bits() == y.to_bits()), "{name} at {ta}: {ya:?} vs {yb:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn time_tolerance_is_the_setting_or_4_ulp() {
+    assert_eq!(time_tolerance(1e-12, 1.0), 1e-12);
+    assert_eq!(time_tolerance(1e-12, 1e6), 4.0 * (f64::from_bits(1e6f64.to_bits() + 1) - 1e6));
+    assert_eq!(time_tolerance(0.0, 1.0), 4.0 * f64::EPSILON);
+    assert_eq!(time_tolerance(f64::NAN, 1.0), 4.0 * f64::EPSILON);
+}
