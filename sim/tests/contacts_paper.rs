@@ -89,6 +89,7 @@ fn paper_question_findings() {
             let e: f64 = last.electric_energy.iter().sum();
             let (rel, _) = balance(&c);
             eprintln!("{file} {run}: E = Σ E_j = {e:.4} J, residual {rel:.1e}, {} events, {} steps", c.events.len(), c.report.stats.steps);
+            let names: Vec<String> = s.run_contact_models(s.run(run).unwrap()).iter().map(|c| c.name().to_string()).collect();
             for k in 0..last.contacts.len() {
                 let touching_s = c.samples.iter().filter(|o| touching(o.contacts[k].mode)).count() as f64 * dt;
                 let sticking_s = c.samples.iter().filter(|o| o.contacts[k].mode == ContactMode::Sticking).count() as f64 * dt;
@@ -103,7 +104,8 @@ fn paper_question_findings() {
                 let times = |kind| c.events.iter().filter(|e| e.contact == k && e.kind == kind).map(|e| format!("{:.6}", e.t)).collect::<Vec<_>>().join(" ");
                 let f = &last.contacts[k];
                 eprintln!(
-                    "  contact {k}: in contact {touching_s:.3} s (sticking {sticking_s:.3} s), lift-offs {} [{}], touch-downs {} impacts {} rests {} [{}], stick→slip {}, slip→stick {}, impact loss {:.4e} J, friction work {:.4e} J, max |f_t|/f_n {ratio:.4}, f_n(end) {:.3} N",
+                    "  {}: in contact {touching_s:.3} s (sticking {sticking_s:.3} s), lift-offs {} [{}], touch-downs {} impacts {} rests {} [{}], stick→slip {}, slip→stick {}, impact loss {:.4e} J, friction work {:.4e} J, max |f_t|/f_n {ratio:.4}, f_n(end) {:.3} N",
+                    names[k],
                     count(ContactEventKind::LiftOff),
                     times(ContactEventKind::LiftOff),
                     count(ContactEventKind::TouchDown),
