@@ -8,7 +8,7 @@ use schemas::IntegratorInfo;
 
 use crate::error::{short, SceneError};
 use crate::integrate::{
-    integrate_sampled_within, ArkImex, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rodas, RodasMethod, Rosenbrock, SplitSystem, Stats,
+    integrate_hybrid, integrate_sampled_within, ArkImex, EventSettings, HybridSystem, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rodas, RodasMethod, Rosenbrock, SplitSystem, Stats,
     StepControl, Stepper,
 };
 use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, RosenbrockSpec};
@@ -159,15 +159,40 @@ impl Integrator {
         deadline: Option<crate::integrate::Deadline>,
         on_sample: impl FnMut(f64, &[f64]) -> Result<(), S::Error>,
     ) -> Result<Stats, IntegrateError<S::Error>> {
-        let dim = y0.len();
-        let mut stepper: Box<dyn Stepper<S>> = match *self {
+        let mut stepper: Box<dyn Stepper<S>> = self.stepper(y0.len());
+        integrate_sampled_within(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, deadline, on_sample)
+    }
+
+    /// The stepper of this method for a system of dimension `dim`.
+    fn stepper<S: OdeJacobian + SplitSystem>(&self, dim: usize) -> Box<dyn Stepper<S>> {
+        match *self {
             Integrator::Rk4 { step } => Box::new(Rk4::new(dim, step)),
             Integrator::Dopri45(c) => Box::new(DormandPrince45::new(dim, c)),
             Integrator::Rosenbrock { control, jacobian_reuse } => Box::new(Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse)),
             Integrator::Imex(c) => Box::new(ArkImex::new(dim, c)),
             Integrator::Rodas { method, control, jacobian_reuse } => Box::new(Rodas::new(dim, control).with_method(method).with_jacobian_reuse(jacobian_reuse)),
-        };
-        integrate_sampled_within(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, deadline, on_sample)
+        }
+    }
+
+    /// [`Integrator::integrate`] for a [`HybridSystem`] (rigid or compliant contacts): the
+    /// same stepper driven by [`integrate_hybrid`] (events located on its dense output, the
+    /// system's modes switched there, the stepper restarted), with `settings`. `on_sample`
+    /// gets the system too (its modes and its event log). For rk4 the event times are those
+    /// of its cubic Hermite interpolant (O(h⁴)), and a sign change and back within one step
+    /// goes unseen (`integrate/events.rs`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn integrate_hybrid<S: OdeJacobian + SplitSystem + HybridSystem>(
+        &self,
+        sys: &mut S,
+        y0: &[f64],
+        t_end: f64,
+        dt_out: f64,
+        deadline: Option<crate::integrate::Deadline>,
+        settings: EventSettings,
+        on_sample: impl FnMut(f64, &[f64], &mut S) -> Result<(), S::Error>,
+    ) -> Result<Stats, IntegrateError<S::Error>> {
+        let mut stepper: Box<dyn Stepper<S>> = self.stepper(y0.len());
+        integrate_hybrid(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, deadline, settings, on_sample)
     }
 }
 

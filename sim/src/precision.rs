@@ -14,12 +14,27 @@
 //! arm is anywhere in its workspace), or a max energy error above the largest electric energy
 //! the reference motors took in (`max_j max_t |E_j,ref|`, at least 1 J): the energy balance no
 //! longer means anything. [`recommend`] picks the cheapest `ok` run within a requested error.
+//!
+//! Scenes with unilateral or compliant contacts run event-driven (`run.rs`: the same path as
+//! `sim run`), the reference and every variant alike. The errors are still measured on the
+//! shared output grid, so they include the shift of the event times: a sample between a run's
+//! event and the reference's compares states on either side of the jump. Positions are
+//! continuous at events (impacts jump velocities only), so the hand error there is about
+//! `|Δt_event| × |v_hand|` and stays a fair trajectory error; the link works `W_j` jump at an
+//! impact by the rotors' impulsive work, so the energy error near an event can reach that jump.
+//! Hence the event times are compared directly as well: [`Row::max_event_time_error_s`], the
+//! largest `|t − t_ref|` over events matched by contact and kind (the k-th event of a contact
+//! and kind in the run with the k-th of the same contact and kind in the reference), and
+//! [`Row::unmatched_events`], how many events of the run or the reference had no partner
+//! (a bounce more or less, a missed lift-off). Both are absent (`None`) when neither the run
+//! nor the reference had an event (every bilateral scene).
 
 use std::time::Instant;
 
 use nalgebra::Vector3;
 use serde::Serialize;
 
+use crate::dynamics::contact::ContactEventKind;
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
 use crate::dynamics::motor::Electrical;
 use crate::error::{RunError, SceneError};
@@ -59,16 +74,23 @@ pub struct Row {
     pub reach_m: f64,
     /// Simulated time / wall time.
     pub speed_vs_real_time: f64,
+    /// max over matched contact events of |t − t_ref|, s (module doc); `None` without events.
+    pub max_event_time_error_s: Option<f64>,
+    /// Events of the run or of the reference without a partner of the same contact and kind;
+    /// `None` without events.
+    pub unmatched_events: Option<u64>,
 }
 
-/// The reference trajectory: per sample, the hand and every W_j, E_j.
+/// The reference trajectory: per sample, the hand and every W_j, E_j; and the contact events
+/// (time, contact index, kind), in time order.
 pub struct Reference {
     pub hand: Vec<Vector3<f64>>,
     pub energies: Vec<Vec<f64>>,
+    pub events: Vec<(f64, usize, ContactEventKind)>,
 }
 
 fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Stats, f64), RunError> {
-    let mut r = Reference { hand: Vec::new(), energies: Vec::new() };
+    let mut r = Reference { hand: Vec::new(), energies: Vec::new(), events: Vec::new() };
     let mut drift = 0.0f64;
     // the hand, the quadratures and C need forward kinematics only, not a right-hand side
     let rep = crate::run::simulate_outputs(scene, run, Default::default(), OutputLevel::Kinematic, |o| {
@@ -77,6 +99,7 @@ fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Sta
         e.extend_from_slice(&o.electric_energy);
         r.energies.push(e);
         drift = o.constraint_position.iter().fold(drift, |m, c| m.max(c.abs()));
+        r.events.extend(o.events.iter().map(|e| (e.t, e.contact, e.kind)));
         Ok(())
     })?;
     Ok((r, rep.stats, drift))
@@ -136,6 +159,8 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
         max_drift_m: f64::NAN,
         reach_m: reference.reach_m(),
         speed_vs_real_time: f64::NAN,
+        max_event_time_error_s: None,
+        unmatched_events: None,
     };
     // timing: the simulation alone, best of `repeats`
     for _ in 0..repeats.max(1) {
@@ -165,6 +190,7 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
                 .zip(&reference.energies)
                 .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
                 .fold(0.0, f64::max);
+            (row.max_event_time_error_s, row.unmatched_events) = match_events(&r.events, &reference.events);
         }
         Err(e) => row.status = format!("failed: {e}"),
     }
@@ -186,6 +212,33 @@ impl Reference {
     pub fn energy_scale_j(&self) -> f64 {
         self.energies.iter().flatten().fold(1.0, |m, e| m.max(e.abs()))
     }
+}
+
+/// The event times of a run against the reference's (module doc): the largest `|t − t_ref|`
+/// over events paired by contact and kind in order, and the number without a partner; `None`s
+/// when neither has an event.
+pub fn match_events(run: &[(f64, usize, ContactEventKind)], reference: &[(f64, usize, ContactEventKind)]) -> (Option<f64>, Option<u64>) {
+    if run.is_empty() && reference.is_empty() {
+        return (None, None);
+    }
+    let mut worst = 0.0f64;
+    let mut unmatched = 0u64;
+    // every (contact, kind) that occurs in either list
+    let mut keys: Vec<(usize, ContactEventKind)> = Vec::new();
+    for &(_, c, k) in run.iter().chain(reference) {
+        if !keys.contains(&(c, k)) {
+            keys.push((c, k));
+        }
+    }
+    for key in keys {
+        let times = |list: &[(f64, usize, ContactEventKind)]| -> Vec<f64> { list.iter().filter(|e| (e.1, e.2) == key).map(|e| e.0).collect() };
+        let (a, b) = (times(run), times(reference));
+        for (x, y) in a.iter().zip(&b) {
+            worst = worst.max((x - y).abs());
+        }
+        unmatched += a.len().abs_diff(b.len()) as u64;
+    }
+    (Some(worst), Some(unmatched))
 }
 
 /// Why a run with these max errors against `reference` has diverged, or `None` (module docs).
@@ -318,6 +371,8 @@ mod tests {
             max_drift_m: 0.0,
             reach_m: 2.0,
             speed_vs_real_time: 1.0,
+            max_event_time_error_s: None,
+            unmatched_events: None,
         }
     }
 
@@ -326,7 +381,24 @@ mod tests {
         Reference {
             hand: vec![Vector3::new(1.5, 0.0, 0.0), Vector3::new(0.0, 2.0, 0.0)],
             energies: vec![vec![1.0, -40.0], vec![3.0, 12.0]],
+            events: Vec::new(),
         }
+    }
+
+    // Events are paired by contact and kind in order: the largest time difference over the
+    // pairs, and the count of events without a partner (here one extra impact at contact 1).
+    #[test]
+    fn events_are_matched_by_contact_and_kind() {
+        use ContactEventKind::{Impact, LiftOff};
+        assert_eq!(match_events(&[], &[]), (None, None));
+        let reference = [(0.5, 0, LiftOff), (0.7, 1, Impact), (0.9, 1, Impact)];
+        let run = [(0.5 + 2e-9, 0, LiftOff), (0.7 - 5e-9, 1, Impact), (0.9 + 1e-9, 1, Impact), (0.95, 1, Impact)];
+        let (worst, unmatched) = match_events(&run, &reference);
+        assert!((worst.unwrap() - 5e-9).abs() < 1e-15, "{worst:?}");
+        assert_eq!(unmatched, Some(1));
+        // a lift-off is never paired with an impact, nor contact 0 with contact 1
+        let (worst, unmatched) = match_events(&[(0.5, 1, LiftOff)], &[(0.5, 0, LiftOff)]);
+        assert_eq!((worst, unmatched), (Some(0.0), Some(2)));
     }
 
     // The bounds of the module docs: the reach (2 m here) and the energy scale (40 J here);

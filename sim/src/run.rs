@@ -118,18 +118,34 @@ pub fn simulate_outputs(
     // limits are monitored on the full outputs only (they need τ, i and the command)
     let mut monitor =
         if level == OutputLevel::Full { LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, dt_out) } else { None };
-    let mut on_sample = |t: f64, y: &[f64]| -> Result<(), RunError> {
-        probe.outputs_at(level, t, y, &mut out)?;
+    // one sample; `hybrid`: the stepper's system of an event-driven run, whose modes the probe
+    // takes over first and whose event log (since the last sample) moves into the outputs
+    let mut on_sample = |t: f64, y: &[f64], hybrid: Option<&mut ArmSystem<'_>>| -> Result<(), RunError> {
+        match hybrid {
+            Some(sys) => {
+                probe.copy_modes_from(sys);
+                probe.outputs_at(level, t, y, &mut out)?;
+                out.events.clear();
+                sys.drain_events(&mut out.events);
+            }
+            None => probe.outputs_at(level, t, y, &mut out)?,
+        }
         samples += 1;
         if let Some(m) = monitor.as_mut() {
             m.observe(&out);
         }
         sink(&out)
     };
-    let stats = scene
-        .integrator
-        .integrate(&mut sys, &y0, scene.duration, dt_out, deadline, &mut on_sample)
-        .map_err(|e| map_err(e, &names, budget, scene.integrator.method()))?;
+    let result = if sys.is_hybrid() {
+        // unilateral or compliant contacts: event-driven
+        // (the scene's event settings plug in here once the scene carries them)
+        let settings = crate::integrate::EventSettings::default();
+        scene.integrator.integrate_hybrid(&mut sys, &y0, scene.duration, dt_out, deadline, settings, |t, y, sys| on_sample(t, y, Some(sys)))
+    } else {
+        // every contact bilateral (the paper's runs): the smooth path, as before
+        scene.integrator.integrate(&mut sys, &y0, scene.duration, dt_out, deadline, |t, y| on_sample(t, y, None))
+    };
+    let stats = result.map_err(|e| map_err(e, &names, budget, scene.integrator.method()))?;
     Ok(RunReport { stats, samples, last: out, limits: monitor.map(|m| m.summary()) })
 }
 

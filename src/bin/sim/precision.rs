@@ -119,7 +119,13 @@ fn csv(rows: &[Row]) -> Result<String> {
 fn table(rows: &[Row], scene: &str, run: &str, duration: f64, accuracy: f64) -> Result<String> {
     let mut o = String::new();
     writeln!(o, "Speed against error: scene `{scene}`, run `{run}`, {duration} s simulated; reference dopri45 rtol 1e-12")?;
-    let head = ["method", "setting", "wall [ms]", "RHS", "steps", "rejected", "hand [m]", "energy [J]", "drift [m]", "x real", "status"];
+    // scenes with contact events get the event-time error and the unmatched events
+    let with_events = rows.iter().any(|r| r.max_event_time_error_s.is_some());
+    let mut head = vec!["method", "setting", "wall [ms]", "RHS", "steps", "rejected", "hand [m]", "energy [J]", "drift [m]", "x real"];
+    if with_events {
+        head.extend(["event t [s]", "unmatched"]);
+    }
+    head.push("status");
     let cells: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
@@ -134,11 +140,15 @@ fn table(rows: &[Row], scene: &str, run: &str, duration: f64, accuracy: f64) -> 
                     format!("{:.2e}", r.max_link_energy_error_j),
                     format!("{:.1e}", r.max_drift_m),
                     format!("{:.0}", r.speed_vs_real_time),
-                    r.status.clone(),
                 ]);
+                if with_events {
+                    c.push(r.max_event_time_error_s.map_or(String::from("-"), |e| format!("{e:.1e}")));
+                    c.push(r.unmatched_events.map_or(String::from("-"), |n| n.to_string()));
+                }
+                c.push(r.status.clone());
             } else {
                 // a failed run: no numbers, the reason in the status column
-                c.extend(std::iter::repeat_n(String::from("-"), 8));
+                c.extend(std::iter::repeat_n(String::from("-"), head.len() - 3));
                 c.push(r.status.clone());
             }
             c
