@@ -48,6 +48,9 @@ struct Description {
     joints: Vec<String>,
     moving_mass_kg: f64,
     contacts: Vec<String>,
+    /// Each contact's model and parameters, when some contact is not bilateral (issue 11).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    contact_models: Vec<String>,
     runs: Vec<RunDescription>,
     duration_s: f64,
     output_rate_hz: f64,
@@ -98,6 +101,18 @@ fn text<T: Serialize>(v: &T) -> String {
     serde_json::to_string(v).unwrap_or_default().trim_matches('"').to_string()
 }
 
+/// A contact model in words, with its parameters.
+fn model_phrase(m: &sim::dynamics::contact::ContactModel) -> String {
+    use sim::dynamics::contact::ContactModel as M;
+    match *m {
+        M::Bilateral => "bilateral".into(),
+        M::Unilateral { restitution, friction } => format!("unilateral, restitution {restitution}, friction {friction}"),
+        M::Compliant { stiffness, damping, friction, slip_velocity } => {
+            format!("compliant, stiffness {stiffness} N/m, damping {damping} N s/m, friction {friction}, slip velocity {slip_velocity} m/s")
+        }
+    }
+}
+
 fn describe(s: &Scene) -> Description {
     Description {
         scene: s.spec().name.clone(),
@@ -106,6 +121,11 @@ fn describe(s: &Scene) -> Description {
         joints: s.model().joint_names(),
         moving_mass_kg: s.model().total_mass(),
         contacts: s.contacts().iter().map(|c| c.name.clone()).collect(),
+        contact_models: if s.contact_models().iter().all(|c| c.model == sim::dynamics::contact::ContactModel::Bilateral) {
+            Vec::new()
+        } else {
+            s.contact_models().iter().map(|c| format!("{}: {}", c.name(), model_phrase(&c.model))).collect()
+        },
         runs: s
             .runs()
             .iter()
@@ -186,6 +206,9 @@ pub fn run(a: &CheckArgs) -> Result<u8> {
             writeln!(o, "scene `{}` ({}) is valid", d.scene, d.source)?;
             writeln!(o, "  robot        {}: {} joints ({joints}), {:.3} kg moving", d.robot, d.joints.len(), d.moving_mass_kg)?;
             writeln!(o, "  contacts     {}", if d.contacts.is_empty() { "none".into() } else { d.contacts.join(", ") })?;
+            for m in &d.contact_models {
+                writeln!(o, "  contact      {m}")?;
+            }
             for r in &d.runs {
                 writeln!(o, "  run          {}: contacts [{}]", r.name, r.contacts.join(", "))?;
             }
