@@ -81,16 +81,39 @@ fn the_motor_force_on_the_held_ball_is_the_closed_form() {
     assert!(negative > 100, "the held ball is pulled down late in the run");
 }
 
+///
+/// With every method (`lift_off_with_every_method`): while resting the state is constant and
+/// f_n depends on t alone (through q_d), so the event function is exact on any interpolant and
+/// the same 1e-10 s holds.
 #[test]
 fn a_resting_point_lifts_off_when_the_growing_force_reaches_its_weight() {
+    lift_off(json!({"method": "dopri45", "rtol": 1e-12, "atol": 1e-14}));
+}
+
+#[test]
+fn lift_off_with_every_method() {
+    for integrator in [
+        json!({"method": "rk4", "step": 1e-3}),
+        json!({"method": "rosenbrock", "rtol": 1e-10, "atol": 1e-12}),
+        json!({"method": "imex", "rtol": 1e-10, "atol": 1e-12}),
+        json!({"method": "rodas5p", "rtol": 1e-10, "atol": 1e-12}),
+        json!({"method": "rodas4", "rtol": 1e-10, "atol": 1e-12}),
+    ] {
+        eprintln!("{integrator}");
+        lift_off(integrator);
+    }
+}
+
+fn lift_off(integrator: serde_json::Value) {
     let scene = pushed_ball(json!({"model": "unilateral", "restitution": 0.0, "friction": 0.5}));
+    let scene = scene.vary(|s| s.integrator = serde_json::from_value(integrator.clone()).unwrap()).unwrap();
     let force = push;
     let period = PERIOD;
     let t_lo = bisect(0.0, period, |t| force(t) - M * G);
     let c = collect(&scene, "r");
     let lift: Vec<_> = c.events_of(ContactEventKind::LiftOff);
     assert_eq!(lift.len(), 1, "one lift-off; events {:?}", c.events);
-    assert!((lift[0].t - t_lo).abs() <= 1e-10, "lift-off at {} s, closed form {t_lo} s (diff {:e})", lift[0].t, lift[0].t - t_lo);
+    assert!((lift[0].t - t_lo).abs() <= 1e-10, "{integrator}: lift-off at {} s, closed form {t_lo} s (diff {:e})", lift[0].t, lift[0].t - t_lo);
     assert!(c.events.iter().all(|e| e.kind == ContactEventKind::LiftOff), "no other event: {:?}", c.events);
     let mut before = 0;
     for o in c.between(-1.0, t_lo - 1e-6) {
@@ -125,11 +148,34 @@ fn a_resting_point_lifts_off_when_the_growing_force_reaches_its_weight() {
 /// the speeds are compared to δv = 1e-9 v_0 (4.4e-9 m/s, 40× the bound), impulses to
 /// m (1 + e) δv, losses to 2 m v_k δv; at rest after t_9: |g| ≤ 1e-9 m (the gap tolerance),
 /// f_n = m g to 1e-9, |ż| ≤ 1e-9 m/s.
+///
+/// The same with every method (`bouncing_ball_with_every_method`): free flight (z quadratic
+/// in t) is reproduced exactly by every method of order ≥ 2 and by every dense output of
+/// degree ≥ 2 (RK4's cubic Hermite interpolant included), so the same tolerances apply.
 #[test]
 fn the_bouncing_ball_follows_the_geometric_sequence_and_comes_to_rest_by_the_stated_rule() {
+    bouncing_ball(json!({"method": "dopri45", "rtol": 1e-12, "atol": 1e-14}));
+}
+
+#[test]
+fn bouncing_ball_with_every_method() {
+    for integrator in [
+        json!({"method": "rk4", "step": 1e-3}),
+        json!({"method": "rosenbrock", "rtol": 1e-10, "atol": 1e-12}),
+        json!({"method": "imex", "rtol": 1e-10, "atol": 1e-12}),
+        json!({"method": "rodas5p", "rtol": 1e-10, "atol": 1e-12}),
+        json!({"method": "rodas4", "rtol": 1e-10, "atol": 1e-12}),
+    ] {
+        eprintln!("{integrator}");
+        bouncing_ball(integrator);
+    }
+}
+
+fn bouncing_ball(integrator: serde_json::Value) {
     let (h0, e, v_rest): (f64, f64, f64) = (1.0, 0.5, 0.01);
     let mut s = ball([0.0, 0.0, h0], [0.0; 3], [0.0, 0.0, -G], 2.0, json!({"model": "unilateral", "restitution": e}));
     s["events"] = json!({"rest_velocity": v_rest});
+    s["integrator"] = integrator.clone();
     let scene = load(&s, &point_urdf(M));
     let v0 = (2.0 * G * h0).sqrt();
     let n = (0..).find(|&k| v0 * e.powi(k) < v_rest).unwrap() as usize;
@@ -144,10 +190,10 @@ fn the_bouncing_ball_follows_the_geometric_sequence_and_comes_to_rest_by_the_sta
     let kinds: Vec<_> = c.events.iter().map(|e| e.kind).collect();
     let mut want = vec![ContactEventKind::Impact; n];
     want.push(ContactEventKind::Rest);
-    assert_eq!(kinds, want, "events {:?}", c.events);
+    assert_eq!(kinds, want, "{integrator}: events {:?}", c.events);
     for (k, ev) in c.events.iter().enumerate() {
         let vk = v0 * e.powi(k as i32);
-        assert!((ev.t - t[k]).abs() <= 1e-9 * t[k], "event {k}: t = {} s, closed form {} s", ev.t, t[k]);
+        assert!((ev.t - t[k]).abs() <= 1e-9 * t[k], "{integrator}: event {k}: t = {} s, closed form {} s", ev.t, t[k]);
         let dv = 1e-9 * v0;
         assert!((ev.gap_rate_before + vk).abs() <= dv, "event {k}: ġ⁻ = {}, −v_k = {}", ev.gap_rate_before, -vk);
         let e_k = if k < n { e } else { 0.0 };
