@@ -1,12 +1,15 @@
 //! The event driver on abstract hybrid problems with closed-form event times, for every
 //! method (`toys.rs`).
 
-use super::toys::{methods, Ball, LiftOff, Law, Thresholds, Toy};
+use super::toys::{methods, Ball, LiftOff, Law, MovedStart, Thresholds, Toy};
 use super::*;
 use crate::integrate::test_problems::{HarmonicOscillator, Kepler, RhsFailure, StiffLinear};
 use crate::integrate::{integrate_sampled, ArkImex, DormandPrince45, Rk4, Rodas, Rosenbrock, StepControl};
 
 const G: f64 = 9.81;
+
+/// The samples of a run and its statistics.
+type Samples = (Vec<(f64, [f64; 2])>, Stats);
 
 /// Runs `toy` from `y0` at 0 to `t_end`, sampling every `dt`; returns the samples.
 fn run<L: Law>(
@@ -16,7 +19,7 @@ fn run<L: Law>(
     t_end: f64,
     dt: f64,
     settings: EventSettings,
-) -> Result<(Vec<(f64, [f64; 2])>, Stats), IntegrateError<RhsFailure>> {
+) -> Result<Samples, IntegrateError<RhsFailure>> {
     let mut samples = Vec::new();
     let stats = integrate_hybrid(st, toy, 0.0, &y0, t_end, dt, None, settings, |t, y, _| {
         samples.push((t, [y[0], y[1]]));
@@ -317,4 +320,70 @@ fn time_tolerance_is_the_setting_or_4_ulp() {
     assert_eq!(time_tolerance(1e-12, 1e6), 4.0 * (f64::from_bits(1e6f64.to_bits() + 1) - 1e6));
     assert_eq!(time_tolerance(0.0, 1.0), 4.0 * f64::EPSILON);
     assert_eq!(time_tolerance(f64::NAN, 1.0), 4.0 * f64::EPSILON);
+}
+
+/// `Integrator::integrate_hybrid` (the scene's integrator) drives the event driver with every
+/// method of a scene: the bouncing ball's impact times within 1e-9 relative of the closed
+/// form, 13 bounces and a rest, through the scene-level dispatch.
+#[test]
+fn the_scene_integrator_dispatches_every_method_to_the_event_driver() {
+    use crate::integrator::Integrator;
+    let (h0, e, v_rest) = (1.0, 0.5, 1e-3);
+    let (bounces, rest) = ball_closed_form(h0, e, v_rest);
+    for json in [
+        r#"{"method":"rk4","step":1e-5}"#,
+        r#"{"method":"dopri45","rtol":1e-10,"atol":1e-12,"h_max":0.05}"#,
+        r#"{"method":"rosenbrock","rtol":1e-10,"atol":1e-12,"h_max":0.05}"#,
+        r#"{"method":"rodas5p","rtol":1e-10,"atol":1e-12,"h_max":0.05}"#,
+        r#"{"method":"rodas4","rtol":1e-10,"atol":1e-12,"h_max":0.05}"#,
+        r#"{"method":"imex","rtol":1e-10,"atol":1e-12,"h_max":0.05}"#,
+    ] {
+        let spec = serde_json::from_str(json).unwrap();
+        let integrator = Integrator::from_spec(&spec, "ball.json", 2.0, 1e-3).unwrap();
+        let mut toy = Toy::new(Ball::new(G, e, v_rest));
+        let mut n = 0;
+        let stats = integrator
+            .integrate_hybrid(&mut toy, &[h0, 0.0], 2.0, 1e-3, None, EventSettings::default(), |_, _, _| {
+                n += 1;
+                Ok(())
+            })
+            .expect(json);
+        assert_eq!(n, 2001, "{json}");
+        assert!(stats.steps > 0);
+        assert_eq!(toy.law.bounces.len(), bounces.len(), "{json}");
+        for (t, t_cf) in toy.law.bounces.iter().zip(&bounces) {
+            assert!(((t - t_cf) / t_cf).abs() <= 1e-9, "{json}: {t} vs {t_cf}");
+        }
+        let t_rest = toy.law.rest.expect("rests");
+        assert!(((t_rest - rest) / rest).abs() <= 1e-9, "{json}: rest {t_rest} vs {rest}");
+    }
+}
+
+/// A handler that leaves its function exactly 0 at the restart (threshold moved onto the
+/// state, direction 0) does not fire again at once: the function is disarmed until it has
+/// left 0, then it only grows. One event, no chattering, for every method.
+#[test]
+fn a_function_left_at_zero_by_the_handler_is_disarmed() {
+    for (name, mut st) in methods::<Thresholds>(0.1, 1e-8, 1e-10, 0.25) {
+        let mut toy = Toy::new(Thresholds { c: vec![0.5], dirs: vec![0], shift: Some(0.0) });
+        run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.1, EventSettings::default()).expect(name);
+        assert_eq!(toy.log.len(), 1, "{name}: {:?}", toy.times());
+    }
+}
+
+/// init_modes runs before the first sample: a start it moves (x0 = 0 -> 0.2) is the first
+/// sample, and the threshold at 0.5 is then crossed at t = 0.3 (1e-12 s); without a move the
+/// first sample is y0 bit for bit.
+#[test]
+fn init_modes_runs_before_the_first_sample() {
+    for (name, mut st) in methods::<MovedStart>(0.1, 1e-8, 1e-10, 0.25) {
+        let mut toy = Toy::new(MovedStart { inner: Thresholds { c: vec![0.5], dirs: vec![1], shift: None }, start: 0.2 });
+        let (samples, _) = run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.1, EventSettings::default()).expect(name);
+        assert_eq!(samples[0], (0.0, [0.2, 1.0]), "{name}");
+        assert!((toy.times()[0] - 0.3).abs() <= 1e-12, "{name}: {:?}", toy.times());
+    }
+    let y0 = [0.1 + 0.2, 1.0 / 3.0];
+    let mut toy = Toy::new(Thresholds { c: vec![5.0], dirs: vec![1], shift: None });
+    let (samples, _) = run(&mut Rk4::new(2, 0.1), &mut toy, y0, 1.0, 0.1, EventSettings::default()).unwrap();
+    assert_eq!(samples[0].1.map(f64::to_bits), y0.map(f64::to_bits));
 }

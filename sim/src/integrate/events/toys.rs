@@ -18,6 +18,10 @@ pub(super) trait Law {
     fn events(&self, t: f64, y: &[f64], out: &mut [f64]);
     /// Switches modes at an event; returns whether it changed `y`.
     fn handle(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> bool;
+    /// The modes at the start; may move `y` (returns whether it did). Default: nothing.
+    fn init(&mut self, _y: &mut [f64]) -> bool {
+        false
+    }
 }
 
 /// A toy system driven by a [`Law`], logging every handled event and counting evaluations.
@@ -84,8 +88,8 @@ impl<L: Law> HybridSystem for Toy<L> {
         self.law.events(t, y, out);
         Ok(())
     }
-    fn init_modes(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool, RhsFailure> {
-        Ok(false)
+    fn init_modes(&mut self, _t: f64, y: &mut [f64]) -> Result<bool, RhsFailure> {
+        Ok(self.law.init(y))
     }
     fn handle_events(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> Result<bool, RhsFailure> {
         self.log.push((t, fired.to_vec(), [y[0], y[1]]));
@@ -96,8 +100,11 @@ impl<L: Law> HybridSystem for Toy<L> {
     }
 }
 
+/// A named stepper for a toy.
+pub(super) type Named<L> = (&'static str, Box<dyn Stepper<Toy<L>>>);
+
 /// Every method, named: rk4 with step `h`, the adaptive ones with `rtol`, `atol`, `h_max`.
-pub(super) fn methods<L: Law>(h: f64, rtol: f64, atol: f64, h_max: f64) -> Vec<(&'static str, Box<dyn Stepper<Toy<L>>>)> {
+pub(super) fn methods<L: Law>(h: f64, rtol: f64, atol: f64, h_max: f64) -> Vec<Named<L>> {
     let c = StepControl { h_max, ..StepControl::new(rtol, atol) };
     vec![
         ("rk4", Box::new(Rk4::new(2, h))),
@@ -153,7 +160,7 @@ impl Law for Ball {
             y[1] = 0.0;
         } else {
             self.bounces.push(t);
-            y[1] = -self.e * y[1];
+            y[1] *= -self.e;
         }
         true
     }
@@ -192,13 +199,41 @@ impl Law for LiftOff {
     }
 }
 
-/// `x(t) = t` (`x0 = 0`, `v = 1`) and thresholds: function `i` is `x − c_i` (direction
+/// `x(t) = x0 + t` (`v = 1`) and thresholds: function `i` is `x − c_i` (direction
 /// `dirs[i]`); at each event the handler moves the threshold of every fired function to
 /// `x + shift` (no move for `shift = None`).
 pub(super) struct Thresholds {
     pub(super) c: Vec<f64>,
     pub(super) dirs: Vec<i8>,
     pub(super) shift: Option<f64>,
+}
+
+/// [`Thresholds`] whose `init_modes` moves `x0` to `start` (an "impact at t0").
+pub(super) struct MovedStart {
+    pub(super) inner: Thresholds,
+    pub(super) start: f64,
+}
+
+impl Law for MovedStart {
+    fn n(&self) -> usize {
+        self.inner.n()
+    }
+    fn dir(&self, i: usize) -> i8 {
+        self.inner.dir(i)
+    }
+    fn acc(&self, t: f64, y: &[f64]) -> f64 {
+        self.inner.acc(t, y)
+    }
+    fn events(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        self.inner.events(t, y, out)
+    }
+    fn handle(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> bool {
+        self.inner.handle(t, y, fired)
+    }
+    fn init(&mut self, y: &mut [f64]) -> bool {
+        y[0] = self.start;
+        true
+    }
 }
 
 impl Law for Thresholds {
