@@ -406,6 +406,39 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
         }
     }
 
+    // contacts with a contact model (unilateral, compliant): what they did
+    for r in runs.iter() {
+        for c in r.contact_states.iter().filter(|c| c.model.as_deref() != Some("bilateral")) {
+            let ev = &c.events;
+            let model = match (&c.model, c.friction) {
+                (Some(m), Some(mu)) => format!(" ({m}, μ = {mu})"),
+                (Some(m), None) => format!(" ({m})"),
+                _ => String::new(),
+            };
+            let stick = match (c.stick_friction_needed, c.contact_friction_needed) {
+                (Some(s), Some(a)) => format!("; friction needed to stick {s:.3} (over every sample in contact {a:.3})"),
+                (None, Some(a)) => format!("; never sticks (max |f_t|/f_n in contact {a:.3})"),
+                _ => String::new(),
+            };
+            out.push(format!(
+                "{}, {}{model}: in contact for {:.3} s of {:.3} s; {} lift-offs, {} touch-downs, {} impacts, {} rests, {} stick→slip, {} slip→stick; \
+                 impacts lost {:.3e} J, friction dissipated {:.3e} J{stick}.",
+                r.run,
+                c.contact,
+                c.time_in_contact_s,
+                r.t_end_s,
+                ev.lift_offs,
+                ev.touch_downs,
+                ev.impacts,
+                ev.rests,
+                ev.stick_to_slip,
+                ev.slip_to_stick,
+                c.impact_loss_j,
+                c.friction_work_j,
+            ));
+        }
+    }
+
     // energy balance
     let worst = (0..runs.len())
         .filter_map(|k| runs[k].energy.max_abs_residual_rel.map(|x| (k, x)))

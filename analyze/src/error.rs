@@ -32,6 +32,17 @@ pub enum Error {
         detail: String,
     },
 
+    /// A contact event that names no contact of the run, or an unknown kind.
+    #[error("{file}: /contact_events message {index} at t = {t_s} s: {field} = {value:?}: {detail}")]
+    BadEvent {
+        file: String,
+        index: usize,
+        t_s: f64,
+        field: &'static str,
+        value: String,
+        detail: String,
+    },
+
     /// A topic the metrics need has no messages.
     #[error("{file}: topic {topic} has no messages")]
     NoSamples { file: String, topic: String },

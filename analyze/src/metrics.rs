@@ -36,8 +36,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::Error;
 
+mod contacts;
 mod reductions;
 mod signal;
+pub use contacts::{ContactStateMetrics, EventCounts};
 pub use reductions::Reductions;
 
 /// How the run ended (metadata `result.status`).
@@ -195,9 +197,15 @@ pub struct RunMetrics {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limits: Option<LimitsMetrics>,
     /// The energy balance's terms that only some scenes have (metadata `energy_terms`: the
-    /// back-EMF conversion when K_e ≠ K_t, the soft stops' stored energy and loss), at the end.
+    /// back-EMF conversion when K_e ≠ K_t, the soft stops' stored energy and loss, the contacts'
+    /// impact loss, friction work and damping loss), at the end.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub energy_terms: Option<schemas::EnergyTermsRecord>,
+    /// Per contact, from `/contacts` and `/contact_events` (runs with a unilateral or compliant
+    /// contact; empty for the paper's bilateral runs): time in contact, events, losses, the
+    /// friction needed to stick ([`contacts`] module docs).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact_states: Vec<ContactStateMetrics>,
 }
 
 /// The `limits` record of a run: limits exceeded and drive saturations, joint and kind each
@@ -231,8 +239,12 @@ impl RunMetrics {
 }
 
 /// The topics [`run_metrics`] reads; [`read_run_metrics`] decodes only these (the transforms
-/// and joint states, most of a recording, are skipped).
-pub const METRIC_TOPICS: [&str; 4] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, topics::ENERGY];
+/// and joint states, most of a recording, are skipped). The last two exist only in runs with a
+/// unilateral or compliant contact; the others are [`REQUIRED_METRIC_TOPICS`].
+pub const METRIC_TOPICS: [&str; 6] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, topics::ENERGY, topics::CONTACT_EVENTS, topics::CONTACTS];
+
+/// The topics every recording must have for its metrics.
+pub const REQUIRED_METRIC_TOPICS: [&str; 4] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, topics::ENERGY];
 
 /// Reads the recording at `path` and computes its metrics; errors name the file.
 ///
@@ -298,9 +310,13 @@ pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
 /// `incomplete`: the recording was recovered without its `result` record; the reason.
 fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Error> {
     let mut acc = Reductions::default();
-    rec.replay(&METRIC_TOPICS, &mut acc).map_err(|e| acc.take_error(e))?;
+    // the contact topics only when the file has them (events first: file order)
+    let present: Vec<&str> = METRIC_TOPICS.iter().copied().filter(|t| REQUIRED_METRIC_TOPICS.contains(t) || rec.channel(t).is_some()).collect();
+    rec.replay(&present, &mut acc).map_err(|e| acc.take_error(e))?;
     acc.finish(rec, incomplete)
 }
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_contacts;

@@ -11,7 +11,11 @@
 //!   with the SI unit in lower case (`_m`, `_s`, `_j`, `_a`, `_n`) or `_ratio`/`_rel`: run-level
 //!   `err_z_rms_m`, `E_total_j`, `E_total_ratio`, `peak_current_a`; per link `W.joint4_j`,
 //!   `E.joint4_j`, `E.joint4_ratio`; per contact `fn_min.elbow4_n`, `pull.elbow4_s`,
-//!   `first_pull.elbow4_s`. Empty cells where a run lacks the joint or contact or the value does
+//!   `first_pull.elbow4_s`; per contact with a contact model in some run (`/contacts`, issue 11)
+//!   `in_contact.elbow4_s`, `lift_offs.elbow4`, `touch_downs.…`, `impacts.…`, `rests.…`,
+//!   `stick_to_slip.…`, `slip_to_stick.…` (counts), `impact_loss.elbow4_j`, `friction_work.…_j`,
+//!   `damping_loss.…_j`, `mu_stick.elbow4_ratio`, `mu_contact.…_ratio`, `fn_contact_min.…_n`,
+//!   `fn_contact_max.…_n`. Empty cells where a run lacks the joint or contact or the value does
 //!   not exist. Numbers use Rust's shortest round-trip form.
 
 use std::fmt;

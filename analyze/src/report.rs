@@ -171,6 +171,7 @@ pub fn render_report(
     out.push_str(&crate::render::render_comparison_markdown(cmp));
     out.push('\n');
 
+    contacts(&mut out, &runs, &labels);
     audit(&mut out, &runs, &labels, info);
 
     if !figures.is_empty() {
@@ -186,6 +187,48 @@ pub fn render_report(
         out.pop();
     }
     out
+}
+
+/// Section "Contacts": what the table did at each contact, for the runs that have contacts.
+/// Bilateral contacts (the paper's) hold the point on the table with a force of either sign: the
+/// time they pull (`f_n < 0`) is what a real table could not do. Unilateral (rigid, with impacts
+/// and Coulomb friction, Pfeiffer & Glocker 1996) and compliant contacts only push: their time
+/// in contact, events, losses and the friction they needed to stick.
+fn contacts(out: &mut String, runs: &[&RunMetrics], labels: &[String]) {
+    if runs.iter().all(|r| r.contacts.is_empty()) {
+        return;
+    }
+    out.push_str(
+        "## Contacts
+
+         A bilateral contact (the paper's) holds its point on the table with a force of either          sign; where f_n < 0 the table pulls, which a real table cannot. Unilateral contacts          (rigid: impacts with restitution, Coulomb friction) and compliant ones (spring-damper)          only push; for them: the time in contact, the events, the energy lost in impacts and          to friction, and the friction coefficient each needed to stick (max |f_t|/f_n).
+
+",
+    );
+    out.push_str("| run | contact | model | in contact [s] | f_n < 0 [s] | min f_n [N] | lift-offs | impacts | impact loss [J] | friction work [J] | μ to stick |\n");
+    out.push_str("|:--|:--|:--|--:|--:|--:|--:|--:|--:|--:|--:|\n");
+    for (r, name) in runs.iter().zip(labels) {
+        for c in &r.contact_forces {
+            let state = r.contact_states.iter().find(|s| s.contact == c.contact);
+            let row = match state {
+                Some(s) => format!(
+                    "{} | {:.4} | {:.4} | {:.3} | {} | {} | {:.3e} | {:.3e} | {}",
+                    s.model.as_deref().unwrap_or("-"),
+                    s.time_in_contact_s,
+                    c.pull_time_s,
+                    c.min_normal_force_n,
+                    s.events.lift_offs,
+                    s.events.impacts,
+                    s.impact_loss_j,
+                    s.friction_work_j,
+                    s.stick_friction_needed.map_or("-".into(), |x| format!("{x:.3}")),
+                ),
+                None => format!("bilateral | {:.4} | {:.4} | {:.3} | - | - | - | - | -", r.t_end_s, c.pull_time_s, c.min_normal_force_n),
+            };
+            let _ = writeln!(out, "| {name} | {} | {row} |", c.contact);
+        }
+    }
+    out.push('\n');
 }
 
 fn audit(out: &mut String, runs: &[&RunMetrics], labels: &[String], info: &[RunInfo]) {
@@ -261,4 +304,32 @@ fn audit(out: &mut String, runs: &[&RunMetrics], labels: &[String], info: &[RunI
         }
     }
     out.push('\n');
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The section "Contacts": a bilateral run's rows give the pull time; the unilateral run's
+    /// its model, time in contact (exact to its events, 0.596 s), events and friction needed.
+    #[test]
+    fn the_report_has_a_contacts_section() {
+        let dir = tempfile::tempdir().unwrap();
+        let (s, _) = schemas::synth::unilateral();
+        let uni = crate::metrics::read_run_metrics(&s.write_in(dir.path())).unwrap();
+        let mut runs = crate::compare::tests::paper_runs();
+        runs[0].contact_forces[1].pull_time_s = 0.31;
+        runs.push(uni);
+        let cmp = Comparison::new(&runs, None).unwrap();
+        let info: Vec<RunInfo> = runs
+            .iter()
+            .map(|_| RunInfo { tool: None, format_version: Some(2), integrator: None, sampled: [Err("none".into()), Err("none".into())] })
+            .collect();
+        let text = render_report(&cmp, &info, &[], None);
+        let section = &text[text.find("## Contacts").unwrap_or_else(|| panic!("{text}"))..];
+        let section = &section[..section.find("## Energy audit").unwrap()];
+        assert!(section.contains("| two-elbow | elbow7 | bilateral | 5.0000 | 0.3100 |"), "{section}");
+        assert!(section.contains("| unilateral | elbow4 | unilateral | 0.5960 | 0.0000 | 0.000 | 1 | 1 | 6.000e-2 | 6.000e-3 | 0.300 |"), "{section}");
+        assert!(!section.contains("no-elbow"), "no contacts, no rows: {section}");
+    }
 }

@@ -41,10 +41,10 @@ pub mod writer;
 pub use error::Error;
 pub use messages::{
     frame_transform, hand_points, timestamp, ConstraintState, EnergyState, HandState, JointState,
-    Message, MotorState, RosString, TopicMessage, Vec3,
+    Message, MotorState, RosString, TopicMessage, Vec3, contact_mode, ContactEventMsg, ContactState, CONTACT_EVENT_KINDS,
 };
 pub use meta::{
-    EnergyTermsRecord, IntegratorInfo, LimitEventInfo, LimitsRecord, MetadataRecord, ModelInfo, RecordingInfo,
+    ContactInfo, ContactsRecord, EnergyTermsRecord, IntegratorInfo, LimitEventInfo, LimitsRecord, MetadataRecord, ModelInfo, RecordingInfo,
     RunDescription, RunInfo, RunNames, RunResult, RunStatus, SceneRecord, Setup, UrdfRecord,
 };
 pub use reader::{

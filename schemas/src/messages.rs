@@ -125,6 +125,80 @@ pub struct EnergyState {
     pub gear_friction_loss: f64,
 }
 
+/// The state of every contact of a run that has a non-bilateral contact (topic
+/// [`crate::topics::CONTACTS`]; absent from the recordings of purely bilateral runs). Arrays
+/// have one entry per contact, in the order of `name` (= metadata `run.contacts`). Sign
+/// conventions: gap `g = n · p − d` (> 0 separated), normal force `f_n` (> 0 pushes the point
+/// off the plane); tangential quantities in the plane's tangent basis `(t1, t2)` (world frame,
+/// recorded in the `contacts` metadata record).
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
+pub struct ContactState {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Contact names, in array order.
+    pub name: Vec<String>,
+    /// Mode code: 0 separated, 1 sticking, 2 sliding (also frictionless in touch), 3 bilateral.
+    pub mode: Vec<u32>,
+    /// Gap g, m.
+    pub gap: Vec<f64>,
+    /// Gap rate dg/dt, m/s.
+    pub gap_rate: Vec<f64>,
+    /// Normal force f_n, N.
+    pub normal_force: Vec<f64>,
+    /// Friction force on the point along t1, N.
+    pub friction_force_t1: Vec<f64>,
+    /// Friction force on the point along t2, N.
+    pub friction_force_t2: Vec<f64>,
+    /// Slip velocity of the point relative to the plane along t1, m/s.
+    pub slip_velocity_t1: Vec<f64>,
+    /// Slip velocity along t2, m/s.
+    pub slip_velocity_t2: Vec<f64>,
+    /// Kinetic energy lost in this contact's impacts since t = 0 (rotors included), J.
+    pub impact_loss: Vec<f64>,
+    /// Work dissipated by this contact's friction since t = 0, `∫ −f_t · v_t dt ≥ 0`, J.
+    pub friction_work: Vec<f64>,
+    /// A compliant contact's damping loss since t = 0, `∫ (f_n − k δ) dδ/dt dt`, J (0 for the
+    /// other models).
+    pub damping_loss: Vec<f64>,
+}
+
+/// One contact event (topic [`crate::topics::CONTACT_EVENTS`]): log time = event time, written
+/// before the sample that follows the event.
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
+pub struct ContactEventMsg {
+    /// Event time, s (located on the integrator's dense output).
+    pub time: f64,
+    /// The contact's name (metadata `run.contacts`).
+    pub contact: String,
+    /// `lift-off`, `touch-down`, `impact`, `rest`, `stick-to-slip` or `slip-to-stick`
+    /// ([`CONTACT_EVENT_KINDS`]).
+    pub kind: String,
+    /// Normal impulse of an impact, N·s (0 for the other kinds).
+    pub impulse: f64,
+    /// Kinetic energy lost in an impact (rotors included), J (0 for the other kinds).
+    pub energy_lost: f64,
+    /// Gap rate just before the event, m/s.
+    pub gap_rate_before: f64,
+    /// Gap rate just after the event, m/s.
+    pub gap_rate_after: f64,
+}
+
+/// Every value of [`ContactEventMsg::kind`].
+pub const CONTACT_EVENT_KINDS: [&str; 6] = ["lift-off", "touch-down", "impact", "rest", "stick-to-slip", "slip-to-stick"];
+
+/// The mode codes of [`ContactState::mode`], by name.
+pub mod contact_mode {
+    pub const SEPARATED: u32 = 0;
+    pub const STICKING: u32 = 1;
+    pub const SLIDING: u32 = 2;
+    pub const BILATERAL: u32 = 3;
+
+    /// `separated`, `sticking`, `sliding`, `bilateral`, or `None` for an unknown code.
+    pub fn name(code: u32) -> Option<&'static str> {
+        ["separated", "sticking", "sliding", "bilateral"].get(code as usize).copied()
+    }
+}
+
 /// A message type bound to the one topic that carries it, for typed reading
 /// ([`crate::Recording::read`]).
 pub trait TopicMessage: serde::de::DeserializeOwned {
@@ -142,6 +216,12 @@ impl TopicMessage for HandState {
 }
 impl TopicMessage for EnergyState {
     const TOPIC: &'static str = topics::ENERGY;
+}
+impl TopicMessage for ContactState {
+    const TOPIC: &'static str = topics::CONTACTS;
+}
+impl TopicMessage for ContactEventMsg {
+    const TOPIC: &'static str = topics::CONTACT_EVENTS;
 }
 impl TopicMessage for JointState {
     const TOPIC: &'static str = topics::JOINT_STATES;
@@ -241,7 +321,7 @@ macro_rules! protobuf_message {
     )*};
 }
 
-protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState);
+protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg);
 
 // every Foxglove well-known schema, so `sim` can record any of them without touching this crate
 use foxglove::messages as fm;

@@ -20,6 +20,14 @@
 //! | `result` | `limits_exceeded`, `saturations` (only runs whose scene monitors limits) | 2 |
 //! | `limits` | `monitored`, `resolution`, `exceeded`, `saturations`, `events` (JSON array) — only runs whose scene monitors limits | 2 |
 //! | `energy_terms` | `emf_conversion`, `stop_energy`, `stop_loss` — only the terms a scene has | 2 |
+//! | `energy_terms` | `impact_loss`, `friction_work`, `damping_loss` (totals over the contacts) — only runs with a non-bilateral contact | 2+ |
+//! | `contacts` | `contacts` (JSON array of [`ContactInfo`]), `time_tolerance`, `gap_tolerance`, `velocity_tolerance`, `rest_velocity`, `max_events` — only runs with a non-bilateral contact | 2+ |
+//!
+//! `2+`: added within format 2 by issue 11 (contacts), with the topics `/contacts` and
+//! `/contact_events`, all only in runs with a non-bilateral contact. The version was NOT bumped,
+//! on purpose: the version is written into every recording (record `recording`, the MCAP
+//! header's library), and the recordings of purely bilateral runs (the paper's archive) must
+//! stay byte-identical; a format-2 reader ignores records and topics it does not know.
 //!
 //! Readers ignore keys they do not know (a newer writer may add some) and reject a record that
 //! lacks a key its format version must have, naming the record and the key.
@@ -28,6 +36,9 @@ use std::collections::BTreeMap;
 
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
+
+mod contacts;
+pub use contacts::{ContactInfo, ContactsRecord};
 
 /// A metadata record: its MCAP name and its keys (the struct's fields, every value text).
 pub trait MetadataRecord: Serialize + DeserializeOwned {
@@ -334,7 +345,7 @@ impl MetadataRecord for LimitsRecord {
 
 /// Record `energy_terms`: the final values of the energy balance's terms that only some scenes
 /// have (the `/energy` messages keep their layout; their residual includes these terms).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnergyTermsRecord {
     /// `∫ Σ (K_e − K_t) k i q̇ dt`, J (scenes with K_e ≠ K_t).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
@@ -345,6 +356,16 @@ pub struct EnergyTermsRecord {
     /// The soft stops' damping loss, J (scenes with stops).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
     pub stop_loss: Option<f64>,
+    /// Kinetic energy lost in the contacts' impacts, summed over the contacts, J (runs with a
+    /// non-bilateral contact; per contact in `/contacts`).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub impact_loss: Option<f64>,
+    /// Work dissipated by the contacts' friction, summed, J (runs with a non-bilateral contact).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub friction_work: Option<f64>,
+    /// The compliant contacts' damping loss, summed, J (runs with a non-bilateral contact).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub damping_loss: Option<f64>,
 }
 
 impl MetadataRecord for EnergyTermsRecord {

@@ -13,11 +13,14 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::meta::{RecordingInfo, RunInfo, RunNames, RunResult, Setup};
+use crate::meta::{ContactsRecord, EnergyTermsRecord, RecordingInfo, RunInfo, RunNames, RunResult, Setup};
 use crate::{
-    hand_points, to_log_time, topics, ConstraintState, EnergyState, HandState, JointState, MotorState, RecordingWriter,
-    Vec3,
+    hand_points, to_log_time, topics, ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, MotorState,
+    RecordingWriter, Vec3,
 };
+
+mod contacts;
+pub use contacts::{unilateral, UnilateralTruth};
 
 /// A message as a function of time (its `time` field is set by the writer).
 pub type Signal<T> = Box<dyn Fn(f64) -> T>;
@@ -48,6 +51,15 @@ pub struct Synth {
     pub time_scale: f64,
     /// A sample left out of every topic (a gap), by index.
     pub drop_sample: Option<usize>,
+    /// `/contacts` (runs with a non-bilateral contact; `None`: no such topic).
+    pub contacts: Option<Signal<ContactState>>,
+    /// `/contact_events`, each written at its `time` before the first sample at or after it
+    /// (as `sim` writes them); the topic is registered when `contacts` is given.
+    pub contact_events: Vec<ContactEventMsg>,
+    /// Record `contacts`.
+    pub contacts_record: Option<ContactsRecord>,
+    /// Record `energy_terms`.
+    pub energy_terms: Option<EnergyTermsRecord>,
 }
 
 impl Synth {
@@ -80,6 +92,10 @@ impl Synth {
             hand_points: false,
             time_scale: 1.0,
             drop_sample: None,
+            contacts: None,
+            contact_events: Vec::new(),
+            contacts_record: None,
+            energy_terms: None,
         }
     }
 
@@ -129,6 +145,10 @@ impl Synth {
             (Some(n), None) => w.write_record(n).expect("run record"),
             (None, _) => {}
         }
+        if let Some(r) = &self.contacts_record {
+            w.write_record(r).expect("contacts record");
+        }
+        let mut events = self.contact_events.iter().peekable();
         for k in 0..=self.n {
             if self.drop_sample == Some(k) {
                 continue;
@@ -155,6 +175,15 @@ impl Synth {
             if let Some(f) = &self.joint_states {
                 w.write(topics::JOINT_STATES, ns, &JointState { stamp_ns: ns, ..f(t) }).expect("joint states");
             }
+            if let Some(f) = &self.contacts {
+                while let Some(e) = events.next_if(|e| e.time <= t) {
+                    w.write(topics::CONTACT_EVENTS, to_log_time(e.time * self.time_scale), e).expect("contact event");
+                }
+                w.write(topics::CONTACTS, ns, &ContactState { time: t, ..f(t) }).expect("contacts");
+            }
+        }
+        if let Some(r) = &self.energy_terms {
+            w.write_record(r).expect("energy_terms record");
         }
         if let Some(r) = &self.result {
             w.write_record(r).expect("result record");

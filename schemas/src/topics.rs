@@ -24,7 +24,18 @@ pub const ENERGY: &str = "/energy";
 /// [`crate::PointCloud`] (`foxglove.PointCloud`): actual and desired hand as 2 points.
 pub const HAND_POINTS: &str = "/hand_points";
 
-/// Every topic above, in the order a recording normally registers them.
+/// [`crate::ContactState`]: mode, gap, forces, slip and cumulative losses per contact. Only in
+/// runs with a non-bilateral contact ([`CONTACT_TOPICS`]); not in [`ALL`].
+pub const CONTACTS: &str = "/contacts";
+/// [`crate::ContactEventMsg`]: one message per contact event, at the event time. Only in runs
+/// with a non-bilateral contact; not in [`ALL`].
+pub const CONTACT_EVENTS: &str = "/contact_events";
+
+/// The topics only runs with a non-bilateral (unilateral or compliant) contact have, in the
+/// order they are registered (after [`ALL`]).
+pub const CONTACT_TOPICS: [&str; 2] = [CONTACTS, CONTACT_EVENTS];
+
+/// Every topic every recording has (the ones above but [`CONTACT_TOPICS`]), in the order a recording normally registers them.
 pub const ALL: [&str; 8] = [
     ROBOT_DESCRIPTION,
     TF,
@@ -62,6 +73,7 @@ pub fn array_required(topic: &str, field: &str) -> bool {
     matches!(
         (topic, field),
         (MOTORS, "current") | (ENERGY, "link_work" | "electric_energy") | (CONSTRAINTS, "normal_force" | "position" | "velocity")
+            | (CONTACTS, "name" | "mode" | "gap" | "gap_rate" | "normal_force")
     )
 }
 
@@ -76,12 +88,17 @@ pub fn entry_label(item: &crate::Value) -> Option<&str> {
 }
 
 /// The index of the array `field` of messages on `topic`, for the arrays of [`MOTORS`],
-/// [`ENERGY`], [`JOINT_STATES`] and [`CONSTRAINTS`]; `None` for anything else.
+/// [`ENERGY`], [`JOINT_STATES`], [`CONSTRAINTS`] and [`CONTACTS`]; `None` for anything else.
 pub fn array_index(topic: &str, field: &str) -> Option<ArrayIndex> {
     match (topic, field) {
         (MOTORS, "current" | "voltage" | "back_emf" | "electric_power" | "torque")
         | (ENERGY, "link_work" | "electric_energy") => Some(ArrayIndex::Joint),
         (CONSTRAINTS, "normal_force" | "position" | "velocity") => Some(ArrayIndex::Contact),
+        (
+            CONTACTS,
+            "name" | "mode" | "gap" | "gap_rate" | "normal_force" | "friction_force_t1" | "friction_force_t2" | "slip_velocity_t1"
+            | "slip_velocity_t2" | "impact_loss" | "friction_work" | "damping_loss",
+        ) => Some(ArrayIndex::Contact),
         (JOINT_STATES, "position" | "velocity" | "effort") => Some(ArrayIndex::Joint),
         _ => None,
     }

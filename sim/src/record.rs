@@ -4,16 +4,26 @@
 //! `/joint_states` (q, q̇, τ of eq 12), `/motors`, `/constraints`, `/hand`, `/energy`,
 //! `/hand_points`; and metadata with everything needed to reproduce the run (scene, URDF,
 //! tool version, integrator), nothing that differs between two identical runs.
+//!
+//! Runs with a non-bilateral contact (issue 11: rigid unilateral contacts after Pfeiffer &
+//! Glocker, *Multibody Dynamics with Unilateral Contacts*, 1996; compliant ones) also get
+//! `/contacts` (mode, gap, forces, slip, cumulative contact losses per contact, every sample),
+//! `/contact_events` (one message per event at the event time, written before the sample that
+//! follows it), the metadata record `contacts` (models, parameters, planes, tangent bases, event
+//! settings) and the contact totals in `energy_terms`. Purely bilateral runs (the paper's) write
+//! none of these: their recordings are byte for byte what they were.
 
 use std::path::{Path, PathBuf};
 
 use schemas::{
-    frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
+    frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactInfo, ContactState,
+    ContactsRecord, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
     JointState, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
 use schemas::{Quaternion, Vector3};
 
+use crate::dynamics::contact::{Contact, ContactEvent, ContactModel, ContactOutput};
 use crate::error::RunError;
 use crate::joint_limits::LimitMonitor;
 use crate::scene::{Run, Scene};
@@ -38,6 +48,91 @@ fn set(dst: &mut Vec<f64>, src: &[f64]) {
     dst.extend_from_slice(src);
 }
 
+/// `dst` = `f` of every contact output (no allocation once `dst` has grown to the run's size).
+fn set_with<T>(dst: &mut Vec<T>, src: &[ContactOutput], f: impl Fn(&ContactOutput) -> T) {
+    dst.clear();
+    dst.extend(src.iter().map(f));
+}
+
+/// The event settings recorded in the `contacts` record (the design's tolerances of issue 11).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactSettings {
+    /// Width of the bracket an event time is located to, s.
+    pub time_tolerance: f64,
+    /// A contact is closed when `|g| ≤ gap_tolerance` (m) and `|ġ| ≤ velocity_tolerance` (m/s).
+    pub gap_tolerance: f64,
+    pub velocity_tolerance: f64,
+    /// Impacts slower than this are plastic (the Zeno rule), m/s.
+    pub rest_velocity: f64,
+    /// Most events in a run.
+    pub max_events: u64,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        ContactSettings { time_tolerance: 1e-12, gap_tolerance: 1e-9, velocity_tolerance: 1e-9, rest_velocity: 1e-4, max_events: 100_000 }
+    }
+}
+
+/// The contacts of `run`, in its order, with their models.
+// MERGE (issue 11): once `Scene::contacts` holds `dynamics::contact::Contact` (arm branch),
+// this is `run.contacts.iter().map(|&k| scene.contacts[k].clone()).collect()`.
+fn run_contacts(scene: &Scene, run: &Run) -> Vec<Contact> {
+    run.contacts.iter().map(|&k| Contact::new(scene.contacts[k].clone(), ContactModel::Bilateral)).collect()
+}
+
+/// The event settings of `scene`.
+// MERGE (issue 11): read them from the scene's `events` settings (arm branch).
+fn contact_settings(_scene: &Scene) -> ContactSettings {
+    ContactSettings::default()
+}
+
+/// Record `contacts`: every contact of the run (its model and parameters, plane, tangent basis)
+/// and the event settings.
+pub fn contacts_record(contacts: &[Contact], settings: &ContactSettings) -> ContactsRecord {
+    let xyz = |v: &nalgebra::Vector3<f64>| [v.x, v.y, v.z];
+    let contacts = contacts
+        .iter()
+        .map(|c| {
+            let mut info = ContactInfo {
+                name: c.name().to_string(),
+                model: c.model.name().to_string(),
+                restitution: None,
+                friction: None,
+                stiffness: None,
+                damping: None,
+                slip_velocity: None,
+                normal: xyz(&c.plane.normal_world),
+                offset: c.plane.offset,
+                t1: xyz(&c.t1),
+                t2: xyz(&c.t2),
+            };
+            match c.model {
+                ContactModel::Bilateral => {}
+                ContactModel::Unilateral { restitution, friction } => {
+                    info.restitution = Some(restitution);
+                    info.friction = Some(friction);
+                }
+                ContactModel::Compliant { stiffness, damping, friction, slip_velocity } => {
+                    info.stiffness = Some(stiffness);
+                    info.damping = Some(damping);
+                    info.friction = Some(friction);
+                    info.slip_velocity = Some(slip_velocity);
+                }
+            }
+            info
+        })
+        .collect();
+    ContactsRecord {
+        contacts,
+        time_tolerance: settings.time_tolerance,
+        gap_tolerance: settings.gap_tolerance,
+        velocity_tolerance: settings.velocity_tolerance,
+        rest_velocity: settings.rest_velocity,
+        max_events: settings.max_events,
+    }
+}
+
 /// Writes one run. Create, `record` every sample, then `finish` (or `fail`).
 pub struct Recorder<'a> {
     scene: &'a Scene,
@@ -54,6 +149,15 @@ pub struct Recorder<'a> {
     monitor: Option<LimitMonitor>,
     /// The last sample's `E_conv`, `ΣV_s`, `E_s` (record `energy_terms`, scenes that have them).
     terms: [f64; 3],
+    /// The run has a non-bilateral contact: `/contacts`, `/contact_events`, record `contacts`.
+    hybrid: bool,
+    /// `/contacts`, names set once, arrays reused every sample.
+    contact_state: ContactState,
+    /// `/contact_events`, reused for every event.
+    contact_event: ContactEventMsg,
+    /// The last sample's impact loss, friction work and damping loss summed over the contacts
+    /// (record `energy_terms`, hybrid runs).
+    contact_terms: [f64; 3],
 }
 
 impl<'a> Recorder<'a> {
@@ -74,15 +178,31 @@ impl<'a> Recorder<'a> {
     /// the bench `record` compares them).
     #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
     pub fn create_with(path: &Path, scene: &'a Scene, run: &Run, options: WriterOptions, tap: Option<Tap>) -> Result<Self, RunError> {
+        Self::create_described(path, scene, run, options, tap, &run_contacts(scene, run), &contact_settings(scene))
+    }
+
+    /// [`Recorder::create_with`] for the run's `contacts` (in its order, with their models) and
+    /// event `settings`: a run with a non-bilateral contact also gets the record `contacts`.
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
+    pub(crate) fn create_described(
+        path: &Path,
+        scene: &'a Scene,
+        run: &Run,
+        options: WriterOptions,
+        tap: Option<Tap>,
+        contacts: &[Contact],
+        settings: &ContactSettings,
+    ) -> Result<Self, RunError> {
         let err = |source| RunError::Recording { path: path.to_path_buf(), source };
         let mut writer = RecordingWriter::create_tapped(path, options, tap).map_err(err)?;
         let joint_names = scene.model.joint_names();
-        let contact_names: Vec<String> = run.contacts.iter().map(|&k| scene.contacts[k].name.clone()).collect();
+        let contact_names: Vec<String> = contacts.iter().map(|c| c.name().to_string()).collect();
+        let hybrid = contacts.iter().any(|c| c.model != ContactModel::Bilateral);
         writer.write_record(&RecordingInfo::new(TOOL)).map_err(err)?;
         let run_info = RunInfo {
             scene: scene.spec.name.clone(),
             run: run.name.clone(),
-            contacts: contact_names,
+            contacts: contact_names.clone(),
             joint_names: joint_names.clone(),
             setup: Setup {
                 integrator: scene.integrator.describe(),
@@ -114,6 +234,9 @@ impl<'a> Recorder<'a> {
                 repaired_inertias: crate::dynamics::model::repair_summary(&scene.model.repaired_inertias),
             })
             .map_err(err)?;
+        if hybrid {
+            writer.write_record(&contacts_record(contacts, settings)).map_err(err)?;
+        }
 
         writer
             .write(topics::ROBOT_DESCRIPTION, 0, &RosString { data: scene.urdf_xml.clone() })
@@ -135,6 +258,10 @@ impl<'a> Recorder<'a> {
             energy: EnergyState::default(),
             monitor: LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, 1.0 / scene.output_rate),
             terms: [0.0; 3],
+            hybrid,
+            contact_state: ContactState { name: contact_names, ..Default::default() },
+            contact_event: ContactEventMsg::default(),
+            contact_terms: [0.0; 3],
         })
     }
 
@@ -146,6 +273,13 @@ impl<'a> Recorder<'a> {
         self.terms = [o.loss_conversion, o.stop_energy, o.loss_stop];
         let t_ns = to_log_time(o.t);
         let model = &self.scene.model;
+
+        // the contact events since the previous sample, at their own times (≤ t), before it
+        if self.hybrid {
+            for ev in &o.events {
+                self.write_event(ev)?;
+            }
+        }
         let path = &self.path;
         let err = |source| RunError::Recording { path: path.clone(), source };
 
@@ -211,7 +345,51 @@ impl<'a> Recorder<'a> {
         en.gear_friction_loss = o.loss_gear_friction;
         en.balance_residual = o.balance_residual;
         self.writer.write(topics::ENERGY, t_ns, &self.energy).map_err(&err)?;
+
+        if self.hybrid && !o.contacts.is_empty() {
+            let cs = &mut self.contact_state;
+            cs.time = o.t;
+            set_with(&mut cs.mode, &o.contacts, |c| c.mode.code());
+            set_with(&mut cs.gap, &o.contacts, |c| c.gap);
+            set_with(&mut cs.gap_rate, &o.contacts, |c| c.gap_rate);
+            set_with(&mut cs.normal_force, &o.contacts, |c| c.normal_force);
+            set_with(&mut cs.friction_force_t1, &o.contacts, |c| c.friction_force[0]);
+            set_with(&mut cs.friction_force_t2, &o.contacts, |c| c.friction_force[1]);
+            set_with(&mut cs.slip_velocity_t1, &o.contacts, |c| c.slip_velocity[0]);
+            set_with(&mut cs.slip_velocity_t2, &o.contacts, |c| c.slip_velocity[1]);
+            set_with(&mut cs.impact_loss, &o.contacts, |c| c.impact_loss);
+            set_with(&mut cs.friction_work, &o.contacts, |c| c.friction_work);
+            set_with(&mut cs.damping_loss, &o.contacts, |c| c.damping_loss);
+            self.contact_terms = [cs.impact_loss.iter().sum(), cs.friction_work.iter().sum(), cs.damping_loss.iter().sum()];
+            self.writer.write(topics::CONTACTS, t_ns, &self.contact_state).map_err(&err)?;
+        }
         Ok(())
+    }
+
+    /// One contact event on `/contact_events`, log time = the event time.
+    fn write_event(&mut self, ev: &ContactEvent) -> Result<(), RunError> {
+        let path = &self.path;
+        let e = &mut self.contact_event;
+        e.time = ev.t;
+        e.contact.clear();
+        match self.contact_state.name.get(ev.contact) {
+            Some(name) => e.contact.push_str(name),
+            None => {
+                let detail = format!("contact index {} of a run with {} contacts", ev.contact, self.contact_state.name.len());
+                return Err(RunError::Recording {
+                    path: path.clone(),
+                    source: schemas::Error::BadMetadata { file: path.display().to_string(), record: "contacts".into(), key: "contact".into(), detail },
+                });
+            }
+        }
+        e.kind.clear();
+        e.kind.push_str(ev.kind.name());
+        e.impulse = ev.impulse;
+        e.energy_lost = ev.energy_lost;
+        e.gap_rate_before = ev.gap_rate_before;
+        e.gap_rate_after = ev.gap_rate_after;
+        let err = |source| RunError::Recording { path: path.clone(), source };
+        self.writer.write(topics::CONTACT_EVENTS, to_log_time(ev.t), &self.contact_event).map_err(err)
     }
 
     /// Close the file with a result record, then rename it into place. `outcome` is `Ok` with
@@ -249,13 +427,17 @@ impl<'a> Recorder<'a> {
             let rec = LimitsRecord { monitored: sum.monitored, resolution: sum.resolution, exceeded, saturations, events };
             self.writer.write_record(&rec).map_err(err)?;
         }
-        let (conv, stops) = (self.scene.drives.has_conversion, self.scene.stops.is_some());
-        if conv || stops {
+        let (conv, stops, hybrid) = (self.scene.drives.has_conversion, self.scene.stops.is_some(), self.hybrid);
+        if conv || stops || hybrid {
             let [c, e, l] = self.terms;
+            let [imp, fric, damp] = self.contact_terms;
             let rec = EnergyTermsRecord {
                 emf_conversion: conv.then_some(c),
                 stop_energy: stops.then_some(e),
                 stop_loss: stops.then_some(l),
+                impact_loss: hybrid.then_some(imp),
+                friction_work: hybrid.then_some(fric),
+                damping_loss: hybrid.then_some(damp),
             };
             self.writer.write_record(&rec).map_err(err)?;
         }
@@ -263,3 +445,6 @@ impl<'a> Recorder<'a> {
         self.writer.finish_tapped().map_err(err)
     }
 }
+
+#[cfg(test)]
+mod tests;

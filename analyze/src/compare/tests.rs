@@ -47,6 +47,7 @@ pub(crate) fn run(name: &str, contacts: &[&str], e: &[f64], w: &[f64], z_rms: f6
         status: Status::Complete,
         limits: None,
         energy_terms: None,
+        contact_states: Vec::new(),
         error: None,
         error_time_s: None,
         hand_error: HandError {
@@ -211,4 +212,21 @@ fn a_pulling_table_is_reported_with_duration_start_and_minimum() {
     assert!(has(&c, want), "{:#?}", c.findings);
     assert!(!has(&c, "two-elbow: every normal force"));
     assert!(has(&c, "one-elbow: every normal force stays >= 0"));
+}
+
+/// A run with unilateral contacts (the synthetic one) gets one finding per such contact: its
+/// time in contact, its events, its losses and the friction it needed to stick.
+#[test]
+fn unilateral_contacts_are_reported_with_events_and_friction_needed() {
+    let dir = tempfile::tempdir().unwrap();
+    let (s, _) = schemas::synth::unilateral();
+    let uni = crate::metrics::read_run_metrics(&s.write_in(dir.path())).unwrap();
+    let mut runs = paper_runs();
+    runs.push(uni);
+    let c = Comparison::new(&runs, None).unwrap();
+    let want = "unilateral, elbow4 (unilateral, μ = 0.6): in contact for 0.596 s of 1.000 s; 1 lift-offs, 0 touch-downs, 1 impacts, 1 rests, 0 stick→slip, 1 slip→stick; \
+                impacts lost 6.000e-2 J, friction dissipated 6.000e-3 J; friction needed to stick 0.300 (over every sample in contact 0.600).";
+    assert!(has(&c, want), "{:#?}", c.findings);
+    assert!(has(&c, "unilateral, elbow7 (unilateral, μ = 0.6): in contact for 1.000 s"));
+    assert!(!Comparison::new(&paper_runs(), None).unwrap().findings.iter().any(|f| f.contains("in contact for")));
 }

@@ -3,10 +3,11 @@
 //! the checks each message passes before it counts.
 
 use schemas::topics::ArrayIndex;
-use schemas::{topics, ConstraintState, DecodedMessage, EnergyState, HandState, MotorState, Recording, RunResult, RunStatus};
+use schemas::{topics, ConstraintState, ContactEventMsg, ContactState, DecodedMessage, EnergyState, HandState, MotorState, Recording, RunResult, RunStatus};
 
 use super::signal::negative_time;
-use super::{AxisError, ContactMetrics, EnergyAudit, HandError, LinkMetrics, PeakCurrent, RunMetrics, Status, METRIC_TOPICS};
+use super::contacts::ContactReductions;
+use super::{AxisError, ContactMetrics, EnergyAudit, HandError, LinkMetrics, PeakCurrent, RunMetrics, Status, REQUIRED_METRIC_TOPICS};
 use crate::Error;
 
 /// `max_k |v_k|` and the time of its first occurrence.
@@ -114,6 +115,9 @@ pub struct Reductions {
     n_contacts: Option<usize>,
     /// Why the last message was refused (see the `Visitor` impl).
     error: Option<Error>,
+    /// `/contacts` and `/contact_events` (runs with contact models).
+    contact_states: ContactReductions,
+    contact_state_samples: Samples,
 }
 
 /// An array of `len` entries (one per `per`) where the first message of the run had `*seen`.
@@ -206,7 +210,7 @@ impl Reductions {
                 (status, r.error, r.error_time_s)
             }
         };
-        for topic in METRIC_TOPICS {
+        for topic in REQUIRED_METRIC_TOPICS {
             rec.check_topic(topic)?;
         }
         let non_empty = |topic: &str, s: &Samples| if s.count == 0 { Err(Error::NoSamples { file: file(), topic: topic.into() }) } else { Ok(()) };
@@ -241,6 +245,18 @@ impl Reductions {
                 });
             }
         }
+        if self.contact_state_samples.count > 0 {
+            if let (Status::Complete, Some(setup)) = (status, &run.setup) {
+                let (dt, s) = (1.0 / setup.output_rate_hz, &self.contact_state_samples);
+                if s.last_t < setup.duration_s - dt * (1.0 + 1e-6) {
+                    return Err(Error::ShortRun { file: file(), topic: topics::CONTACTS.into(), samples: s.count, t_end_s: s.last_t, duration_s: setup.duration_s });
+                }
+            }
+        }
+        let contact_states = match self.contact_state_samples.count {
+            0 => Vec::new(),
+            _ => self.contact_states.finish(&rec.source, &run.contacts, rec.record_opt::<schemas::ContactsRecord>()?.as_ref())?,
+        };
         let joint_names = run.joint_names;
         let contacts = run.contacts;
         let n = self.hand_samples.count;
@@ -314,6 +330,7 @@ impl Reductions {
                 None => None,
             },
             energy_terms: rec.record_opt::<schemas::EnergyTermsRecord>()?,
+            contact_states,
         })
     }
 }
@@ -390,6 +407,15 @@ impl Reductions {
                     self.energy_first = Some(e.clone().into_owned());
                 }
                 self.energy_last = Some(e.into_owned());
+            }
+            topics::CONTACTS => {
+                let c = m.decode_ref::<ContactState>(sizes)?;
+                let t = Self::sample(&mut self.contact_state_samples, m)?;
+                self.contact_states.state(t, &c);
+            }
+            topics::CONTACT_EVENTS => {
+                let e = m.decode::<ContactEventMsg>(sizes)?;
+                self.contact_states.event(m, e)?;
             }
             _ => {}
         }

@@ -326,7 +326,7 @@ impl schemas::Visitor for Generic {
     }
 }
 
-fn generic_metrics(path: &Path) -> Result<RunMetrics, Error> {
+pub(super) fn generic_metrics(path: &Path) -> Result<RunMetrics, Error> {
     let mut acc = Generic(Reductions::default());
     let rec = schemas::stream_recording(path, Some(&METRIC_TOPICS), &mut acc).map_err(|e| acc.0.take_error(e))?;
     acc.0.finish(&rec, None)

@@ -96,6 +96,26 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
             format!("first_pull.{c}_s"),
         ]);
     }
+    // contacts with a contact model in some run (`/contacts`): their states
+    let states = super::union(runs.iter().flat_map(|r| r.contact_states.iter().map(|c| c.contact.as_str())));
+    for c in &states {
+        head.extend([
+            format!("in_contact.{c}_s"),
+            format!("lift_offs.{c}"),
+            format!("touch_downs.{c}"),
+            format!("impacts.{c}"),
+            format!("rests.{c}"),
+            format!("stick_to_slip.{c}"),
+            format!("slip_to_stick.{c}"),
+            format!("impact_loss.{c}_j"),
+            format!("friction_work.{c}_j"),
+            format!("damping_loss.{c}_j"),
+            format!("mu_stick.{c}_ratio"),
+            format!("mu_contact.{c}_ratio"),
+            format!("fn_contact_min.{c}_n"),
+            format!("fn_contact_max.{c}_n"),
+        ]);
+    }
 
     let mut lines = Vec::with_capacity(runs.len());
     for (k, r) in runs.iter().enumerate() {
@@ -166,6 +186,28 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
             row.opt(c.map(|c| c.min_normal_force_n));
             row.opt(c.map(|c| c.pull_time_s));
             row.opt(c.and_then(|c| c.first_pull_s));
+        }
+        for name in &states {
+            let c = r.contact_states.iter().find(|c| c.contact == *name);
+            row.opt(c.map(|c| c.time_in_contact_s));
+            let ev = c.map(|c| &c.events);
+            for n in [
+                ev.map(|e| e.lift_offs),
+                ev.map(|e| e.touch_downs),
+                ev.map(|e| e.impacts),
+                ev.map(|e| e.rests),
+                ev.map(|e| e.stick_to_slip),
+                ev.map(|e| e.slip_to_stick),
+            ] {
+                row.opt(n.map(|n| n as f64));
+            }
+            row.opt(c.map(|c| c.impact_loss_j));
+            row.opt(c.map(|c| c.friction_work_j));
+            row.opt(c.map(|c| c.damping_loss_j));
+            row.opt(c.and_then(|c| c.stick_friction_needed));
+            row.opt(c.and_then(|c| c.contact_friction_needed));
+            row.opt(c.and_then(|c| c.min_normal_force_in_contact_n));
+            row.opt(c.and_then(|c| c.max_normal_force_in_contact_n));
         }
         lines.push(row.0.into_iter().map(Option::unwrap_or_default).collect());
     }

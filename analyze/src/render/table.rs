@@ -235,6 +235,61 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         t.write(&mut out, markdown);
     }
 
+    // contact models (runs with `/contacts`)
+    if runs.iter().any(|r| !r.contact_states.is_empty()) {
+        let mut t = Table::new(
+            "Contact states (unilateral and compliant contacts: time in contact, events, losses; \
+             μ to stick = max |f_t|/f_n over the sticking samples, in contact = over every sample in contact)",
+            &[
+                "run",
+                "contact",
+                "model",
+                "μ",
+                "in contact [s]",
+                "lift-offs",
+                "touch-downs",
+                "impacts",
+                "rests",
+                "stick→slip",
+                "slip→stick",
+                "impact loss [J]",
+                "friction work [J]",
+                "damping loss [J]",
+                "μ to stick",
+                "μ in contact",
+                "f_n min [N]",
+                "f_n max [N]",
+            ],
+        );
+        t.table.left = 3;
+        for (k, r) in runs.iter().enumerate() {
+            for c in &r.contact_states {
+                let ev = &c.events;
+                t.table.rows.push(vec![
+                    name(k),
+                    c.contact.clone(),
+                    c.model.clone().unwrap_or_else(|| "-".into()),
+                    c.friction.map_or("-".into(), |m| f(m, 3)),
+                    f(c.time_in_contact_s, 4),
+                    ev.lift_offs.to_string(),
+                    ev.touch_downs.to_string(),
+                    ev.impacts.to_string(),
+                    ev.rests.to_string(),
+                    ev.stick_to_slip.to_string(),
+                    ev.slip_to_stick.to_string(),
+                    e(c.impact_loss_j),
+                    e(c.friction_work_j),
+                    e(c.damping_loss_j),
+                    q(c.stick_friction_needed),
+                    q(c.contact_friction_needed),
+                    c.min_normal_force_in_contact_n.map_or("-".into(), |x| f(x, 3)),
+                    c.max_normal_force_in_contact_n.map_or("-".into(), |x| f(x, 3)),
+                ]);
+            }
+        }
+        t.write(&mut out, markdown);
+    }
+
     // energy balance
     // the report explains the balance in its own section (report.rs)
     if !markdown {

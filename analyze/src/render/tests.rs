@@ -141,3 +141,43 @@ fn metrics_table_has_no_ratios_or_findings() {
         "{text}"
     );
 }
+
+/// The synthetic unilateral run next to a bilateral one: the table gains a "Contact states"
+/// section with one row per contact of the unilateral run; the CSV 14 columns per such contact
+/// (empty cells for the bilateral run), the bilateral-only CSV is unchanged; JSON round-trips.
+#[test]
+fn contact_states_get_rows_columns_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let (s, _) = schemas::synth::unilateral();
+    let uni = crate::metrics::read_run_metrics(&s.write_in(dir.path())).unwrap();
+    let runs = paper_runs();
+    let plain = render_metrics(&runs, Format::Csv).unwrap();
+    let all: Vec<RunMetrics> = runs.iter().cloned().chain([uni.clone()]).collect();
+
+    let table = render_metrics(&all, Format::Table).unwrap();
+    assert!(table.contains("Contact states"), "{table}");
+    let section = &table[table.find("Contact states").unwrap()..];
+    let rows: Vec<&str> = section.lines().take_while(|l| !l.is_empty()).filter(|l| l.starts_with("unilateral")).collect();
+    assert_eq!(rows.len(), 2, "{section}");
+    let row = rows[0];
+    assert!(row.contains("elbow4"), "{row}");
+    for cell in ["0.600", "0.5960", "0.300", "10.000"] {
+        assert!(row.contains(cell), "{cell} in {row}");
+    }
+    assert!(!render_metrics(&runs, Format::Table).unwrap().contains("Contact states"));
+
+    let csv = render_metrics(&all, Format::Csv).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(cells(lines[0]), cells(plain.lines().next().unwrap()) + 2 * 14);
+    assert!(lines.iter().all(|l| cells(l) == cells(lines[0])));
+    let head: Vec<&str> = lines[0].split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name} in {head:?}"));
+    let last: Vec<&str> = lines[4].split(',').collect();
+    assert_eq!(last[col("in_contact.elbow4_s")].parse::<f64>().unwrap(), uni.contact_states[0].time_in_contact_s);
+    assert_eq!(last[col("impacts.elbow4")], "1");
+    assert_eq!(last[col("mu_stick.elbow7_ratio")], "0.25");
+    assert_eq!(lines[1].split(',').nth(col("impacts.elbow4")), Some(""), "no such contact state in two-elbow");
+
+    let json = render_metrics(&all, Format::Json).unwrap();
+    assert_eq!(serde_json::from_str::<Vec<RunMetrics>>(&json).unwrap(), all);
+}

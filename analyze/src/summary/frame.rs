@@ -8,7 +8,10 @@ use crate::metrics::RunMetrics;
 /// One DataFrame, one row per entry of `rows`: [`BASE_COLUMNS`] (`min_normal_force_n`: the lowest
 /// over the contacts, `pull_time_s`: the longest; both null without contacts), then `error`, `bytes`,
 /// `E.<joint>_j` and `W.<joint>_j` for every joint of any run (null where a run has no such
-/// joint), then `p.<param>` for each of `params` (Float64 when every value is a number, else
+/// joint), then for every contact with a contact model in any run (`/contacts`)
+/// `in_contact.<c>_s`, `lift_offs.<c>`, `impacts.<c>`, `impact_loss.<c>_j`, `friction_work.<c>_j`,
+/// `damping_loss.<c>_j`, `mu_stick.<c>_ratio` (null where a run has no such contact), then
+/// `p.<param>` for each of `params` (Float64 when every value is a number, else
 /// text).
 pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<DataFrame> {
     let n = rows.len();
@@ -71,6 +74,31 @@ pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<Dat
     }
     for j in &joints {
         cols.push(Column::new(format!("W.{j}_j").into(), link(j, |l| l.work_j)));
+    }
+    // per contact with a contact model (`/contacts`) in some run, in first-seen order
+    let mut states: Vec<&str> = Vec::new();
+    for r in rows {
+        for c in &r.metrics.contact_states {
+            if !states.contains(&c.contact.as_str()) {
+                states.push(&c.contact);
+            }
+        }
+    }
+    type StateFn = fn(&crate::metrics::ContactStateMetrics) -> Option<f64>;
+    let state_columns: [(&str, &str, StateFn); 7] = [
+        ("in_contact", "_s", |c| Some(c.time_in_contact_s)),
+        ("lift_offs", "", |c| Some(c.events.lift_offs as f64)),
+        ("impacts", "", |c| Some(c.events.impacts as f64)),
+        ("impact_loss", "_j", |c| Some(c.impact_loss_j)),
+        ("friction_work", "_j", |c| Some(c.friction_work_j)),
+        ("damping_loss", "_j", |c| Some(c.damping_loss_j)),
+        ("mu_stick", "_ratio", |c| c.stick_friction_needed),
+    ];
+    for c in &states {
+        for (quantity, unit, f) in state_columns {
+            let values: Vec<Option<f64>> = rows.iter().map(|r| r.metrics.contact_states.iter().find(|s| s.contact == *c).and_then(f)).collect();
+            cols.push(Column::new(format!("{quantity}.{c}{unit}").into(), values));
+        }
     }
     for (k, p) in params.iter().enumerate() {
         let values: Vec<Option<&serde_json::Value>> = rows.iter().map(|r| r.params[k].as_ref()).collect();
@@ -157,3 +185,27 @@ fn filter_mask(column: &Column, f: &Filter) -> Result<BooleanChunked, String> {
     mask.fill_null_with_values(false).map_err(|e| e.to_string())
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The synthetic unilateral run and a bilateral one: 7 columns per contact with a contact
+    /// model, the unilateral run's values, nulls for the bilateral run.
+    #[test]
+    fn contact_state_columns() {
+        let dir = tempfile::tempdir().unwrap();
+        let (s, _) = schemas::synth::unilateral();
+        let uni = crate::metrics::read_run_metrics(&s.write_in(dir.path())).unwrap();
+        let plain = crate::compare::tests::paper_runs().remove(0);
+        let row = |metrics: RunMetrics| SummaryRow { metrics, bytes: 0, integrator: None, params: vec![] };
+        let df = summary_frame(&[row(plain.clone()), row(uni.clone())], &[]).unwrap();
+        let only = summary_frame(&[row(plain)], &[]).unwrap();
+        assert_eq!(df.width(), only.width() + 2 * 7);
+        let get = |name: &str| df.column(name).unwrap().f64().unwrap().get(1);
+        assert_eq!(get("in_contact.elbow4_s"), Some(uni.contact_states[0].time_in_contact_s));
+        assert_eq!(get("impacts.elbow4"), Some(1.0));
+        assert_eq!(get("mu_stick.elbow7_ratio"), Some(0.25));
+        assert_eq!(df.column("impacts.elbow4").unwrap().f64().unwrap().get(0), None);
+    }
+}

@@ -7,12 +7,17 @@ use anyhow::Result;
 use cli::{exit, print_out, TableFormat, Verbosity};
 
 /// Compare runs against a baseline: hand error, E and W totals and their ratios, per-link W_j
-/// and E_j, contact forces, energy balance, and findings in plain sentences.
+/// and E_j, contact forces, contact states (unilateral/compliant contacts), energy balance, and
+/// findings in plain sentences.
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
-Output: sections (runs, hand error in mm, energy totals, per-link energy, contacts, energy
-balance, findings) for people; -f json is the comparison as stable keys, -f csv one row per run
-(columns such as err_z_rms_m, E_total_j, E.joint4_j, E.joint4_ratio, fn_min.elbow4_n).
+Output: sections (runs, hand error in mm, energy totals, per-link energy, contacts, contact
+states, energy balance, findings) for people; -f json is the comparison as stable keys, -f csv
+one row per run (columns such as err_z_rms_m, E_total_j, E.joint4_j, E.joint4_ratio,
+fn_min.elbow4_n; for contacts with a contact model in_contact.elbow4_s, impacts.elbow4,
+friction_work.elbow4_j, mu_stick.elbow4_ratio ...). Contact states: unilateral and compliant
+contacts (recordings with /contacts): time in contact, lift-offs, touch-downs, impacts, rests,
+stick/slip transitions, impact loss, friction work, damping loss, the friction needed to stick.
 
 Examples:
   analyze compare out/

@@ -9,7 +9,8 @@ use anyhow::{Context, Result};
 use cli::{exit, Verbosity};
 
 /// The comparison report as one Markdown document: what stands out, the tables (hand error,
-/// energy totals and per link with ratios to the baseline, contacts), the energy audit
+/// energy totals and per link with ratios to the baseline, contacts), a contacts section (pull
+/// time of bilateral contacts; time in contact, events, losses of unilateral ones), the energy audit
 /// (electric energy in; kinetic, potential, magnetic stored; R, D and D_m losses; residual; the
 /// integrals rechecked from the samples) and the figures.
 #[derive(Debug, clap::Args)]

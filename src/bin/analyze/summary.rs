@@ -52,8 +52,10 @@ const SUMMARY_HELP: &str = "\
 Output: one row per recording. Columns (SI units, the unit as a lower-case suffix): file scene
 run status contacts n_contacts integrator t_end_s samples err_norm_rms_m err_norm_max_m
 err_z_rms_m err_z_max_m E_total_j W_total_j peak_current_a peak_current_joint fn_min_n
-pull_max_s residual_max_rel error bytes, E.<joint>_j and W.<joint>_j per link, p.<path> per
---param. The table shows a readable subset unless --columns is given; -f json and -f csv every
+pull_max_s residual_max_rel error bytes, E.<joint>_j and W.<joint>_j per link; per contact
+with a contact model (unilateral or compliant: the recording has /contacts) in_contact.<c>_s
+lift_offs.<c> impacts.<c> impact_loss.<c>_j friction_work.<c>_j damping_loss.<c>_j
+mu_stick.<c>_ratio; p.<path> per --param. The table shows a readable subset unless --columns is given; -f json and -f csv every
 column.
 
 Examples:

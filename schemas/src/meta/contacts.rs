@@ -1,0 +1,141 @@
+//! Record `contacts` (format 2+, see the parent module; only runs with a non-bilateral contact): each contact's model
+//! and parameters, its plane and tangent basis, and the event settings of the run. The models
+//! are those of issue 11 (Pfeiffer & Glocker 1996 for the rigid unilateral contact with Newton
+//! restitution and Coulomb friction; a spring-damper for the compliant one).
+
+use serde::{Deserialize, Serialize};
+
+use super::MetadataRecord;
+
+/// One contact of the run, as it ran.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactInfo {
+    /// The contact's name (as in `run.contacts`).
+    pub name: String,
+    /// `bilateral`, `unilateral` or `compliant`.
+    pub model: String,
+    /// Newton's coefficient of restitution e ∈ [0, 1] (unilateral).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+    /// Coulomb friction coefficient μ ≥ 0 (unilateral, compliant).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// Normal stiffness k, N/m (compliant).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<f64>,
+    /// Normal damping c, N·s/m (compliant).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
+    /// Regularisation speed v_s of the friction law, m/s (compliant).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slip_velocity: Option<f64>,
+    /// The plane's unit normal n, world frame.
+    pub normal: [f64; 3],
+    /// The plane's offset d (the plane is n · x = d), m.
+    pub offset: f64,
+    /// The tangent basis of `/contacts`' `*_t1`, `*_t2` fields, world frame.
+    pub t1: [f64; 3],
+    pub t2: [f64; 3],
+}
+
+/// Record `contacts`: every contact of the run (all of them, bilateral ones too, in
+/// `run.contacts` order) and the settings of the event-driven integration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactsRecord {
+    /// A JSON array of [`ContactInfo`].
+    #[serde(with = "json_contacts")]
+    pub contacts: Vec<ContactInfo>,
+    /// Width of the bracket an event time is located to, s.
+    #[serde(with = "super::sci")]
+    pub time_tolerance: f64,
+    /// A contact is closed when `|g| ≤ gap_tolerance`, m …
+    #[serde(with = "super::sci")]
+    pub gap_tolerance: f64,
+    /// … and `|dg/dt| ≤ velocity_tolerance`, m/s.
+    #[serde(with = "super::sci")]
+    pub velocity_tolerance: f64,
+    /// Impacts slower than this are plastic and end a bouncing sequence (the Zeno rule), m/s.
+    #[serde(with = "super::sci")]
+    pub rest_velocity: f64,
+    /// Most events in a run.
+    #[serde(with = "super::text")]
+    pub max_events: u64,
+}
+
+impl MetadataRecord for ContactsRecord {
+    const NAME: &'static str = "contacts";
+}
+
+impl ContactsRecord {
+    /// The contact named `name`.
+    pub fn contact(&self, name: &str) -> Option<&ContactInfo> {
+        self.contacts.iter().find(|c| c.name == name)
+    }
+}
+
+/// [`ContactsRecord::contacts`] as JSON text.
+mod json_contacts {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    use super::ContactInfo;
+
+    pub fn serialize<S: Serializer>(v: &[ContactInfo], s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&serde_json::to_string(v).map_err(serde::ser::Error::custom)?)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<ContactInfo>, D::Error> {
+        let s = String::deserialize(d)?;
+        serde_json::from_str(&s).map_err(|e| serde::de::Error::custom(format!("{s:?} is not a JSON array of contacts: {e}")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{from_entries, to_entries};
+    use super::*;
+
+    pub(crate) fn sample() -> ContactsRecord {
+        let plane = |name: &str, model: &str| ContactInfo {
+            name: name.into(),
+            model: model.into(),
+            restitution: None,
+            friction: None,
+            stiffness: None,
+            damping: None,
+            slip_velocity: None,
+            normal: [0.0, 0.0, 1.0],
+            offset: 0.0,
+            t1: [1.0, 0.0, 0.0],
+            t2: [0.0, 1.0, 0.0],
+        };
+        let elbow4 = ContactInfo { restitution: Some(0.5), friction: Some(0.6), ..plane("elbow4", "unilateral") };
+        let pad = ContactInfo { stiffness: Some(1e5), damping: Some(300.0), friction: Some(0.6), slip_velocity: Some(1e-3), ..plane("pad", "compliant") };
+        ContactsRecord {
+            contacts: vec![elbow4, pad, plane("elbow7", "bilateral")],
+            time_tolerance: 1e-12,
+            gap_tolerance: 1e-9,
+            velocity_tolerance: 1e-9,
+            rest_velocity: 1e-4,
+            max_events: 100_000,
+        }
+    }
+
+    /// Every key is text, numbers in `{:e}` form; the record reads back equal, and a bad
+    /// contacts list is named.
+    #[test]
+    fn the_contacts_record_round_trips() {
+        let r = sample();
+        let e = to_entries(&r).unwrap();
+        let keys: Vec<&str> = e.keys().map(String::as_str).collect();
+        assert_eq!(keys, ["contacts", "gap_tolerance", "max_events", "rest_velocity", "time_tolerance", "velocity_tolerance"]);
+        assert_eq!(e["time_tolerance"], "1e-12");
+        assert_eq!(e["max_events"], "100000");
+        // the bilateral contact has no model parameters in the text
+        assert!(e["contacts"].contains(r#"{"name":"elbow7","model":"bilateral","normal""#), "{}", e["contacts"]);
+        assert_eq!(from_entries::<ContactsRecord>(&e).unwrap(), r);
+        assert_eq!(r.contact("pad").and_then(|c| c.stiffness), Some(1e5));
+        let mut bad = e.clone();
+        bad.insert("contacts".into(), "[1]".into());
+        assert!(from_entries::<ContactsRecord>(&bad).unwrap_err().contains("not a JSON array of contacts"));
+    }
+}
