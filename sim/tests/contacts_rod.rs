@@ -91,3 +91,57 @@ fn the_held_frictionless_rod_has_the_closed_form_normal_force() {
     let n = M * G / (1.0 + 3.0 * theta.cos().powi(2));
     assert!((c.samples[0].normal_force[0] - n).abs() <= 1e-9 * n, "N = {}, m g / (1 + 3 cos² θ) = {n}", c.samples[0].normal_force[0]);
 }
+
+/// Two simultaneous impacts (the velocity-level complementarity over the closed contacts): the
+/// rod (half-length l = 0.5 m, m = 1 kg, its centre of mass moved d = 0.1 m towards end 2)
+/// falls flat from h0 = 0.2 m, frictionless, and hits the table with both ends at once at
+/// `t = sqrt(2 h0 / g)`, speed v = sqrt(2 g h0). With both impulses positive (Newton's law at
+/// both: ġ⁺ = −e ġ⁻), the rod's vertical speed becomes e v and its rotation stays 0, so by linear
+/// and angular momentum (about the centre of mass) `Λ1 + Λ2 = m (1 + e) v`,
+/// `Λ1 (l + d) = Λ2 (l − d)`: `Λ1 = m (1 + e) v (l − d)/(2l)`, `Λ2 = m (1 + e) v (l + d)/(2l)`
+/// (independent of the inertia); each contact's loss `Λ_k (1 − e) v / 2`. e = 0: the rod stays
+/// down and rests on both ends with the statics `f_1 = m g (l − d)/(2l)`, `f_2 = m g (l + d)/(2l)`.
+/// e = 0.5: both ends leave at e v. Tolerances 1e-9 relative (free fall is exact in dopri45; the
+/// event bracket 1e-12 s moves v by 1e-11 m/s).
+#[test]
+fn simultaneous_impacts_of_a_rod_falling_flat_split_the_impulse_by_the_centre_of_mass() {
+    let (h0, d) = (0.2, 0.1);
+    let urdf = rod_urdf(M, L).replace(r#"<inertial><origin xyz="0 0 0"/>"#, &format!(r#"<inertial><origin xyz="{d} 0 0"/>"#));
+    assert!(urdf.contains(&format!(r#"<origin xyz="{d} 0 0"/><mass"#)));
+    let v = (2.0 * G * h0).sqrt();
+    let t_hit = (2.0 * h0 / G).sqrt();
+    for e in [0.0, 0.5] {
+        let mut s = passive_scene("rod", &["x", "z", "pitch"], &[0.0, h0, 0.0], &[0.0; 3], [0.0, 0.0, -G], 0.3, 1e-12);
+        add_table_contact(&mut s, "end1", json!({"link": "rod", "offset": [-L, 0.0, 0.0]}), json!({"model": "unilateral", "restitution": e}));
+        add_table_contact(&mut s, "end2", json!({"link": "rod", "offset": [L, 0.0, 0.0]}), json!({"model": "unilateral", "restitution": e}));
+        let c = collect(&load(&s, &urdf), "r");
+        let first: Vec<_> = c.events.iter().filter(|ev| (ev.t - t_hit).abs() <= 1e-9 * t_hit).collect();
+        assert_eq!(first.len(), 2, "e = {e}: one impact per end at {t_hit} s: {:?}", c.events);
+        let share = [(L - d) / (2.0 * L), (L + d) / (2.0 * L)];
+        for ev in first {
+            let k = ev.contact;
+            let lam = M * (1.0 + e) * v * share[k];
+            assert!((ev.impulse - lam).abs() <= 1e-9 * lam, "e = {e}, end {}: Λ = {} N s, closed form {lam}", k + 1, ev.impulse);
+            let lost = lam * (1.0 - e) * v / 2.0;
+            assert!((ev.energy_lost - lost).abs() <= 1e-9 * M * v * v, "e = {e}, end {}: lost {} J, closed form {lost}", k + 1, ev.energy_lost);
+            assert!((ev.gap_rate_after - e * v).abs() <= 1e-9 * v, "e = {e}, end {}: ġ⁺ = {}", k + 1, ev.gap_rate_after);
+        }
+        if e == 0.0 {
+            assert_eq!(c.events.len(), 2, "then at rest: {:?}", c.events);
+            for o in c.between(t_hit + 1e-3, 1.0) {
+                for k in 0..2 {
+                    let want = M * G * share[k];
+                    assert!(touching(o.contacts[k].mode), "t = {}, end {}: {:?}", o.t, k + 1, o.contacts[k].mode);
+                    assert!((o.contacts[k].normal_force - want).abs() <= 1e-9 * want, "t = {}, end {}: f_n {} vs statics {want}", o.t, k + 1, o.contacts[k].normal_force);
+                }
+                assert!(o.qd.iter().all(|x| x.abs() <= 1e-9), "t = {}: at rest {:?}", o.t, o.qd);
+            }
+        } else {
+            // both ends leave together and the rod stays level
+            for o in c.between(t_hit + 1e-3, t_hit + 2.0 * e * v / G - 1e-3) {
+                assert!(o.contacts.iter().all(|f| f.mode == ContactMode::Separated), "t = {}", o.t);
+                assert!(o.q[2].abs() <= 1e-9 && o.qd[2].abs() <= 1e-9, "t = {}: the rod tilts: {:?}", o.t, o.q);
+            }
+        }
+    }
+}
