@@ -10,6 +10,8 @@
 //! size (≤ a few 1e3 J), so the residual is bounded by 1e-8 of the electric energy drawn
 //! `Σ_j |E_j(t_end)|` (the bound), at every sample.
 
+#![allow(clippy::needless_range_loop)] // per-contact arrays indexed together
+
 mod contacts_support;
 
 use std::path::Path;

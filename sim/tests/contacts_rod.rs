@@ -18,6 +18,8 @@
 //! `N = m g / B` (B = 0.16: six times the weight) and friction +μ N along x at t = 0 (1e-9
 //! relative: one small LU solve, condition ~ 1/B).
 
+#![allow(clippy::needless_range_loop)] // per-contact arrays indexed together
+
 mod contacts_support;
 
 use contacts_support::*;

@@ -152,6 +152,7 @@ impl Collected {
     }
 }
 
+#[allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `sim::run::simulate`
 pub fn try_collect(scene: &Scene, run: &str) -> Result<Collected, RunError> {
     let r = scene.run(run).unwrap_or_else(|| panic!("no run {run}")).clone();
     let (mut samples, mut events) = (Vec::new(), Vec::new());
