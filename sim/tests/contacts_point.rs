@@ -391,3 +391,28 @@ fn a_ball_on_a_compliant_table_follows_the_damped_oscillator_and_loses_the_dampi
     }
     assert!(flying > 20, "{flying} samples in flight after the bounce");
 }
+
+/// The smallest case of a sticking contact whose tangential rows are rank-deficient: the ball
+/// with its y joint locked (`robot.locked`, q = (x, z)) cannot move along t2 = y, so the t2 row
+/// of J is zero. Friction must still hold it (q̈ is unique; only the force along y is
+/// undetermined, and 0 is a solution): under the push g_x = 3 m/s² < μ g_z (μ = 0.4) it sticks
+/// with f_t = (−m g_x, 0), no motion (1e-10 m), no event, as the three-joint ball does. (Planar
+/// arms, the rod and the double pendulum, and the paper arm with two sticking elbows — whose
+/// out-of-plane rows both depend on the yaw joint alone — have such rows.)
+#[test]
+fn a_planar_point_sticks_although_its_out_of_plane_friction_row_is_zero() {
+    let mut s = ball([0.0; 3], [0.0; 3], [3.0, 0.0, -G], 0.2, json!({"model": "unilateral", "friction": 0.4}));
+    s["robot"] = json!({"locked": {"y": 0.0}});
+    s["passive"] = json!(["x", "z"]);
+    s["initial"] = json!({"q": [0.0, 0.0], "qd": [0.0, 0.0]});
+    s["target"] = json!({"kind": "joint-spline", "waypoints": [{"t": 0.0, "q": [0.0, 0.0]}, {"t": 1.0, "q": [0.0, 0.0]}]});
+    let c = collect(&load(&s, &point_urdf(M)), "r");
+    assert!(c.events.is_empty(), "{:?}", c.events);
+    for o in &c.samples {
+        let f = &o.contacts[0];
+        assert_eq!(f.mode, ContactMode::Sticking, "t = {}", o.t);
+        assert!(o.q[0].abs() <= 1e-10, "t = {}: x = {}", o.t, o.q[0]);
+        assert!((f.friction_force[0] + M * 3.0).abs() <= 1e-9 * M * G && f.friction_force[1].abs() <= 1e-9 * M * G, "t = {}: f_t {:?}", o.t, f.friction_force);
+        assert!((f.normal_force - M * G).abs() <= 1e-9 * M * G);
+    }
+}
