@@ -128,7 +128,14 @@ fn paper_question_findings() {
             let last = c.samples.last().unwrap();
             let e: f64 = last.electric_energy.iter().sum();
             let (rel, _) = balance(&c);
-            eprintln!("{file} {run}: E = Σ E_j = {e:.4} J, residual {rel:.1e}, {} events, {} steps", c.events.len(), c.report.stats.steps);
+            let err: Vec<f64> = c.samples.iter().map(|o| (o.hand - o.hand_desired).norm()).collect();
+            let rms = (err.iter().map(|x| x * x).sum::<f64>() / err.len() as f64).sqrt();
+            let max = err.iter().copied().fold(0.0, f64::max);
+            eprintln!(
+                "{file} {run}: E = Σ E_j = {e:.4} J, residual {rel:.1e}, hand error rms {rms:.4e} m max {max:.4e} m, {} events, {} steps",
+                c.events.len(),
+                c.report.stats.steps
+            );
             let names: Vec<String> = s.run_contact_models(s.run(run).unwrap()).iter().map(|c| c.name().to_string()).collect();
             for k in 0..last.contacts.len() {
                 let touching_s = c.samples.iter().filter(|o| touching(o.contacts[k].mode)).count() as f64 * dt;
