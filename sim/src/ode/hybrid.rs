@@ -79,6 +79,12 @@ impl Hybrid {
     }
 }
 
+/// A sliding contact sticks when its slip speed falls to this, m/s (ev1 of a sliding contact
+/// is `v_t · s_ref − STICK_SPEED`): the sliding right-hand side has a `1/|v_t|` singularity
+/// in the slip direction's rate as the slip stops, which no step-size control crosses; the
+/// last 1e-6 m/s are removed by a velocity projection (`stop_slip`).
+pub const STICK_SPEED: f64 = 1e-6;
+
 fn mu_of(c: &Contact) -> f64 {
     match c.model {
         ContactModel::Unilateral { friction, .. } => friction,
@@ -231,6 +237,9 @@ impl ArmSystem<'_> {
         if h.count > h.settings.max_events {
             return Err(RunError::TooManyEvents { t: e.t, max_events: h.settings.max_events });
         }
+        if std::env::var("MODES_DEBUG").is_ok() {
+            eprintln!("event t = {:.12} contact {} {:?} impulse {:e} lost {:e} gd {:e} -> {:e}", e.t, e.contact, e.kind, e.impulse, e.energy_lost, e.gap_rate_before, e.gap_rate_after);
+        }
         h.log.push(e);
         Ok(())
     }
@@ -290,6 +299,60 @@ impl ArmSystem<'_> {
         Ok((closed, opened))
     }
 
+    /// Slip→stick at `|v_t| ≤ 2 STICK_SPEED`: the remaining slip velocity of the `stopping`
+    /// contacts is removed by the M_J-weighted velocity projection that keeps the other active
+    /// velocity rows (normal rows of the contacts in touch, tangential rows of the sticking
+    /// ones) — the impulse friction would deliver over the last ~1e-6 m/s — and its kinetic
+    /// energy loss (≤ ½ m (2e-6 m/s)²) is booked as friction work (the rotors' share of the
+    /// jump into W_j, as at impacts), so the balance stays closed.
+    fn stop_slip(&mut self, t: f64, y: &mut [f64], stopping: &[usize]) -> Result<(), RunError> {
+        use crate::dynamics::contact::solve::{solve_active, ActiveRow, RowForce};
+        let l = self.layout;
+        let nv = l.nv;
+        self.prepare_at(t, y)?;
+        let h = self.hybrid.as_mut().expect("hybrid");
+        let r = &h.cd.rows;
+        let mut rows = Vec::new();
+        for k in 0..h.contacts.len() {
+            let m = h.state.mode[k];
+            if matches!(m, ContactMode::Sticking | ContactMode::Sliding | ContactMode::Bilateral) {
+                rows.push(ActiveRow { row: 3 * k, force: RowForce::Same, extra: r.vel[3 * k] - r.bias[3 * k] });
+            }
+            if m == ContactMode::Sticking || stopping.contains(&k) {
+                for a in 1..3 {
+                    rows.push(ActiveRow { row: 3 * k + a, force: RowForce::Same, extra: r.vel[3 * k + a] - r.bias[3 * k + a] });
+                }
+            }
+        }
+        let zeros = vec![0.0; nv];
+        let mut dqd = vec![0.0; nv];
+        let fd = &self.ws.fd;
+        solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, &zeros, r, &rows, &mut h.cd.scratch, &mut dqd)
+            .map_err(|_| DynamicsError::SingularConstraints { t, constraints: "the slip-to-stick velocity projection".into() })?;
+        // ΔT = −(q̇⁻ + ½ Δq̇)ᵀ M_J Δq̇ with M_J = M + J_m (data.m from this evaluation)
+        let d = &self.scene.drives;
+        let m = &self.ws.data.m;
+        let mut lost = 0.0;
+        for i in 0..nv {
+            let mut md = d.jm[i] * dqd[i];
+            for j in 0..nv {
+                md += m[(i, j)] * dqd[j];
+            }
+            lost -= (y[l.qd().start + i] + 0.5 * dqd[i]) * md;
+        }
+        for j in 0..nv {
+            let before = y[l.qd().start + j];
+            let after = before + dqd[j];
+            y[l.work().start + j] += -d.jm[j] * (after * after - before * before) / 2.0;
+            y[l.qd().start + j] = after;
+        }
+        let share = lost / stopping.len() as f64;
+        for &k in stopping {
+            y[l.friction_work(k)] += share;
+        }
+        Ok(())
+    }
+
     /// The mode problem over `closed` at (t, y) with `preferred` modes; logs the mode changes
     /// not logged yet (`logged`), and refreshes `s_ref`.
     fn resolve_modes(&mut self, t: f64, y: &[f64], closed: &[usize], preferred: &[ContactMode], logged: &[usize]) -> Result<(), RunError> {
@@ -341,6 +404,7 @@ impl ArmSystem<'_> {
             if h.state.mode[k] == ContactMode::Sliding {
                 let v = c.plane.point.velocity(&self.ws.data);
                 h.s_ref[k] = slip_direction([c.t1.dot(&v), c.t2.dot(&v)], h.state.slip[k]);
+                h.state.slip[k] = h.s_ref[k];
             }
         }
     }
@@ -378,7 +442,7 @@ impl HybridSystem for ArmSystem<'_> {
                 (_, ContactMode::Sticking) => (f_n, mu_of(c) * f_n - f_t[0].hypot(f_t[1])),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
-                    (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
+                    (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] - STICK_SPEED } else { 1.0 })
                 }
             };
             out[2 * k] = e0;
@@ -444,6 +508,7 @@ impl HybridSystem for ArmSystem<'_> {
         let mut touched = Vec::new();
         let mut pending = Vec::new();
         let mut logged = Vec::new();
+        let mut stopping = Vec::new();
         for k in 0..nc {
             let (f0, f1) = (fired[2 * k], fired[2 * k + 1]);
             if !(f0 || f1) {
@@ -481,6 +546,10 @@ impl HybridSystem for ArmSystem<'_> {
                         }
                     } else if f1 {
                         preferred[k] = ContactMode::Sticking;
+                        let v = h.cd.rows.slip(k);
+                        if v[0].hypot(v[1]) <= 2.0 * STICK_SPEED {
+                            stopping.push(k);
+                        }
                     }
                 }
             }
@@ -513,6 +582,10 @@ impl HybridSystem for ArmSystem<'_> {
             if !closed.contains(&k) {
                 closed.push(k);
             }
+        }
+        if !stopping.is_empty() {
+            self.stop_slip(t, y, &stopping)?;
+            moved = true;
         }
         self.resolve_modes(t, y, &closed, &preferred, &logged)?;
         Ok(moved)

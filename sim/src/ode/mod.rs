@@ -41,3 +41,5 @@ mod workspace;
 pub use arm::ArmSystem;
 pub use layout::Layout;
 pub use outputs::{OutputLevel, Outputs};
+#[cfg(test)]
+mod hybrid_tests;

@@ -62,8 +62,10 @@ impl ContactData {
     }
 }
 
-/// Slip speeds below this use the stored slip direction (m/s).
-pub const SLIP_DIRECTION_SPEED: f64 = 1e-9;
+/// Slip speeds below this use the stored slip direction (m/s): the direction `v_t/|v_t|` of
+/// Coulomb friction turns at a rate `|a_t⊥|/|v_t|`, unbounded as a slip starts or stops; below
+/// 1e-6 m/s the direction is frozen (the stored one, refreshed after each step above it).
+pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 
 /// The slip direction of a sliding contact: `v_t/|v_t|` when `|v_t|` > [`SLIP_DIRECTION_SPEED`],
 /// else the stored one.

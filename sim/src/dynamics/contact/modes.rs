@@ -5,7 +5,8 @@
 //! [`MAX_CLOSED_CONTACTS`]; at events only, so the allocations here are at events).
 //!
 //! Candidates per closed contact: separated; sticking (μ > 0 and `|v_t| ≤ vel_tol`); sliding
-//! (along `v_t/|v_t|` when `|v_t| > vel_tol`; from rest along the impending direction
+//! (along `v_t/|v_t|` when `|v_t| > vel_tol`; from rest along the direction s with `a_t ∥ s`,
+//! found by the fixed-point iteration `s ← a_t/|a_t|` started from the impending direction
 //! `−f_t/|f_t|` of the same combination with the contact sticking; frictionless: the normal
 //! row alone). Feasibility, with tolerances relative to the solution's scale
 //! (`tol_f = 1e-8 (1 N + max |f|)`, `tol_a = 1e-8 (1 + max |q̈|)`): separated → `g̈ ≥ −tol_a`;
@@ -127,6 +128,94 @@ pub fn choose_modes(
                 }
             }
         }
+        let rest_sliders: Vec<usize> = closed
+            .iter()
+            .enumerate()
+            .filter(|&(i, &k)| cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0)
+            .map(|(_, &k)| k)
+            .collect();
+        if ok && rest_sliders.len() == 1 {
+            // one contact starting to slide: the directions s(φ) = (cos φ, sin φ) with a_t ∥ s
+            // and a_t · s > 0 are the roots of cross(a_t(φ), s(φ)); scanned at 5° and refined by
+            // bisection to 1e-13 rad; the root nearest the impending direction is taken
+            let k = rest_sliders[0];
+            let s0 = trial.slip[k];
+            let eval = |phi: f64, trial: &mut ContactState, fd: &mut ForwardData, cd: &mut ContactData| -> Option<(f64, f64)> {
+                trial.slip[k] = [phi.cos(), phi.sin()];
+                solve_modes(contacts, trial, stabilization, fd, cd).ok()?;
+                let qdd = &fd.qdd.as_slice()[..nv];
+                let a = [cd.rows.dot(3 * k + 1, qdd) + cd.rows.bias[3 * k + 1], cd.rows.dot(3 * k + 2, qdd) + cd.rows.bias[3 * k + 2]];
+                let sv = trial.slip[k];
+                Some((a[0] * sv[1] - a[1] * sv[0], a[0] * sv[0] + a[1] * sv[1]))
+            };
+            let n = 72;
+            let mut best: Option<(f64, f64)> = None;
+            let step = std::f64::consts::TAU / n as f64;
+            let mut prev = eval(0.0, &mut trial, fd, cd);
+            for i in 1..=n {
+                let phi = i as f64 * step;
+                let cur = eval(phi, &mut trial, fd, cd);
+                if let (Some((c0, _)), Some((c1, _))) = (prev, cur) {
+                    if c0 == 0.0 || c0.signum() != c1.signum() {
+                        let (mut lo, mut hi, mut clo) = (phi - step, phi, c0);
+                        while hi - lo > 1e-13 {
+                            let mid = 0.5 * (lo + hi);
+                            match eval(mid, &mut trial, fd, cd) {
+                                Some((cm, _)) if cm.signum() == clo.signum() && cm != 0.0 => {
+                                    lo = mid;
+                                    clo = cm;
+                                }
+                                Some(_) => hi = mid,
+                                None => break,
+                            }
+                        }
+                        let root = 0.5 * (lo + hi);
+                        if let Some((_, dot)) = eval(root, &mut trial, fd, cd) {
+                            if dot >= 0.0 {
+                                let closeness = root.cos() * s0[0] + root.sin() * s0[1];
+                                if best.is_none_or(|(_, c)| closeness > c) {
+                                    best = Some((root, closeness));
+                                }
+                            }
+                        }
+                    }
+                }
+                prev = cur;
+            }
+            match best {
+                Some((phi, _)) => trial.slip[k] = [phi.cos(), phi.sin()],
+                None => trial.slip[k] = s0,
+            }
+        } else if ok && from_rest {
+            // the consistent slip direction from rest: a_t ∥ s (so v_t grows along s and the
+            // direction v_t/|v_t| is smooth); fixed-point iteration s ← a_t/|a_t| from the
+            // impending direction, to 1e-12 (at most 50 solves)
+            for _ in 0..50 {
+                if solve_modes(contacts, &trial, stabilization, fd, cd).is_err() {
+                    ok = false;
+                    break;
+                }
+                let qdd = &fd.qdd.as_slice()[..nv];
+                let mut change = 0.0f64;
+                for (i, &k) in closed.iter().enumerate() {
+                    if cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 {
+                        let a = [cd.rows.dot(3 * k + 1, qdd) + cd.rows.bias[3 * k + 1], cd.rows.dot(3 * k + 2, qdd) + cd.rows.bias[3 * k + 2]];
+                        let m = a[0].hypot(a[1]);
+                        if m > 0.0 {
+                            let s_new = [a[0] / m, a[1] / m];
+                            change = change.max((s_new[0] - trial.slip[k][0]).hypot(s_new[1] - trial.slip[k][1]));
+                            // only a direction the slip can take (a_t · s > 0): otherwise keep s and let the check decide
+                            if s_new[0] * trial.slip[k][0] + s_new[1] * trial.slip[k][1] > 0.0 {
+                                trial.slip[k] = s_new;
+                            }
+                        }
+                    }
+                }
+                if change <= 1e-12 {
+                    break;
+                }
+            }
+        }
         if ok && solve_modes(contacts, &trial, stabilization, fd, cd).is_ok() {
             let qdd = &fd.qdd.as_slice()[..nv];
             let qmax = qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -143,6 +232,10 @@ pub fn choose_modes(
                         f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -tol_a)
                     }
                 };
+            }
+            if std::env::var("MODES_DEBUG").is_ok() {
+                let info: Vec<String> = closed.iter().map(|&k| format!("{:?} fn={:.4e} ft={:?} gdd={:.3e} at=({:.3e},{:.3e})", trial.mode[k], cd.f_n[k], cd.f_t[k], cd.rows.dot(3 * k, qdd) + cd.rows.bias[3 * k], cd.rows.dot(3 * k + 1, qdd) + cd.rows.bias[3 * k + 1], cd.rows.dot(3 * k + 2, qdd) + cd.rows.bias[3 * k + 2])).collect();
+                eprintln!("t={t} feasible={feasible_here} {}", info.join(" | "));
             }
             if feasible_here {
                 let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();

@@ -39,6 +39,8 @@ pub struct ActiveRow {
 pub struct ActiveScratch {
     x: Vec<f64>,
     a: Vec<f64>,
+    a2: Vec<f64>,
+    rhs: Vec<f64>,
     inv: Vec<f64>,
     piv: Vec<usize>,
     u: Vec<f64>,
@@ -52,6 +54,8 @@ impl ActiveScratch {
         ActiveScratch {
             x: vec![0.0; m * nv],
             a: vec![0.0; m * m],
+            a2: vec![0.0; m * m],
+            rhs: vec![0.0; m],
             inv: vec![0.0; m],
             piv: vec![0; m],
             u: vec![0.0; nv],
@@ -107,19 +111,56 @@ pub fn solve_active(
         }
         s.lambda[i] = -rows.bias[ai.row] - ai.extra - rows.dot(ai.row, &s.u);
     }
-    let scale = (0..m).map(|i| s.a[i * m + i].abs()).fold(0.0, f64::max);
-    let a = &mut s.a[..m * m];
-    let lam = &mut s.lambda[..m];
-    if symmetric {
-        // A is symmetric (and column-major = row-major): the Cholesky of dynamics/cholesky.rs
-        if !cholesky::factor_in_place(a, m, &mut s.inv[..m]) || (0..m).any(|i| a[i * m + i] * a[i * m + i] <= 1e-13 * scale) {
-            return Err(Singular);
+    // a redundant set (two welded points of a planar chain: statically indeterminate forces)
+    // has a singular A: as in the bilateral path (dynamics/spd.rs), a pivot ratio below 1e-6
+    // (condition above 1e12) retries with A + ε I, ε = 1e-10 max diag(A) (Tikhonov), which
+    // keeps q̈ unique to O(ε) and splits the forces among the redundant rows
+    let max_diag = (0..m).map(|i| s.a[i * m + i].abs()).fold(0.0, f64::max);
+    s.a2[..m * m].copy_from_slice(&s.a[..m * m]);
+    s.rhs[..m].copy_from_slice(&s.lambda[..m]);
+    let mut solved = false;
+    for eps in [0.0, 1e-10 * max_diag] {
+        let a = &mut s.a[..m * m];
+        a.copy_from_slice(&s.a2[..m * m]);
+        for i in 0..m {
+            a[i * m + i] += eps;
         }
-        cholesky::solve_lower(a, &s.inv[..m], m, lam);
-        cholesky::solve_upper_transposed(a, &s.inv[..m], m, lam);
-    } else {
-        lu_solve_in_place(a, m, &mut s.piv[..m], lam, 1e-13 * scale)?;
+        let lam = &mut s.lambda[..m];
+        lam.copy_from_slice(&s.rhs[..m]);
+        if symmetric {
+            // A is symmetric (column-major = row-major): the Cholesky of dynamics/cholesky.rs
+            if !cholesky::factor_in_place(a, m, &mut s.inv[..m]) {
+                continue;
+            }
+            let (lo, hi) = (0..m).fold((f64::INFINITY, 0.0f64), |(lo, hi), i| (lo.min(a[i * m + i]), hi.max(a[i * m + i])));
+            if eps == 0.0 && !(lo > 1e-6 * hi) {
+                continue;
+            }
+            cholesky::solve_lower(a, &s.inv[..m], m, lam);
+            cholesky::solve_upper_transposed(a, &s.inv[..m], m, lam);
+            solved = true;
+            break;
+        } else {
+            let mut u_min = f64::INFINITY;
+            let mut u_max = 0.0f64;
+            if lu_solve_in_place(a, m, &mut s.piv[..m], lam, 1e-14 * max_diag).is_err() {
+                continue;
+            }
+            for i in 0..m {
+                u_min = u_min.min(a[i * m + i].abs());
+                u_max = u_max.max(a[i * m + i].abs());
+            }
+            if eps == 0.0 && !(u_min > 1e-12 * u_max) {
+                continue;
+            }
+            solved = true;
+            break;
+        }
     }
+    if !solved {
+        return Err(Singular);
+    }
+    let lam = &s.lambda[..m];
     qdd.copy_from_slice(&s.u);
     for k in 0..m {
         let f = lam[k];

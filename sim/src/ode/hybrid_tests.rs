@@ -1,0 +1,83 @@
+//! End-to-end checks of the hybrid arm through the event driver (`integrate_hybrid`) on the
+//! paper scene with unilateral elbows.
+
+use crate::dynamics::contact::ContactEvent;
+use crate::integrate::{integrate_hybrid, DormandPrince45, EventSettings, StepControl};
+use crate::scene::Scene;
+
+use super::{ArmSystem, Outputs};
+
+/// The paper scene with its elbows unilateral (μ, e), and optionally a table under `table`.
+pub(crate) fn paper_unilateral(mu: f64, e: f64, table: &[&str]) -> Scene {
+    Scene::paper()
+        .expect("paper")
+        .vary(|s| {
+            for c in &mut s.contacts {
+                c.model = Some("unilateral".into());
+                c.friction = Some(mu);
+                c.restitution = Some(e);
+            }
+            if !table.is_empty() {
+                s.table = Some(crate::scene::spec::TableSpec {
+                    plane: crate::scene::spec::PlaneSpec { normal: [0.0, 0.0, 1.0], offset: 0.0 },
+                    points: table.iter().map(|j| crate::scene::spec::TablePointSpec { name: format!("t-{j}"), point: crate::scene::spec::PointSpec { joint: Some(j.to_string()), link: None, offset: [0.0; 3] } }).collect(),
+                    model: None,
+                    restitution: Some(e),
+                    friction: Some(mu),
+                    stiffness: None,
+                    damping: None,
+                    slip_velocity: None,
+                });
+            }
+        })
+        .expect("a valid variation")
+}
+
+/// Run `run` of `scene` to `t_end` with dopri45 (rtol, atol), outputs every `dt_out`.
+pub(crate) fn run_hybrid(scene: &Scene, run: &str, t_end: f64, dt_out: f64, rtol: f64, atol: f64) -> Result<(Vec<Outputs>, Vec<ContactEvent>), String> {
+    let run = scene.run(run).expect("run");
+    let mut sys = ArmSystem::new(scene, run);
+    let mut probe = ArmSystem::new(scene, run);
+    let y0 = sys.initial_state();
+    let control = StepControl { h_max: dt_out, max_steps: 2_000_000, ..StepControl::new(rtol, atol) };
+    let mut stepper: Box<dyn crate::integrate::Stepper<ArmSystem>> = if std::env::var("EXPLORE_RODAS").is_ok() {
+        Box::new(crate::integrate::Rodas::new(y0.len(), control).with_method(crate::integrate::RodasMethod::Rodas5P))
+    } else {
+        Box::new(DormandPrince45::new(y0.len(), control))
+    };
+    let mut outs = Vec::new();
+    let mut events = Vec::new();
+    let settings = EventSettings { time_tol: 1e-12, max_events: 10_000, max_events_at_one_time: 32 };
+    integrate_hybrid(stepper.as_mut(), &mut sys, 0.0, &y0, t_end, dt_out, None, settings, |t, y, s: &mut ArmSystem| {
+        probe.copy_modes_from(s);
+        let mut o = Outputs::default();
+        probe.outputs(t, y, &mut o)?;
+        s.drain_events(&mut o.events);
+        events.extend(o.events.iter().copied());
+        outs.push(o);
+        Ok(())
+    })
+    .map_err(|e| format!("{e:?}"))?;
+    Ok((outs, events))
+}
+
+#[test]
+fn explore_paper_unilateral() {
+    let scene = paper_unilateral(0.5, 0.0, &[]);
+    let runs = std::env::var("EXPLORE_RUNS").unwrap_or("two-elbow,one-elbow,no-elbow".into());
+    let t_end: f64 = std::env::var("EXPLORE_T").map(|x| x.parse().unwrap()).unwrap_or(5.0);
+    for run in runs.split(',') {
+        match run_hybrid(&scene, run, t_end, 1e-3, 1e-8, 1e-10) {
+            Ok((outs, events)) => {
+                let last = outs.last().unwrap();
+                let ej: f64 = last.electric_energy.iter().sum();
+                let worst = outs.iter().map(|o| o.balance_residual.abs()).fold(0.0, f64::max);
+                println!("{run}: E = {ej:.6} J, worst residual {worst:e}, events {}", events.len());
+                for e in events.iter().take(20) {
+                    println!("  t = {:.9} contact {} {:?} dT {:e} gd {:e} -> {:e}", e.t, e.contact, e.kind, e.energy_lost, e.gap_rate_before, e.gap_rate_after);
+                }
+            }
+            Err(e) => println!("{run}: error {e}"),
+        }
+    }
+}
