@@ -34,7 +34,7 @@ use std::time::Instant;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use crate::dynamics::contact::ContactEventKind;
+use crate::dynamics::contact::{ContactEventKind, ContactMode};
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod};
 use crate::dynamics::motor::Electrical;
 use crate::error::{RunError, SceneError};
@@ -68,7 +68,7 @@ pub struct Row {
     pub max_hand_error_m: f64,
     /// max over samples and joints of |W_j − W_j,ref| and |E_j − E_j,ref|, J.
     pub max_link_energy_error_j: f64,
-    /// max over samples and contacts of |C|, m.
+    /// max over samples and contacts of |C|, m (event-driven runs: contacts in touch only).
     pub max_drift_m: f64,
     /// Largest |r_hand| of the reference, m: the hand error above which the run is `diverged`.
     pub reach_m: f64,
@@ -98,11 +98,20 @@ fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Sta
         let mut e = o.link_work.clone();
         e.extend_from_slice(&o.electric_energy);
         r.energies.push(e);
-        drift = o.constraint_position.iter().fold(drift, |m, c| m.max(c.abs()));
+        drift = o.constraint_position.iter().enumerate().filter(|&(k, _)| held(o, k)).fold(drift, |m, (_, c)| m.max(c.abs()));
         r.events.extend(o.events.iter().map(|e| (e.t, e.contact, e.kind)));
         Ok(())
     })?;
     Ok((r, rep.stats, drift))
+}
+
+/// Whether contact `k`'s position is a constraint at this sample, so that `|C|` is drift: every
+/// contact of a bilateral run (`o.contacts` empty); in an event-driven run only a contact in
+/// touch (sticking, sliding, bilateral) — an open contact's gap is no error. (A compliant
+/// contact in touch reports sticking or sliding, and its penetration then counts as drift:
+/// the outputs do not carry the model.)
+fn held(o: &crate::ode::Outputs, k: usize) -> bool {
+    o.contacts.get(k).is_none_or(|c| c.mode != ContactMode::Separated)
 }
 
 /// An adaptive `method` at `rtol` (atol = rtol / 100), steps of at most `h_max`.
@@ -383,6 +392,20 @@ mod tests {
             energies: vec![vec![1.0, -40.0], vec![3.0, 12.0]],
             events: Vec::new(),
         }
+    }
+
+    // Drift counts every contact of a bilateral run (no contact outputs), and in an
+    // event-driven run only the contacts in touch: an open contact's gap is not an error.
+    #[test]
+    fn drift_counts_only_held_contacts() {
+        use crate::dynamics::contact::ContactOutput;
+        let mut o = crate::ode::Outputs { constraint_position: vec![1e-9, 0.3], ..Default::default() };
+        assert!(held(&o, 0) && held(&o, 1));
+        let c = |mode| ContactOutput { mode, ..Default::default() };
+        o.contacts = vec![c(ContactMode::Sticking), c(ContactMode::Separated)];
+        assert!(held(&o, 0) && !held(&o, 1));
+        o.contacts = vec![c(ContactMode::Sliding), c(ContactMode::Bilateral)];
+        assert!(held(&o, 0) && held(&o, 1));
     }
 
     // Events are paired by contact and kind in order: the largest time difference over the

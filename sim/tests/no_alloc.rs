@@ -2,14 +2,15 @@
 //! integration of the paper's two-elbow run (the RHS: IK, PD, RNEA, CRBA, contacts, Cholesky
 //! and Schur complement), for every integrator, after construction and the first step, over
 //! 1100 steps (dopri45's stiffness test runs at step 1000); and the driver with its wall-clock
-//! deadline allocates the same for 100 steps as for 500.
+//! deadline allocates the same for 100 steps as for 500; so does the event driver
+//! (`integrate_hybrid`) for a bouncing ball, whatever its step count.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use std::time::{Duration, Instant};
 
-use sim::integrate::{integrate_sampled_within, ArkImex, Deadline, DormandPrince45, Rk4, Rodas, RodasMethod, Rosenbrock, StepControl, Stepper};
+use sim::integrate::{integrate_hybrid, integrate_sampled_within, ArkImex, EventSettings, HybridSystem, OdeSystem, Deadline, DormandPrince45, Rk4, Rodas, RodasMethod, Rosenbrock, StepControl, Stepper};
 use sim::scene::Scene;
 use sim::ode::ArmSystem;
 
@@ -177,4 +178,67 @@ fn targets_do_not_allocate() {
         scene.target().eval(k as f64 * 0.05, scene.model(), scene.hand(), &mut scratch, &mut q, &mut qd, Some(&mut qdd)).unwrap();
     }
     assert_eq!(allocs() - before, 0, "paper target with q̈_d");
+}
+
+/// A ball, y = [h, v], h'' = -9.81, bouncing with restitution 0.8 (event h = 0 downwards).
+struct Ball;
+
+impl OdeSystem for Ball {
+    type Error = std::convert::Infallible;
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&mut self, _t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), Self::Error> {
+        dydt[0] = y[1];
+        dydt[1] = -9.81;
+        Ok(())
+    }
+}
+
+impl HybridSystem for Ball {
+    fn n_events(&self) -> usize {
+        1
+    }
+    fn event_direction(&self, _i: usize) -> i8 {
+        -1
+    }
+    fn events(&mut self, _t: f64, y: &[f64], out: &mut [f64]) -> Result<(), Self::Error> {
+        out[0] = y[0];
+        Ok(())
+    }
+    fn init_modes(&mut self, _t: f64, _y: &mut [f64]) -> Result<bool, Self::Error> {
+        Ok(false)
+    }
+    fn handle_events(&mut self, _t: f64, y: &mut [f64], _fired: &[bool]) -> Result<bool, Self::Error> {
+        y[1] *= -0.8;
+        Ok(true)
+    }
+}
+
+/// The event driver allocates per run (its buffers), not per step nor per event: the same
+/// count for a ball run (2 s, 3 bounces) with steps of at most 1e-2 s and 1e-3 s (rk4: 1e-3
+/// and 1e-4 s), root finding and restarts included.
+#[test]
+fn the_event_driver_does_not_allocate_per_step_or_event() {
+    let count = |st: &mut dyn Stepper<Ball>| {
+        let (mut bounces, mut v_last) = (0, 0.0);
+        let before = allocs();
+        integrate_hybrid(st, &mut Ball, 0.0, &[1.0, 0.0], 2.0, 1e-2, None, EventSettings::default(), |_, y, _| {
+            if y[1] > 0.0 && v_last <= 0.0 {
+                bounces += 1;
+            }
+            v_last = y[1];
+            Ok(())
+        })
+        .unwrap();
+        (allocs() - before, bounces)
+    };
+    let c = |h_max: f64| StepControl { h_max, ..StepControl::new(1e-9, 1e-12) };
+    for (name, (a, na), (b, nb)) in [
+        ("dopri45, h_max 1e-2 / 1e-3", count(&mut DormandPrince45::new(2, c(1e-2))), count(&mut DormandPrince45::new(2, c(1e-3)))),
+        ("rk4, h 1e-3 / 1e-4", count(&mut Rk4::new(2, 1e-3)), count(&mut Rk4::new(2, 1e-4))),
+    ] {
+        assert_eq!((na, nb), (3, 3), "{name}: bounces at 0.45, 1.17, 1.75 s");
+        assert_eq!(a, b, "{name}: {a} vs {b} allocations");
+    }
 }

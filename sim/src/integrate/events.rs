@@ -118,7 +118,8 @@ impl Default for EventSettings {
 /// - [`HybridSystem::init_modes`] is called at `(t0, y0)` before anything else; the first
 ///   sample is `y0` bit for bit unless it moved `y0`.
 /// - [`HybridSystem::after_step`] is called after every accepted step that has no event (after
-///   the projection).
+///   the projection, before the next step: so not after the step that ends the run), when the
+///   system has event functions.
 /// - With `sys.n_events() == 0` the samples, the steps and the statistics are those of
 ///   `integrate_sampled_within` bit for bit.
 /// - `settings.time_tol` that is not finite and positive means "as fine as `t` resolves"

@@ -126,3 +126,63 @@ fn small_scene_is_valid() {
     forward_kinematics(&s.model, &mut data, &s.q0);
     assert!((s.hand.position(&data) - s.circle().unwrap().position(0.0)).norm() < 1e-12);
 }
+
+/// Contact models (issue 11): bad models, keys and values are rejected naming the field and the
+/// value; a unilateral elbow above the table is accepted (it starts separated) but one inside
+/// it (g0 < −1e-9 m) is rejected with its gap; the table construct adds its points to every run.
+#[test]
+fn contact_models_are_validated() {
+    expect_err(|v| v["contacts"][0]["model"] = "sticky".into(), "contacts[0].model", "sticky");
+    expect_err(
+        |v| {
+            v["contacts"][0]["model"] = "unilateral".into();
+            v["contacts"][0]["restitution"] = 1.5.into();
+        },
+        "contacts[0].restitution",
+        "1.5",
+    );
+    expect_err(
+        |v| {
+            v["contacts"][1]["model"] = "unilateral".into();
+            v["contacts"][1]["friction"] = (-0.1).into();
+        },
+        "contacts[1].friction",
+        "-0.1",
+    );
+    expect_err(
+        |v| {
+            v["contacts"][0]["model"] = "unilateral".into();
+            v["contacts"][0]["stiffness"] = 1e5.into();
+        },
+        "contacts[0].stiffness",
+        "100000",
+    );
+    expect_err(|v| v["contacts"][0]["friction"] = 0.5.into(), "contacts[0].friction", "0.5");
+    expect_err(|v| v["contacts"][0]["model"] = "compliant".into(), "contacts[0].stiffness", "(absent)");
+    expect_err(
+        |v| {
+            v["contacts"][0]["model"] = "unilateral".into();
+            v["contacts"][0]["plane"]["offset"] = 0.01.into();
+        },
+        "contacts[0]",
+        "g(q0) = -1.000e-2",
+    );
+    // above the table: fine for a unilateral contact
+    let s = with(|v| {
+        v["contacts"][0]["model"] = "unilateral".into();
+        v["contacts"][0]["plane"]["offset"] = (-0.01).into();
+    })
+    .expect("a unilateral elbow may start above the table");
+    assert_eq!(s.contact_models()[0].model, crate::dynamics::contact::ContactModel::Unilateral { restitution: 0.0, friction: 0.0 });
+    assert!(s.run_is_hybrid(&s.runs[0]) && !s.run_is_hybrid(&s.runs[2]));
+    // the table: its points belong to every run; the spec without it re-serialises unchanged
+    let s = with(|v| {
+        v["table"] = serde_json::json!({"plane": {"normal": [0, 0, 1], "offset": 0}, "points": [{"name": "t5", "point": {"joint": "joint5"}}], "friction": 0.4});
+    })
+    .expect("a table under joint5");
+    let k = s.contacts().iter().position(|c| c.name == "t5").expect("the table point is a contact");
+    assert!(s.runs.iter().all(|r| r.contacts.contains(&k)));
+    assert_eq!(s.contact_models()[k].model, crate::dynamics::contact::ContactModel::Unilateral { restitution: 0.0, friction: 0.4 });
+    let paper_json = serde_json::to_value(paper().spec()).unwrap();
+    assert!(paper_json.get("table").is_none() && paper_json.get("events").is_none() && paper_json["contacts"][0].get("model").is_none());
+}

@@ -156,20 +156,23 @@ pub fn choose_modes(
                 let phi = i as f64 * step;
                 let cur = eval(phi, &mut trial, fd, cd);
                 if let (Some((c0, _)), Some((c1, _))) = (prev, cur) {
-                    if c0 == 0.0 || c0.signum() != c1.signum() {
-                        let (mut lo, mut hi, mut clo) = (phi - step, phi, c0);
+                    let root = if c0 == 0.0 {
+                        Some(phi - step)
+                    } else if c0 * c1 < 0.0 {
+                        let (mut lo, mut hi) = (phi - step, phi);
                         while hi - lo > 1e-13 {
                             let mid = 0.5 * (lo + hi);
                             match eval(mid, &mut trial, fd, cd) {
-                                Some((cm, _)) if cm.signum() == clo.signum() && cm != 0.0 => {
-                                    lo = mid;
-                                    clo = cm;
-                                }
+                                Some((cm, _)) if cm * c0 > 0.0 => lo = mid,
                                 Some(_) => hi = mid,
                                 None => break,
                             }
                         }
-                        let root = 0.5 * (lo + hi);
+                        Some(0.5 * (lo + hi))
+                    } else {
+                        None
+                    };
+                    if let Some(root) = root {
                         if let Some((_, dot)) = eval(root, &mut trial, fd, cd) {
                             if dot >= 0.0 {
                                 let closeness = root.cos() * s0[0] + root.sin() * s0[1];
