@@ -318,5 +318,3 @@ fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Er
 
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod tests_contacts;

@@ -183,8 +183,26 @@ pub struct ContactEventMsg {
     pub gap_rate_after: f64,
 }
 
+/// The values of [`ContactEventMsg::kind`].
+pub mod contact_event_kind {
+    /// `f_n` fell to zero: the contact opens.
+    pub const LIFT_OFF: &str = "lift-off";
+    /// The gap closed with no approach speed: the contact closes without an impact.
+    pub const TOUCH_DOWN: &str = "touch-down";
+    /// The gap closed with approach speed: an impulse (Newton's restitution).
+    pub const IMPACT: &str = "impact";
+    /// A bouncing sequence ended (the approach speed fell below the rest velocity): a plastic
+    /// impact, the contact closes.
+    pub const REST: &str = "rest";
+    pub const STICK_TO_SLIP: &str = "stick-to-slip";
+    pub const SLIP_TO_STICK: &str = "slip-to-stick";
+}
+
 /// Every value of [`ContactEventMsg::kind`].
-pub const CONTACT_EVENT_KINDS: [&str; 6] = ["lift-off", "touch-down", "impact", "rest", "stick-to-slip", "slip-to-stick"];
+pub const CONTACT_EVENT_KINDS: [&str; 6] = {
+    use contact_event_kind::*;
+    [LIFT_OFF, TOUCH_DOWN, IMPACT, REST, STICK_TO_SLIP, SLIP_TO_STICK]
+};
 
 /// The mode codes of [`ContactState::mode`], by name.
 pub mod contact_mode {

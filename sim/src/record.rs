@@ -275,11 +275,7 @@ impl<'a> Recorder<'a> {
         let model = &self.scene.model;
 
         // the contact events since the previous sample, at their own times (≤ t), before it
-        if self.hybrid {
-            for ev in &o.events {
-                self.write_event(ev)?;
-            }
-        }
+        self.record_events(&o.events)?;
         let path = &self.path;
         let err = |source| RunError::Recording { path: path.clone(), source };
 
@@ -366,7 +362,21 @@ impl<'a> Recorder<'a> {
         Ok(())
     }
 
+    /// Contact events outside a sample: those logged after the last sample of a run that then
+    /// failed (drain the system's log and call this before [`Recorder::finish`]), so the file
+    /// says what happened up to the failure. Written only for runs with a non-bilateral contact.
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
+    pub fn record_events(&mut self, events: &[ContactEvent]) -> Result<(), RunError> {
+        if self.hybrid {
+            for ev in events {
+                self.write_event(ev)?;
+            }
+        }
+        Ok(())
+    }
+
     /// One contact event on `/contact_events`, log time = the event time.
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
     fn write_event(&mut self, ev: &ContactEvent) -> Result<(), RunError> {
         let path = &self.path;
         let e = &mut self.contact_event;

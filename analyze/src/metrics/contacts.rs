@@ -20,6 +20,7 @@
 //! Memory: a few numbers per contact, plus the status changes and the events (bounded by the
 //! run's `max_events`).
 
+use schemas::contact_event_kind as kind;
 use schemas::{contact_mode, ContactEventMsg, ContactState, DecodedMessage, CONTACT_EVENT_KINDS};
 use serde::{Deserialize, Serialize};
 
@@ -189,14 +190,14 @@ impl ContactReductions {
             let m = &mut out[k];
             let c = &mut m.events;
             match e.kind.as_str() {
-                "lift-off" => c.lift_offs += 1,
-                "touch-down" => c.touch_downs += 1,
-                "impact" => c.impacts += 1,
-                "rest" => c.rests += 1,
-                "stick-to-slip" => c.stick_to_slip += 1,
+                kind::LIFT_OFF => c.lift_offs += 1,
+                kind::TOUCH_DOWN => c.touch_downs += 1,
+                kind::IMPACT => c.impacts += 1,
+                kind::REST => c.rests += 1,
+                kind::STICK_TO_SLIP => c.stick_to_slip += 1,
                 _ => c.slip_to_stick += 1, // the kinds were checked as they came
             }
-            if matches!(e.kind.as_str(), "impact" | "rest") {
+            if matches!(e.kind.as_str(), kind::IMPACT | kind::REST) {
                 m.impact_energy_lost_j += e.energy_lost;
             }
         }
@@ -204,13 +205,12 @@ impl ContactReductions {
         for (k, m) in out.iter_mut().enumerate() {
             let Some(acc) = self.contacts.get(k) else { continue };
             for &(t0, t1, closing) in &acc.changes {
-                let inside = per_contact[k].iter().filter(|(t, _)| *t > t0 && *t <= t1);
+                let mut inside = per_contact[k].iter().filter(|(t, _)| *t > t0 && *t <= t1);
                 let part = if closing {
-                    let closer = inside.filter(|(_, e)| matches!(e.kind.as_str(), "touch-down" | "impact" | "rest")).last();
+                    let closer = inside.rfind(|(_, e)| matches!(e.kind.as_str(), kind::TOUCH_DOWN | kind::IMPACT | kind::REST));
                     closer.map_or(0.5 * (t1 - t0), |(t, _)| t1 - t)
                 } else {
-                    let mut inside = inside;
-                    let opener = inside.find(|(_, e)| e.kind == "lift-off");
+                    let opener = inside.find(|(_, e)| e.kind == kind::LIFT_OFF);
                     opener.map_or(0.5 * (t1 - t0), |(t, _)| t - t0)
                 };
                 m.time_in_contact_s += part;

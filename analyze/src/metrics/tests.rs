@@ -7,6 +7,8 @@ use super::*;
 use schemas::synth::{contact_forces, currents, hand_error, linear_energy, Synth};
 use schemas::{EnergyState, RunResult, RunStatus};
 
+mod contacts;
+
 fn read(s: &Synth) -> (tempfile::TempDir, RunMetrics) {
     let dir = tempfile::tempdir().unwrap();
     let m = read_run_metrics(&s.write_in(dir.path())).unwrap();

@@ -69,6 +69,9 @@ fn contact_states_events_and_records_read_back_equal() {
     for o in &outs {
         rec.record(o).unwrap();
     }
+    // an event after the last sample (a run that then failed): written by `record_events`
+    let late = event(2.5e-3, 1, ContactEventKind::Rest);
+    rec.record_events(&[late]).unwrap();
     rec.finish(Ok(&crate::integrate::Stats::default())).unwrap();
 
     let r = read_recording(&path).unwrap();
@@ -97,7 +100,7 @@ fn contact_states_events_and_records_read_back_equal() {
         assert_eq!(*s, want);
     }
     let events = r.read::<ContactEventMsg>().unwrap();
-    let want: Vec<&ContactEvent> = outs.iter().flat_map(|o| &o.events).collect();
+    let want: Vec<&ContactEvent> = outs.iter().flat_map(|o| &o.events).chain([&late]).collect();
     assert_eq!(events.len(), want.len());
     for ((t, e), w) in events.iter().zip(want) {
         assert_eq!(*t, w.t, "log time = event time");
@@ -143,4 +146,15 @@ fn a_bilateral_run_writes_no_contact_channels() {
     }
     assert!(r.record_opt::<ContactsRecord>().unwrap().is_none());
     assert!(r.record_opt::<EnergyTermsRecord>().unwrap().is_none());
+}
+
+/// The event kinds and mode codes of the simulator are the recording format's.
+#[test]
+fn event_kinds_and_mode_codes_are_the_formats() {
+    use ContactEventKind::*;
+    let kinds: Vec<&str> = [LiftOff, TouchDown, Impact, Rest, StickToSlip, SlipToStick].iter().map(|k| k.name()).collect();
+    assert_eq!(kinds, schemas::CONTACT_EVENT_KINDS);
+    for m in [ContactMode::Separated, ContactMode::Sticking, ContactMode::Sliding, ContactMode::Bilateral] {
+        assert_eq!(schemas::contact_mode::name(m.code()), Some(m.name()));
+    }
 }

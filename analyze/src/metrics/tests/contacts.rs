@@ -7,7 +7,7 @@ use std::path::Path;
 use schemas::synth::{unilateral, Synth};
 use schemas::{ConstraintState, ContactEventMsg};
 
-use super::*;
+use super::super::*;
 
 fn read(s: &Synth) -> (tempfile::TempDir, Result<RunMetrics, Error>) {
     let dir = tempfile::tempdir().unwrap();
@@ -52,7 +52,7 @@ fn unilateral_contacts_have_the_known_times_counts_and_losses() {
     // in memory, and through the generic trees: the same numbers
     let rec = schemas::read_recording(&path).unwrap();
     assert_eq!(serde_json::to_string(&run_metrics(&rec).unwrap()).unwrap(), serde_json::to_string(&m).unwrap());
-    assert_eq!(serde_json::to_string(&super::tests::generic_metrics(&path).unwrap()).unwrap(), serde_json::to_string(&m).unwrap());
+    assert_eq!(serde_json::to_string(&super::generic_metrics(&path).unwrap()).unwrap(), serde_json::to_string(&m).unwrap());
     // the JSON round-trips (the field is skipped only when empty)
     let back: RunMetrics = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
     assert_eq!(back.contact_states, m.contact_states);
