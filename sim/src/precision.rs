@@ -87,13 +87,16 @@ pub struct Reference {
     pub hand: Vec<Vector3<f64>>,
     pub energies: Vec<Vec<f64>>,
     pub events: Vec<(f64, usize, ContactEventKind)>,
+    /// Wall time the reference run took, s: sets the variants' budget ([`Reference::budget`]).
+    pub wall_s: f64,
 }
 
-fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Stats, f64), RunError> {
-    let mut r = Reference { hand: Vec::new(), energies: Vec::new(), events: Vec::new() };
+fn collect(scene: &Scene, run: &Run, budget: crate::run::Budget) -> Result<(Reference, crate::integrate::Stats, f64), RunError> {
+    let mut r = Reference { hand: Vec::new(), energies: Vec::new(), events: Vec::new(), wall_s: 0.0 };
     let mut drift = 0.0f64;
+    let t0 = Instant::now();
     // the hand, the quadratures and C need forward kinematics only, not a right-hand side
-    let rep = crate::run::simulate_outputs(scene, run, Default::default(), OutputLevel::Kinematic, |o| {
+    let rep = crate::run::simulate_outputs(scene, run, budget, OutputLevel::Kinematic, |o| {
         r.hand.push(o.hand);
         let mut e = o.link_work.clone();
         e.extend_from_slice(&o.electric_energy);
@@ -102,6 +105,7 @@ fn collect(scene: &Scene, run: &Run) -> Result<(Reference, crate::integrate::Sta
         r.events.extend(o.events.iter().map(|e| (e.t, e.contact, e.kind)));
         Ok(())
     })?;
+    r.wall_s = t0.elapsed().as_secs_f64();
     Ok((r, rep.stats, drift))
 }
 
@@ -135,21 +139,33 @@ fn variation(
     })
 }
 
-/// Why the reference run could not be made.
+/// Why the reference run could not be made (`method`: the reference's method and tolerance).
 #[derive(Debug, thiserror::Error)]
 pub enum ReferenceError {
-    #[error("the reference scene (dopri45, rtol 1e-12): {0}")]
-    Scene(#[from] SceneError),
-    #[error("the reference run (dopri45, rtol 1e-12): {0}")]
-    Run(#[from] RunError),
+    #[error("the reference scene ({method}): {source}")]
+    Scene { method: &'static str, source: SceneError },
+    #[error("the reference run ({method}): {source}")]
+    Run { method: &'static str, source: RunError },
 }
 
 /// The tight reference: Dormand–Prince at rtol 1e-12, atol 1e-14, steps of at most the output
-/// interval, CRBA + Schur.
+/// interval, CRBA + Schur. A run with a frictional rigid contact is referenced by RODAS5P at the
+/// same tolerances instead: a slowly sliding contact is stiff (the direction of isotropic Coulomb
+/// friction turns at a rate that grows without bound as the slip stops), where an explicit method
+/// crawls at its stability limit.
 pub fn reference(scene: &Scene, run: &Run) -> Result<Reference, ReferenceError> {
-    let spec = IntegratorSpec::Dopri45(AdaptiveSpec { rtol: 1e-12, atol: 1e-14, h_max: Some(1.0 / scene.output_rate), max_steps: None });
-    let s = variation(scene, spec, MassMatrixMethod::Crba, ConstraintSolver::Schur, |_| {})?;
-    Ok(collect(&s, run)?.0)
+    let adaptive = AdaptiveSpec { rtol: 1e-12, atol: 1e-14, h_max: Some(1.0 / scene.output_rate), max_steps: None };
+    let frictional = run.contacts.iter().any(|&k| {
+        matches!(scene.contact_models()[k].model, crate::dynamics::contact::ContactModel::Unilateral { friction, .. } if friction > 0.0)
+    });
+    let (spec, method) = if frictional {
+        let r = crate::scene::spec::RosenbrockSpec { rtol: adaptive.rtol, atol: adaptive.atol, h_max: adaptive.h_max, max_steps: None, jacobian_reuse: None };
+        (IntegratorSpec::Rodas5p(r), "rodas5p, rtol 1e-12")
+    } else {
+        (IntegratorSpec::Dopri45(adaptive), "dopri45, rtol 1e-12")
+    };
+    let s = variation(scene, spec, MassMatrixMethod::Crba, ConstraintSolver::Schur, |_| {}).map_err(|source| ReferenceError::Scene { method, source })?;
+    Ok(collect(&s, run, Default::default()).map_err(|source| ReferenceError::Run { method, source })?.0)
 }
 
 /// Measure one variant against the reference.
@@ -174,7 +190,7 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
     // timing: the simulation alone, best of `repeats`
     for _ in 0..repeats.max(1) {
         let t0 = Instant::now();
-        match crate::run::simulate_outputs(s, run, Default::default(), OutputLevel::Kinematic, |_| Ok(())) {
+        match crate::run::simulate_outputs(s, run, reference.budget(), OutputLevel::Kinematic, |_| Ok(())) {
             Ok(rep) => {
                 row.wall_s = row.wall_s.min(t0.elapsed().as_secs_f64());
                 row.rhs_evals = rep.stats.rhs_evals;
@@ -189,7 +205,7 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
     }
     row.speed_vs_real_time = s.duration / row.wall_s;
     // errors: one more run that keeps the samples
-    match collect(s, run) {
+    match collect(s, run, reference.budget()) {
         Ok((r, _, drift)) => {
             row.max_drift_m = drift;
             row.max_hand_error_m = r.hand.iter().zip(&reference.hand).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
@@ -212,6 +228,16 @@ pub fn measure(v: &Variant, run: &Run, reference: &Reference, repeats: usize) ->
 }
 
 impl Reference {
+    /// What a variant may spend: 50 times the reference's wall time, at least 30 s and at most
+    /// the default budget of a run. A variant slower than that is of no use in a work–precision
+    /// diagram (the reference is the tightest run), and a method that crawls (an explicit method
+    /// on a stiff sliding contact) fails in bounded time instead of after the full budget.
+    pub fn budget(&self) -> crate::run::Budget {
+        let limit = crate::limits::DEFAULT_MAX_WALL_TIME.as_secs_f64();
+        let s = (50.0 * self.wall_s).clamp(30.0, limit);
+        crate::run::Budget::wall_time(std::time::Duration::from_secs_f64(s))
+    }
+
     /// Largest |r_hand| over the reference samples, m.
     pub fn reach_m(&self) -> f64 {
         self.hand.iter().map(|h| h.norm()).fold(0.0, f64::max)
@@ -391,6 +417,7 @@ mod tests {
             hand: vec![Vector3::new(1.5, 0.0, 0.0), Vector3::new(0.0, 2.0, 0.0)],
             energies: vec![vec![1.0, -40.0], vec![3.0, 12.0]],
             events: Vec::new(),
+            wall_s: 1.0,
         }
     }
 
