@@ -62,7 +62,7 @@ pub(crate) fn run_hybrid(scene: &Scene, run: &str, t_end: f64, dt_out: f64, rtol
 }
 
 /// Exploration (prints per-run energies and events; `cargo test -- --ignored explore`):
-/// EXPLORE_RUNS, EXPLORE_T, EXPLORE_RODAS=1 (rodas5p instead of dopri45), MODES_DEBUG=1.
+/// EXPLORE_RUNS, EXPLORE_T, EXPLORE_RODAS=1 (rodas5p instead of dopri45), EXPLORE_RTOL, EXPLORE_TABLE.
 #[test]
 #[ignore]
 fn explore_paper_unilateral() {
