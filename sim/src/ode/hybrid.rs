@@ -237,9 +237,6 @@ impl ArmSystem<'_> {
         if h.count > h.settings.max_events {
             return Err(RunError::TooManyEvents { t: e.t, max_events: h.settings.max_events });
         }
-        if std::env::var("MODES_DEBUG").is_ok() {
-            eprintln!("event t = {:.12} contact {} {:?} impulse {:e} lost {:e} gd {:e} -> {:e}", e.t, e.contact, e.kind, e.impulse, e.energy_lost, e.gap_rate_before, e.gap_rate_after);
-        }
         h.log.push(e);
         Ok(())
     }

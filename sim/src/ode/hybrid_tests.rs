@@ -33,14 +33,14 @@ pub(crate) fn paper_unilateral(mu: f64, e: f64, table: &[&str]) -> Scene {
         .expect("a valid variation")
 }
 
-/// Run `run` of `scene` to `t_end` with dopri45 (rtol, atol), outputs every `dt_out`.
-pub(crate) fn run_hybrid(scene: &Scene, run: &str, t_end: f64, dt_out: f64, rtol: f64, atol: f64) -> Result<(Vec<Outputs>, Vec<ContactEvent>), String> {
+/// Run `run` of `scene` to `t_end` with dopri45 or rodas5p (rtol, atol), outputs every `dt_out`.
+pub(crate) fn run_hybrid(scene: &Scene, run: &str, t_end: f64, dt_out: f64, rtol: f64, atol: f64, rodas: bool) -> Result<(Vec<Outputs>, Vec<ContactEvent>), String> {
     let run = scene.run(run).expect("run");
     let mut sys = ArmSystem::new(scene, run);
     let mut probe = ArmSystem::new(scene, run);
     let y0 = sys.initial_state();
     let control = StepControl { h_max: dt_out, max_steps: 2_000_000, ..StepControl::new(rtol, atol) };
-    let mut stepper: Box<dyn crate::integrate::Stepper<ArmSystem>> = if std::env::var("EXPLORE_RODAS").is_ok() {
+    let mut stepper: Box<dyn crate::integrate::Stepper<ArmSystem>> = if rodas {
         Box::new(crate::integrate::Rodas::new(y0.len(), control).with_method(crate::integrate::RodasMethod::Rodas5P))
     } else {
         Box::new(DormandPrince45::new(y0.len(), control))
@@ -62,20 +62,26 @@ pub(crate) fn run_hybrid(scene: &Scene, run: &str, t_end: f64, dt_out: f64, rtol
 }
 
 /// Exploration (prints per-run energies and events; `cargo test -- --ignored explore`):
-/// EXPLORE_RUNS, EXPLORE_T, EXPLORE_RODAS=1 (rodas5p instead of dopri45), MODES_DEBUG=1.
+/// EXPLORE_RUNS, EXPLORE_T, EXPLORE_RODAS=1 (rodas5p instead of dopri45), EXPLORE_RTOL, EXPLORE_TABLE.
 #[test]
 #[ignore]
 fn explore_paper_unilateral() {
-    let scene = paper_unilateral(0.5, 0.0, &[]);
+    let table: Vec<String> = std::env::var("EXPLORE_TABLE").map(|x| x.split(',').map(String::from).collect()).unwrap_or_default();
+    let table: Vec<&str> = table.iter().map(String::as_str).collect();
+    let scene = paper_unilateral(0.5, 0.0, &table);
     let runs = std::env::var("EXPLORE_RUNS").unwrap_or("two-elbow,one-elbow,no-elbow".into());
     let t_end: f64 = std::env::var("EXPLORE_T").map(|x| x.parse().unwrap()).unwrap_or(5.0);
     for run in runs.split(',') {
-        match run_hybrid(&scene, run, t_end, 1e-3, 1e-8, 1e-10) {
+        let rtol: f64 = std::env::var("EXPLORE_RTOL").map(|x| x.parse().unwrap()).unwrap_or(1e-8);
+        match run_hybrid(&scene, run, t_end, 1e-3, rtol, rtol * 1e-2, std::env::var("EXPLORE_RODAS").is_ok()) {
             Ok((outs, events)) => {
                 let last = outs.last().unwrap();
                 let ej: f64 = last.electric_energy.iter().sum();
                 let worst = outs.iter().map(|o| o.balance_residual.abs()).fold(0.0, f64::max);
-                println!("{run}: E = {ej:.6} J, worst residual {worst:e}, events {}", events.len());
+                let rel = outs.iter().map(|o| o.balance_residual.abs() / o.electric_energy.iter().sum::<f64>().abs().max(1e-3)).fold(0.0, f64::max);
+                let imp: Vec<f64> = last.contacts.iter().map(|c| c.impact_loss).collect();
+                let fr: Vec<f64> = last.contacts.iter().map(|c| c.friction_work).collect();
+                println!("{run}: E = {ej:.6} J, worst residual {worst:e} J (relative {rel:e}), events {}, impact loss {imp:?} J, friction work {fr:?} J", events.len());
                 for e in events.iter().take(20) {
                     println!("  t = {:.9} contact {} {:?} dT {:e} gd {:e} -> {:e}", e.t, e.contact, e.kind, e.energy_lost, e.gap_rate_before, e.gap_rate_after);
                 }
@@ -92,9 +98,8 @@ fn explore_paper_unilateral() {
 /// logged impact losses (1e-15 J: the same numbers added), and the losses are positive.
 #[test]
 fn paper_unilateral_energy_balance_closes_through_impacts() {
-    std::env::set_var("EXPLORE_RODAS", "1");
     let scene = paper_unilateral(0.5, 0.0, &[]);
-    let (outs, events) = run_hybrid(&scene, "two-elbow", 0.1, 1e-3, 1e-10, 1e-12).expect("runs");
+    let (outs, events) = run_hybrid(&scene, "two-elbow", 0.1, 1e-3, 1e-10, 1e-12, true).expect("runs");
     let impacts: Vec<_> = events.iter().filter(|e| e.kind == crate::dynamics::contact::ContactEventKind::Impact).collect();
     assert!(impacts.len() >= 2, "expected the two elbows' impacts, got {events:?}");
     for o in &outs {
@@ -107,4 +112,32 @@ fn paper_unilateral_energy_balance_closes_through_impacts() {
         assert!((last.contacts[k].impact_loss - logged).abs() <= 1e-15, "contact {k}: {} vs {logged}", last.contacts[k].impact_loss);
         assert!(logged > 0.0 && last.contacts[k].friction_work > 0.0, "contact {k}: losses {logged}, friction {}", last.contacts[k].friction_work);
     }
+}
+
+/// Unilateral ≡ bilateral while the table pushes: the one-elbow run with a frictionless
+/// unilateral elbow (μ = 0) follows the bilateral paper run (the same row, solved by the
+/// active-row path) until its lift-off: q within 1e-9 rad at every sample before it (dopri45
+/// rtol 1e-10: both runs are accurate to ~1e-10, and the two solves agree to 1e-12); the
+/// lift-off is where the bilateral normal force changes sign (between the samples around it,
+/// which the bilateral run gives positive before and negative after).
+#[test]
+fn frictionless_unilateral_equals_bilateral_until_lift_off() {
+    let bil = Scene::paper().expect("paper");
+    let uni = paper_unilateral(0.0, 0.0, &[]);
+    let (b, _) = run_hybrid(&bil, "one-elbow", 0.06, 1e-3, 1e-10, 1e-12, false).expect("bilateral");
+    let (u, events) = run_hybrid(&uni, "one-elbow", 0.06, 1e-3, 1e-10, 1e-12, false).expect("unilateral");
+    let lift = events.iter().find(|e| e.kind == crate::dynamics::contact::ContactEventKind::LiftOff).expect("the elbow lifts off (the bilateral table pulls at 0.02 s)");
+    let mut compared = 0;
+    for (ob, ou) in b.iter().zip(&u) {
+        if ou.t >= lift.t {
+            break;
+        }
+        let d = ob.q.iter().zip(&ou.q).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(d <= 1e-9, "t = {}: q differs by {d:e} rad before the lift-off at {}", ou.t, lift.t);
+        assert!(ob.normal_force[0] > 0.0, "t = {}: the bilateral force is already negative before the lift-off", ob.t);
+        compared += 1;
+    }
+    assert!(compared >= 2, "lift-off at {} s leaves nothing to compare", lift.t);
+    let after = b.iter().find(|o| o.t >= lift.t).expect("a sample after the lift-off");
+    assert!(after.normal_force[0] < 0.0, "bilateral f_n at {} s = {} after the lift-off at {}", after.t, after.normal_force[0], lift.t);
 }

@@ -7,6 +7,7 @@ mod contacts;
 mod ctx;
 mod robot;
 pub mod spec;
+mod spec_contacts;
 mod target;
 
 use std::path::Path;

@@ -6,6 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 
+pub use super::spec_contacts::{EventsSpec, LawKeys, TablePointSpec, TableSpec};
+
 /// A per-joint setting: one number for every joint, or an array with one per joint (dof order).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
@@ -601,57 +603,6 @@ pub struct ContactSpec {
     pub slip_velocity: Option<f64>,
 }
 
-/// `"table"`: one plane under named points; each point becomes a contact (unilateral unless
-/// `model` says otherwise) that is part of every run.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TableSpec {
-    pub plane: PlaneSpec,
-    pub points: Vec<TablePointSpec>,
-    /// `"bilateral"` (absent), `"unilateral"` or `"compliant"`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub model: Option<String>,
-    /// Newton's coefficient of restitution e in [0, 1] (unilateral; default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub restitution: Option<f64>,
-    /// Coulomb friction coefficient mu >= 0 (unilateral, compliant; default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub friction: Option<f64>,
-    /// Normal stiffness k, N/m (compliant; required).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stiffness: Option<f64>,
-    /// Normal damping c, N s/m (compliant; default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub damping: Option<f64>,
-    /// Regularisation speed v_s of the compliant friction, m/s (default 1e-3).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub slip_velocity: Option<f64>,
-}
-
-/// One point of the table construct.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TablePointSpec {
-    pub name: String,
-    pub point: PointSpec,
-}
-
-/// `"events"`: settings of the event-driven integration (every key optional).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EventsSpec {
-    /// Width of the bracket an event time is located to, s (default 1e-12).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub time_tolerance: Option<f64>,
-    /// Impacts slower than this are plastic and end a bouncing sequence (the Zeno rule), m/s
-    /// (default 1e-4).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub rest_velocity: Option<f64>,
-    /// Most contact events in a run (default 100000).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max_events: Option<u64>,
-}
-
 /// The plane `normal · x = offset`, world frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -764,41 +715,4 @@ pub struct RunSpec {
     pub name: String,
     /// Names of the contacts active in this run.
     pub contacts: Vec<String>,
-}
-
-/// The model keys of a contact or of the table, as written.
-#[derive(Clone, Copy, Debug)]
-pub struct LawKeys<'a> {
-    pub model: Option<&'a str>,
-    pub restitution: Option<f64>,
-    pub friction: Option<f64>,
-    pub stiffness: Option<f64>,
-    pub damping: Option<f64>,
-    pub slip_velocity: Option<f64>,
-}
-
-impl ContactSpec {
-    pub fn law(&self) -> LawKeys<'_> {
-        LawKeys {
-            model: self.model.as_deref(),
-            restitution: self.restitution,
-            friction: self.friction,
-            stiffness: self.stiffness,
-            damping: self.damping,
-            slip_velocity: self.slip_velocity,
-        }
-    }
-}
-
-impl TableSpec {
-    pub fn law(&self) -> LawKeys<'_> {
-        LawKeys {
-            model: self.model.as_deref(),
-            restitution: self.restitution,
-            friction: self.friction,
-            stiffness: self.stiffness,
-            damping: self.damping,
-            slip_velocity: self.slip_velocity,
-        }
-    }
 }

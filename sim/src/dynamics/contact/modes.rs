@@ -236,10 +236,6 @@ pub fn choose_modes(
                     }
                 };
             }
-            if std::env::var("MODES_DEBUG").is_ok() {
-                let info: Vec<String> = closed.iter().map(|&k| format!("{:?} fn={:.4e} ft={:?} gdd={:.3e} at=({:.3e},{:.3e})", trial.mode[k], cd.f_n[k], cd.f_t[k], cd.rows.dot(3 * k, qdd) + cd.rows.bias[3 * k], cd.rows.dot(3 * k + 1, qdd) + cd.rows.bias[3 * k + 1], cd.rows.dot(3 * k + 2, qdd) + cd.rows.bias[3 * k + 2])).collect();
-                eprintln!("t={t} feasible={feasible_here} {}", info.join(" | "));
-            }
             if feasible_here {
                 let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();
                 feasible.push(Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), qdd: qdd.to_vec(), score });

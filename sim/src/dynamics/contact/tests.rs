@@ -364,3 +364,33 @@ fn sliding_solve_satisfies_its_equations() {
         assert!(e <= 1e-10 * (1.0 + fd.b.amax()), "joint {j}: M q̈ − b differs from the contact force by {e:e}");
     }
 }
+
+/// A compliant contact on a point mass m (k = 1e4 N/m, c = 50 N s/m, μ = 0.4, v_s = 1e-3 m/s) at
+/// penetration δ = 2 mm, δ̇ = 0.1 m/s, slip (0.3, −0.4) m/s: f_n = k δ + c δ̇, the friction
+/// `−μ f_n v_t / sqrt(|v_t|² + v_s²)`, and m q̈ = m g + f (1e-12 relative); pulled out fast
+/// (k δ + c δ̇ < 0) the force is 0, and above the plane nothing acts.
+#[test]
+fn compliant_forces_on_a_point_mass() {
+    let m = 0.7;
+    let model = point_mass(m);
+    let drives = force_drives(3);
+    let (k, c, mu, vs) = (1e4, 50.0, 0.4, 1e-3);
+    let contacts = [table(&model, "ball", Vector3::zeros(), "pad", ContactModel::Compliant { stiffness: k, damping: c, friction: mu, slip_velocity: vs })];
+    for (z, zd, expect_force) in [(-2e-3, -0.1, true), (-2e-3, 1.0, false), (1e-3, -0.1, false)] {
+        let qd = [0.3, -0.4, zd];
+        let mut data = Data::new(&model);
+        let (mut fd, mut cd) = (ForwardData::new(3, 1), ContactData::new(3, 1));
+        let state = ContactState::new(&contacts);
+        forward_dynamics_contacts(&plant(&model, &drives), &contacts, &state, &mut data, &mut fd, &mut cd, 0.0, &[0.0, 0.0, z], &qd, &[0.0; 3], &[0.0; 3]).expect("solve");
+        let (delta, delta_d) = (-z, -zd);
+        let f_n = if delta > 0.0 { (k * delta + c * delta_d).max(0.0) } else { 0.0 };
+        assert_eq!(f_n > 0.0, expect_force, "z = {z}, ż = {zd}");
+        let w = -mu * f_n / (0.3f64 * 0.3 + 0.4 * 0.4 + vs * vs).sqrt();
+        let f = [w * 0.3, w * -0.4, f_n];
+        assert!((cd.f_n[0] - f_n).abs() <= 1e-12 * f_n.max(1.0), "f_n {} vs {f_n}", cd.f_n[0]);
+        for (j, fj) in f.iter().enumerate() {
+            let a = fj / m - if j == 2 { G } else { 0.0 };
+            assert!((fd.qdd[j] - a).abs() <= 1e-12 * a.abs().max(1.0), "z = {z}: q̈[{j}] = {} vs {a}", fd.qdd[j]);
+        }
+    }
+}
