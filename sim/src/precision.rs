@@ -155,17 +155,28 @@ pub enum ReferenceError {
 /// crawls at its stability limit.
 pub fn reference(scene: &Scene, run: &Run) -> Result<Reference, ReferenceError> {
     let adaptive = AdaptiveSpec { rtol: 1e-12, atol: 1e-14, h_max: Some(1.0 / scene.output_rate), max_steps: None };
-    let frictional = run.contacts.iter().any(|&k| {
-        matches!(scene.contact_models()[k].model, crate::dynamics::contact::ContactModel::Unilateral { friction, .. } if friction > 0.0)
-    });
-    let (spec, method) = if frictional {
+    let method = reference_method(scene, run);
+    let spec = if method.starts_with("rodas5p") {
         let r = crate::scene::spec::RosenbrockSpec { rtol: adaptive.rtol, atol: adaptive.atol, h_max: adaptive.h_max, max_steps: None, jacobian_reuse: None };
-        (IntegratorSpec::Rodas5p(r), "rodas5p, rtol 1e-12")
+        IntegratorSpec::Rodas5p(r)
     } else {
-        (IntegratorSpec::Dopri45(adaptive), "dopri45, rtol 1e-12")
+        IntegratorSpec::Dopri45(adaptive)
     };
     let s = variation(scene, spec, MassMatrixMethod::Crba, ConstraintSolver::Schur, |_| {}).map_err(|source| ReferenceError::Scene { method, source })?;
     Ok(collect(&s, run, Default::default()).map_err(|source| ReferenceError::Run { method, source })?.0)
+}
+
+/// The method and tolerance of [`reference`] for `run` of `scene`: "rodas5p, rtol 1e-12" when
+/// the run has a frictional rigid contact, else "dopri45, rtol 1e-12".
+pub fn reference_method(scene: &Scene, run: &Run) -> &'static str {
+    let frictional = run.contacts.iter().any(|&k| {
+        matches!(scene.contact_models()[k].model, crate::dynamics::contact::ContactModel::Unilateral { friction, .. } if friction > 0.0)
+    });
+    if frictional {
+        "rodas5p, rtol 1e-12"
+    } else {
+        "dopri45, rtol 1e-12"
+    }
 }
 
 /// Measure one variant against the reference.

@@ -71,7 +71,8 @@ pub fn run(a: &PrecisionArgs, v: Verbosity) -> Result<u8> {
     cli::create_dir(&a.out)?;
     let ladder = sim::precision::default_ladder(&scene)?;
     let bar = cli::progress::count(ladder.len() + 1, "precision", "runs", v.quiet);
-    bar.set_message("reference (dopri45, rtol 1e-12)");
+    let method = sim::precision::reference_method(&scene, &run);
+    bar.set_message(format!("reference ({method})"));
     let reference = sim::precision::reference(&scene, &run)?;
     bar.inc(1);
     let mut rows = Vec::with_capacity(ladder.len());
@@ -98,7 +99,7 @@ pub fn run(a: &PrecisionArgs, v: Verbosity) -> Result<u8> {
     let text = match a.format.format {
         Format::Json => serde_json::to_string_pretty(&rows)? + "\n",
         Format::Csv => csv(&rows)?,
-        Format::Table => table(&rows, &scene.spec().name, &run.name, scene.duration(), a.accuracy)?,
+        Format::Table => table(&rows, &scene.spec().name, &run.name, method, scene.duration(), a.accuracy)?,
     };
     print_out(&text)?;
     if !v.quiet {
@@ -116,9 +117,9 @@ fn csv(rows: &[Row]) -> Result<String> {
     Ok(String::from_utf8(w.into_inner().context("writing the precision table")?)?)
 }
 
-fn table(rows: &[Row], scene: &str, run: &str, duration: f64, accuracy: f64) -> Result<String> {
+fn table(rows: &[Row], scene: &str, run: &str, reference: &str, duration: f64, accuracy: f64) -> Result<String> {
     let mut o = String::new();
-    writeln!(o, "Speed against error: scene `{scene}`, run `{run}`, {duration} s simulated; reference dopri45 rtol 1e-12")?;
+    writeln!(o, "Speed against error: scene `{scene}`, run `{run}`, {duration} s simulated; reference {}", reference.replace(',', ""))?;
     // scenes with contact events get the event-time error and the unmatched events
     let with_events = rows.iter().any(|r| r.max_event_time_error_s.is_some());
     let mut head = vec!["method", "setting", "wall [ms]", "RHS", "steps", "rejected", "hand [m]", "energy [J]", "drift [m]", "x real"];
