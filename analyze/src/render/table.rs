@@ -203,8 +203,14 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
 
     // contacts
     if !contacts(runs).is_empty() {
+        let opening = runs.iter().any(|r| r.contact_states.iter().any(|c| c.model.as_deref() != Some("bilateral")));
         let mut t = Table::new(
-            "Contacts (f_n < 0: the table pulls)",
+            if opening {
+                "Contacts (f_n < 0: the table pulls; max |C|, |C'|: how far a held contact drifts, - for a unilateral or \
+                 compliant contact, whose gap opens: see the contact states)"
+            } else {
+                "Contacts (f_n < 0: the table pulls)"
+            },
             &[
                 "run",
                 "contact",
@@ -220,6 +226,9 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         for (k, r) in runs.iter().enumerate() {
             for c in &r.contact_forces {
                 let first = c.first_pull_s.map_or("-".into(), |t| f(t, 3));
+                // a unilateral or compliant contact's |C| is its gap when open, not a drift
+                let opens = r.contact_states.iter().any(|s| s.contact == c.contact && s.model.as_deref() != Some("bilateral"));
+                let drift = |x: f64| if opens { "-".to_string() } else { e(x) };
                 t.table.rows.push(vec![
                     name(k),
                     c.contact.clone(),
@@ -227,8 +236,8 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
                     f(c.t_min_normal_force_s, 3),
                     f(c.pull_time_s, 3),
                     first,
-                    e(c.max_abs_position_m),
-                    e(c.max_abs_velocity_m_s),
+                    drift(c.max_abs_position_m),
+                    drift(c.max_abs_velocity_m_s),
                 ]);
             }
         }
@@ -293,28 +302,29 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
     // energy balance
     // the report explains the balance in its own section (report.rs)
     if !markdown {
-        let mut t = Table::new(
+        // runs with unilateral or compliant contacts lose energy in them too (impacts,
+        // friction, compliant damping): a column of their own, only when some run has them,
+        // so that every row adds up (a bilateral comparison prints as before)
+        let contact_losses = |r: &RunMetrics| -> f64 { r.contact_states.iter().map(|c| c.impact_loss_j + c.friction_work_j + c.damping_loss_j).sum() };
+        let with_contacts = runs.iter().any(|r| !r.contact_states.is_empty());
+        let title = if with_contacts {
+            "Energy balance at t_end [J]: E = ΔT + ΔV + Δ(L i²/2) + R loss + D loss + D_m loss + contact losses + residual \
+             (R: windings, D: joints, D_m: gears; contact: impacts, friction and compliant damping, with ½ k δ² of a \
+             compliant contact pressed at t_end in the residual; - where a recording has only D + D_m)"
+        } else {
             "Energy balance at t_end [J]: E = ΔT + ΔV + Δ(L i²/2) + R loss + D loss + D_m loss + residual \
-             (R: windings, D: joints, D_m: gears; - where a recording has only D + D_m)",
-            &[
-                "run",
-                "E",
-                "ΔT",
-                "ΔV",
-                "Δ(L i²/2)",
-                "R loss",
-                "D loss",
-                "D_m loss",
-                "D + D_m",
-                "residual",
-                "max |residual|",
-                "max |res| / E",
-            ],
-        );
+             (R: windings, D: joints, D_m: gears; - where a recording has only D + D_m)"
+        };
+        let mut head = vec!["run", "E", "ΔT", "ΔV", "Δ(L i²/2)", "R loss", "D loss", "D_m loss", "D + D_m"];
+        if with_contacts {
+            head.push("contact losses");
+        }
+        head.extend(["residual", "max |residual|", "max |res| / E"]);
+        let mut t = Table::new(title, &head);
         for (k, r) in runs.iter().enumerate() {
             let a = &r.energy;
             let rel = a.max_abs_residual_rel.map_or("-".into(), e);
-            t.table.rows.push(vec![
+            let mut row = vec![
                 name(k),
                 f(a.electric_j, 4),
                 f(a.kinetic_change_j, 4),
@@ -324,10 +334,12 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
                 a.gear_friction_loss_j.map_or("-".into(), |g| f(a.friction_loss_j - g, 4)),
                 a.gear_friction_loss_j.map_or("-".into(), |g| f(g, 4)),
                 f(a.friction_loss_j, 4),
-                e(a.residual_j),
-                e(a.max_abs_residual_j),
-                rel,
-            ]);
+            ];
+            if with_contacts {
+                row.push(if r.contact_states.is_empty() { "-".into() } else { f(contact_losses(r), 4) });
+            }
+            row.extend([e(a.residual_j), e(a.max_abs_residual_j), rel]);
+            t.table.rows.push(row);
         }
         t.write(&mut out, markdown);
     }
