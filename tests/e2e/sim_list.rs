@@ -20,22 +20,24 @@ fn list_shows_every_builtin_scene_with_its_dof_and_runs_in_each_format() {
     let rows: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let rows = rows.as_array().unwrap();
     let got: Vec<(&str, u64)> = rows.iter().map(|r| (r["name"].as_str().unwrap(), r["dof"].as_u64().unwrap())).collect();
-    // the paper (10 joints) and the three real arms: UR5e-like 6, Panda-like 7, SO-100-like 6
-    assert_eq!(got, [("paper", 10), ("ur5e-like", 6), ("panda-like", 7), ("hobby-arm", 6)]);
+    // the paper (10 joints), the paper arm over a real table, and the three real arms:
+    // UR5e-like 6, Panda-like 7, SO-100-like 6
+    assert_eq!(got, [("paper", 10), ("paper-unilateral", 10), ("ur5e-like", 6), ("panda-like", 7), ("hobby-arm", 6)]);
     assert_eq!(rows[0]["runs"], serde_json::json!(["two-elbow", "one-elbow", "no-elbow"]));
-    for r in &rows[1..] {
+    assert_eq!(rows[1]["runs"], serde_json::json!(["two-elbow-unilateral", "one-elbow-unilateral", "whole-table"]));
+    for r in &rows[2..] {
         let runs = r["runs"].as_array().unwrap();
         assert_eq!(runs.len(), 2, "each arm: the task with its contact and without");
         assert_eq!(runs[1], "free");
         assert!(r["description"].as_str().unwrap().contains("SOURCES.md"), "{r}");
     }
     let table = stdout(&run_sim(&["list"]));
-    for name in ["paper", "ur5e-like", "panda-like", "hobby-arm"] {
+    for name in ["paper", "paper-unilateral", "ur5e-like", "panda-like", "hobby-arm"] {
         assert!(table.lines().any(|l| l.starts_with(&format!("{name} "))), "{name} missing from\n{table}");
     }
     let csv = stdout(&run_sim(&["list", "-f", "csv"]));
     assert_eq!(csv.lines().next(), Some("name,dof,robot,urdf,runs,description"));
-    assert_eq!(csv::Reader::from_reader(csv.as_bytes()).records().count(), 4);
+    assert_eq!(csv::Reader::from_reader(csv.as_bytes()).records().count(), 5);
 }
 
 #[test]

@@ -144,7 +144,8 @@ mod tests {
             assert!(b.file_text(&s.urdf).is_ok(), "{}: its URDF is embedded", b.name);
         }
         let dof: Vec<usize> = BUILTINS.iter().map(|b| b.summary().unwrap().dof).collect();
-        assert_eq!(dof, [10, 6, 7, 6]);
+        assert_eq!(dof, [10, 10, 6, 7, 6]);
+        assert_eq!(find("paper-unilateral").unwrap().summary().unwrap().runs, ["two-elbow-unilateral", "one-elbow-unilateral", "whole-table"]);
         assert_eq!(find("panda-like").unwrap().summary().unwrap().runs, ["with-elbow", "free"]);
         assert!(find("no-such-arm").is_none());
     }
