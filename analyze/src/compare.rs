@@ -9,10 +9,14 @@
 //!   (the paper's Fig. 4-25 at t = end).
 //! - **Findings**, plain sentences checking SCENE.md "The paper's conclusions": which run draws
 //!   the least electric energy and which has the smallest z error; whether "more elbows → less
-//!   electric energy and smaller z error" holds over runs ordered by number of contacts (every
-//!   run with more contacts must be strictly lower than every run with fewer); which links have
-//!   the largest `|E_j - E_j,base|`; and, per contact, when and how long `f_n < 0` (the table
-//!   pulls, which a real table cannot do; SCENE.md "Physics checks").
+//!   electric energy and smaller z error" holds over runs ordered by number of contacts that
+//!   carried the arm (every run with more contacts must be strictly lower than every run with
+//!   fewer), within each scene ([`claims`]); when a bilateral run and a run of another scene with
+//!   a unilateral table have the same contacts carrying force, how the conclusions change
+//!   ([`claims`]); which links have the largest `|E_j - E_j,base|`; per contact, when and how long
+//!   `f_n < 0` (the table pulls, which a real table cannot do; SCENE.md "Physics checks"); per
+//!   unilateral or compliant contact what it did, the contacts that never touched the table
+//!   collapsed into one sentence per run.
 
 use serde::{Deserialize, Serialize};
 
@@ -175,70 +179,6 @@ fn link_table(runs: &[RunMetrics], base: usize) -> Vec<LinkComparison> {
         .collect()
 }
 
-fn plural(n: usize, one: &str) -> String {
-    if n == 1 {
-        format!("{n} {one}")
-    } else {
-        format!("{n} {one}s")
-    }
-}
-
-/// Whether the value falls strictly with more contacts: `Some(holds)` with a sentence, or
-/// `None` when every run has the same number of contacts.
-fn trend(
-    runs: &[RunMetrics],
-    what: &str,
-    value: impl Fn(&RunMetrics) -> f64,
-    show: impl Fn(f64) -> String,
-) -> (Option<bool>, String) {
-    let mut order: Vec<usize> = (0..runs.len()).collect();
-    order.sort_by_key(|&k| runs[k].contacts.len());
-    let n = |k: usize| runs[k].contacts.len();
-    if n(order[0]) == n(order[order.len() - 1]) {
-        return (
-            None,
-            format!(
-                "More elbows → {what}: cannot be checked, every run has {}.",
-                plural(n(0), "contact")
-            ),
-        );
-    }
-    let label = |k: usize| {
-        format!(
-            "{} ({}) {}",
-            runs[k].run,
-            plural(n(k), "contact"),
-            show(value(&runs[k]))
-        )
-    };
-    let mut broken = Vec::new();
-    for &a in &order {
-        for &b in order.iter().filter(|&&b| n(b) > n(a)) {
-            // a NaN compares as not below, so it breaks the trend
-            let below =
-                value(&runs[b]).partial_cmp(&value(&runs[a])) == Some(std::cmp::Ordering::Less);
-            if !below {
-                broken.push(format!("{} is not below {}", label(b), label(a)));
-            }
-        }
-    }
-    if broken.is_empty() {
-        let chain: Vec<String> = order.iter().map(|&k| label(k)).collect();
-        (
-            Some(true),
-            format!("More elbows → {what}: holds ({}).", chain.join(" > ")),
-        )
-    } else {
-        (
-            Some(false),
-            format!(
-                "More elbows → {what}: does not hold: {}.",
-                broken.join("; ")
-            ),
-        )
-    }
-}
-
 fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<String> {
     let mut out = Vec::new();
     let b = &runs[base];
@@ -327,27 +267,10 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
         r.run
     ));
 
-    // the paper's claim, over runs ordered by number of contacts
-    let (e_ok, e_text) = trend(
-        runs,
-        "less electric energy",
-        |r| r.electric_energy_total_j,
-        |x| format!("{x:.3} J"),
-    );
-    let (z_ok, z_text) = trend(
-        runs,
-        "smaller z error",
-        |r| r.hand_error.z.rms_m,
-        |x| format!("{:.3} mm", x * 1e3),
-    );
-    out.push(e_text);
-    out.push(z_text);
-    let claim = "\"more elbows → less electric energy and smaller z error\"";
-    out.push(match (e_ok, z_ok) {
-        (Some(true), Some(true)) => format!("So {claim} holds across these runs."),
-        (Some(_), Some(_)) => format!("So {claim} does not hold across these runs."),
-        _ => format!("So {claim} cannot be checked on these runs."),
-    });
+    // the paper's claim, per scene, over runs ordered by the number of contacts that carried the
+    // arm; then how it changes when the table can only push
+    let verdicts = claims::claim_findings(runs, &mut out);
+    out.extend(claims::table_pairs(runs, base, &verdicts));
 
     // largest per-link electric-energy gaps to the baseline
     for (k, r) in runs.iter().enumerate().filter(|&(k, _)| k != base) {
@@ -408,8 +331,13 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
 
     // contacts with a contact model (unilateral, compliant): what they did
     for r in runs.iter() {
+        let mut untouched = Vec::new();
         for c in r.contact_states.iter().filter(|c| c.model.as_deref() != Some("bilateral")) {
             let ev = &c.events;
+            if c.time_in_contact_s == 0.0 && ev.touch_downs == 0 && ev.impacts == 0 && ev.rests == 0 {
+                untouched.push(c.contact.as_str());
+                continue;
+            }
             let model = match (&c.model, c.friction) {
                 (Some(m), Some(mu)) => format!(" ({m}, μ = {mu})"),
                 (Some(m), None) => format!(" ({m})"),
@@ -437,6 +365,9 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
                 c.friction_work_j,
             ));
         }
+        if !untouched.is_empty() {
+            out.push(format!("{}: {} never touched the table.", r.run, untouched.join(", ")));
+        }
     }
 
     // energy balance
@@ -451,6 +382,8 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
     }
     out
 }
+
+mod claims;
 
 #[cfg(test)]
 pub(crate) mod tests;

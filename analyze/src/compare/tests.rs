@@ -230,3 +230,167 @@ fn unilateral_contacts_are_reported_with_events_and_friction_needed() {
     assert!(has(&c, "unilateral, elbow7 (unilateral, μ = 0.6): in contact for 1.000 s"));
     assert!(!Comparison::new(&paper_runs(), None).unwrap().findings.iter().any(|f| f.contains("in contact for")));
 }
+
+/// A unilateral contact state (μ = 0.5) in contact for `t` s, with one impact if `t > 0`.
+fn state(name: &str, t: f64) -> crate::metrics::ContactStateMetrics {
+    crate::metrics::ContactStateMetrics {
+        contact: name.into(),
+        model: Some("unilateral".into()),
+        friction: Some(0.5),
+        time_in_contact_s: t,
+        events: crate::metrics::EventCounts { impacts: u64::from(t > 0.0), ..Default::default() },
+        impact_energy_lost_j: 0.0,
+        impact_loss_j: 0.0,
+        friction_work_j: 0.0,
+        damping_loss_j: 0.0,
+        stick_friction_needed: None,
+        contact_friction_needed: None,
+        min_normal_force_in_contact_n: None,
+        max_normal_force_in_contact_n: None,
+    }
+}
+
+/// A run of scene `paper-unilateral` whose declared contacts are unilateral, each in contact for
+/// the time given.
+fn unilateral(name: &str, contacts: &[(&str, f64)], e: &[f64], z_rms: f64) -> RunMetrics {
+    let names: Vec<&str> = contacts.iter().map(|c| c.0).collect();
+    let mut r = run(name, &names, e, &[1.0; 3], z_rms);
+    r.scene = "paper-unilateral".into();
+    r.contact_states = contacts.iter().map(|&(c, t)| state(c, t)).collect();
+    r
+}
+
+/// The paper's runs (two-elbow's table pulls on elbow4 for 4 s) and a unilateral scene:
+/// two-elbow-unilateral 7 J (elbow4 0.5 s, elbow7 5 s in contact), one-elbow-unilateral 9 J,
+/// whole-table 7 J (4 candidates, only elbow4 and elbow7 touch).
+fn mixed_runs() -> Vec<RunMetrics> {
+    let mut runs = paper_runs();
+    (runs[0].contact_forces[0].pull_time_s, runs[0].contact_forces[0].first_pull_s) = (4.0, Some(0.5));
+    runs.push(unilateral("two-elbow-unilateral", &[("elbow4", 0.5), ("elbow7", 5.0)], &[3.0, 3.0, 1.0], 1.5e-3));
+    runs.push(unilateral("one-elbow-unilateral", &[("elbow4", 5.0)], &[3.5, 4.0, 1.5], 2.5e-3));
+    let table = [("joint3", 0.0), ("elbow4", 0.5), ("elbow7", 5.0), ("hand", 0.0)];
+    runs.push(unilateral("whole-table", &table, &[3.0, 3.0, 1.0], 1.5e-3));
+    runs
+}
+
+/// The paper alone: every finding, in order, exactly (the text `sim` prints for it; the
+/// per-scene checks must not change it).
+#[test]
+fn paper_alone_findings_are_unchanged() {
+    let c = Comparison::new(&paper_runs(), None).unwrap();
+    let want = [
+        "Baseline: no-elbow (no contacts); ratios are run / baseline.",
+        "Least total electric energy: two-elbow (6.000 J, 0.600 × baseline).",
+        "Smallest z error: two-elbow (RMS 1.000 mm, max 2.000 mm).",
+        "More elbows → less electric energy: holds (no-elbow (0 contacts) 10.000 J > one-elbow (1 contact) 8.000 J > two-elbow (2 contacts) 6.000 J).",
+        "More elbows → smaller z error: holds (no-elbow (0 contacts) 4.000 mm > one-elbow (1 contact) 2.000 mm > two-elbow (2 contacts) 1.000 mm).",
+        "So \"more elbows → less electric energy and smaller z error\" holds across these runs.",
+        "Largest electric-energy gaps of two-elbow to no-elbow: joint1 -3.000 J (-60.0 %), joint2 -1.000 J (-25.0 %), joint3 +0.000 J (+0.0 %).",
+        "Largest electric-energy gaps of one-elbow to no-elbow: joint1 -2.000 J (-40.0 %), joint2 -0.500 J (-12.5 %), joint3 +0.500 J (+50.0 %).",
+        "two-elbow: every normal force stays >= 0 (minimum 0.500 N): the table only pushes.",
+        "one-elbow: every normal force stays >= 0 (minimum 0.500 N): the table only pushes.",
+        "Energy balance: the largest |residual| is 1.67e-7 of the electric energy (two-elbow).",
+    ];
+    assert_eq!(c.findings, want);
+}
+
+/// Runs of two scenes: the claim is checked within each, over the contacts that carried the arm
+/// (whole-table: 2 of 4 touched, so it ranks with two-elbow-unilateral, not above it), never
+/// across scenes.
+#[test]
+fn the_claim_is_checked_per_scene_over_the_contacts_that_carried_the_arm() {
+    let c = Comparison::new(&mixed_runs(), None).unwrap();
+    let want = [
+        "Scene paper: More elbows → less electric energy: holds (no-elbow (0 contacts) 10.000 J > one-elbow (1 contact) 8.000 J > two-elbow (2 contacts) 6.000 J).",
+        "Scene paper: More elbows → smaller z error: holds (no-elbow (0 contacts) 4.000 mm > one-elbow (1 contact) 2.000 mm > two-elbow (2 contacts) 1.000 mm).",
+        "So \"more elbows → less electric energy and smaller z error\" holds in scene paper (3 runs).",
+        "Scene paper-unilateral: More elbows → less electric energy: holds (one-elbow-unilateral (1 contact) 9.000 J > two-elbow-unilateral (2 contacts) 7.000 J, whole-table (2 of 4 contacts touched) 7.000 J).",
+        "Scene paper-unilateral: More elbows → smaller z error: holds (one-elbow-unilateral (1 contact) 2.500 mm > two-elbow-unilateral (2 contacts) 1.500 mm, whole-table (2 of 4 contacts touched) 1.500 mm).",
+        "So \"more elbows → less electric energy and smaller z error\" holds in scene paper-unilateral (3 runs).",
+    ];
+    let k = c.findings.iter().position(|f| f.starts_with("Scene paper:")).expect("per-scene sentences");
+    assert_eq!(c.findings[k..k + want.len()], want, "{:#?}", c.findings);
+    assert!(!c.findings.iter().any(|f| f.contains("across these runs") || f.contains("(4 contacts)")), "{:#?}", c.findings);
+
+    // a broken trend inside one scene names only that scene's runs
+    let mut runs = mixed_runs();
+    runs[4].electric_energy_total_j = 6.5; // one-elbow-unilateral below two-elbow-unilateral's 7 J
+    let c = Comparison::new(&runs, None).unwrap();
+    assert!(has(&c, "Scene paper-unilateral: More elbows → less electric energy: does not hold: two-elbow-unilateral (2 contacts) 7.000 J is not below one-elbow-unilateral (1 contact) 6.500 J; whole-table (2 of 4 contacts touched) 7.000 J is not below one-elbow-unilateral (1 contact) 6.500 J."), "{:#?}", c.findings);
+    assert!(has(&c, "So \"more elbows → less electric energy and smaller z error\" does not hold in scene paper-unilateral (3 runs)."));
+    assert!(has(&c, "holds in scene paper (3 runs)."));
+
+    // one run per scene: nothing to compare within a scene
+    let c = Comparison::new(&[runs[0].clone(), runs[3].clone()], None).unwrap();
+    assert!(has(&c, "cannot be checked on these runs: it is checked within a scene, and no scene has two runs."), "{:#?}", c.findings);
+    assert!(!has(&c, "More elbows"));
+}
+
+/// Contacts that never touched (no time in contact, no touch-down, impact or rest) are one
+/// sentence per run; a contact in contact for no sampled time but with an impact keeps its own.
+#[test]
+fn contacts_that_never_touched_are_one_sentence_per_run() {
+    let mut runs = mixed_runs();
+    let c = Comparison::new(&runs, None).unwrap();
+    assert!(has(&c, "whole-table: joint3, hand never touched the table."), "{:#?}", c.findings);
+    assert!(!has(&c, "whole-table, joint3") && !has(&c, "whole-table, hand"), "{:#?}", c.findings);
+    assert!(has(&c, "whole-table, elbow4 (unilateral, μ = 0.5): in contact for 0.500 s of 5.000 s;"));
+    assert_eq!(c.findings.iter().filter(|f| f.contains("never touched")).count(), 1, "{:#?}", c.findings);
+
+    runs[5].contact_states[3].events.impacts = 1; // the hand hit the table between two samples
+    let c = Comparison::new(&runs, None).unwrap();
+    assert!(has(&c, "whole-table: joint3 never touched the table."), "{:#?}", c.findings);
+    assert!(has(&c, "whole-table, hand (unilateral, μ = 0.5): in contact for 0.000 s of 5.000 s; 0 lift-offs, 0 touch-downs, 1 impacts"));
+}
+
+/// Bilateral runs paired with unilateral runs of the other scene by the names of the contacts
+/// that carried the arm: savings against no-elbow (10 J), hand errors, time in contact, the
+/// bilateral table's pull time; whole-table pairs with two-elbow by its touched set.
+#[test]
+fn bilateral_and_unilateral_runs_are_paired_by_the_contacts_that_carried_the_arm() {
+    let c = Comparison::new(&mixed_runs(), None).unwrap();
+    let want = [
+        "How the paper's conclusions change when the table can only push: bilateral run → run of another scene with a \
+         unilateral or compliant table, paired by the names of the contacts that carried the arm, over the same duration.",
+        "two-elbow → two-elbow-unilateral (same contacts elbow4, elbow7): electric energy 6.000 J → 7.000 J (× 1.167), \
+         saving against no-elbow 40.0 % → 30.0 %, z error RMS 1.000 mm → 1.500 mm, |e| RMS 3.000 mm → 3.500 mm; \
+         time in contact (two-elbow-unilateral): elbow4 0.500 s, elbow7 5.000 s of 5.000 s; two-elbow's table pulled (f_n < 0) on elbow4 for 4.000 s.",
+        "two-elbow → whole-table (whole-table: 4 candidate contacts, only elbow4, elbow7 touched; paired by those): \
+         electric energy 6.000 J → 7.000 J (× 1.167), saving against no-elbow 40.0 % → 30.0 %, z error RMS 1.000 mm → 1.500 mm, \
+         |e| RMS 3.000 mm → 3.500 mm; time in contact (whole-table): elbow4 0.500 s, elbow7 5.000 s of 5.000 s; \
+         two-elbow's table pulled (f_n < 0) on elbow4 for 4.000 s.",
+        "one-elbow → one-elbow-unilateral (same contacts elbow4): electric energy 8.000 J → 9.000 J (× 1.125), \
+         saving against no-elbow 20.0 % → 10.0 %, z error RMS 2.000 mm → 2.500 mm, |e| RMS 4.000 mm → 4.500 mm; \
+         time in contact (one-elbow-unilateral): elbow4 5.000 s of 5.000 s; one-elbow's table never pulled.",
+        "So with a table that can only push, \"more elbows → less electric energy and smaller z error\" still holds in \
+         scene paper-unilateral (holds in scene paper with the bilateral table).",
+    ];
+    let k = c.findings.iter().position(|f| f.starts_with("How the paper's")).expect("the pair block");
+    assert_eq!(c.findings[k..k + want.len()], want, "{:#?}", c.findings);
+    assert_eq!(c.findings.iter().filter(|f| f.contains(" → ") && f.contains("electric energy ") && f.contains("saving")).count(), 3);
+
+    // different durations, or the same scene, or the same model: no pair
+    let mut runs = mixed_runs();
+    runs[4].t_end_s = 4.0;
+    let c = Comparison::new(&runs, None).unwrap();
+    assert!(!has(&c, "one-elbow → one-elbow-unilateral") && has(&c, "two-elbow → whole-table"), "{:#?}", c.findings);
+    for r in &mut runs[3..] {
+        r.scene = "paper".into();
+    }
+    let c = Comparison::new(&runs, None).unwrap();
+    assert!(!has(&c, "How the paper's conclusions change"), "{:#?}", c.findings);
+    let mut runs = mixed_runs();
+    for r in &mut runs[3..] {
+        r.contact_states.iter_mut().for_each(|s| s.model = Some("bilateral".into()));
+    }
+    assert!(!has(&Comparison::new(&runs, None).unwrap(), "How the paper's conclusions change"));
+
+    // a changed conclusion is said so; no run without contacts of the same duration: no saving
+    let mut runs = mixed_runs();
+    runs[4].hand_error.z.rms_m = 1e-3; // one-elbow-unilateral's z error below two-elbow-unilateral's
+    runs[2].t_end_s = 4.0;
+    let c = Comparison::new(&runs, None).unwrap();
+    assert!(!has(&c, "still holds"), "{:#?}", c.findings);
+    assert!(has(&c, "\"more elbows → less electric energy and smaller z error\" does not hold in scene paper-unilateral (holds in scene paper with the bilateral table)."), "{:#?}", c.findings);
+    assert!(has(&c, "two-elbow → two-elbow-unilateral (same contacts elbow4, elbow7): electric energy 6.000 J → 7.000 J (× 1.167), z error RMS"), "{:#?}", c.findings);
+}
