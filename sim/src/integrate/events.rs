@@ -15,8 +15,18 @@
 //! - an accepted step `[t_lo, t_hi]` has a *sign change* of function `i` when, with the
 //!   function's direction `d_i` ([`HybridSystem::event_direction`]), `g_i(t_lo) > 0 ≥
 //!   g_i(t_hi)` (`d_i = −1`), `g_i(t_lo) < 0 ≤ g_i(t_hi)` (`d_i = +1`) or either (`d_i = 0`).
-//!   A function exactly 0 at the start of a step is thereby *disarmed* for that step: one
-//!   exactly 0 at a (re)start fires only after it has left 0 (at a later step start);
+//!   A function of direction −1 (+1) that is `≤ 0` (`≥ 0`) at a (re)start — on its firing side
+//!   already, e.g. a contact force exactly 0 in the undetermined case `f_n = 0, g̈ = 0`, or a
+//!   slip speed below its threshold — is, when the system asks for it
+//!   ([`HybridSystem::event_tolerance`]), *watched from its start value* `g₀` until it has left
+//!   its firing side: the driver tests `g − g₀` instead of `g`. A root of `g − g₀` is located
+//!   like any other (a slip that starts from rest and comes back to rest); a function that moves
+//!   from `g₀` straight to its firing side, by more than the system's
+//!   [`HybridSystem::event_tolerance`], within a step that starts at `g₀` fires at that step's
+//!   start (for the first step: at the restart itself). So a contact closed with `f_n = 0` whose
+//!   force then turns negative opens at once instead of pulling unseen, while a function that
+//!   only jitters at its start value fires nothing. Other functions exactly 0 at a start are
+//!   disarmed for that step;
 //! - the bracket `[t_lo, t_hi]` is narrowed by the Illinois secant on the function with the
 //!   largest `|g(t_hi)| / |g(t_hi) − g(t_lo)|` (all functions are evaluated at each trial point;
 //!   a sign change of any function in `[t_lo, t_mid]` keeps that half), to a width
@@ -52,7 +62,7 @@ mod tests;
 #[cfg(test)]
 mod toys;
 
-use self::locate::{crosses, locate_root, Bracket};
+use self::locate::{crosses, locate_root, Bracket, Side};
 use super::sampled::{OutputGrid, Pace};
 use super::{Deadline, IntegrateError, OdeSystem, Stats, Stepper};
 
@@ -87,6 +97,19 @@ pub trait HybridSystem: OdeSystem {
     /// default does nothing.
     fn after_step(&mut self, t: f64, y: &[f64]) {
         let _ = (t, y);
+    }
+
+    /// Whether function `i`, when it is on its firing side at a (re)start, is watched from its
+    /// start value (the module doc), and if so how far past that value, towards its firing
+    /// side, it must move for the driver to take the event at a step's start (in the function's
+    /// own units). For a system whose events always change what the fired function means (a
+    /// contact's force becomes its gap), a function on its firing side after a restart is a
+    /// state the modes do not allow, and must be watched. The default `None`: not watched (a
+    /// function that stays past its root after an event that did not change it is no new
+    /// event), and one exactly 0 is disarmed until it has left 0.
+    fn event_tolerance(&self, i: usize) -> Option<f64> {
+        let _ = i;
+        None
     }
 }
 
@@ -159,6 +182,7 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
     if n_ev > 0 {
         br.refresh_directions(sys);
         sys.events(t0, stepper.y(), &mut br.g_lo).map_err(rhs)?;
+        br.set_bases(sys);
     }
     let mut k = 1;
     let mut pace = Pace::new(deadline, t0, t_end);
@@ -199,6 +223,7 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
             // the next step's start values are taken at the (projected) state
             sys.after_step(stepper.t(), stepper.y());
             sys.events(stepper.t(), stepper.y(), &mut br.g_lo).map_err(rhs)?;
+            br.release_and_shift_lo();
         }
         let t_before = stepper.t();
         let t_after = stepper.step(sys, t_end)?;
@@ -213,13 +238,15 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
             continue;
         }
         sys.events(t_after, stepper.y(), &mut br.g_hi).map_err(rhs)?;
-        if !(0..n_ev).any(|i| crosses(br.dir[i], br.g_lo[i], br.g_hi[i])) {
+        br.shift(Side::Hi);
+        let at_start = br.left_at_start();
+        if !at_start && !(0..n_ev).any(|i| crosses(br.dir[i], br.g_lo[i], br.g_hi[i])) {
             continue;
         }
 
         // an event in [t_before, t_after]: its time, then the samples before it
         let tol = time_tolerance(settings.time_tol, t_after);
-        let t_star = locate_root(stepper, sys, &mut br, t_before, t_after, tol, &mut buf)?;
+        let t_star = if at_start { t_before } else { locate_root(stepper, sys, &mut br, t_before, t_after, tol, &mut buf)? };
         while k <= n_out && grid.time(k) < t_star {
             let t_k = grid.time(k);
             stepper.interpolate(t_k, &mut buf);
@@ -241,11 +268,13 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
         // switch the modes (and jump the state) at t*, project, restart there
         stepper.interpolate(t_star, &mut y_star);
         sys.handle_events(t_star, &mut y_star, &br.fired).map_err(rhs)?;
+        pace.after_event(t_star)?;
         sys.project(t_star, &mut y_star).map_err(rhs)?;
         done = add_stats(done, stepper.stats());
         stepper.init(sys, t_star, &y_star)?;
         br.refresh_directions(sys);
         sys.events(t_star, stepper.y(), &mut br.g_lo).map_err(rhs)?;
+        br.set_bases(sys);
         restarted = true;
         stepped = false;
     }

@@ -224,6 +224,15 @@ impl Pace {
         }
         Ok(())
     }
+
+    /// After an event handled at `t`: [`IntegrateError::OutOfTime`] past the deadline. Read at
+    /// every event, since handling one (a system's mode problem) may cost far more than a step.
+    pub(super) fn after_event<E>(&self, t: f64) -> Result<(), IntegrateError<E>> {
+        match self.deadline {
+            Some(deadline) if Instant::now() >= deadline.at => Err(IntegrateError::OutOfTime { t }),
+            _ => Ok(()),
+        }
+    }
 }
 
 #[cfg(test)]

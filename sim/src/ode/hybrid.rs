@@ -420,6 +420,23 @@ impl HybridSystem for ArmSystem<'_> {
         }
     }
 
+    /// The dead band of a function that starts on its firing side (`integrate::events`): a gap
+    /// must close by more than the closed-contact tolerance (`gap_tol`, m), a force turn
+    /// negative (or leave the friction cone) by more than 1e-8 N, a slip speed fall by more than
+    /// `vel_tol` (m/s) — far above the solver's noise at f_n = 0, far below any force that
+    /// matters — before the event is taken at the restart itself.
+    fn event_tolerance(&self, i: usize) -> Option<f64> {
+        let h = self.hybrid.as_ref()?;
+        let k = i / 2;
+        let cs = &self.scene.contact_settings;
+        match (h.contacts[k].model, h.state.mode[k], i % 2) {
+            (ContactModel::Unilateral { .. }, ContactMode::Separated, 0) => Some(cs.gap_tol),
+            (ContactModel::Unilateral { .. }, ContactMode::Sliding, 1) => Some(cs.vel_tol),
+            (ContactModel::Unilateral { .. }, ContactMode::Sticking | ContactMode::Sliding, _) => Some(1e-8),
+            _ => None,
+        }
+    }
+
     fn events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
         if self.hybrid.is_none() {
             return Ok(());

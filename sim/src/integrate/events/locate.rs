@@ -18,11 +18,101 @@ pub(super) struct Bracket {
     g_mid: Vec<f64>,
     pub(super) dir: Vec<i8>,
     pub(super) fired: Vec<bool>,
+    /// The start value `g₀` a function is watched from (module doc of `events`), and whether it
+    /// is watched so; `g_lo`, `g_hi` and the trial values hold `g − g₀` for those.
+    base: Vec<f64>,
+    watched: Vec<bool>,
+    /// `event_tolerance(i)` of the watched functions, read with the bases.
+    tolerance: Vec<f64>,
+}
+
+/// Which end of the bracket a fresh evaluation of the functions went into.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Side {
+    Hi,
 }
 
 impl Bracket {
     pub(super) fn new(n: usize) -> Self {
-        Bracket { g_lo: vec![0.0; n], g_hi: vec![0.0; n], g_mid: vec![0.0; n], dir: vec![0; n], fired: vec![false; n] }
+        Bracket {
+            g_lo: vec![0.0; n],
+            g_hi: vec![0.0; n],
+            g_mid: vec![0.0; n],
+            dir: vec![0; n],
+            fired: vec![false; n],
+            base: vec![0.0; n],
+            watched: vec![false; n],
+            tolerance: vec![0.0; n],
+        }
+    }
+
+    /// At a (re)start, with `g_lo` the raw values there: a function of direction −1 (+1) at or
+    /// on its firing side (`≤ 0`, `≥ 0`) is watched from its value, so `g_lo` becomes 0 for it.
+    pub(super) fn set_bases<S: HybridSystem>(&mut self, sys: &S) {
+        for i in 0..self.g_lo.len() {
+            let g = self.g_lo[i];
+            let on_firing_side = match self.dir[i] {
+                d if d < 0 => g <= 0.0,
+                d if d > 0 => g >= 0.0,
+                _ => false,
+            };
+            let tolerance = sys.event_tolerance(i);
+            self.watched[i] = on_firing_side && g.is_finite() && tolerance.is_some();
+            self.base[i] = if self.watched[i] { g } else { 0.0 };
+            self.tolerance[i] = tolerance.unwrap_or(0.0);
+            if self.watched[i] {
+                self.g_lo[i] = 0.0;
+            }
+        }
+    }
+
+    /// At a step start, with `g_lo` the raw values there: a watched function that has left its
+    /// firing side (`> 0` for direction −1, `< 0` for +1) is watched no more; the others are
+    /// shifted by their start value.
+    pub(super) fn release_and_shift_lo(&mut self) {
+        for i in 0..self.g_lo.len() {
+            if !self.watched[i] {
+                continue;
+            }
+            let g = self.g_lo[i];
+            let left = match self.dir[i] {
+                d if d < 0 => g > 0.0,
+                d if d > 0 => g < 0.0,
+                _ => true,
+            };
+            if left {
+                self.watched[i] = false;
+                self.base[i] = 0.0;
+            } else {
+                self.g_lo[i] = g - self.base[i];
+            }
+        }
+    }
+
+    /// Shift a fresh evaluation by the start values of the watched functions.
+    pub(super) fn shift(&mut self, side: Side) {
+        let v = match side {
+            Side::Hi => &mut self.g_hi,
+        };
+        shift(v, &self.base, &self.watched);
+    }
+
+    /// Whether a watched function sat at (or before) its start value at the step's start and
+    /// has moved past it to its firing side by more than its tolerance at the step's end: then
+    /// those functions fire, at the step's start; `fired` is set.
+    pub(super) fn left_at_start(&mut self) -> bool {
+        let mut any = false;
+        for i in 0..self.g_lo.len() {
+            let (lo, hi, tol) = (self.g_lo[i], self.g_hi[i], self.tolerance[i]);
+            self.fired[i] = self.watched[i]
+                && match self.dir[i] {
+                    d if d < 0 => lo <= 0.0 && hi < -tol,
+                    d if d > 0 => lo >= 0.0 && hi > tol,
+                    _ => false,
+                };
+            any |= self.fired[i];
+        }
+        any
     }
 
     /// Reads the directions of the current mode from `sys`.
@@ -108,6 +198,7 @@ pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
         }
         stepper.interpolate(t_mid, y);
         sys.events(t_mid, y, &mut br.g_mid).map_err(IntegrateError::Rhs)?;
+        shift(&mut br.g_mid, &br.base, &br.watched);
         side_prev = side;
         match pick(&br.g_lo, &br.g_mid, &br.dir) {
             Some(i) => {
@@ -128,6 +219,15 @@ pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
         br.fired[i] = crosses(br.dir[i], br.g_lo[i], br.g_hi[i]);
     }
     Ok(t_hi)
+}
+
+/// `v[i] -= base[i]` for the watched functions.
+fn shift(v: &mut [f64], base: &[f64], watched: &[bool]) {
+    for ((x, b), w) in v.iter_mut().zip(base).zip(watched) {
+        if *w {
+            *x -= b;
+        }
+    }
 }
 
 /// Called without a sign change: fires nothing (the caller checked there is one).

@@ -176,6 +176,25 @@ fn lift_off_under_a_linear_force_at_the_closed_form_time() {
     }
 }
 
+/// A function that starts on its firing side is watched from its start value (module doc): the
+/// mass on the table with no weight (m g = 0, so the contact force is exactly 0 at t0) pushed by
+/// F = a t would be held by a pulling table (force −a t) if the zero start disarmed the lift-off;
+/// it lifts off at t0 itself, then x(t) = a t³ / (6 m) (within 1e-9 m), for every method.
+#[test]
+fn a_contact_force_that_starts_at_zero_and_turns_negative_lifts_off_at_once() {
+    let (m, a) = (2.0, 7.0);
+    for (name, mut st) in methods::<LiftOff>(1e-2, 1e-10, 1e-12, 0.05) {
+        let mut toy = Toy::new(LiftOff { m, g: 0.0, a, in_contact: true });
+        let (samples, _) = run(st.as_mut(), &mut toy, [0.0, 0.0], 1.0, 0.01, EventSettings::default()).expect(name);
+        let t = toy.times();
+        assert_eq!(t, vec![0.0], "{name}: one lift-off, at t0");
+        for (t, y) in &samples {
+            let x = a * t.powi(3) / (6.0 * m);
+            assert!((y[0] - x).abs() <= 1e-9, "{name}: x({t}) = {}, closed form {x}", y[0]);
+        }
+    }
+}
+
 /// Two thresholds crossed in the same step (0.41 and 0.40, rk4 step 1 and an adaptive h_max
 /// of 1): the earlier (function 1, at 0.40) is handled first, alone, then function 0 at 0.41;
 /// a function exactly 0 at the start (x − 0, direction 0) is never reported.

@@ -18,6 +18,10 @@ pub(super) trait Law {
     fn events(&self, t: f64, y: &[f64], out: &mut [f64]);
     /// Switches modes at an event; returns whether it changed `y`.
     fn handle(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> bool;
+    /// [`HybridSystem::event_tolerance`] of every function. Default: not watched.
+    fn watch(&self) -> Option<f64> {
+        None
+    }
     /// The modes at the start; may move `y` (returns whether it did). Default: nothing.
     fn init(&mut self, _y: &mut [f64]) -> bool {
         false
@@ -97,6 +101,9 @@ impl<L: Law> HybridSystem for Toy<L> {
     }
     fn after_step(&mut self, _t: f64, _y: &[f64]) {
         self.after_steps += 1;
+    }
+    fn event_tolerance(&self, _i: usize) -> Option<f64> {
+        self.law.watch()
     }
 }
 
@@ -196,6 +203,10 @@ impl Law for LiftOff {
     fn handle(&mut self, _t: f64, _y: &mut [f64], _fired: &[bool]) -> bool {
         self.in_contact = !self.in_contact;
         false
+    }
+    /// Its event changes what the function means (force, then height), as the arm's do.
+    fn watch(&self) -> Option<f64> {
+        Some(0.0)
     }
 }
 

@@ -1,0 +1,62 @@
+//! Contacts whose event functions start on their firing side (the review of issue 11, F1 and
+//! F4): the event driver watches such a function from its start value
+//! (`sim/src/integrate/events.rs`), so a contact closed with f_n = 0 whose force then turns
+//! negative lifts off at once instead of pulling, and a slip that starts slower than the stick
+//! speed (1e-6 m/s) stops at once instead of reversing under a frozen friction direction.
+
+mod contacts_support;
+use contacts_support::*;
+use serde_json::json;
+use sim::dynamics::contact::{ContactEventKind, ContactMode};
+
+/// A 1 kg ball resting on the table with NO gravity (f_n = 0 and g̈ = 0 at t0: the undetermined
+/// case, where the mode problem keeps the contact closed), pulled up by its z motor from t = 0
+/// (PD towards a joint spline 0 → 0.4 m in 1 s). The force the closed contact would need is
+/// −F(t) < 0 from the first instant: the ball must lift off at t0. Checked with and without
+/// friction: one lift-off at t = 0 exactly, no other event, and the recorded normal force never
+/// below −1e-8 N (the dead band of a force function; a pulling table would reach −10 N by 0.5 s).
+#[test]
+fn a_ball_resting_with_zero_force_lifts_off_at_once_when_pulled() {
+    for keys in [json!({"model": "unilateral", "friction": 0.5}), json!({"model": "unilateral"})] {
+        let mut s = passive_scene("ball", &["x", "y", "z"], &[0.0; 3], &[0.0; 3], [0.0, 0.0, 0.0], 0.5, 1e-12);
+        add_table_contact(&mut s, "floor", json!({"link": "ball"}), keys.clone());
+        s["passive"] = json!(["x", "y"]);
+        s["controller"] = json!({"kp": [0.0, 0.0, 100.0], "kd": 0.0});
+        s["target"] = json!({"kind": "joint-spline", "waypoints": [{"t": 0.0, "q": [0.0, 0.0, 0.0]}, {"t": 1.0, "q": [0.0, 0.0, 0.4]}]});
+        let c = collect(&load(&s, &point_urdf(1.0)), "r");
+        let kinds: Vec<(f64, ContactEventKind)> = c.events.iter().map(|e| (e.t, e.kind)).collect();
+        assert_eq!(kinds, vec![(0.0, ContactEventKind::LiftOff)], "{keys}");
+        let min_fn = c.samples.iter().map(|o| o.contacts[0].normal_force).fold(f64::INFINITY, f64::min);
+        assert!(min_fn >= -1e-8, "{keys}: the table pulled with {min_fn} N");
+        let last = c.samples.last().expect("samples");
+        assert_eq!(last.contacts[0].mode, ContactMode::Separated, "{keys}");
+        assert!(last.contacts[0].gap > 1e-3, "{keys}: the ball rose to {} m", last.contacts[0].gap);
+    }
+}
+
+/// A block sliding at 5e-7 m/s, below the stick speed 1e-6 m/s at which a slip ends (README,
+/// "Slip → stick"): its slip-to-stick function starts on its firing side, and as friction slows
+/// the block it fires at t0: the slip stops at once (the remaining 5e-7 m/s removed by the
+/// velocity projection, its ½ m v² booked as friction work). Before the fix the friction
+/// direction stayed frozen and pushed the block backwards (it ended 7.6e-14 m behind its start).
+/// Checked: one slip-to-stick at t = 0, then sticking with x ≥ 0 and |ẋ| ≤ 1e-12 m/s, and the
+/// friction work ½ m v₀² to 1e-9 relative, never decreasing.
+#[test]
+fn a_slip_slower_than_the_stick_speed_stops_at_once() {
+    let v0 = 5e-7;
+    let mut s = passive_scene("ball", &["x", "y", "z"], &[0.0; 3], &[v0, 0.0, 0.0], [0.0, 0.0, -G], 0.01, 1e-12);
+    add_table_contact(&mut s, "floor", json!({"link": "ball"}), json!({"model": "unilateral", "friction": 0.5}));
+    let c = collect(&load(&s, &point_urdf(1.0)), "r");
+    let kinds: Vec<(f64, ContactEventKind)> = c.events.iter().map(|e| (e.t, e.kind)).collect();
+    assert_eq!(kinds, vec![(0.0, ContactEventKind::SlipToStick)]);
+    let mut w_prev = 0.0;
+    for o in &c.samples[1..] {
+        assert_eq!(o.contacts[0].mode, ContactMode::Sticking, "t = {}", o.t);
+        assert!(o.q[0] >= 0.0 && o.qd[0].abs() <= 1e-12, "t = {}: x = {}, x' = {}", o.t, o.q[0], o.qd[0]);
+        let w = o.contacts[0].friction_work;
+        assert!(w >= w_prev, "friction work decreased at t = {}: {w} < {w_prev}", o.t);
+        w_prev = w;
+    }
+    let expected = 0.5 * v0 * v0;
+    assert!((w_prev - expected).abs() <= 1e-9 * expected, "friction work {w_prev}, ½ m v0² = {expected}");
+}
