@@ -324,8 +324,30 @@ impl ArmSystem<'_> {
         let zeros = vec![0.0; nv];
         let mut dqd = vec![0.0; nv];
         let fd = &self.ws.fd;
-        solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, &zeros, r, &rows, &mut h.cd.scratch, &mut dqd)
-            .map_err(|_| DynamicsError::SingularConstraints { t, constraints: "the slip-to-stick velocity projection".into() })?;
+        if solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, &zeros, r, &rows, &mut h.cd.scratch, &mut dqd).is_err() {
+            // name the contacts whose rows are involved (review F6)
+            let mut names: Vec<&str> = Vec::new();
+            for a in &rows {
+                let n = h.contacts[a.row / 3].name();
+                if !names.contains(&n) {
+                    names.push(n);
+                }
+            }
+            let stop: Vec<&str> = stopping.iter().map(|&k| h.contacts[k].name()).collect();
+            return Err(DynamicsError::SingularConstraints {
+                t,
+                constraints: format!("the slip-to-stick velocity projection stopping {} (rows of {})", stop.join(", "), names.join(", ")),
+            }
+            .into());
+        }
+        // per-contact loss ΔT_k = −Λ_kᵀ(v⁻_k + v⁺_k)/2 over the contact's rows (as impact.rs;
+        // the terms sum to ΔT), Λ in `rows` order (review F7)
+        let mut lost_k = vec![0.0; h.contacts.len()];
+        for (i, a) in rows.iter().enumerate() {
+            let v_before = r.vel[a.row];
+            let v_after = v_before + r.dot(a.row, &dqd);
+            lost_k[a.row / 3] -= h.cd.scratch.lambda[i] * (v_before + v_after) / 2.0;
+        }
         // ΔT = −(q̇⁻ + ½ Δq̇)ᵀ M_J Δq̇ with M_J = M + J_m (data.m from this evaluation)
         let d = &self.scene.drives;
         let m = &self.ws.data.m;
@@ -343,9 +365,13 @@ impl ArmSystem<'_> {
             y[l.work().start + j] += -d.jm[j] * (after * after - before * before) / 2.0;
             y[l.qd().start + j] = after;
         }
-        let share = lost / stopping.len() as f64;
-        for &k in stopping {
-            y[l.friction_work(k)] += share;
+        // the normal-row terms of contacts that do not stop are drift corrections, booked to
+        // their own contact; the split sums to ΔT up to the solve's rounding, which goes to the
+        // first stopping contact so the booked total is exactly the kinetic-energy loss
+        let rounding = lost - lost_k.iter().sum::<f64>();
+        lost_k[stopping[0]] += rounding;
+        for (k, x) in lost_k.iter().enumerate() {
+            y[l.friction_work(k)] += x;
         }
         Ok(())
     }
@@ -571,8 +597,13 @@ impl HybridSystem for ArmSystem<'_> {
                 }
             }
             closed.retain(|k| !opened.contains(k));
+            // only the approaching contacts were logged by the impact (Impact/Rest); a contact
+            // that was in touch and is thrown off by the impulse gets its LiftOff from
+            // resolve_modes (review F3)
             for k in opened {
-                logged.push(k);
+                if approaching.contains(&k) {
+                    logged.push(k);
+                }
             }
         }
         for k in touched {
