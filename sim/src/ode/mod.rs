@@ -31,6 +31,7 @@
 //! `projection.rs`.
 
 mod arm;
+mod describe;
 mod hybrid;
 mod jacobian;
 mod layout;
