@@ -37,6 +37,7 @@ mod jacobian;
 mod layout;
 mod outputs;
 mod projection;
+mod stop_slip;
 mod workspace;
 
 pub use arm::ArmSystem;
