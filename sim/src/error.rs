@@ -95,7 +95,7 @@ pub enum RunError {
     NonFiniteState { t: f64, index: usize, name: String },
     #[error("the integrator stopped at t = {t:.9} s: more than {max_steps} steps (integrator.max_steps) with {method}; {hint}; raise integrator.max_steps if the run needs more", hint = slow_run_hint(method))]
     TooManySteps { t: f64, max_steps: usize, method: &'static str },
-    #[error("the run stopped at t = {t:.9} s: more than {max_events} contact events; a contact chatters, or the run is long (contacts.max_events)")]
+    #[error("the run stopped at t = {t:.9} s: more than {max_events} contact events; a contact chatters, or the run is long (events.max_events)")]
     TooManyEvents { t: f64, max_events: u64 },
     #[error("the run stopped at t = {t:.9} s: {count} contact events in a row at the same instant (within {window:e} s): the contact modes chatter; {events}")]
     Chattering { t: f64, count: u32, window: f64, events: String },

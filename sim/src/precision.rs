@@ -112,8 +112,11 @@ fn collect(scene: &Scene, run: &Run, budget: crate::run::Budget) -> Result<(Refe
 /// Whether contact `k`'s position is a constraint at this sample, so that `|C|` is drift: every
 /// contact of a bilateral run (`o.contacts` empty); in an event-driven run only a contact in
 /// touch (sticking, sliding, bilateral) — an open contact's gap is no error. (A compliant
-/// contact in touch reports sticking or sliding, and its penetration then counts as drift:
-/// the outputs do not carry the model.)
+/// contact has no discrete mode: at `OutputLevel::Kinematic`, which precision uses, the
+/// outputs carry no forces and report its stored mode, always separated, so its penetration
+/// never counts as drift — rightly, as penetration is the compliant model's state, not a
+/// constraint violation. Only at the Full level is a compliant contact with f_n > 0 reported
+/// as sliding.)
 fn held(o: &crate::ode::Outputs, k: usize) -> bool {
     o.contacts.get(k).is_none_or(|c| c.mode != ContactMode::Separated)
 }

@@ -146,7 +146,14 @@ pub fn simulate_outputs(
         // every contact bilateral (the paper's runs): the smooth path, as before
         scene.integrator.integrate(&mut sys, &y0, scene.duration, dt_out, deadline, |t, y| on_sample(t, y, None))
     };
-    let stats = result.map_err(|e| map_err(e, &names, budget, scene.integrator.method()))?;
+    let stats = result.map_err(|e| match map_err(e, &names, budget, scene.integrator.method()) {
+        // the driver names event-function indices; the system knows the contacts and their
+        // current modes (review F5)
+        RunError::Chattering { t, count, window, events } => {
+            RunError::Chattering { t, count, window, events: sys.describe_event_functions(&events) }
+        }
+        other => other,
+    })?;
     Ok(RunReport { stats, samples, last: out, limits: monitor.map(|m| m.summary()) })
 }
 

@@ -24,7 +24,7 @@ mod contacts_support;
 
 use contacts_support::*;
 use serde_json::json;
-use sim::dynamics::contact::ContactMode;
+use sim::dynamics::contact::{ContactEventKind, ContactMode};
 use sim::error::{DynamicsError, RunError};
 
 const M: f64 = 1.0;
@@ -145,5 +145,39 @@ fn simultaneous_impacts_of_a_rod_falling_flat_split_the_impulse_by_the_centre_of
                 assert!(o.q[2].abs() <= 1e-9 && o.qd[2].abs() <= 1e-9, "t = {}: the rod tilts: {:?}", o.t, o.q);
             }
         }
+    }
+}
+
+/// Review F3: a contact in touch that another contact's impact throws off logs a lift-off.
+/// The rod (m, half-length l, I = m l²/3 about its centre) rests frictionless on a contact A
+/// at its centre and turns freely at φ̇ = ω (gravity and N = m g both act at the centre: no
+/// torque, so φ is linear and the centre stays on the table). Its end B (offset +l, height
+/// −l sin φ) reaches the table at φ = 0, t* = −φ0/ω, with ġ_B⁻ = −l ω = −v. Newton's law over
+/// {A, B} (W M⁻¹ Wᵀ = [[1, 1], [1, 4]]/m): Λ_A = 0, Λ_B = m (1+e) v / 4, so A leaves with
+/// ġ_A⁺ = (1+e) v / 4 and B with e v. Expected at t*: one impact (B) and one lift-off (A).
+/// Tolerances: t* to 1e-9 s (event bracket 1e-12 s), rates 1e-9 relative.
+#[test]
+fn a_contact_thrown_off_by_another_contacts_impact_logs_a_lift_off() {
+    let (phi0, omega, e) = (-0.1, 1.0, 0.5);
+    let mut s = passive_scene("rod", &["x", "z", "pitch"], &[0.0, 0.0, phi0], &[0.0, 0.0, omega], [0.0, 0.0, -G], 0.12, 1e-12);
+    add_table_contact(&mut s, "centre", json!({"link": "rod", "offset": [0.0, 0.0, 0.0]}), json!({"model": "unilateral"}));
+    add_table_contact(&mut s, "end", json!({"link": "rod", "offset": [L, 0.0, 0.0]}), json!({"model": "unilateral", "restitution": e}));
+    let c = collect(&load(&s, &rod_urdf(M, L)), "r");
+    let t_star = -phi0 / omega;
+    let v = L * omega;
+    let at: Vec<_> = c.events.iter().filter(|ev| (ev.t - t_star).abs() <= 1e-9).collect();
+    let impacts: Vec<_> = at.iter().filter(|ev| ev.kind == ContactEventKind::Impact).collect();
+    let lifts: Vec<_> = at.iter().filter(|ev| ev.kind == ContactEventKind::LiftOff).collect();
+    assert_eq!(impacts.len(), 1, "one impact at {t_star} s: {:?}", c.events);
+    assert_eq!(impacts[0].contact, 1, "the end hits: {:?}", impacts[0]);
+    let lam = M * (1.0 + e) * v / 4.0;
+    assert!((impacts[0].impulse - lam).abs() <= 1e-9 * lam, "Λ_B = {} N s, closed form {lam}", impacts[0].impulse);
+    assert_eq!(lifts.len(), 1, "one lift-off of the centre at {t_star} s: {:?}", c.events);
+    assert_eq!(lifts[0].contact, 0, "the centre leaves: {:?}", lifts[0]);
+    let rate = (1.0 + e) * v / 4.0;
+    assert!((lifts[0].gap_rate_after - rate).abs() <= 1e-9 * rate, "ġ_A⁺ = {} m/s, closed form {rate}", lifts[0].gap_rate_after);
+    assert_eq!(c.events.len(), 2, "nothing else before the centre lands again: {:?}", c.events);
+    for o in c.between(t_star + 1e-3, 0.12) {
+        assert_eq!(o.contacts[0].mode, ContactMode::Separated, "t = {}: the centre is in the air", o.t);
     }
 }

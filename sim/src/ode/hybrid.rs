@@ -211,7 +211,7 @@ impl ArmSystem<'_> {
     }
 
     /// Inputs and [`prepare`] at (t, y) for the hybrid path (no mode-dependent solve).
-    fn prepare_at(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+    pub(super) fn prepare_at(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
         self.inputs(t, y)?;
         let l = self.layout;
         let s = self.scene;
@@ -294,60 +294,6 @@ impl ArmSystem<'_> {
             }
         }
         Ok((closed, opened))
-    }
-
-    /// Slip→stick at `|v_t| ≤ 2 STICK_SPEED`: the remaining slip velocity of the `stopping`
-    /// contacts is removed by the M_J-weighted velocity projection that keeps the other active
-    /// velocity rows (normal rows of the contacts in touch, tangential rows of the sticking
-    /// ones) — the impulse friction would deliver over the last ~1e-6 m/s — and its kinetic
-    /// energy loss (≤ ½ m (2e-6 m/s)²) is booked as friction work (the rotors' share of the
-    /// jump into W_j, as at impacts), so the balance stays closed.
-    fn stop_slip(&mut self, t: f64, y: &mut [f64], stopping: &[usize]) -> Result<(), RunError> {
-        use crate::dynamics::contact::solve::{solve_active, ActiveRow, RowForce};
-        let l = self.layout;
-        let nv = l.nv;
-        self.prepare_at(t, y)?;
-        let h = self.hybrid.as_mut().expect("hybrid");
-        let r = &h.cd.rows;
-        let mut rows = Vec::new();
-        for k in 0..h.contacts.len() {
-            let m = h.state.mode[k];
-            if matches!(m, ContactMode::Sticking | ContactMode::Sliding | ContactMode::Bilateral) {
-                rows.push(ActiveRow { row: 3 * k, force: RowForce::Same, extra: r.vel[3 * k] - r.bias[3 * k] });
-            }
-            if m == ContactMode::Sticking || stopping.contains(&k) {
-                for a in 1..3 {
-                    rows.push(ActiveRow { row: 3 * k + a, force: RowForce::Same, extra: r.vel[3 * k + a] - r.bias[3 * k + a] });
-                }
-            }
-        }
-        let zeros = vec![0.0; nv];
-        let mut dqd = vec![0.0; nv];
-        let fd = &self.ws.fd;
-        solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, &zeros, r, &rows, &mut h.cd.scratch, &mut dqd)
-            .map_err(|_| DynamicsError::SingularConstraints { t, constraints: "the slip-to-stick velocity projection".into() })?;
-        // ΔT = −(q̇⁻ + ½ Δq̇)ᵀ M_J Δq̇ with M_J = M + J_m (data.m from this evaluation)
-        let d = &self.scene.drives;
-        let m = &self.ws.data.m;
-        let mut lost = 0.0;
-        for i in 0..nv {
-            let mut md = d.jm[i] * dqd[i];
-            for j in 0..nv {
-                md += m[(i, j)] * dqd[j];
-            }
-            lost -= (y[l.qd().start + i] + 0.5 * dqd[i]) * md;
-        }
-        for j in 0..nv {
-            let before = y[l.qd().start + j];
-            let after = before + dqd[j];
-            y[l.work().start + j] += -d.jm[j] * (after * after - before * before) / 2.0;
-            y[l.qd().start + j] = after;
-        }
-        let share = lost / stopping.len() as f64;
-        for &k in stopping {
-            y[l.friction_work(k)] += share;
-        }
-        Ok(())
     }
 
     /// The mode problem over `closed` at (t, y) with `preferred` modes; logs the mode changes
@@ -588,8 +534,13 @@ impl HybridSystem for ArmSystem<'_> {
                 }
             }
             closed.retain(|k| !opened.contains(k));
+            // only the approaching contacts were logged by the impact (Impact/Rest); a contact
+            // that was in touch and is thrown off by the impulse gets its LiftOff from
+            // resolve_modes (review F3)
             for k in opened {
-                logged.push(k);
+                if approaching.contains(&k) {
+                    logged.push(k);
+                }
             }
         }
         for k in touched {

@@ -141,3 +141,38 @@ fn frictionless_unilateral_equals_bilateral_until_lift_off() {
     let after = b.iter().find(|o| o.t >= lift.t).expect("a sample after the lift-off");
     assert!(after.normal_force[0] < 0.0, "bilateral f_n at {} s = {} after the lift-off at {}", after.t, after.normal_force[0], lift.t);
 }
+
+/// Review F5: event function i is function i % 2 of contact i / 2 in that contact's CURRENT
+/// mode; the chattering error's "event functions [..]" is rewritten with the contacts' names.
+#[test]
+fn event_functions_are_described_by_contact_and_current_mode() {
+    use crate::dynamics::contact::ContactMode;
+    use crate::integrate::HybridSystem;
+    let scene = paper_unilateral(0.5, 0.0, &[]);
+    let run = scene.run("two-elbow").expect("the paper's two-elbow run");
+    let mut sys = ArmSystem::new(&scene, run);
+    let mut y = sys.initial_state();
+    sys.init_modes(0.0, &mut y).expect("consistent initial modes");
+    let names: Vec<String> = scene.run_contact_models(run).iter().map(|c| c.name().to_string()).collect();
+    assert!(names.len() >= 2, "two elbows: {names:?}");
+    let modes = sys.contact_modes().to_vec();
+    assert_eq!(modes.len(), names.len());
+    assert!(modes.iter().any(|&m| m != ContactMode::Separated), "the paper's elbows start on the table: {modes:?}");
+    for (k, name) in names.iter().enumerate() {
+        let (ev0, ev1) = match modes[k] {
+            ContactMode::Sticking => ("lift-off", "stick-to-slip"),
+            ContactMode::Sliding => ("lift-off", "slip-to-stick"),
+            ContactMode::Separated | ContactMode::Bilateral => ("touch-down", "separated: constant"),
+        };
+        assert_eq!(sys.describe_event_function(2 * k).as_deref(), Some(format!("contact {name} ({ev0} function)").as_str()));
+        assert_eq!(sys.describe_event_function(2 * k + 1).as_deref(), Some(format!("contact {name} ({ev1} function)").as_str()));
+    }
+    assert_eq!(sys.describe_event_function(2 * names.len()), None, "out of range");
+    let text = sys.describe_event_functions("event functions [0, 3]");
+    let want = format!("event functions {}, {}", sys.describe_event_function(0).unwrap(), sys.describe_event_function(3).unwrap());
+    assert_eq!(text, want);
+    assert!(text.contains(&names[0]) && text.contains(&names[1]), "{text}");
+    // text that is not the driver's index list is kept
+    assert_eq!(sys.describe_event_functions("something else"), "something else");
+    assert_eq!(sys.describe_event_functions("event functions [99]"), "event functions [99]");
+}

@@ -31,11 +31,13 @@
 //! `projection.rs`.
 
 mod arm;
+mod describe;
 mod hybrid;
 mod jacobian;
 mod layout;
 mod outputs;
 mod projection;
+mod stop_slip;
 mod workspace;
 
 pub use arm::ArmSystem;

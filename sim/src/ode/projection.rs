@@ -5,7 +5,7 @@
 //! Integration*, §IV.4; Ascher et al., "Stabilization of constrained mechanical systems with
 //! DAEs and invariant manifolds", 1995). Redundant rows are regularised as in the force solve (`dynamics/spd.rs`).
 
-use crate::dynamics::constraints::constraint_jacobian;
+use crate::dynamics::constraints::{constraint_jacobian, PointOnPlane};
 use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
 use crate::dynamics::spd::solve_regularized;
 use crate::error::DynamicsError;
@@ -23,12 +23,17 @@ fn form_jjt(p: &mut ProjectionScratch, nc: usize) {
 }
 
 /// Solve `J Jᵀ x = rhs` in place, regularised like the force solve when J Jᵀ is singular.
-fn solve_jjt(p: &mut ProjectionScratch, t: f64, nc: usize) -> Result<(), DynamicsError> {
+fn solve_jjt(p: &mut ProjectionScratch, t: f64, nc: usize, contacts: &[PointOnPlane]) -> Result<(), DynamicsError> {
     form_jjt(p, nc);
     match solve_regularized(&p.jjt, &mut p.work, &mut p.rhs) {
         Some(_) => Ok(()),
-        None => Err(DynamicsError::SingularConstraints { t, constraints: "projection".into() }),
+        None => Err(DynamicsError::SingularConstraints { t, constraints: format!("the projection onto the constraints: {}", constraint_names(contacts).join(", ")) }),
     }
+}
+
+/// The constraints' names, for a singular projection's error (an error path only).
+fn constraint_names(contacts: &[PointOnPlane]) -> Vec<&str> {
+    contacts.iter().map(|c| c.name.as_str()).collect()
 }
 
 impl ArmSystem<'_> {
@@ -55,7 +60,7 @@ impl ArmSystem<'_> {
             }
             forward_velocities(model, data, &y[l.qd()]);
             constraint_jacobian(model, data, &self.contacts, &mut p.jac, &mut p.jdqd);
-            solve_jjt(p, t, nc)?;
+            solve_jjt(p, t, nc, &self.contacts)?;
             // Δq = −Jᵀ x
             for j in 0..l.nv {
                 let dq: f64 = (0..nc).map(|k| p.jac[(k, j)] * p.rhs[k]).sum();
@@ -73,7 +78,7 @@ impl ArmSystem<'_> {
             worst = worst.max(p.rhs[k].abs());
         }
         if worst > 1e-13 {
-            solve_jjt(p, t, nc)?;
+            solve_jjt(p, t, nc, &self.contacts)?;
             for j in 0..l.nv {
                 let dv: f64 = (0..nc).map(|k| p.jac[(k, j)] * p.rhs[k]).sum();
                 y[l.qd().start + j] -= dv;
@@ -100,7 +105,11 @@ impl ArmSystem<'_> {
         if !h.state.mode.iter().any(|&m| held(m)) {
             return Ok(false);
         }
-        let singular = || DynamicsError::SingularConstraints { t, constraints: "projection".into() };
+        // the error names the contacts whose rows are projected on (review F6)
+        let singular = |contacts: &[crate::dynamics::contact::Contact], mode: &[ContactMode]| {
+            let names: Vec<&str> = contacts.iter().zip(mode).filter(|(_, &m)| held(m)).map(|(c, _)| c.name()).collect();
+            DynamicsError::SingularConstraints { t, constraints: format!("the projection onto the contacts in touch: {}", names.join(", ")) }
+        };
         let mut changed = false;
         for pass in 0..6 {
             let q = &y[l.q()];
@@ -119,7 +128,7 @@ impl ArmSystem<'_> {
             if worst <= 1e-13 || pass == 5 {
                 break;
             }
-            solve_active(&h.eye, &h.ones, &h.zeros, r, &h.proj_rows, &mut h.cd.scratch, &mut h.proj_dx).map_err(|_| singular())?;
+            solve_active(&h.eye, &h.ones, &h.zeros, r, &h.proj_rows, &mut h.cd.scratch, &mut h.proj_dx).map_err(|_| singular(&h.contacts, &h.state.mode))?;
             for j in 0..l.nv {
                 y[l.q().start + j] += h.proj_dx[j];
             }
@@ -141,7 +150,7 @@ impl ArmSystem<'_> {
             }
         }
         if worst > 1e-13 {
-            solve_active(&h.eye, &h.ones, &h.zeros, r, &h.proj_rows, &mut h.cd.scratch, &mut h.proj_dx).map_err(|_| singular())?;
+            solve_active(&h.eye, &h.ones, &h.zeros, r, &h.proj_rows, &mut h.cd.scratch, &mut h.proj_dx).map_err(|_| singular(&h.contacts, &h.state.mode))?;
             for j in 0..l.nv {
                 y[l.qd().start + j] += h.proj_dx[j];
             }

@@ -102,5 +102,17 @@ pub fn solve_impact(
         }
         return Ok(Impact { impulse, gap_rate_before: before, gap_rate_after: aft, energy_lost: lost, dqd });
     }
-    Err(DynamicsError::InconsistentContact { t, contact: names(), why: "the impact problem has no solution (redundant contacts?)".into() })
+    Err(DynamicsError::InconsistentContact { t, contact: names(), why: impact_failure(contacts, bilateral) })
+}
+
+/// Why the impact problem over the unilateral contacts (named in the error's `contact`) and
+/// `bilateral` has no solution: every active set gave a singular or infeasible system (review F6).
+fn impact_failure(contacts: &[Contact], bilateral: &[usize]) -> String {
+    let mut why = String::from("the impact problem (Newton's law over the unilateral contacts at the table");
+    if !bilateral.is_empty() {
+        let names: Vec<&str> = bilateral.iter().map(|&k| contacts[k].name()).collect();
+        why.push_str(&format!(", with the bilateral contacts {} as equalities", names.join(", ")));
+    }
+    why.push_str(") has no solution: every active set is singular or infeasible (redundant contacts?)");
+    why
 }
