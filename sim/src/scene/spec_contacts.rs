@@ -13,7 +13,7 @@ use super::spec::{ContactSpec, PlaneSpec, PointSpec};
 pub struct TableSpec {
     pub plane: PlaneSpec,
     pub points: Vec<TablePointSpec>,
-    /// `"bilateral"` (absent), `"unilateral"` or `"compliant"`.
+    /// `"unilateral"` (absent), `"bilateral"` or `"compliant"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<String>,
     /// Newton's coefficient of restitution e in [0, 1] (unilateral; default 0).
