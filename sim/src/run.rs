@@ -137,8 +137,7 @@ pub fn simulate_outputs(
         sink(&out)
     };
     let result = if sys.is_hybrid() {
-        // unilateral or compliant contacts: event-driven
-        // (the scene's event settings plug in here once the scene carries them)
+        // unilateral or compliant contacts: event-driven, with the scene's `events` settings
         let cs = &scene.contact_settings;
         let settings = crate::integrate::EventSettings { time_tol: cs.time_tol, max_events: cs.max_events, ..Default::default() };
         scene.integrator.integrate_hybrid(&mut sys, &y0, scene.duration, dt_out, deadline, settings, |t, y, sys| on_sample(t, y, Some(sys)))
