@@ -150,6 +150,40 @@ pub struct Plant<'a> {
     pub stabilization: Stabilization,
 }
 
+/// The placements at `q` (RNEA, CRBA and the contacts share them), the bias forces h + G, the
+/// generalised force `b = K_m i − h − G − (D + D_m) q̇ [+ τ_joint]` into `fd.b`, and
+/// `M_J = M + J_m` into `fd.m_j` (not yet factored): the part of eq 21 that does not depend on
+/// the constraints, shared by the bilateral solve below and the contacts' active-row solve
+/// (`dynamics/contact/forward.rs`).
+pub(crate) fn generalized_force_and_inertia(plant: &Plant, data: &mut Data, fd: &mut ForwardData, q: &[f64], qd: &[f64], current: &[f64]) {
+    let (model, drives) = (plant.model, plant.drives);
+    let nv = model.nv;
+    forward_kinematics(model, data, q);
+    bias_forces_placed(model, data, qd);
+    for j in 0..nv {
+        fd.b[j] = drives.km[j] * current[j] - data.tau[j];
+    }
+    if drives.has_friction {
+        for j in 0..nv {
+            fd.b[j] -= (drives.d[j] + drives.dm[j]) * qd[j];
+        }
+    }
+    if fd.joint_torque {
+        for j in 0..nv {
+            fd.b[j] += fd.tau_joint[j];
+        }
+    }
+    match plant.mass_matrix {
+        // in world coordinates, from the world placements just computed (crba.rs)
+        MassMatrixMethod::Crba => crba_world(model, data),
+        MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
+    };
+    fd.m_j.copy_from(&data.m);
+    for j in 0..nv {
+        fd.m_j[(j, j)] += drives.jm[j];
+    }
+}
+
 /// Solve eq 21 at time `t` (used only in error messages) for the state `q` (rad), `qd`
 /// (rad/s), `current` (A) and the motor voltages `voltage` (V), all of length nv.
 /// Outputs in `fd`: `qdd`, `f_n`, `di`, `tau_motor`; `data` holds the placements at `q` and,
@@ -167,34 +201,7 @@ pub fn forward_dynamics(
     let (model, drives) = (plant.model, plant.drives);
     let nv = model.nv;
     let nc = plant.contacts.len();
-
-    // placements once (RNEA, CRBA and the contacts share them), then the bias forces h + G
-    // and b = K_m i − h − G − (D + D_m) q̇
-    forward_kinematics(model, data, q);
-    bias_forces_placed(model, data, qd);
-    for j in 0..nv {
-        fd.b[j] = drives.km[j] * current[j] - data.tau[j];
-    }
-    if drives.has_friction {
-        for j in 0..nv {
-            fd.b[j] -= (drives.d[j] + drives.dm[j]) * qd[j];
-        }
-    }
-    if fd.joint_torque {
-        for j in 0..nv {
-            fd.b[j] += fd.tau_joint[j];
-        }
-    }
-    // M_J = M + J_m
-    match plant.mass_matrix {
-        // in world coordinates, from the world placements just computed (crba.rs)
-        MassMatrixMethod::Crba => crba_world(model, data),
-        MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
-    };
-    fd.m_j.copy_from(&data.m);
-    for j in 0..nv {
-        fd.m_j[(j, j)] += drives.jm[j];
-    }
+    generalized_force_and_inertia(plant, data, fd, q, qd, current);
     // constraint rows
     if nc > 0 {
         forward_velocities(model, data, qd);

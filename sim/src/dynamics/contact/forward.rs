@@ -12,12 +12,9 @@ use super::rows::{contact_rows, ContactRows};
 use super::solve::{solve_active, ActiveRow, ActiveScratch, RowForce, Singular};
 use super::{Contact, ContactMode, ContactModel};
 use crate::dynamics::cholesky;
-use crate::dynamics::crba::crba_world;
 use crate::dynamics::data::Data;
-use crate::dynamics::forward::{ForwardData, MassMatrixMethod, Plant, Stabilization};
-use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
-use crate::dynamics::rnea::bias_forces_placed;
-use crate::dynamics::walker_orin;
+use crate::dynamics::forward::{generalized_force_and_inertia, ForwardData, Plant, Stabilization};
+use crate::dynamics::kinematics::forward_velocities;
 use crate::error::DynamicsError;
 
 /// The discrete state of a run's contacts: the mode of each, and the slip direction
@@ -92,31 +89,9 @@ pub fn prepare(
     qd: &[f64],
     current: &[f64],
 ) -> Result<(), DynamicsError> {
-    let (model, drives) = (plant.model, plant.drives);
+    let model = plant.model;
     let nv = model.nv;
-    forward_kinematics(model, data, q);
-    bias_forces_placed(model, data, qd);
-    for j in 0..nv {
-        fd.b[j] = drives.km[j] * current[j] - data.tau[j];
-    }
-    if drives.has_friction {
-        for j in 0..nv {
-            fd.b[j] -= (drives.d[j] + drives.dm[j]) * qd[j];
-        }
-    }
-    if fd.joint_torque {
-        for j in 0..nv {
-            fd.b[j] += fd.tau_joint[j];
-        }
-    }
-    match plant.mass_matrix {
-        MassMatrixMethod::Crba => crba_world(model, data),
-        MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
-    };
-    fd.m_j.copy_from(&data.m);
-    for j in 0..nv {
-        fd.m_j[(j, j)] += drives.jm[j];
-    }
+    generalized_force_and_inertia(plant, data, fd, q, qd, current);
     forward_velocities(model, data, qd);
     contact_rows(model, data, contacts, &mut cd.rows);
     // compliant forces into b
