@@ -35,6 +35,7 @@ mod ros2msg;
 #[cfg(feature = "synth")]
 pub mod synth;
 pub mod topics;
+pub mod units;
 pub mod value;
 pub mod writer;
 
@@ -69,8 +70,11 @@ pub use foxglove::messages::{
 /// metadata record `recording` ([`RecordingInfo`]); [`meta`] lists what each version holds.
 ///
 /// History: 0 had no `run.joint_names`; 1 added them; 2 added `/energy`
-/// `gear_friction_loss` (the D_m part of the friction loss).
-pub const FORMAT_VERSION: u32 = 2;
+/// `gear_friction_loss` (the D_m part of the friction loss); 3 added the names of the arrays
+/// inside `/motors`, `/energy` and `/constraints` (`name`), each channel's units (MCAP channel
+/// metadata `units`, [`units`]) and the scene topics for the viewers ([`topics::SCENE`],
+/// [`topics::CONTACT_MARKERS`]).
+pub const FORMAT_VERSION: u32 = 3;
 
 /// Simulated seconds -> log time in ns, rounded to nearest. Negative times and NaN give 0,
 /// times beyond ~584 years saturate at `u64::MAX`.

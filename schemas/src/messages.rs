@@ -55,6 +55,10 @@ pub struct MotorState {
     pub electric_power: Vec<f64>,
     /// Torque delivered to the link (after gearing and friction), N·m.
     pub torque: Vec<f64>,
+    /// Joint names, in array order (= metadata `run.joint_names`), so that a viewer can label
+    /// the arrays without the metadata (since format version 3; empty in older files).
+    #[serde(default)]
+    pub name: Vec<String>,
 }
 
 /// State of every constraint (topic [`crate::topics::CONSTRAINTS`]), one entry per constraint.
@@ -68,6 +72,10 @@ pub struct ConstraintState {
     pub position: Vec<f64>,
     /// Constraint rate dC/dt, m/s.
     pub velocity: Vec<f64>,
+    /// Contact names, in array order (= metadata `run.contacts`; since format version 3, empty
+    /// in older files).
+    #[serde(default)]
+    pub name: Vec<String>,
 }
 
 /// A 3-vector (m unless stated otherwise).
@@ -123,6 +131,10 @@ pub struct EnergyState {
     /// files: ask [`crate::Recording::has_gear_friction_loss`].
     #[serde(default)]
     pub gear_friction_loss: f64,
+    /// Joint names of `link_work` and `electric_energy`, in array order (= metadata
+    /// `run.joint_names`; since format version 3, empty in older files).
+    #[serde(default)]
+    pub name: Vec<String>,
 }
 
 /// The state of every contact of a run that has a non-bilateral contact (topic

@@ -31,6 +31,15 @@ pub const CONTACTS: &str = "/contacts";
 /// with a non-bilateral contact; not in [`ALL`].
 pub const CONTACT_EVENTS: &str = "/contact_events";
 
+/// `foxglove.SceneUpdate`, written once at t = 0: what does not move in the run, for the 3D
+/// panels of Foxglove (Rerun draws it from its own `.rrd`, `analyze view`): the table (each
+/// contact plane), the target path of the hand. Since format version 3.
+pub const SCENE: &str = "/scene";
+/// `foxglove.SceneUpdate`, every sample: per contact a marker at the contact point coloured by
+/// its mode and an arrow of the contact force (a pulling bilateral force drawn distinctly), and
+/// the actual and desired hand as spheres coloured apart. Since format version 3.
+pub const CONTACT_MARKERS: &str = "/contact_markers";
+
 /// The topics only runs with a non-bilateral (unilateral or compliant) contact have, in the
 /// order they are registered (after [`ALL`]).
 pub const CONTACT_TOPICS: [&str; 2] = [CONTACTS, CONTACT_EVENTS];
@@ -91,9 +100,9 @@ pub fn entry_label(item: &crate::Value) -> Option<&str> {
 /// [`ENERGY`], [`JOINT_STATES`], [`CONSTRAINTS`] and [`CONTACTS`]; `None` for anything else.
 pub fn array_index(topic: &str, field: &str) -> Option<ArrayIndex> {
     match (topic, field) {
-        (MOTORS, "current" | "voltage" | "back_emf" | "electric_power" | "torque")
-        | (ENERGY, "link_work" | "electric_energy") => Some(ArrayIndex::Joint),
-        (CONSTRAINTS, "normal_force" | "position" | "velocity") => Some(ArrayIndex::Contact),
+        (MOTORS, "current" | "voltage" | "back_emf" | "electric_power" | "torque" | "name")
+        | (ENERGY, "link_work" | "electric_energy" | "name") => Some(ArrayIndex::Joint),
+        (CONSTRAINTS, "normal_force" | "position" | "velocity" | "name") => Some(ArrayIndex::Contact),
         (
             CONTACTS,
             "name" | "mode" | "gap" | "gap_rate" | "normal_force" | "friction_force_t1" | "friction_force_t2" | "slip_velocity_t1"

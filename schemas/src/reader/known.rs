@@ -110,6 +110,8 @@ struct MotorWire {
     electric_power: Vec<f64>,
     #[prost(double, repeated, tag = "6")]
     torque: Vec<f64>,
+    #[prost(string, repeated, tag = "7")]
+    name: Vec<String>,
 }
 
 #[derive(Clone, PartialEq, prost::Message)]
@@ -122,6 +124,8 @@ struct ConstraintWire {
     position: Vec<f64>,
     #[prost(double, repeated, tag = "4")]
     velocity: Vec<f64>,
+    #[prost(string, repeated, tag = "5")]
+    name: Vec<String>,
 }
 
 #[derive(Clone, PartialEq, prost::Message)]
@@ -150,6 +154,8 @@ struct EnergyWire {
     balance_residual: f64,
     #[prost(double, tag = "12")]
     gear_friction_loss: f64,
+    #[prost(string, repeated, tag = "13")]
+    name: Vec<String>,
 }
 
 fn vec3(w: Option<Vec3Wire>) -> Vec3 {
@@ -192,13 +198,14 @@ pub(crate) fn decode(kind: KnownKind, data: &[u8]) -> Result<Known, String> {
                     back_emf: w.back_emf.clone(),
                     electric_power: w.electric_power.clone(),
                     torque: w.torque.clone(),
+                    name: w.name.clone(),
                 })
             }
             KnownKind::Constraints => {
                 let w = &mut s.constraints;
                 w.clear();
                 w.merge(data).map_err(err)?;
-                Known::Constraints(ConstraintState { time: w.time, normal_force: w.normal_force.clone(), position: w.position.clone(), velocity: w.velocity.clone() })
+                Known::Constraints(ConstraintState { time: w.time, normal_force: w.normal_force.clone(), position: w.position.clone(), velocity: w.velocity.clone(), name: w.name.clone() })
             }
             KnownKind::Energy => {
                 let w = &mut s.energy;
@@ -217,6 +224,7 @@ pub(crate) fn decode(kind: KnownKind, data: &[u8]) -> Result<Known, String> {
                     friction_loss: w.friction_loss,
                     balance_residual: w.balance_residual,
                     gear_friction_loss: w.gear_friction_loss,
+                    name: w.name.clone(),
                 })
             }
         })
@@ -229,6 +237,8 @@ pub(crate) enum Field<'a> {
     Num(f64),
     List(&'a [f64]),
     Vec3(&'a Vec3),
+    /// The names of the entries of the arrays (`name`, since format version 3).
+    Names(&'a [String]),
 }
 
 impl Known {
@@ -249,13 +259,15 @@ impl Known {
                 f("voltage", List(&m.voltage))?;
                 f("back_emf", List(&m.back_emf))?;
                 f("electric_power", List(&m.electric_power))?;
-                f("torque", List(&m.torque))
+                f("torque", List(&m.torque))?;
+                f("name", Field::Names(&m.name))
             }
             Known::Constraints(c) => {
                 f("time", Num(c.time))?;
                 f("normal_force", List(&c.normal_force))?;
                 f("position", List(&c.position))?;
-                f("velocity", List(&c.velocity))
+                f("velocity", List(&c.velocity))?;
+                f("name", Field::Names(&c.name))
             }
             Known::Energy(e) => {
                 f("time", Num(e.time))?;
@@ -269,7 +281,8 @@ impl Known {
                 f("resistive_loss", Num(e.resistive_loss))?;
                 f("friction_loss", Num(e.friction_loss))?;
                 f("balance_residual", Num(e.balance_residual))?;
-                f("gear_friction_loss", Num(e.gear_friction_loss))
+                f("gear_friction_loss", Num(e.gear_friction_loss))?;
+                f("name", Field::Names(&e.name))
             }
         }
     }
@@ -283,6 +296,7 @@ impl Known {
                 Field::Num(x) => num(x),
                 Field::List(xs) => Value::List(xs.iter().map(|&x| num(x)).collect()),
                 Field::Vec3(v) => Value::Struct(vec![("x".into(), num(v.x)), ("y".into(), num(v.y)), ("z".into(), num(v.z))]),
+                Field::Names(names) => Value::List(names.iter().map(|n| Value::String(n.clone())).collect()),
             };
             out.push((name.to_string(), v));
             ControlFlow::<()>::Continue(())
@@ -324,15 +338,18 @@ impl Known {
     }
 
     /// Its arrays, `(field, length)` in field order: the first `n` of the array returned.
-    pub(crate) fn lists(&self) -> ([(&'static str, usize); 5], usize) {
-        let mut out = [("", 0); 5];
+    pub(crate) fn lists(&self) -> ([(&'static str, usize); 6], usize) {
+        let mut out = [("", 0); 6];
         let mut n = 0;
         let _ = self.fields(|name, field| {
-            if let Field::List(xs) = field {
-                if n < out.len() {
-                    out[n] = (name, xs.len());
-                    n += 1;
-                }
+            let len = match field {
+                Field::List(xs) => xs.len(),
+                Field::Names(names) => names.len(),
+                _ => return ControlFlow::<()>::Continue(()),
+            };
+            if n < out.len() {
+                out[n] = (name, len);
+                n += 1;
             }
             ControlFlow::<()>::Continue(())
         });

@@ -76,7 +76,7 @@ pub fn unilateral() -> (Synth, UnilateralTruth) {
     }));
     s.constraints = Some(Box::new(|t| {
         let (_, g, gd, f_n, ..) = elbow4(t);
-        ConstraintState { time: t, normal_force: vec![f_n, 20.0], position: vec![g, 0.0], velocity: vec![gd, 0.0] }
+        ConstraintState { time: t, normal_force: vec![f_n, 20.0], position: vec![g, 0.0], velocity: vec![gd, 0.0], name: Vec::new() }
     }));
     s.energy = Some(Box::new(|t| linear_energy(t, 3, 1.0, 2.0)));
     let event = |time: f64, kind: &str, impulse: f64, energy_lost: f64, before: f64, after: f64| ContactEventMsg {

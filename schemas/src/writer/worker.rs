@@ -163,7 +163,7 @@ impl Worker {
             s.registered = true;
             w.add_schema_with_id(chan.schema_id, &s.name, s.encoding, &s.data).map_err(|e| write_error(&self.file, e))?;
         }
-        let metadata = BTreeMap::new();
+        let metadata = crate::units::channel_metadata(&chan.topic);
         w.add_channel_with_id(id, chan.schema_id, &chan.topic, chan.encoding, &metadata).map_err(|e| write_error(&self.file, e))?;
         Ok(())
     }
