@@ -146,6 +146,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             back_emf,
             electric_power: power.clone(),
             torque: torque.to_vec(),
+            ..Default::default()
         };
         w.write(topics::MOTORS, ns, &motors)?;
 
@@ -159,6 +160,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }],
             position: vec![gap],
             velocity: vec![-0.02 * (2.0 * t).sin()],
+            ..Default::default()
         };
         w.write(topics::CONSTRAINTS, ns, &constraints)?;
 

@@ -17,10 +17,14 @@ fn floats(max: usize) -> impl Strategy<Value = Vec<f64>> {
     prop::collection::vec(any_f64(), 0..max)
 }
 
+fn names(max: usize) -> impl Strategy<Value = Vec<String>> {
+    prop::collection::vec("[a-zA-Z0-9_/ é]{0,12}", 0..max)
+}
+
 fn motor() -> impl Strategy<Value = MotorState> {
-    (any_f64(), floats(12), floats(12), floats(12), floats(12), floats(12)).prop_map(|(time, current, voltage, back_emf, electric_power, torque)| {
-        MotorState { time, current, voltage, back_emf, electric_power, torque }
-    })
+    (any_f64(), floats(12), floats(12), floats(12), floats(12), floats(12), names(12)).prop_map(
+        |(time, current, voltage, back_emf, electric_power, torque, name)| MotorState { time, current, voltage, back_emf, electric_power, torque, name },
+    )
 }
 
 fn vec3() -> impl Strategy<Value = Vec3> {
@@ -32,7 +36,7 @@ fn hand() -> impl Strategy<Value = HandState> {
 }
 
 fn energy() -> impl Strategy<Value = EnergyState> {
-    (any_f64(), floats(12), floats(12), prop::collection::vec(any_f64(), 10)).prop_map(|(time, link_work, electric_energy, s)| EnergyState {
+    (any_f64(), floats(12), floats(12), prop::collection::vec(any_f64(), 10), names(12)).prop_map(|(time, link_work, electric_energy, s, name)| EnergyState {
         time,
         link_work,
         electric_energy,
@@ -45,6 +49,7 @@ fn energy() -> impl Strategy<Value = EnergyState> {
         friction_loss: s[6],
         balance_residual: s[7],
         gear_friction_loss: s[8],
+        name,
     })
 }
 
@@ -55,7 +60,8 @@ fn joints() -> impl Strategy<Value = JointState> {
 }
 
 fn constraints() -> impl Strategy<Value = ConstraintState> {
-    (any_f64(), floats(4), floats(4), floats(4)).prop_map(|(time, normal_force, position, velocity)| ConstraintState { time, normal_force, position, velocity })
+    (any_f64(), floats(4), floats(4), floats(4), names(4))
+        .prop_map(|(time, normal_force, position, velocity, name)| ConstraintState { time, normal_force, position, velocity, name })
 }
 
 /// The Debug text distinguishes every value we care about (-0.0, NaN) and equals for equal bits
