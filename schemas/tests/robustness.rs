@@ -349,7 +349,7 @@ fn not_a_file_and_huge_non_mcap_files_are_refused_before_reading() {
 /// record and the version; older versions read.
 #[test]
 fn an_unknown_format_version_is_refused() {
-    for (version, ok) in [("0", true), ("2", true), ("3", false), ("99", false), ("two", false)] {
+    for (version, ok) in [("0", true), ("2", true), ("3", true), ("4", false), ("99", false), ("two", false)] {
         let b = foreign(|w| {
             let mut m = std::collections::BTreeMap::new();
             m.insert("format_version".to_string(), version.to_string());
