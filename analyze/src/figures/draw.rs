@@ -333,23 +333,24 @@ where
     let mut note = None;
     if let Some(unit) = &panel.robust_unit {
         if let Some(((a, b), true)) = scale::robust_range(lines.iter().flat_map(|l| l.points.iter().map(|p| p.1))) {
-            let worst = lines
-                .iter()
-                .flat_map(|l| l.points.iter().map(move |p| (l, *p)))
-                .filter(|(_, p)| p.1 > b || p.1 < a)
-                .max_by(|u, v| {
-                    let out = |y: f64| if y > b { y - b } else { a - y };
-                    out(u.1 .1).total_cmp(&out(v.1 .1))
-                });
-            if let Some((l, (t, y))) = worst {
-                note = Some(format!(
-                    "off scale: {} {unit} at t = {} s ({})",
-                    three_digits(y),
-                    three_digits(t),
-                    super::markup::plain(&l.label)
-                ));
+            let (a, b) = if panel.zero_line { (a.min(0.0), b.max(0.0)) } else { (a, b) };
+            // what the axis shows (padded as below)
+            let (a, b) = padded(a, b, 0.06);
+            // the most extreme value above the range and the one below, each with its time and run
+            let extreme = |above: bool| {
+                lines
+                    .iter()
+                    .flat_map(|l| l.points.iter().map(move |p| (l, *p)))
+                    .filter(|(_, p)| if above { p.1 > b } else { p.1 < a })
+                    .max_by(|u, v| if above { u.1 .1.total_cmp(&v.1 .1) } else { v.1 .1.total_cmp(&u.1 .1) })
+                    .map(|(l, (t, y))| format!("{} {unit} at t = {} s ({})", three_digits(y), three_digits(t), super::markup::plain(&l.label)))
+            };
+            let parts: Vec<String> = [extreme(true), extreme(false)].into_iter().flatten().map(|p| format!("off scale: {p}")).collect();
+            if !parts.is_empty() {
+                note = Some(parts);
             }
-            (y0, y1) = (a, b);
+            let pad = 0.06 / 1.12 * (b - a);
+            (y0, y1) = (a + pad, b - pad);
         }
     }
     if panel.zero_line {
@@ -402,7 +403,7 @@ fn fill<DB: DrawingBackend, Y>(
     x_desc: &str,
     y_desc: &str,
     (xr, yr): ((f64, f64), (f64, f64)),
-    note: Option<String>,
+    note: Option<Vec<String>>,
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
@@ -445,18 +446,24 @@ where
         }
     }
     if let Some(note) = note {
-        // on a white box in the top left corner of the plotting area, over the lines
+        // one line per side, on a white box in the top left corner of the plotting area
         let area = chart.plotting_area();
-        let style = TextStyle::from(("sans-serif", 14).into_font()).color(&RGBColor(60, 60, 60));
-        let (w, h) = area.estimate_text_size(&note, &style).map_err(e)?;
+        let style = TextStyle::from(("sans-serif", 13).into_font()).color(&RGBColor(60, 60, 60));
+        let mut w = 0;
+        for line in &note {
+            w = w.max(area.estimate_text_size(line, &style).map_err(e)?.0 as i32);
+        }
+        let row = 16;
         let at = area.map_coordinate(&(xr.0, yr.1));
-        let (x, y) = (at.0 + 6, at.1 + 4);
         let root = area.strip_coord_spec();
         let (ox, oy) = root.get_base_pixel();
-        let (bx, by) = (x - ox, y - oy);
-        root.draw(&Rectangle::new([(bx - 4, by - 2), (bx + w as i32 + 4, by + h as i32 + 4)], WHITE.mix(0.9).filled())).map_err(e)?;
-        root.draw(&Rectangle::new([(bx - 4, by - 2), (bx + w as i32 + 4, by + h as i32 + 4)], RGBColor(170, 170, 170).stroke_width(1))).map_err(e)?;
-        root.draw(&Text::new(note, (bx, by), style)).map_err(e)?;
+        let (bx, by) = (at.0 + 6 - ox, at.1 + 4 - oy);
+        let corners = [(bx - 4, by - 2), (bx + w + 4, by + row * note.len() as i32 + 2)];
+        root.draw(&Rectangle::new(corners, WHITE.mix(0.9).filled())).map_err(e)?;
+        root.draw(&Rectangle::new(corners, RGBColor(170, 170, 170).stroke_width(1))).map_err(e)?;
+        for (k, line) in note.into_iter().enumerate() {
+            root.draw(&Text::new(line, (bx, by + row * k as i32), style.clone())).map_err(e)?;
+        }
     }
     Ok(())
 }
