@@ -338,7 +338,7 @@ fn grid_plot(fig: &Figure, panels: Vec<Panel>, legend: Vec<Key>) -> Plot {
 /// joint, on a robust y range ([`super::scale::robust_range`]).
 fn per_joint_plot(fig: &Figure, runs: &[RunSeries], pick: impl Fn(&RunSeries) -> &Series, y: &str, unit: &str) -> Plot {
     let joints = runs.iter().map(|r| pick(r).cols.len()).max().unwrap_or(0);
-    let panels = (0..joints)
+    let mut panels: Vec<Panel> = (0..joints)
         .map(|j| {
             let lines = runs
                 .iter()
@@ -358,6 +358,11 @@ fn per_joint_plot(fig: &Figure, runs: &[RunSeries], pick: impl Fn(&RunSeries) ->
             p
         })
         .collect();
+    if panels.is_empty() {
+        let mut p = Panel::new(T_DESC, y, Vec::new());
+        p.subtitle = Some("the motors".into());
+        panels.push(p);
+    }
     grid_plot(fig, panels, run_keys(runs, |r| !pick(r).is_empty()))
 }
 

@@ -386,11 +386,11 @@ where
         Some((lo, hi)) => {
             let chart = builder.build_cartesian_2d(xr.0..xr.1, (lo..hi).log_scale()).map_err(e)?;
             let y_desc = format!("{} (log scale)", panel.y_desc);
-            fill(chart, panel, &lines, x_desc, &y_desc, (xr, (lo, hi)), None)
+            fill(chart, panel, &lines, (x_desc, &y_desc), (xr, (lo, hi)), true, None)
         }
         None => {
             let chart = builder.build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(e)?;
-            fill(chart, panel, &lines, x_desc, &panel.y_desc, (xr, yr), note)
+            fill(chart, panel, &lines, (x_desc, &panel.y_desc), (xr, yr), false, note)
         }
     }
 }
@@ -400,9 +400,9 @@ fn fill<DB: DrawingBackend, Y>(
     mut chart: ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
     panel: &Panel,
     lines: &[Line],
-    x_desc: &str,
-    y_desc: &str,
+    (x_desc, y_desc): (&str, &str),
     (xr, yr): ((f64, f64), (f64, f64)),
+    log: bool,
     note: Option<Vec<String>>,
 ) -> Result<(), String>
 where
@@ -415,8 +415,8 @@ where
         .configure_mesh()
         .x_desc(x_desc)
         .y_desc(y_desc)
-        .x_label_formatter(&|v| scale::tick(*v))
-        .y_label_formatter(&|v| scale::tick(*v))
+        .x_label_formatter(&|v| scale::tick_in(*v, xr.1 - xr.0))
+        .y_label_formatter(&|v| if log { scale::tick(*v) } else { scale::tick_in(*v, yr.1 - yr.0) })
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
         .light_line_style(RGBColor(240, 240, 240))

@@ -33,6 +33,29 @@ pub(super) fn tick(v: f64) -> String {
     s.replace('-', "\u{2212}")
 }
 
+/// The label of tick `v` on a linear axis `span` long: as many decimals as a tenth of the span
+/// needs, plus one, trailing zeros dropped (0.00002 on a 1e-4 axis, 0.5 on a 5 s one), so
+/// ticks of a small range do not all read 0.
+pub(super) fn tick_in(v: f64, span: f64) -> String {
+    if !(span.is_finite() && span > 0.0) {
+        return tick(v);
+    }
+    let step = (span / 10.0).log10().floor();
+    if v.abs() < 1e-6 * span {
+        return "0".into();
+    }
+    if span < 1e-3 {
+        // a tiny axis (a joint that barely moves): scientific, the digits the step needs
+        let k = (span.log10().floor() - step).clamp(0.0, 6.0) as usize;
+        return format!("{v:.k$e}").replace('-', "\u{2212}");
+    }
+    let d = (1.0 - step).clamp(0.0, 15.0) as usize;
+    let s = format!("{v:.d$}");
+    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
+    let s = if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') { "0".to_string() } else { s };
+    s.replace('-', "\u{2212}")
+}
+
 /// The `q`-quantile (type 1) of sorted finite values.
 fn quantile(sorted: &[f64], q: f64) -> f64 {
     let k = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
@@ -132,6 +155,16 @@ pub(super) fn clip_y(pts: &[(f64, f64)], lo: f64, hi: f64) -> Vec<Vec<(f64, f64)
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ticks_of_small_ranges_keep_their_digits() {
+        let got: Vec<String> = [-4e-5, -2e-5, 0.0, 2e-5].map(|v| tick_in(v, 1e-4)).to_vec();
+        assert_eq!(got, ["−4.0e−5", "−2.0e−5", "0", "2.0e−5"]);
+        assert_eq!(tick_in(5e-26, 2e-10), "0");
+        assert_eq!([-0.02, 0.005, 1e-18].map(|v| tick_in(v, 0.05)), ["−0.02", "0.005", "0"]);
+        assert_eq!([0.0, 0.5, 4.5, 5.0].map(|v| tick_in(v, 5.0)), ["0", "0.5", "4.5", "5"]);
+        assert_eq!([0.0, 1000.0, 3500.0].map(|v| tick_in(v, 3500.0)), ["0", "1000", "3500"]);
+    }
 
     #[test]
     fn ticks_have_no_useless_decimals() {
