@@ -25,7 +25,7 @@ const INTRO: &str = "The figures of the paper (Fig. 1-25) and a few more, drawn 
 recordings by `analyze figures`. Every run has the same colour in every figure. Fig. 1-3 show \
 how well the hand follows the circle, Fig. 4-5 the work and electric energy of all links, \
 Fig. 6-25 the same per link (even numbers: the work of link j, odd numbers: its motor's \
-electric energy). The only dashed line is the target; a y axis marked "log scale" is \
+electric energy). The only dashed line is the target; a y axis marked (log scale) is \
 logarithmic; a run whose line lies under another's says so in the legend.";
 
 fn run_lines(runs: &[RunSeries], sources: &[PathBuf]) -> Vec<String> {
