@@ -384,6 +384,9 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
 }
 
 mod claims;
+mod headline;
+pub use headline::LONG_PULL;
+pub(crate) use headline::num;
 
 #[cfg(test)]
 pub(crate) mod tests;

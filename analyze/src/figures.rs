@@ -6,16 +6,20 @@
 //! - Fig. 1-3 (`fig01_xy`, `fig02_xz`, `fig03_yz`): the hand path r(t) in the xy, xz and yz
 //!   planes, every run over the target path r_d(t) (dashed), equal scales on both axes, a dot
 //!   where each path starts (`/hand` `actual`, `desired`);
-//! - Fig. 4, 5 (`fig04_work_total`, `fig05_electric_total`): W(t) = Σ_j ∫ τ_j q'_j dt and
-//!   E(t) = Σ_j ∫ i_j v_j dt (`/energy` totals);
+//! - Fig. 4, 5 (`fig04_work_total`, `fig05_electric_total`): W(t) = Σ_j ∫ τ_j q̇_j dt and
+//!   E(t) = Σ_j ∫ i_j v_j dt (`/energy` totals), on a log axis when the runs differ by more
+//!   than a decade (the paper's: 114 J with two elbows, 3195 J without);
 //! - Fig. 6-25 (`fig06_work_link01` … `fig25_electric_link10`): W_j(t) (even numbers) and
 //!   E_j(t) (odd numbers) of link j = 1 … n, as the paper numbers them (Fig. 6 + 2 (j - 1));
-//! - and beyond the paper (`extra_*`): motor currents and voltages (one panel per run, one line
-//!   per joint), the table's normal force on each elbow with a zero line (f_n < 0: the table
-//!   pulls), and the hand error |r - r_d| over time.
+//! - and beyond the paper (`extra_*`): motor currents and voltages as small multiples (one
+//!   panel per joint, every run in it), the table's normal force on each contact (one panel
+//!   per contact, a zero line: f_n < 0, the table pulls), and the hand error |r - r_d|.
 //!
-//! A figure whose data no recording has is still written, saying so. [`write_index`] writes
-//! `index.md` and `index.html`, every figure in order with its caption.
+//! Drawing conventions (one colour per run in every figure, one line width, dashes only for the
+//! target, legend strips, robust and log axes, ticks): [`draw`] and [`scale`]; labels use real
+//! sub- and superscripts ([`markup`]); the PNG is rendered from the SVG ([`render`]). A figure
+//! whose data no recording has is still written, saying so. [`write_index`] writes `index.md`
+//! and `index.html`, every figure in order with its caption.
 
 use std::path::{Path, PathBuf};
 
@@ -27,12 +31,16 @@ use crate::Error;
 mod catalogue;
 mod draw;
 mod index;
+pub mod markup;
+mod render;
+mod scale;
 mod work_precision;
 
 pub use index::write_index;
 pub use work_precision::{work_precision, WorkPrecisionSeries};
 
-/// DejaVu Sans (licence beside it in `analyze/assets`): every figure of the project uses it.
+/// DejaVu Sans (licence beside it in `analyze/assets`): every figure of the project uses it
+/// (plotters measures text with it, resvg renders the PNG with it).
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// Registers DejaVu Sans as plotters' "sans-serif" (once), so PNGs look the same everywhere.
@@ -95,6 +103,8 @@ pub struct RunSeries {
     pub name: String,
     /// Metadata `run.contacts` (elbow names, in `/constraints` array order); may be empty.
     pub contacts: Vec<String>,
+    /// Metadata `run.joint_names` (in the order of the per-joint arrays); may be empty.
+    pub joints: Vec<String>,
     /// Hand position r, m: columns x, y, z.
     pub actual: Series,
     /// Target r_d, m: columns x, y, z.
@@ -137,7 +147,8 @@ impl SeriesCollect {
         let run = rec.run_opt()?;
         Ok(RunSeries {
             name: run.as_ref().map_or_else(|| stem.to_string(), |r| r.run.clone()),
-            contacts: run.map(|r| r.contacts).unwrap_or_default(),
+            contacts: run.as_ref().map(|r| r.contacts.clone()).unwrap_or_default(),
+            joints: run.map(|r| r.joint_names).unwrap_or_default(),
             ..self.0
         })
     }
@@ -194,7 +205,8 @@ pub struct Figure {
     /// The paper's figure number (1-25), `None` for the figures beyond the paper.
     pub number: Option<u32>,
     pub stem: String,
-    /// "Fig. 4: All link work (∫ τ·q' dt)", as drawn over the figure.
+    /// "Fig. 4: All link work, W = Σ ∫ τ q̇ dt", as drawn over the figure, sub- and
+    /// superscripts marked ([`markup`]: [`markup::plain`] drops the marks).
     pub caption: String,
     /// One or two sentences for the index page: what is drawn and how to read it.
     pub note: String,

@@ -1,5 +1,7 @@
-//! The comparison report as one Markdown document (`analyze report`): what stands out first,
-//! then the tables of [`crate::render`] (runs, hand error, energy totals and per link with
+//! The comparison report as one Markdown document (`analyze report`): the findings that matter
+//! physically first, one sentence each ([`Comparison::headline`]: a table that pulls before
+//! anything else), then the details (the comparison's findings, sentences that differ only in
+//! the run they name merged into one), then the tables of [`crate::render`] (runs, hand error, energy totals and per link with
 //! ratios to the baseline, contacts), then the energy audit (the balance term by term, and the
 //! integrals checked against the samples, [`crate::integrals`]), then the figures.
 //!
@@ -72,42 +74,122 @@ pub struct RunInfo {
     pub sampled: [Result<SampledIntegrals, String>; 2],
 }
 
-/// What the check of a run's integrals says, in one sentence, when something is worth saying.
-fn sampled_finding(name: &str, s: &[Result<SampledIntegrals, String>; 2]) -> Option<String> {
-    let [Ok(whole), after] = s else { return None };
-    if whole.agrees() {
-        return None;
+/// What the check of the runs' integrals says, one sentence per kind of result, when something
+/// is worth saying: the runs whose samples reproduce the integrals only after the start-up
+/// transient in one sentence (the largest difference named), those that do not at all in
+/// another.
+fn sampled_findings(labels: &[String], info: &[RunInfo]) -> Vec<String> {
+    // (run, worst joint's difference J, its text) of the runs in each kind
+    let (mut transient, mut wrong) = (Vec::new(), Vec::new());
+    let mut dt = None;
+    let mut from = None;
+    for (name, i) in labels.iter().zip(info) {
+        let [Ok(whole), after] = &i.sampled else { continue };
+        if whole.agrees() {
+            continue;
+        }
+        dt = Some(whole.dt_s);
+        let worst = whole
+            .electric
+            .iter()
+            .zip(&whole.joints)
+            .max_by(|a, b| a.0.difference_j().total_cmp(&b.0.difference_j()))
+            .map(|(i, j)| (i.difference_j(), format!("E of {j} off by {} J of {} J in {name}", crate::compare::num(i.difference_j()), crate::compare::num(i.recorded_j))))
+            .unwrap_or((0.0, String::new()));
+        match after {
+            Ok(a) if a.agrees() => {
+                from = Some(a.from_s);
+                transient.push((name.as_str(), worst));
+            }
+            _ => wrong.push((name.as_str(), worst)),
+        }
     }
-    let worst = whole
-        .electric
-        .iter()
-        .zip(&whole.joints)
-        .max_by(|a, b| a.0.difference_j().total_cmp(&b.0.difference_j()))
-        .map(|(i, j)| format!("E of {j} off by {:.3} J of {:.3} J", i.difference_j(), i.recorded_j))
-        .unwrap_or_default();
-    Some(match after {
-        Ok(a) if a.agrees() => format!(
-            "{name}: the samples (every {} s) reproduce the energy integrals from t = {} s on, \
-             within the trapezoid rule's error, but not over the whole run ({worst}): the \
-             start-up transient is faster than the output step. The recorded integrals \
-             (integrated with the motion) are the ones to use.",
-            whole.dt_s, a.from_s
-        ),
-        _ => format!(
-            "{name}: the energy integrals recomputed from the samples (every {} s) do **not** \
-             agree with the recorded ones within the trapezoid rule's estimated error, even \
-             after the start ({worst}). Either the signals change faster than the output step \
-             (record at a higher rate to tell) or the recorded integrals are wrong.",
-            whole.dt_s
-        ),
-    })
+    let names = |v: &[(&str, (f64, String))]| v.iter().map(|x| x.0).collect::<Vec<_>>().join(", ");
+    let largest = |v: &[(&str, (f64, String))]| v.iter().max_by(|a, b| a.1 .0.total_cmp(&b.1 .0)).map(|x| x.1 .1.clone()).unwrap_or_default();
+    let dt = dt.map_or(String::new(), |d| format!(" (every {d} s)"));
+    let mut out = Vec::new();
+    if !transient.is_empty() {
+        out.push(format!(
+            "{}: the samples{dt} reproduce the energy integrals from t = {} s on, within the \
+             trapezoid rule's error, but not over the whole run (largest: {}): the start-up \
+             transient is faster than the output step. The recorded integrals (integrated with \
+             the motion) are the ones to use.",
+            names(&transient),
+            from.unwrap_or(0.0),
+            largest(&transient)
+        ));
+    }
+    if !wrong.is_empty() {
+        out.push(format!(
+            "{}: the energy integrals recomputed from the samples{dt} do **not** agree with the \
+             recorded ones within the trapezoid rule's estimated error, even after the start \
+             (largest: {}). Either the signals change faster than the output step (record at a \
+             higher rate to tell) or the recorded integrals are wrong.",
+            names(&wrong),
+            largest(&wrong)
+        ));
+    }
+    out
 }
 
+/// `findings` with the sentences that differ only in the one run they name merged into one
+/// naming every such run ("a, b and c: every normal force stays >= 0 ..."), in the order of
+/// their first appearance.
+fn merge_by_run(findings: &[String], runs: &[String]) -> Vec<String> {
+    // longest names first, so "two-elbow" does not match inside "two-elbow-unilateral"
+    let mut names: Vec<&str> = runs.iter().map(String::as_str).collect();
+    names.sort_by_key(|n| std::cmp::Reverse(n.len()));
+    let boundary = |c: Option<char>| c.is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_'));
+    let template = |f: &str| -> Option<(String, String)> {
+        let mut found: Option<(usize, &str)> = None;
+        let mut masked = f.to_string();
+        for n in &names {
+            let mut at = 0;
+            while let Some(k) = masked[at..].find(n).map(|k| k + at) {
+                let (before, after) = (masked[..k].chars().next_back(), masked[k + n.len()..].chars().next());
+                if boundary(before) && boundary(after) {
+                    if found.is_some_and(|(_, m)| m != *n) {
+                        return None; // two runs named: not merged
+                    }
+                    found = Some((k, n));
+                    masked.replace_range(k..k + n.len(), "\u{0}");
+                    at = k + 1;
+                } else {
+                    at = k + n.len();
+                }
+            }
+        }
+        found.map(|(_, n)| (masked, n.to_string()))
+    };
+    let mut groups: Vec<(Option<String>, Vec<String>, String)> = Vec::new();
+    for f in findings {
+        match template(f) {
+            Some((t, run)) => match groups.iter_mut().find(|g| g.0.as_deref() == Some(t.as_str())) {
+                Some(g) => g.1.push(run),
+                None => groups.push((Some(t), vec![run], f.clone())),
+            },
+            None => groups.push((None, Vec::new(), f.clone())),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(t, runs, original)| match (t, runs.len()) {
+            (Some(t), n) if n > 1 => {
+                let joined = format!("{} and {}", runs[..n - 1].join(", "), runs[n - 1]);
+                t.replace('\u{0}', &joined)
+            }
+            _ => original,
+        })
+        .collect()
+}
 
 /// A figure to show: caption and the path of its image relative to the report.
 #[derive(Debug, Clone)]
 pub struct FigureLink {
+    /// Markdown (inline HTML for sub/superscripts).
     pub caption: String,
+    /// The caption as plain text, for the image's alternative text.
+    pub alt: String,
     pub path: String,
 }
 
@@ -138,14 +220,17 @@ pub fn render_report(
         env!("CARGO_PKG_VERSION")
     );
 
-    out.push_str("## What stands out\n\n");
-    for f in &cmp.findings {
+    out.push_str("## Findings\n\n");
+    for f in cmp.headline() {
         let _ = writeln!(out, "- {f}");
     }
-    for (name, i) in labels.iter().zip(info) {
-        if let Some(f) = sampled_finding(name, &i.sampled) {
-            let _ = writeln!(out, "- {f}");
-        }
+    out.push_str("\n## Details\n\n");
+    let names: Vec<String> = runs.iter().map(|r| r.run.clone()).collect();
+    for f in merge_by_run(&cmp.findings, &names) {
+        let _ = writeln!(out, "- {f}");
+    }
+    for f in sampled_findings(&labels, info) {
+        let _ = writeln!(out, "- {f}");
     }
     out.push('\n');
 
@@ -180,7 +265,7 @@ pub fn render_report(
             let _ = writeln!(out, "Every figure, with notes on how to read it: [{index}]({index}).\n");
         }
         for f in figures {
-            let _ = writeln!(out, "**{}**\n\n![{}]({})\n", f.caption, f.caption, f.path);
+            let _ = writeln!(out, "**{}**\n\n![{}]({})\n", f.caption, f.alt, f.path);
         }
     }
     while out.ends_with("\n\n") {

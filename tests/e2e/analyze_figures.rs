@@ -69,6 +69,26 @@ fn expected_stems() -> Vec<String> {
     v
 }
 
+/// The text content of every `<text>` element of an SVG, tspans included, trimmed.
+fn texts(svg: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for part in svg.split("<text").skip(1) {
+        let body = &part[part.find('>').map_or(0, |k| k + 1)..part.find("</text>").unwrap_or(part.len())];
+        let mut t = String::new();
+        let mut in_tag = false;
+        for c in body.chars() {
+            match c {
+                '<' => in_tag = true,
+                '>' => in_tag = false,
+                c if !in_tag => t.push(c),
+                _ => {}
+            }
+        }
+        out.push(t.trim().to_string());
+    }
+    out
+}
+
 /// A PNG that decodes, is at least 1000 x 700 and has many colours and non-white pixels.
 fn assert_png_has_content(path: &Path) {
     let bytes = std::fs::read(path).unwrap();
@@ -160,18 +180,31 @@ fn every_figure_is_written_as_png_and_svg_and_indexed() {
             "index.html lacks {stem}"
         );
     }
+    let sub = |x: &str| format!(r#"<tspan baseline-shift="sub" font-size="70%">{x}</tspan>"#);
     let xy = std::fs::read_to_string(out.join("fig01_xy.svg")).unwrap();
-    assert!(xy.contains("x [m]") && xy.contains("y [m]") && xy.contains("target r_d"));
+    assert!(xy.contains("x [m]") && xy.contains("y [m]") && xy.contains(&format!("target r{}", sub("d"))), "{xy}");
     let fig4 = std::fs::read_to_string(out.join("fig04_work_total.svg")).unwrap();
-    assert!(fig4.contains("Fig. 4: All link work") && fig4.contains("W = Σ_j W_j [J]"));
+    assert!(fig4.contains("Fig. 4: All link work") && fig4.contains("W [J]"));
     let fig25 = std::fs::read_to_string(out.join("fig25_electric_link10.svg")).unwrap();
-    assert!(fig25.contains("Electric energy of the tenth link") && fig25.contains("E_10 [J]"));
+    assert!(fig25.contains("Electric energy of the tenth link") && fig25.contains(&format!("E{} [J]", sub("10"))));
     let forces = std::fs::read_to_string(out.join("extra_normal_forces.svg")).unwrap();
-    assert!(forces.contains("two-elbow, elbow7") && forces.contains("normal force f_n [N]"));
+    assert!(forces.contains("elbow7") && forces.contains(&format!("f{} [N]", sub("n"))), "{forces}");
     assert!(
-        md.contains("Fig. 25: Electric energy of the tenth link")
+        md.contains("Fig. 25: Electric energy of the tenth link, E<sub>10</sub>")
             && md.contains("Beyond the paper")
     );
+    // no figure text shows a literal underscore or caret (sub/superscripts are tspans)
+    for stem in expected_stems() {
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
+        for text in texts(&svg) {
+            assert!(!text.contains('_') && !text.contains('^'), "{stem}.svg: {text:?}");
+        }
+    }
+    // small multiples: one panel per joint (10), one per contact (2: elbow4, elbow7)
+    let panels = |stem: &str, prefix: &str| texts(&std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap()).iter().filter(|t| t.starts_with(prefix)).count();
+    assert_eq!(panels("extra_currents", "joint "), JOINTS);
+    assert_eq!(panels("extra_voltages", "joint "), JOINTS);
+    assert_eq!(panels("extra_normal_forces", "elbow"), 2);
     let files = std::fs::read_dir(&out).unwrap().count();
     assert_eq!(files, 2 * expected_stems().len() + 2);
 }

@@ -229,7 +229,8 @@ fn report_is_a_document_with_the_audit_and_its_figures() {
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     for want in [
         "# Comparison report",
-        "## What stands out",
+        "## Findings",
+        "## Details",
         "## Tables",
         "## Energy audit",
         "| run | E in | ΔT | ΔV | Δ(½Li²) | R loss | D loss | D_m loss |",

@@ -159,9 +159,9 @@ fn sorted(mut v: Vec<&str>) -> Vec<&str> {
     v
 }
 
-/// The bilateral → unilateral block (module docs): empty when no pair exists. `base` is the
-/// comparison's baseline, preferred for the savings when it has no contacts and the duration.
-pub(super) fn table_pairs(runs: &[RunMetrics], base: usize, verdicts: &[(String, &'static str)]) -> Vec<String> {
+/// The bilateral → unilateral pairs (module docs) as `(bilateral, unilateral)` indices into
+/// `runs`, in run order.
+pub(super) fn pairs(runs: &[RunMetrics]) -> Vec<(usize, usize)> {
     let mut pairs = Vec::new();
     for (ia, a) in runs.iter().enumerate() {
         if !is_bilateral(a) || a.contacts.is_empty() {
@@ -177,6 +177,13 @@ pub(super) fn table_pairs(runs: &[RunMetrics], base: usize, verdicts: &[(String,
             }
         }
     }
+    pairs
+}
+
+/// The bilateral → unilateral block (module docs): empty when no pair exists. `base` is the
+/// comparison's baseline, preferred for the savings when it has no contacts and the duration.
+pub(super) fn table_pairs(runs: &[RunMetrics], base: usize, verdicts: &[(String, &'static str)]) -> Vec<String> {
+    let pairs = pairs(runs);
     if pairs.is_empty() {
         return Vec::new();
     }

@@ -1,4 +1,13 @@
-//! Drawing one figure (one or more stacked panels of lines) with plotters, as SVG and PNG.
+//! Drawing one figure (a grid of panels of lines, under a title and a legend strip) with
+//! plotters as SVG, and its PNG rendered from that SVG ([`super::render`]).
+//!
+//! Line styles mean the same in every figure: one colour per run (its place in the list of
+//! runs, [`COLORS`]), every line [`LINE_WIDTH`] px wide, dashed only for the target r_d; a
+//! thin black line is y = 0 where the sign matters (the table's force). One legend strip under
+//! the title explains every colour and dash of the figure; panels have none, so no legend hides
+//! data. The y axis of each panel follows [`super::scale`]: a log axis when the lines differ by
+//! more than a decade, a range that a short start-up spike does not set (the spike's extreme
+//! value written in the panel), ticks without useless decimals.
 //!
 //! Long series are thinned before drawing: a time series keeps the smallest and largest value
 //! of each of at most [`BUCKETS`] consecutive groups of samples (so spikes stay visible), a
@@ -6,21 +15,30 @@
 
 use std::path::Path;
 
-use image::ImageEncoder;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+
+use super::{render, scale};
 
 /// At most this many groups of samples per time series (two points each).
 const BUCKETS: usize = 1200;
 /// At most this many points per path.
 const PATH_POINTS: usize = 2500;
 
-const MARGIN: u32 = 14;
-const X_LABEL_AREA: u32 = 52;
-const Y_LABEL_AREA: u32 = 92;
+const MARGIN: u32 = 12;
+const X_LABEL_AREA: u32 = 50;
+/// Under a panel that is not in the bottom row: tick labels only.
+const X_TICKS_AREA: u32 = 28;
+const Y_LABEL_AREA: u32 = 84;
 const SUBTITLE_PX: u32 = 18;
+/// Every line of every figure, px.
+pub(super) const LINE_WIDTH: u32 = 2;
+/// A legend strip row, px.
+const STRIP_ROW: u32 = 26;
 
-/// Run (or joint) colours, in order (matplotlib's tab10, red second).
+/// Run colours, in order (matplotlib's tab10, red second).
 pub(super) const COLORS: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -43,8 +61,6 @@ pub(super) struct Line {
     pub path: bool,
     /// Mark the first point with a dot (where a path starts).
     pub start_dot: bool,
-    /// Stroke width, px.
-    pub width: u32,
     pub points: Vec<(f64, f64)>,
 }
 
@@ -56,29 +72,44 @@ impl Line {
             dashed: false,
             path: false,
             start_dot: false,
-            width: 2,
             points: t.iter().copied().zip(y.iter().copied()).collect(),
         }
     }
 }
 
-/// One chart: axes, lines, legend.
+/// One entry of a legend strip: a label and how its lines look.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Key {
+    pub label: String,
+    pub color: RGBColor,
+    pub dashed: bool,
+    /// A thin line (the y = 0 line) rather than a data line.
+    pub thin: bool,
+    /// Text only, no line (a remark on the figure).
+    pub text_only: bool,
+}
+
+impl Key {
+    pub fn line(label: impl Into<String>, color: RGBColor) -> Self {
+        Key { label: label.into(), color, dashed: false, thin: false, text_only: false }
+    }
+}
+
+/// One chart: axes and lines.
 pub(super) struct Panel {
     pub subtitle: Option<String>,
     pub x_desc: String,
     pub y_desc: String,
     pub lines: Vec<Line>,
-    /// A black horizontal line at y = 0 with this legend label.
-    pub zero_line: Option<String>,
+    /// A thin black horizontal line at y = 0 (and y = 0 inside the range).
+    pub zero_line: bool,
     /// One metre is as long on the x axis as on the y axis.
     pub equal_aspect: bool,
-    pub legend: SeriesLabelPosition,
-    /// No legend box (the figure has a legend strip instead).
-    pub no_legend: bool,
-    /// Room above the highest line, as a fraction of the data's y range (for the legend).
-    pub top_pad: f64,
-    /// Fixed y range (set by [`Plot::share_y`]).
-    y_range: Option<(f64, f64)>,
+    /// Unit of y for the note on values outside a robust range ([`scale::robust_range`]);
+    /// `None`: the whole range is shown.
+    pub robust_unit: Option<String>,
+    /// A log y axis when [`scale::wants_log`] says so.
+    pub log_allowed: bool,
 }
 
 impl Panel {
@@ -88,57 +119,45 @@ impl Panel {
             x_desc: x_desc.into(),
             y_desc: y_desc.into(),
             lines,
-            zero_line: None,
+            zero_line: false,
             equal_aspect: false,
-            legend: SeriesLabelPosition::UpperLeft,
-            no_legend: false,
-            top_pad: 0.06,
-            y_range: None,
+            robust_unit: None,
+            log_allowed: false,
         }
     }
 }
 
-/// A figure: a title over panels stacked top to bottom.
+/// A figure: a title over a legend strip over panels in a grid of `cols` columns, filled row
+/// by row.
 pub(super) struct Plot {
     pub title: String,
     pub panels: Vec<Panel>,
     pub size: (u32, u32),
-    /// A legend in one row under the title, for all panels.
-    pub legend_strip: Vec<(String, RGBColor)>,
-    /// All panels get the same y range.
-    pub share_y: bool,
+    pub legend: Vec<Key>,
+    pub cols: usize,
 }
 
 /// Writes `<stem>.svg` and `<stem>.png`.
 pub(super) fn write(plot: &Plot, stem: &Path) -> Result<(), String> {
-    save_svg_png(stem, plot.size, |a| draw(a, plot), |a| draw(a, plot))
+    save_svg_png(stem, plot.size, |a| draw(a, plot))
 }
 
-/// Draws a figure of `size` pixels twice, with `svg` and `png`, in memory, and writes
-/// `<stem>.svg` and `<stem>.png` each atomically and exclusively (`schemas::atomic`; plotters'
-/// own file backends write in place). The PNG is encoded as plotters encodes its files (the
-/// `image` crate's PNG defaults). Errors name the file.
+/// Draws a figure of `size` pixels as SVG in memory, renders its PNG from it, and writes
+/// `<stem>.svg` and `<stem>.png` each atomically (`schemas::atomic`). Errors name the file.
 pub(super) fn save_svg_png(
     stem: &Path,
     size: (u32, u32),
     svg: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> Result<(), String>,
-    png: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> Result<(), String>,
 ) -> Result<(), String> {
     let svg_path = stem.with_extension("svg");
     let png_path = stem.with_extension("png");
     let mut text = String::new();
     svg(SVGBackend::with_string(&mut text, size).into_drawing_area())
         .map_err(|e| format!("{}: {e}", svg_path.display()))?;
+    let text = render::finish_svg(&text);
+    let png = render::png_from_svg(&text).map_err(|e| format!("{}: {e}", png_path.display()))?;
     schemas::atomic::write_file(&svg_path, text).map_err(|e| e.to_string())?;
-    let (w, h) = size;
-    let mut rgb = vec![0u8; w as usize * h as usize * 3];
-    png(BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area())
-        .map_err(|e| format!("{}: {e}", png_path.display()))?;
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut bytes)
-        .write_image(&rgb, w, h, image::ColorType::Rgb8)
-        .map_err(|e| format!("{}: encoding the PNG: {e}", png_path.display()))?;
-    schemas::atomic::write_file(&png_path, bytes).map_err(|e| e.to_string())?;
+    schemas::atomic::write_file(&png_path, png).map_err(|e| e.to_string())?;
     Ok(())
 }
 
@@ -149,44 +168,34 @@ where
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     root.fill(&WHITE).map_err(e)?;
     let mut body = root.titled(&plot.title, ("sans-serif", 24)).map_err(e)?;
-    if !plot.legend_strip.is_empty() {
-        let (strip, rest) = body.split_vertically(34);
-        draw_strip(&strip, &plot.legend_strip).map_err(e)?;
+    if !plot.legend.is_empty() {
+        let rows = strip_rows(&body, &plot.legend).map_err(e)?;
+        let (strip, rest) = body.split_vertically(STRIP_ROW * rows.len() as u32 + 6);
+        draw_strip(&strip, &rows).map_err(e)?;
         body = rest;
     }
-    let shared = if plot.share_y {
-        plot.panels
-            .iter()
-            .filter_map(|p| bounds(&p.lines))
-            .reduce(|a, b| {
-                [
-                    a[0].min(b[0]),
-                    a[1].max(b[1]),
-                    a[2].min(b[2]),
-                    a[3].max(b[3]),
-                ]
-            })
-    } else {
-        None
-    };
-    let areas = body.split_evenly((plot.panels.len().max(1), 1));
-    for (area, panel) in areas.iter().zip(&plot.panels) {
-        match shared {
-            Some(b) => {
-                let y_range = Some(padded(b[2], b[3], 0.06));
-                draw_panel(
-                    area,
-                    &Panel {
-                        y_range,
-                        ..panel.clone_frame()
-                    },
-                    &panel.lines,
-                )?
-            }
-            None => draw_panel(area, panel, &panel.lines)?,
-        }
+    let cols = plot.cols.max(1);
+    let rows = plot.panels.len().div_ceil(cols).max(1);
+    let areas = body.split_evenly((rows, cols));
+    for (k, (area, panel)) in areas.iter().zip(&plot.panels).enumerate() {
+        let bottom = k / cols == rows - 1 || k + cols >= plot.panels.len();
+        draw_panel(area, panel, bottom)?;
     }
     root.present().map_err(e)
+}
+
+/// The y range a panel's lines are judged on (before padding): the log range when the panel
+/// gets a log axis (`true`), else the robust range where the panel asks for one, else the data's.
+pub(super) fn y_span(panel: &Panel) -> Option<(f64, f64, bool)> {
+    let pts: Vec<&[(f64, f64)]> = panel.lines.iter().map(|l| l.points.as_slice()).collect();
+    if let Some((lo, hi)) = scale::wants_log(&pts).filter(|_| panel.log_allowed && !panel.equal_aspect) {
+        return Some((lo, hi, true));
+    }
+    let ys = || panel.lines.iter().flat_map(|l| l.points.iter().map(|p| p.1));
+    if panel.robust_unit.is_some() {
+        return scale::robust_range(ys()).map(|((a, b), _)| (a, b, false));
+    }
+    bounds(&panel.lines).map(|b| (b[2], b[3], false))
 }
 
 /// Smallest and largest finite x and y over all lines, or `None` without a finite point.
@@ -230,61 +239,80 @@ fn equalize(x: &mut (f64, f64), y: &mut (f64, f64), w_px: f64, h_px: f64) {
     widen(y, h_px);
 }
 
-impl Panel {
-    /// Everything but the lines.
-    fn clone_frame(&self) -> Panel {
-        Panel {
-            subtitle: self.subtitle.clone(),
-            x_desc: self.x_desc.clone(),
-            y_desc: self.y_desc.clone(),
-            lines: Vec::new(),
-            zero_line: self.zero_line.clone(),
-            equal_aspect: self.equal_aspect,
-            legend: self.legend.clone(),
-            no_legend: self.no_legend,
-            top_pad: self.top_pad,
-            y_range: self.y_range,
-        }
-    }
+fn strip_font() -> TextStyle<'static> {
+    TextStyle::from(("sans-serif", 16).into_font())
 }
 
-/// Legend entries side by side, centred.
+/// The legend entries in rows that fit the width, each with its width, px.
+fn strip_rows<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    keys: &[Key],
+) -> Result<Vec<Vec<(Key, i32)>>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (w, _) = area.dim_in_pixel();
+    let mut rows: Vec<Vec<(Key, i32)>> = vec![Vec::new()];
+    let mut used = 0;
+    for key in keys {
+        let line = if key.text_only { 0 } else { 30 };
+        let width = area.estimate_text_size(&super::markup::plain(&key.label), &strip_font())?.0 as i32 + line + 22;
+        if used + width > w as i32 - 20 && !rows.last().is_some_and(Vec::is_empty) {
+            rows.push(Vec::new());
+            used = 0;
+        }
+        used += width;
+        if let Some(row) = rows.last_mut() {
+            row.push((key.clone(), width));
+        }
+    }
+    Ok(rows)
+}
+
+/// Legend rows, each centred: a short line in each entry's style, then its label.
 fn draw_strip<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    entries: &[(String, RGBColor)],
+    rows: &[Vec<(Key, i32)>],
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
-    let font = TextStyle::from(("sans-serif", 16).into_font());
-    let widths: Vec<i32> = entries
-        .iter()
-        .map(|(label, _)| {
-            area.estimate_text_size(label, &font)
-                .map(|(w, _)| w as i32 + 30 + 18)
-        })
-        .collect::<Result<_, _>>()?;
-    let (w, h) = area.dim_in_pixel();
-    let mut x = (w as i32 - widths.iter().sum::<i32>()).max(0) / 2;
-    let y = h as i32 / 2;
-    for ((label, color), width) in entries.iter().zip(widths) {
-        area.draw(&PathElement::new(
-            vec![(x, y), (x + 24, y)],
-            color.stroke_width(3),
-        ))?;
-        area.draw(&Text::new(label.clone(), (x + 30, y - 8), font.clone()))?;
-        x += width;
+    let (w, _) = area.dim_in_pixel();
+    for (r, row) in rows.iter().enumerate() {
+        let mut x = (w as i32 - row.iter().map(|k| k.1).sum::<i32>()).max(0) / 2;
+        let y = (STRIP_ROW as i32) * r as i32 + STRIP_ROW as i32 / 2 + 2;
+        for (key, width) in row {
+            if key.text_only {
+                area.draw(&Text::new(key.label.clone(), (x, y - 9), strip_font().color(&RGBColor(70, 70, 70))))?;
+                x += width;
+                continue;
+            }
+            let style = key.color.stroke_width(if key.thin { 1 } else { LINE_WIDTH });
+            let pieces: &[(i32, i32)] = if key.dashed { &[(0, 8), (13, 24)] } else { &[(0, 24)] };
+            for &(a, b) in pieces {
+                area.draw(&PathElement::new(vec![(x + a, y), (x + b, y)], style))?;
+            }
+            area.draw(&Text::new(key.label.clone(), (x + 30, y - 9), strip_font()))?;
+            x += width;
+        }
     }
     Ok(())
 }
 
-fn draw_panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    panel: &Panel,
-    lines: &[Line],
-) -> Result<(), String>
+/// "43.2" for 43.2189: three significant digits, as a tick label.
+fn three_digits(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return scale::tick(v);
+    }
+    let p = 10f64.powi(2 - v.abs().log10().floor() as i32);
+    scale::tick((v * p).round() / p)
+}
+
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, bottom: bool) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
-    let Some([x0, x1, mut y0, mut y1]) = bounds(lines) else {
+    let lines: Vec<Line> = panel
+        .lines
+        .iter()
+        .map(|l| Line { label: l.label.clone(), points: thin(l), ..*l })
+        .collect();
+    let Some([x0, x1, mut y0, mut y1]) = bounds(&lines) else {
         let (w, h) = area.dim_in_pixel();
         let style = TextStyle::from(("sans-serif", 20).into_font()).pos(
             plotters::style::text_anchor::Pos::new(
@@ -301,107 +329,143 @@ where
         .map_err(e)?;
         return Ok(());
     };
-    if panel.zero_line.is_some() {
+    // the note on what lies outside a robust range: the most extreme value, its time and run
+    let mut note = None;
+    if let Some(unit) = &panel.robust_unit {
+        if let Some(((a, b), true)) = scale::robust_range(lines.iter().flat_map(|l| l.points.iter().map(|p| p.1))) {
+            let (a, b) = if panel.zero_line { (a.min(0.0), b.max(0.0)) } else { (a, b) };
+            // what the axis shows (padded as below)
+            let (a, b) = padded(a, b, 0.06);
+            // the most extreme value above the range and the one below, each with its time and run
+            let extreme = |above: bool| {
+                lines
+                    .iter()
+                    .flat_map(|l| l.points.iter().map(move |p| (l, *p)))
+                    .filter(|(_, p)| if above { p.1 > b } else { p.1 < a })
+                    .max_by(|u, v| if above { u.1 .1.total_cmp(&v.1 .1) } else { v.1 .1.total_cmp(&u.1 .1) })
+                    .map(|(l, (t, y))| format!("{} {unit} at t = {} s ({})", three_digits(y), three_digits(t), super::markup::plain(&l.label)))
+            };
+            let parts: Vec<String> = [extreme(true), extreme(false)].into_iter().flatten().map(|p| format!("off scale: {p}")).collect();
+            if !parts.is_empty() {
+                note = Some(parts);
+            }
+            let pad = 0.06 / 1.12 * (b - a);
+            (y0, y1) = (a + pad, b - pad);
+        }
+    }
+    if panel.zero_line {
         (y0, y1) = (y0.min(0.0), y1.max(0.0));
     }
-    let mut xr = if panel.equal_aspect {
-        padded(x0, x1, 0.05)
-    } else {
-        (x0, x1)
-    };
+    // a time axis starts at t = 0 when the first sample is just after it
+    let x0 = if !panel.equal_aspect && x0 > 0.0 && x0 < 0.05 * (x1 - x0) { 0.0 } else { x0 };
+    let mut xr = if panel.equal_aspect { padded(x0, x1, 0.05) } else { (x0, x1) };
     if xr.1 <= xr.0 {
         xr = padded(x0, x1, 0.0);
     }
     let mut yr = padded(y0, y1, 0.06);
-    yr.1 += (panel.top_pad - 0.06).max(0.0) * (yr.1 - yr.0) / 1.12;
-    if let Some(r) = panel.y_range {
-        yr = r;
-    }
+    let x_area = if bottom { X_LABEL_AREA } else { X_TICKS_AREA };
     if panel.equal_aspect {
         let (w, h) = area.dim_in_pixel();
-        let sub = if panel.subtitle.is_some() {
-            SUBTITLE_PX + 10
-        } else {
-            0
-        };
-        let w_px = w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1) as f64;
-        let h_px = h.saturating_sub(2 * MARGIN + X_LABEL_AREA + sub).max(1) as f64;
+        let sub = if panel.subtitle.is_some() { SUBTITLE_PX + 10 } else { 0 };
+        let w_px = w.saturating_sub(2 * MARGIN + Y_LABEL_AREA + 16).max(1) as f64;
+        let h_px = h.saturating_sub(2 * MARGIN + x_area + sub).max(1) as f64;
         equalize(&mut xr, &mut yr, w_px, h_px);
     }
     let mut builder = ChartBuilder::on(area);
     builder
         .margin(MARGIN)
         .margin_right(MARGIN + 16)
-        .x_label_area_size(X_LABEL_AREA)
+        .x_label_area_size(x_area)
         .y_label_area_size(Y_LABEL_AREA);
     if let Some(s) = &panel.subtitle {
         builder.caption(s, ("sans-serif", SUBTITLE_PX));
     }
-    let mut chart = builder
-        .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-        .map_err(e)?;
+    let pts: Vec<&[(f64, f64)]> = lines.iter().map(|l| l.points.as_slice()).collect();
+    let x_desc = if bottom { panel.x_desc.as_str() } else { "" };
+    match scale::wants_log(&pts).filter(|_| panel.log_allowed && !panel.equal_aspect) {
+        Some((lo, hi)) => {
+            let chart = builder.build_cartesian_2d(xr.0..xr.1, (lo..hi).log_scale()).map_err(e)?;
+            let y_desc = format!("{} (log scale)", panel.y_desc);
+            fill(chart, panel, &lines, (x_desc, &y_desc), (xr, (lo, hi)), true, None)
+        }
+        None => {
+            let chart = builder.build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(e)?;
+            fill(chart, panel, &lines, (x_desc, &panel.y_desc), (xr, yr), false, note)
+        }
+    }
+}
+
+/// The mesh, the lines (cut at the y range) and the note of one panel, on a linear or log y.
+fn fill<DB: DrawingBackend, Y>(
+    mut chart: ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
+    panel: &Panel,
+    lines: &[Line],
+    (x_desc, y_desc): (&str, &str),
+    (xr, yr): ((f64, f64), (f64, f64)),
+    log: bool,
+    note: Option<Vec<String>>,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    std::ops::Range<f64>: AsRangedCoord,
+{
+    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     chart
         .configure_mesh()
-        .x_desc(panel.x_desc.as_str())
-        .y_desc(panel.y_desc.as_str())
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| scale::tick_in(*v, xr.1 - xr.0))
+        .y_label_formatter(&|v| if log { scale::tick(*v) } else { scale::tick_in(*v, yr.1 - yr.0) })
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
-        .light_line_style(RGBColor(238, 238, 238))
+        .light_line_style(RGBColor(240, 240, 240))
         .bold_line_style(RGBColor(215, 215, 215))
         .draw()
         .map_err(e)?;
-    if let Some(label) = &panel.zero_line {
-        chart
-            .draw_series(LineSeries::new(
-                [(xr.0, 0.0), (xr.1, 0.0)],
-                BLACK.stroke_width(1),
-            ))
-            .map_err(e)?
-            .label(label.as_str())
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(1)));
+    if panel.zero_line {
+        chart.draw_series(LineSeries::new([(xr.0, 0.0), (xr.1, 0.0)], BLACK.stroke_width(1))).map_err(e)?;
     }
     for line in lines {
-        let pts = thin(line);
-        if pts.is_empty() {
+        if line.points.is_empty() {
             continue;
         }
-        let (style, width) = (line.color.stroke_width(line.width), line.width);
-        let color = line.color;
-        let dashed = line.dashed;
-        let anno = if dashed {
+        let style = line.color.stroke_width(LINE_WIDTH);
+        let (lo, hi) = (yr.0.min(yr.1), yr.0.max(yr.1));
+        for piece in scale::clip_y(&line.points, lo, hi) {
+            if line.dashed {
+                chart.draw_series(DashedLineSeries::new(piece, 9, 6, style)).map_err(e)?;
+            } else {
+                chart.draw_series(LineSeries::new(piece, style)).map_err(e)?;
+            }
+        }
+        if line.start_dot && (lo..=hi).contains(&line.points[0].1) {
             chart
-                .draw_series(DashedLineSeries::new(pts.clone(), 9, 6, style))
-                .map_err(e)?
-        } else {
-            chart
-                .draw_series(LineSeries::new(pts.clone(), style))
-                .map_err(e)?
-        };
-        anno.label(line.label.as_str()).legend(move |(x, y)| {
-            let s = color.stroke_width(width);
-            let (a, b) = if dashed { (9, 15) } else { (24, 0) };
-            EmptyElement::at((x, y))
-                + PathElement::new(vec![(0, 0), (a, 0)], s)
-                + PathElement::new(vec![(b, 0), (24, 0)], s)
-        });
-        if line.start_dot {
-            chart
-                .draw_series(std::iter::once(Circle::new(pts[0], 5, color.filled())))
+                .draw_series(std::iter::once(Circle::new(line.points[0], 5, line.color.filled())))
                 .map_err(e)?;
         }
     }
-    if panel.no_legend {
-        return Ok(());
+    if let Some(note) = note {
+        // one line per side, on a white box in the top left corner of the plotting area
+        let area = chart.plotting_area();
+        let style = TextStyle::from(("sans-serif", 13).into_font()).color(&RGBColor(60, 60, 60));
+        let mut w = 0;
+        for line in &note {
+            w = w.max(area.estimate_text_size(line, &style).map_err(e)?.0 as i32);
+        }
+        let row = 16;
+        let at = area.map_coordinate(&(xr.0, yr.1));
+        let root = area.strip_coord_spec();
+        let (ox, oy) = root.get_base_pixel();
+        let (bx, by) = (at.0 + 6 - ox, at.1 + 4 - oy);
+        let corners = [(bx - 4, by - 2), (bx + w + 4, by + row * note.len() as i32 + 2)];
+        root.draw(&Rectangle::new(corners, WHITE.mix(0.9).filled())).map_err(e)?;
+        root.draw(&Rectangle::new(corners, RGBColor(170, 170, 170).stroke_width(1))).map_err(e)?;
+        for (k, line) in note.into_iter().enumerate() {
+            root.draw(&Text::new(line, (bx, by + row * k as i32), style.clone())).map_err(e)?;
+        }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.88))
-        .border_style(RGBColor(120, 120, 120))
-        .label_font(("sans-serif", 15))
-        .position(panel.legend.clone())
-        .margin(12)
-        .draw()
-        .map_err(e)
+    Ok(())
 }
 
 /// The finite points of a line, thinned (see the module documentation).

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use super::{Figure, FigureError, RunSeries};
+use super::{markup, Figure, FigureError, RunSeries};
 
 /// Writes `dir/index.md` and `dir/index.html` listing `figures` in order (caption, note, the PNG
 /// inline, links to the PNG and SVG), after the runs drawn and the files they came from.
@@ -24,7 +24,9 @@ pub fn write_index(
 const INTRO: &str = "The figures of the paper (Fig. 1-25) and a few more, drawn from the \
 recordings by `analyze figures`. Every run has the same colour in every figure. Fig. 1-3 show \
 how well the hand follows the circle, Fig. 4-5 the work and electric energy of all links, \
-Fig. 6-25 the same per link (even numbers: work W_j, odd numbers: electric energy E_j).";
+Fig. 6-25 the same per link (even numbers: the work of link j, odd numbers: its motor's \
+electric energy). The only dashed line is the target; a y axis marked (log scale) is \
+logarithmic; a run whose line lies under another's says so in the legend.";
 
 fn run_lines(runs: &[RunSeries], sources: &[PathBuf]) -> Vec<String> {
     runs.iter()
@@ -44,8 +46,9 @@ fn run_lines(runs: &[RunSeries], sources: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
-fn heading(f: &Figure) -> &str {
-    &f.caption
+/// The caption with real sub/superscripts (inline HTML, which Markdown passes through).
+fn heading(f: &Figure) -> String {
+    markup::html(&f.caption)
 }
 
 fn markdown(figures: &[Figure], runs: &[RunSeries], sources: &[PathBuf]) -> String {
@@ -66,11 +69,12 @@ fn markdown(figures: &[Figure], runs: &[RunSeries], sources: &[PathBuf]) -> Stri
         }
         let _ = write!(
             s,
-            "\n<a id=\"{stem}\"></a>\n\n### {title}\n\n{note}\n\n![{title}]({stem}.png)\n\n\
+            "\n<a id=\"{stem}\"></a>\n\n### {title}\n\n{note}\n\n![{alt}]({stem}.png)\n\n\
              [PNG]({stem}.png) · [SVG]({stem}.svg)\n",
             stem = f.stem,
             title = heading(f),
-            note = f.note,
+            alt = markup::plain(&f.caption),
+            note = markup::html(&f.note),
         );
     }
     s
@@ -100,7 +104,7 @@ fn html(figures: &[Figure], runs: &[RunSeries], sources: &[PathBuf]) -> String {
             s,
             "<li><a href=\"#{}\">{}</a></li>",
             f.stem,
-            esc(heading(f))
+            markup::html(&esc(&f.caption))
         );
     }
     s.push_str("</ol>\n");
@@ -112,11 +116,12 @@ fn html(figures: &[Figure], runs: &[RunSeries], sources: &[PathBuf]) -> String {
         }
         let _ = writeln!(
             s,
-            "<h3 id=\"{stem}\">{title}</h3>\n<p>{note}</p>\n<p><img src=\"{stem}.png\" alt=\"{title}\"></p>\n\
+            "<h3 id=\"{stem}\">{title}</h3>\n<p>{note}</p>\n<p><img src=\"{stem}.png\" alt=\"{alt}\"></p>\n\
              <p><a href=\"{stem}.png\">PNG</a> · <a href=\"{stem}.svg\">SVG</a></p>",
             stem = f.stem,
-            title = esc(heading(f)),
-            note = esc(&f.note),
+            title = markup::html(&esc(&f.caption)),
+            alt = esc(&markup::plain(&f.caption)),
+            note = markup::html(&esc(&f.note)),
         );
     }
     s.push_str("</body>\n</html>\n");

@@ -50,7 +50,7 @@ where
         .configure_mesh()
         .x_desc("wall time of the run [s]")
         .y_desc(y_desc)
-        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .x_label_formatter(&|v| super::scale::tick(*v))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
@@ -64,10 +64,10 @@ where
             continue;
         }
         chart
-            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(super::draw::LINE_WIDTH)))
             .map_err(e)?
             .label(s.name.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(super::draw::LINE_WIDTH)));
         chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 4, color.filled()))).map_err(e)?;
     }
     chart
@@ -85,5 +85,5 @@ where
 /// error on the y axis.
 pub fn work_precision(series: &[WorkPrecisionSeries], title: &str, y_desc: &str, stem: &Path) -> Result<(), String> {
     register_font();
-    super::draw::save_svg_png(stem, (1000, 700), |a| draw(a, series, title, y_desc), |a| draw(a, series, title, y_desc))
+    super::draw::save_svg_png(stem, (1000, 700), |a| draw(a, series, title, y_desc))
 }

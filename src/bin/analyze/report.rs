@@ -66,7 +66,8 @@ pub fn run(a: &ReportArgs, v: Verbosity) -> Result<u8> {
         // per-link figures 6-25 are on the index page
         for f in figures.iter().filter(|f| f.number.is_none_or(|n| n <= 5)) {
             links.push(FigureLink {
-                caption: f.caption.clone(),
+                caption: analyze::figures::markup::html(&f.caption),
+                alt: analyze::figures::markup::plain(&f.caption),
                 path: format!("figures/{}.png", f.stem),
             });
         }
