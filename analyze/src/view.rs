@@ -36,6 +36,8 @@ pub mod urdf;
 
 #[cfg(feature = "rerun")]
 mod encode;
+#[cfg(all(test, feature = "rerun"))]
+mod tests;
 #[cfg(feature = "rerun")]
 pub use encode::{encode, fnv1a, labels, read_input, Input};
 
@@ -43,7 +45,8 @@ use std::path::{Path, PathBuf};
 
 use crate::Error;
 
-/// Converts the recordings `inputs` into one `.rrd` at `out` (written atomically), application
+/// Converts the recordings `inputs` into one `.rrd` at `out` (written atomically, its directory
+/// created if needed), application
 /// id = `out`'s file stem; `progress` is called after each input is read. Returns the bytes
 /// written. Without the feature `rerun`, an error that says how to get it.
 pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<u64, Error> {
@@ -56,6 +59,9 @@ pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<u6
         }
         let app_id = out.file_stem().map_or_else(|| "recording".to_string(), |s| s.to_string_lossy().into_owned());
         let bytes = encode(&read, &app_id)?;
+        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|source| Error::Io { file: dir.display().to_string(), op: "creating the directory", source })?;
+        }
         schemas::atomic::write_file(out, &bytes)?;
         Ok(bytes.len() as u64)
     }

@@ -13,18 +13,20 @@
 //!   (`kind` 2 = orbital, `position`, `look_target`, `eye_up`), a plot's legend
 //!   `/view/<uuid>/PlotLegend`;
 //! - `/blueprint_panel`, `/selection_panel`, `/time_panel`: `PanelState` (1 hidden,
-//!   2 collapsed, 3 expanded).
+//!   2 collapsed, 3 expanded), and the time panel's `timeline`;
+//! - a plot's fixed y range: `/view/<uuid>/ScalarAxis:range` (`Range1D`, `[f64; 2]`).
 //!
 //! Every row is on the sequence timeline `blueprint` at 0. UUIDs are made from a seed and a
 //! counter, so the same layout gives the same bytes.
 
-use super::chunk::{bool_lists, f32_lists, str_lists, u8_lists, uuid_lists, vec3_lists, Chunk, Index};
+use super::chunk::{bool_lists, f32_lists, range_lists, str_lists, u8_lists, uuid_lists, vec3_lists, Chunk, Index};
 
 const CONTAINER: &str = "rerun.blueprint.archetypes.ContainerBlueprint";
 const VIEW: &str = "rerun.blueprint.archetypes.ViewBlueprint";
 const VIEW_CONTENTS: &str = "rerun.blueprint.archetypes.ViewContents";
 const EYE: &str = "rerun.blueprint.archetypes.EyeControls3D";
 const LEGEND: &str = "rerun.blueprint.archetypes.PlotLegend";
+const AXIS: &str = "rerun.blueprint.archetypes.ScalarAxis";
 const VIEWPORT: &str = "rerun.blueprint.archetypes.ViewportBlueprint";
 const PANEL: &str = "rerun.blueprint.archetypes.PanelBlueprint";
 const TIME_PANEL: &str = "rerun.blueprint.archetypes.TimePanelBlueprint";
@@ -73,11 +75,18 @@ pub struct View {
     /// Entity path expressions (`/a/**`, `- /a/b`); empty: `$origin/**`.
     pub contents: Vec<String>,
     pub eye: Option<Eye>,
+    /// The y axis range of a time series view (else the viewer fits all data).
+    pub y_range: Option<[f64; 2]>,
 }
 
 impl View {
     pub fn new(class: ViewClass, name: impl Into<String>, origin: impl Into<String>) -> Self {
-        View { class, name: name.into(), origin: origin.into(), contents: Vec::new(), eye: None }
+        View { class, name: name.into(), origin: origin.into(), contents: Vec::new(), eye: None, y_range: None }
+    }
+
+    pub fn y_range(mut self, range: Option<[f64; 2]>) -> Self {
+        self.y_range = range;
+        self
     }
 
     pub fn contents(mut self, exprs: impl IntoIterator<Item = String>) -> Self {
@@ -170,13 +179,15 @@ pub fn chunks(root: &Node, seed: u64) -> Vec<Chunk> {
     };
     let bytes = parse_uuid(&root_container);
     out.push(Chunk::new("/viewport", Index::Blueprint).with(VIEWPORT, "root_container", "rerun.blueprint.components.RootContainer", uuid_lists(&[vec![bytes]])));
-    for (path, archetype, field) in
-        [("/blueprint_panel", PANEL, "state"), ("/selection_panel", PANEL, "state"), ("/time_panel", TIME_PANEL, "state")]
-    {
-        // side panels collapsed (room for the views), the time panel expanded (the timeline)
-        let state = if path == "/time_panel" { 3 } else { 2 };
-        out.push(Chunk::new(path, Index::Blueprint).with(archetype, field, "rerun.blueprint.components.PanelState", u8_lists(&[vec![state]])));
+    // every panel collapsed (room for the views); the time panel on `sim_time`
+    for path in ["/blueprint_panel", "/selection_panel"] {
+        out.push(Chunk::new(path, Index::Blueprint).with(PANEL, "state", "rerun.blueprint.components.PanelState", u8_lists(&[vec![2]])));
     }
+    out.push(
+        Chunk::new("/time_panel", Index::Blueprint)
+            .with(TIME_PANEL, "state", "rerun.blueprint.components.PanelState", u8_lists(&[vec![2]]))
+            .with(TIME_PANEL, "timeline", "rerun.blueprint.components.TimelineName", str_lists(&[vec![super::chunk::SIM_TIME.to_string()]])),
+    );
     out
 }
 
@@ -218,11 +229,17 @@ fn emit(node: &Node, ids: &mut Ids, out: &mut Vec<Chunk>) -> String {
                         .with(EYE, "position", "rerun.components.Position3D", vec3_lists(&[vec![f3(e.position)]])),
                 );
             }
+            if let Some([lo, hi]) = v.y_range {
+                out.push(
+                    Chunk::new(format!("{path}/ScalarAxis"), Index::Blueprint)
+                        .with(AXIS, "range", "rerun.components.Range1D", range_lists(lo, hi)),
+                );
+            }
             if v.class == ViewClass::TimeSeries {
-                // legend top left (2 = right top, 1 = left top), shown
+                // legend top right (1 = left top, 2 = right top), shown
                 out.push(
                     Chunk::new(format!("{path}/PlotLegend"), Index::Blueprint)
-                        .with(LEGEND, "corner", "rerun.blueprint.components.Corner2D", u8_lists(&[vec![1]]))
+                        .with(LEGEND, "corner", "rerun.blueprint.components.Corner2D", u8_lists(&[vec![2]]))
                         .with(LEGEND, "visible", "rerun.components.Visible", bool_lists(&[vec![true]])),
                 );
             }

@@ -248,6 +248,15 @@ pub fn uuid_lists(rows: &[Vec<[u8; 16]>]) -> ArrayRef {
     list(Arc::new(b.finish()), rows.iter().map(Vec::len), true)
 }
 
+/// `List<FixedSizeList<f64, 2>>` with one range `[lo, hi]` (`Range1D`).
+pub fn range_lists(lo: f64, hi: f64) -> ArrayRef {
+    use arrow_array::builder::Float64Builder;
+    let mut b = FixedSizeListBuilder::new(Float64Builder::new(), 2).with_field(Arc::new(Field::new("item", DataType::Float64, false)));
+    b.values().append_slice(&[lo, hi]);
+    b.append(true);
+    list(Arc::new(b.finish()), [1], true)
+}
+
 /// A colour `0xRRGGBBAA` from its components.
 pub const fn rgba(r: u8, g: u8, b: u8, a: u8) -> u32 {
     (r as u32) << 24 | (g as u32) << 16 | (b as u32) << 8 | a as u32

@@ -165,6 +165,8 @@ pub struct Bounds {
     pub arm_max: [f64; 3],
     pub hand_min: [f64; 3],
     pub hand_max: [f64; 3],
+    /// The arm's base (the first frame below the root), at t = 0.
+    pub base: [f64; 3],
 }
 
 fn grow(min: &mut [f64; 3], max: &mut [f64; 3], p: [f64; 3]) {
@@ -254,7 +256,18 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
     }
 
     // world positions: arm bounds (every frame origin, a few hundred samples) and contact points
-    let mut bounds = Bounds { arm_min: [f64::INFINITY; 3], arm_max: [f64::NEG_INFINITY; 3], hand_min: [f64::INFINITY; 3], hand_max: [f64::NEG_INFINITY; 3] };
+    let mut bounds = Bounds {
+        arm_min: [f64::INFINITY; 3],
+        arm_max: [f64::NEG_INFINITY; 3],
+        hand_min: [f64::INFINITY; 3],
+        hand_max: [f64::NEG_INFINITY; 3],
+        base: [0.0; 3],
+    };
+    if let Some((base, _)) = run.frames.iter().find(|(_, f)| f.parent == run.root_frame) {
+        if !times.is_empty() {
+            bounds.base = run.world_poses(0).get(base.as_str()).map_or([0.0; 3], |p| p.translation);
+        }
+    }
     let stride = (times.len() / 200).max(1);
     let mut contact_points: Vec<Vec<[f64; 3]>> = vec![Vec::with_capacity(times.len()); run.contacts.len()];
     for k in 0..times.len() {
@@ -265,7 +278,9 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             }
         }
         for (c, pts) in run.contacts.iter().zip(contact_points.iter_mut()) {
-            pts.push(poses.get(c.link.as_str()).map_or([0.0; 3], |p: &Pose| p.apply(c.offset_m)));
+            if let Some(link) = &c.link {
+                pts.push(poses.get(link.as_str()).map_or([0.0; 3], |p: &Pose| p.apply(c.offset_m)));
+            }
         }
     }
 
@@ -313,7 +328,7 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
     // the table: every contact plane, a thin translucent box whose top face is the plane,
     // covering the arm's reach
     let mut planes: Vec<Plane> = Vec::new();
-    for p in run.contacts.iter().map(|c| c.plane).chain(run.other_planes.iter().copied()) {
+    for p in run.contacts.iter().filter_map(|c| c.plane).chain(run.other_planes.iter().copied()) {
         if !planes.contains(&p) {
             planes.push(p);
         }
@@ -337,15 +352,21 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 .with(BOXES, "colors", "rerun.components.Color", u32_lists(&[vec![TABLE]]))
                 .with(BOXES, "fill_mode", "rerun.components.FillMode", u8_lists(&[vec![4]]))
                 .with(BOXES, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![[half as f32, half as f32, (0.5 * thickness) as f32]]]))
-                .with(BOXES, "labels", "rerun.components.Text", str_lists(&[vec![format!("table (contact plane n·x = {:.3} m)", d)]]))
+                .with(BOXES, "labels", "rerun.components.Text", str_lists(&[vec!["table".to_string()]]))
                 .with(BOXES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(q)]])),
         );
     }
 
     // contacts: marker and force arrow per sample, coloured by mode
     let (f_n, f_t, modes) = contact_forces(run);
-    let f_max = f_n.iter().flatten().chain(f_t.iter().flatten()).fold(0.0f64, |a, f| a.max(f.abs()));
-    // the largest force is drawn 0.25 m long
+    // the largest force after the start-up transient (the first 5 % of the samples, where an
+    // impulse-like peak would shrink every arrow) is drawn 0.25 m long
+    let skip = |v: &Vec<f64>, per: usize| v.len() / (20 * per) * per;
+    let f_max = f_n
+        .iter()
+        .flat_map(|v| v[skip(v, 1)..].iter())
+        .chain(f_t.iter().flat_map(|v| v[skip(v, 2)..].iter()))
+        .fold(0.0f64, |a, f| a.max(f.abs()));
     let scale = if f_max > 0.0 { 0.25 / f_max } else { 0.0 };
     let force_times: Vec<i64> = if run.contact_states.is_some() {
         run.contact_states.iter().flatten().map(|(t, _)| ns(*t)).collect()
@@ -354,12 +375,14 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
     };
     let n_rows = force_times.len().min(times.len());
     for (ci, c) in run.contacts.iter().enumerate() {
+        if contact_points[ci].len() < n_rows {
+            continue; // where it acts is unknown: plots only
+        }
         let base = format!("{world}/contacts/{}", escape(&c.name));
-        let norm = c.plane.normal;
+        let norm = c.plane.map_or([0.0, 0.0, 1.0], |p| p.normal);
         let mut colors = Vec::with_capacity(n_rows);
         let mut origins = Vec::with_capacity(n_rows);
         let mut vectors = Vec::with_capacity(n_rows);
-        let mut labels = Vec::with_capacity(n_rows);
         for k in 0..n_rows {
             let fn_k = f_n[ci][k];
             let mode = modes.as_ref().map(|m| m[ci][k]);
@@ -372,12 +395,6 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 f = [0, 1, 2].map(|i| f[i] + a * t1[i] + b * t2[i]);
             }
             vectors.push(vec![f3(f.map(|x| x * scale))]);
-            let what = match mode {
-                Some(m) => schemas::contact_mode::name(m).unwrap_or("?").to_string(),
-                None if fn_k < 0.0 => "pulling".to_string(),
-                None => "pushing".to_string(),
-            };
-            labels.push(vec![format!("{} f_n = {:.1} N ({what})", c.name, fn_k)]);
         }
         let ft = Index::SimTime(force_times[..n_rows].to_vec());
         out.push(
@@ -393,7 +410,6 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         out.push(
             Chunk::new(format!("{base}/force"), ft)
                 .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(ARROWS, "labels", "rerun.components.Text", str_lists(&labels))
                 .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&origins))
                 .with(ARROWS, "vectors", "rerun.components.Vector3D", vec3_lists(&vectors)),
         );

@@ -85,78 +85,79 @@ impl StoreId {
 }
 
 #[derive(Clone, PartialEq, Message)]
-struct SetStoreInfo {
+pub struct SetStoreInfo {
     #[prost(message, optional, tag = "1")]
-    row_id: Option<Tuid>,
+    pub row_id: Option<Tuid>,
     #[prost(message, optional, tag = "2")]
-    info: Option<StoreInfo>,
+    pub info: Option<StoreInfo>,
 }
 
 #[derive(Clone, PartialEq, Message)]
-struct StoreInfo {
+pub struct StoreInfo {
     #[prost(message, optional, tag = "2")]
-    store_id: Option<StoreId>,
+    pub store_id: Option<StoreId>,
     #[prost(message, optional, tag = "5")]
-    store_source: Option<StoreSource>,
+    pub store_source: Option<StoreSource>,
     #[prost(message, optional, tag = "6")]
-    store_version: Option<StoreVersion>,
+    pub store_version: Option<StoreVersion>,
 }
 
 #[derive(Clone, PartialEq, Message)]
-struct StoreSource {
+pub struct StoreSource {
     /// `StoreSourceKind`: 6 = other (the payload is a UTF-8 description).
     #[prost(int32, tag = "1")]
-    kind: i32,
+    pub kind: i32,
     #[prost(message, optional, tag = "2")]
-    extra: Option<StoreSourceExtra>,
+    pub extra: Option<StoreSourceExtra>,
 }
 
 #[derive(Clone, PartialEq, Message)]
-struct StoreSourceExtra {
+pub struct StoreSourceExtra {
     #[prost(bytes = "vec", tag = "1")]
-    payload: Vec<u8>,
+    pub payload: Vec<u8>,
 }
 
 #[derive(Clone, PartialEq, Message)]
-struct StoreVersion {
+pub struct StoreVersion {
     /// `major << 16 | minor << 8 | patch`.
     #[prost(int32, tag = "1")]
-    crate_version_bits: i32,
+    pub crate_version_bits: i32,
 }
 
 #[derive(Clone, PartialEq, Message)]
-struct ArrowMsg {
+pub struct ArrowMsg {
     #[prost(message, optional, tag = "1")]
-    store_id: Option<StoreId>,
+    pub store_id: Option<StoreId>,
     /// `Compression`: 1 = none.
     #[prost(int32, tag = "2")]
-    compression: i32,
+    pub compression: i32,
     #[prost(uint64, tag = "3")]
-    uncompressed_size: u64,
+    pub uncompressed_size: u64,
     /// `Encoding`: 1 = Arrow IPC.
     #[prost(int32, tag = "4")]
-    encoding: i32,
+    pub encoding: i32,
     #[prost(bytes = "vec", tag = "5")]
-    payload: Vec<u8>,
+    pub payload: Vec<u8>,
     #[prost(message, optional, tag = "6")]
-    chunk_id: Option<Tuid>,
+    pub chunk_id: Option<Tuid>,
     #[prost(bool, optional, tag = "7")]
-    is_static: Option<bool>,
+    pub is_static: Option<bool>,
 }
 
 #[derive(Clone, PartialEq, Message)]
-struct BlueprintActivationCommand {
+pub struct BlueprintActivationCommand {
     #[prost(message, optional, tag = "1")]
-    blueprint_id: Option<StoreId>,
+    pub blueprint_id: Option<StoreId>,
     #[prost(bool, tag = "2")]
-    make_active: bool,
+    pub make_active: bool,
     #[prost(bool, tag = "3")]
-    make_default: bool,
+    pub make_default: bool,
 }
 
-const KIND_SET_STORE_INFO: u64 = 1;
-const KIND_ARROW_MSG: u64 = 2;
-const KIND_BLUEPRINT_ACTIVATION: u64 = 3;
+/// Message kinds of the frame header.
+pub const KIND_SET_STORE_INFO: u64 = 1;
+pub const KIND_ARROW_MSG: u64 = 2;
+pub const KIND_BLUEPRINT_ACTIVATION: u64 = 3;
 
 /// An RRD stream being written into memory (the caller writes the bytes atomically).
 pub struct RrdStream {

@@ -31,9 +31,12 @@ pub struct Plane {
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactPoint {
     pub name: String,
-    pub link: String,
+    /// `None` when the recording does not say (no scene, or no `/tf`): no 3D marker then.
+    pub link: Option<String>,
     pub offset_m: [f64; 3],
-    pub plane: Plane,
+    /// `None` when neither the `contacts` record nor the scene gives it: no table is drawn for
+    /// it, and its force arrow points along +z.
+    pub plane: Option<Plane>,
     /// Tangent basis of the friction forces (world frame), from the `contacts` record.
     pub tangents: Option<([f64; 3], [f64; 3])>,
 }
@@ -97,8 +100,8 @@ impl Run {
         };
         let sizes = ArraySizes { joints: joints.len(), contacts: active.len() };
 
-        // geometry
-        let xml = rec.urdf()?.xml;
+        // geometry (a recording of another producer may have no URDF: no visuals then)
+        let xml = rec.record_opt::<schemas::UrdfRecord>()?.map(|u| u.xml).unwrap_or_default();
         let visuals = urdf::visuals(&xml).map_err(|e| bad(&file, format!("metadata urdf: {e}")))?;
         let children = urdf::joint_children(&xml).map_err(|e| bad(&file, format!("metadata urdf: {e}")))?;
 
@@ -117,21 +120,22 @@ impl Run {
             let sc = scene_contacts.iter().find(|c| c.get("name").and_then(|n| n.as_str()) == Some(cname.as_str()));
             let info = record.as_ref().and_then(|r| r.contact(cname));
             let plane = match (info, sc.and_then(|c| scene_plane(c))) {
-                (Some(i), _) => Plane { normal: i.normal, offset_m: i.offset },
-                (None, Some(p)) => p,
-                (None, None) => return Err(bad(&file, format!("contact {cname:?}: no plane in the contacts record or the scene"))),
+                (Some(i), _) => Some(Plane { normal: i.normal, offset_m: i.offset }),
+                (None, p) => p,
             };
             let point = sc.and_then(|c| c.get("point"));
             let link = match (
                 point.and_then(|p| p.get("joint")).and_then(|j| j.as_str()),
                 point.and_then(|p| p.get("link")).and_then(|l| l.as_str()),
             ) {
-                (Some(j), _) => children
-                    .get(j)
-                    .cloned()
-                    .ok_or_else(|| bad(&file, format!("contact {cname:?}: point.joint = {j:?} is no joint of the URDF")))?,
-                (None, Some(l)) => l.to_string(),
-                (None, None) => return Err(bad(&file, format!("contact {cname:?}: the scene does not say where it acts (point.joint or point.link)"))),
+                (Some(j), _) => Some(
+                    children
+                        .get(j)
+                        .cloned()
+                        .ok_or_else(|| bad(&file, format!("contact {cname:?}: point.joint = {j:?} is no joint of the URDF")))?,
+                ),
+                (None, Some(l)) => Some(l.to_string()),
+                (None, None) => None,
             };
             let offset_m = point.and_then(|p| p.get("offset")).and_then(vec3).unwrap_or([0.0; 3]);
             contacts.push(ContactPoint { name: cname.clone(), link, offset_m, plane, tangents: info.map(|i| (i.t1, i.t2)) });
@@ -139,14 +143,17 @@ impl Run {
         let mut other_planes = Vec::new();
         for c in &scene_contacts {
             if let Some(p) = scene_plane(c) {
-                if !contacts.iter().any(|k| k.plane == p) && !other_planes.contains(&p) {
+                if !contacts.iter().any(|k| k.plane == Some(p)) && !other_planes.contains(&p) {
                     other_planes.push(p);
                 }
             }
         }
 
-        // the frame tree
-        let tf: Vec<(f64, Transforms)> = rec.read()?;
+        // the frame tree (none without /tf)
+        let tf: Vec<(f64, Transforms)> = match rec.channel(schemas::topics::TF) {
+            Some(_) => rec.read()?,
+            None => Vec::new(),
+        };
         let mut frames: Vec<(String, Frame)> = Vec::new();
         let mut index: BTreeMap<String, usize> = BTreeMap::new();
         let mut tf_times_ns = Vec::with_capacity(tf.len());
@@ -179,14 +186,18 @@ impl Run {
                 f.in_parent.push(last);
             }
         }
-        let root_frame = frames
-            .iter()
-            .map(|(_, f)| f.parent.clone())
-            .find(|p| !index.contains_key(p))
-            .ok_or_else(|| bad(&file, "/tf has no frames (or no root frame)".into()))?;
-        for c in &contacts {
-            if !index.contains_key(&c.link) {
-                return Err(bad(&file, format!("contact {:?}: link {:?} has no transform in /tf", c.name, c.link)));
+        let root_frame = match frames.iter().map(|(_, f)| f.parent.clone()).find(|p| !index.contains_key(p)) {
+            Some(root) => root,
+            None if frames.is_empty() => "world".to_string(),
+            None => return Err(bad(&file, "/tf: every frame has a parent in /tf (a cycle, no root frame)".into())),
+        };
+        for c in &mut contacts {
+            match &c.link {
+                Some(link) if !frames.is_empty() && !index.contains_key(link) => {
+                    return Err(bad(&file, format!("contact {:?}: link {link:?} has no transform in /tf", c.name)));
+                }
+                Some(_) if frames.is_empty() => c.link = None,
+                _ => {}
             }
         }
 
