@@ -143,6 +143,14 @@ pub enum Error {
     #[error("tables need polars: this build has no feature `tables`; build with `cargo build --release --features tables` (or `cargo install --path . --features tables`)")]
     TablesUnavailable,
 
+    /// A recording cannot be drawn (`analyze view`): what is missing or inconsistent in it.
+    #[error("{file}: {detail}")]
+    View { file: String, detail: String },
+
+    /// `analyze view` needs the feature `rerun` (arrow's IPC writer).
+    #[error("`analyze view` needs the feature `rerun`: build with `cargo build --release --features rerun` (or `cargo install --path . --features rerun`)")]
+    ViewUnavailable,
+
     /// Serializing to JSON failed.
     #[error("writing JSON: {0}")]
     Json(#[from] serde_json::Error),

@@ -8,6 +8,8 @@
 //!   or CSV ([`Format`]).
 //! - `figures` (feature `figures`, on by default): the paper's Fig. 1-25 and more as SVG and PNG
 //!   with an index page, drawn with plotters (`analyze figures`).
+//! - `view` (feature `rerun`, off by default): recordings as Rerun `.rrd` files with a
+//!   blueprint (`analyze view`).
 //!
 //! Typical use (what `sim` does after its runs):
 //! ```no_run
@@ -40,6 +42,7 @@ pub mod figures;
 pub mod frames;
 pub mod summary;
 pub mod metrics;
+pub mod view;
 pub mod render;
 
 pub use compare::Comparison;

@@ -256,6 +256,37 @@ impl TopicMessage for ContactEventMsg {
 impl TopicMessage for JointState {
     const TOPIC: &'static str = topics::JOINT_STATES;
 }
+impl TopicMessage for Transforms {
+    const TOPIC: &'static str = topics::TF;
+}
+
+/// A `/tf` message (`foxglove.FrameTransforms`) as read back: for readers that place geometry
+/// (`analyze view`). The writer writes [`crate::FrameTransforms`]; this is its read side, by
+/// field name, without the timestamps (equal to the log time).
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+pub struct Transforms {
+    pub transforms: Vec<TransformEntry>,
+}
+
+/// One transform of [`Transforms`]: the pose of `child_frame_id` in `parent_frame_id`.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+pub struct TransformEntry {
+    pub parent_frame_id: String,
+    pub child_frame_id: String,
+    /// Position of the child frame's origin in the parent frame, m.
+    pub translation: Vec3,
+    /// Orientation of the child frame in the parent frame, unit quaternion.
+    pub rotation: Quat,
+}
+
+/// A unit quaternion `x i + y j + z k + w` (`foxglove.Quaternion`).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+pub struct Quat {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+    pub w: f64,
+}
 
 /// `std_msgs/msg/String` (ROS 2, CDR). Carries the URDF on [`crate::topics::ROBOT_DESCRIPTION`].
 #[derive(Debug, Clone, PartialEq, Eq, Default)]

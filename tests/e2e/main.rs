@@ -11,6 +11,7 @@ mod bounded_memory;
 mod cli_voice;
 mod format_ownership;
 mod pipeline;
+mod rerun_view;
 mod sampled_energy;
 mod sim_bad_input;
 mod sim_list;

@@ -1,0 +1,73 @@
+//! `analyze view`: recordings as Rerun `.rrd` files that open on the experiment — the arm in 3D
+//! with the table, the target path and the contact forces, the motors' currents and voltages,
+//! the contact forces and modes, the energies and the balance residual, named by joint and
+//! contact, on a `sim_time` duration timeline, laid out by a blueprint (feature `rerun`).
+//!
+//! Written without the `rerun` crate (whose SDK brings an HTTP stack and a newer compiler): the
+//! RRD stream is framed here ([`rrd`], prost for its protobuf messages) and each chunk is an
+//! Arrow record batch in Rerun's chunk layout ([`chunk`], arrow's IPC writer). The layout
+//! follows what the Rerun 0.41 Python SDK writes for the same archetypes and blueprint, and the
+//! acceptance test loads the result back with that SDK (TESTING.md).
+//!
+//! - [`run`]: one recording read for drawing (typed reader of `schemas`);
+//! - [`entities`]: a run's entities as chunks; [`layout`]: the blueprint; [`blueprint`]: a
+//!   blueprint tree as chunks; [`urdf`], [`pose`]: the geometry.
+//!
+//! Ids are deterministic: the recording id is the application id and a hash of the input bytes,
+//! and chunk and row ids count up from a fixed time, so the same inputs give the same bytes.
+
+#[cfg(feature = "rerun")]
+pub mod blueprint;
+#[cfg(feature = "rerun")]
+pub mod chunk;
+#[cfg(feature = "rerun")]
+pub mod entities;
+#[cfg(feature = "rerun")]
+pub mod layout;
+#[cfg(feature = "rerun")]
+pub mod pose;
+#[cfg(feature = "rerun")]
+pub mod rrd;
+#[cfg(feature = "rerun")]
+pub mod run;
+#[cfg(feature = "rerun")]
+pub mod urdf;
+
+
+#[cfg(feature = "rerun")]
+mod encode;
+#[cfg(all(test, feature = "rerun"))]
+mod tests;
+#[cfg(feature = "rerun")]
+pub use encode::{encode, fnv1a, labels, read_input, Input};
+
+use std::path::{Path, PathBuf};
+
+use crate::Error;
+
+/// Converts the recordings `inputs` into one `.rrd` at `out` (written atomically, its directory
+/// created if needed), application
+/// id = `out`'s file stem; `progress` is called after each input is read. Returns the bytes
+/// written. Without the feature `rerun`, an error that says how to get it.
+pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<u64, Error> {
+    #[cfg(feature = "rerun")]
+    {
+        let mut read = Vec::with_capacity(inputs.len());
+        for p in inputs {
+            read.push(read_input(p)?);
+            progress();
+        }
+        let app_id = out.file_stem().map_or_else(|| "recording".to_string(), |s| s.to_string_lossy().into_owned());
+        let bytes = encode(&read, &app_id)?;
+        if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|source| Error::Io { file: dir.display().to_string(), op: "creating the directory", source })?;
+        }
+        schemas::atomic::write_file(out, &bytes)?;
+        Ok(bytes.len() as u64)
+    }
+    #[cfg(not(feature = "rerun"))]
+    {
+        let _ = (inputs, out, progress);
+        Err(Error::ViewUnavailable)
+    }
+}

@@ -1,0 +1,115 @@
+//! `analyze view`: recordings as Rerun `.rrd` files with a blueprint (`analyze::view`, feature
+//! `rerun`); without the feature, an error that says how to get it.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Result};
+use cli::{exit, Verbosity};
+
+/// Recordings as Rerun .rrd files that open on the experiment: the arm in 3D with the table,
+/// the target path, the hand (actual and target) and the contact forces coloured by mode; motor
+/// currents and voltages, contact forces and modes, energies per joint, the totals and the
+/// balance residual as plots named by joint and contact; a `sim_time` duration timeline; a
+/// blueprint that lays it out. Several recordings with -o: one file, side by side.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Output: <stem>.rrd beside each recording, or OUT.rrd with -o (every input in one file: one 3D
+view per run, energies of all runs overlaid, one plot per run and signal). The application id
+is the file stem (Rerun applies a blueprint per application id). Needs the feature `rerun`.
+
+Examples:
+  analyze view out/paper-two-elbow.mcap            -> out/paper-two-elbow.rrd
+  analyze view out/paper-two-elbow.mcap --spawn    and open it in the Rerun viewer
+  analyze view out/ -o out/paper.rrd               every out/*.mcap side by side in one file
+  rerun out/paper-two-elbow.rrd                    open a converted file (Rerun 0.41)")]
+pub struct ViewArgs {
+    /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
+    #[arg(required = true, value_name = "FILES_OR_DIRS")]
+    pub inputs: Vec<PathBuf>,
+    /// Write every input into this one .rrd, side by side [default: <stem>.rrd beside each
+    /// input].
+    #[arg(short = 'o', long = "out", value_name = "OUT.rrd")]
+    pub out: Option<PathBuf>,
+    /// Open the result in the Rerun viewer (`rerun` must be on PATH).
+    #[arg(long)]
+    pub spawn: bool,
+}
+
+fn stem(p: &Path) -> String {
+    p.file_stem().map_or_else(|| "recording".into(), |s| s.to_string_lossy().into_owned())
+}
+
+/// `analyze view`.
+pub fn run(a: &ViewArgs, v: Verbosity) -> Result<u8> {
+    let paths = cli::inputs::expand(&a.inputs)?;
+    // (output, its inputs)
+    let jobs: Vec<(PathBuf, Vec<PathBuf>)> = match &a.out {
+        Some(out) => {
+            if out.extension().is_none_or(|e| e != "rrd") {
+                bail!("-o {}: the output must be a .rrd file", out.display());
+            }
+            vec![(out.clone(), paths.clone())]
+        }
+        None => paths.iter().map(|p| (p.with_extension("rrd"), vec![p.clone()])).collect(),
+    };
+    if a.out.is_some() && paths.len() > 1 {
+        let mut stems: Vec<String> = paths.iter().map(|p| stem(p)).collect();
+        stems.sort();
+        if let Some(w) = stems.windows(2).find(|w| w[0] == w[1]) {
+            bail!("two inputs are named {:?}: in one .rrd each run needs its own name; rename one", w[0]);
+        }
+    }
+    if a.spawn {
+        which_rerun()?;
+    }
+    let written = convert(&jobs, v)?;
+    if a.spawn {
+        let status = std::process::Command::new("rerun").args(&written).status();
+        match status {
+            Ok(s) if s.success() => {}
+            Ok(s) => bail!("the Rerun viewer exited with {s}"),
+            Err(e) => bail!("starting the Rerun viewer (`rerun`): {e}"),
+        }
+    }
+    Ok(exit::SUCCESS)
+}
+
+/// `rerun` on PATH, or an error that says how to get it.
+fn which_rerun() -> Result<()> {
+    let found = std::env::var_os("PATH")
+        .map(|p| std::env::split_paths(&p).any(|d| d.join("rerun").is_file()))
+        .unwrap_or(false);
+    if !found {
+        bail!("--spawn: the Rerun viewer `rerun` is not on PATH; install it with `pip install rerun-sdk==0.41.0` (or open the .rrd later with `rerun FILE.rrd`)");
+    }
+    Ok(())
+}
+
+fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<Vec<PathBuf>> {
+    use anyhow::Context;
+    let total: usize = jobs.iter().map(|(_, i)| i.len()).sum();
+    let bar = cli::progress::count(total, "reading", "recordings", v.quiet || total < 2);
+    let mut written = Vec::new();
+    for (out, inputs) in jobs {
+        let started = std::time::Instant::now();
+        let names = inputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+        let size = analyze::view::convert(inputs, out, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
+        if !v.quiet {
+            let mcap: u64 = inputs.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
+            bar.suspend(|| {
+                eprintln!(
+                    "analyze: {names} -> {} ({} run{}, {:.2} MB from {:.2} MB of MCAP, {:.2} s)",
+                    out.display(),
+                    inputs.len(),
+                    if inputs.len() == 1 { "" } else { "s" },
+                    size as f64 / 1e6,
+                    mcap as f64 / 1e6,
+                    started.elapsed().as_secs_f64()
+                )
+            });
+        }
+        written.push(out.clone());
+    }
+    bar.finish_and_clear();
+    Ok(written)
+}

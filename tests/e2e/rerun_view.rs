@@ -1,0 +1,172 @@
+//! The acceptance test of `analyze view`: a paper recording and a unilateral one converted by
+//! the binary, then read by Rerun itself (the 0.41 Python SDK's reader, `rerun_facts.py`): the
+//! blueprint's views exist (3D arm and hand close-up, plots of currents, voltages, contact
+//! forces, energies, residual), the typed scalar entities exist under the names of the joints
+//! and contacts of the recording, with one row per recorded sample, on a duration timeline.
+//!
+//! The Python is `ELBOW_RERUN_PYTHON` (default `~/.cache/elbow-sim/venv-check/bin/python`, the
+//! venv of `.ci/run`); without it the test fails under CI (`CI` set) and is skipped otherwise.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde::Deserialize;
+
+use crate::{run_analyze, run_sim};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Store {
+    kind: String,
+    application_id: String,
+    recording_id: String,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ViewFact {
+    class: String,
+    name: String,
+    origin: String,
+    query: Vec<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Container {
+    kind: u8,
+    contents: Vec<String>,
+}
+
+/// What `rerun_facts.py` prints.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Facts {
+    stores: Vec<Store>,
+    views: Vec<ViewFact>,
+    containers: Vec<Container>,
+    entities: std::collections::BTreeMap<String, Vec<String>>,
+    timelines: std::collections::BTreeMap<String, String>,
+    series_names: std::collections::BTreeMap<String, Vec<String>>,
+    rows: std::collections::BTreeMap<String, usize>,
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The Python with rerun-sdk 0.41, or `None` (skipped) when it is missing and `CI` is not set.
+fn rerun_python() -> Option<PathBuf> {
+    let p = std::env::var_os("ELBOW_RERUN_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(std::env::var_os("HOME").unwrap_or_default()).join(".cache/elbow-sim/venv-check/bin/python"));
+    let works = Command::new(&p).args(["-c", "import rerun.chunk"]).output().is_ok_and(|o| o.status.success());
+    match (works, std::env::var_os("CI").is_some()) {
+        (true, _) => Some(p),
+        (false, true) => panic!("{}: no Python with rerun-sdk 0.41 (set ELBOW_RERUN_PYTHON); CI needs it for this test", p.display()),
+        (false, false) => {
+            eprintln!("rerun_view: skipped: {} has no rerun-sdk 0.41 (set ELBOW_RERUN_PYTHON, or make the venv of .ci/run)", p.display());
+            None
+        }
+    }
+}
+
+fn facts(python: &Path, rrd: &Path) -> Facts {
+    let o = Command::new(python).arg(root().join("tests/e2e/rerun_facts.py")).arg(rrd).output().expect("python starts");
+    assert!(o.status.success(), "rerun_facts.py {}: {}", rrd.display(), String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&o.stdout)))
+}
+
+fn view(f: &Facts, class: &str, origin: &str) -> bool {
+    f.views.iter().any(|v| v.class == class && v.origin == origin)
+}
+
+/// Converts `mcap` to `rrd` with the binary and checks what Rerun reads against the recording.
+fn check(python: &Path, mcap: &Path, rrd: &Path) -> Facts {
+    let o = run_analyze(&[Path::new("view"), mcap, Path::new("-o"), rrd]);
+    assert!(o.status.success(), "analyze view: {}", String::from_utf8_lossy(&o.stderr));
+    let f = facts(python, rrd);
+    let rec = schemas::read_recording(mcap).unwrap();
+    let run = rec.run().unwrap();
+    let samples = rec.read::<schemas::MotorState>().unwrap().len();
+    let stem = rrd.file_stem().unwrap().to_string_lossy().into_owned();
+
+    // one recording and one blueprint, both of the file stem's application id
+    assert_eq!(f.stores.len(), 2, "{:?}", f.stores);
+    assert!(f.stores.iter().all(|s| s.application_id == stem), "{:?}", f.stores);
+    assert!(f.stores.iter().any(|s| s.kind == "blueprint") && f.stores.iter().any(|s| s.kind == "recording"));
+    assert!(f.stores.iter().all(|s| !s.recording_id.is_empty()));
+    // the simulated time as a duration, not a 1970 timestamp
+    assert_eq!(f.timelines.get("sim_time").map(String::as_str), Some("duration[ns]"), "{:?}", f.timelines);
+
+    // the blueprint: the arm and the hand in 3D, the plots of the experiment, laid out
+    assert_eq!(f.views.iter().filter(|v| v.class == "3D" && v.origin == "/world").count(), 2, "{:?}", f.views);
+    assert!(f.views.iter().any(|v| v.class == "3D" && v.name.contains("side view")));
+    assert!(f.views.iter().any(|v| v.class == "3D" && v.name.contains("hand")));
+    for origin in ["/current_A", "/voltage_V", "/normal_force_N", "/electric_energy_J", "/link_work_J", "/energy_J", "/energy_residual_J"] {
+        assert!(view(&f, "TimeSeries", origin), "no time series of {origin}: {:?}", f.views);
+    }
+    assert!(f.views.iter().all(|v| !v.query.is_empty()));
+    assert!(!f.containers.is_empty() && f.containers.iter().all(|c| (1..=4).contains(&c.kind) && !c.contents.is_empty()));
+
+    // typed scalars named by joint and contact, one row per sample, their series named
+    for j in &run.joint_names {
+        for (signal, unit) in [("current_A", "A"), ("voltage_V", "V"), ("electric_energy_J", "J"), ("link_work_J", "J")] {
+            let e = format!("/{signal}/{j}");
+            assert_eq!(f.entities.get(&e).map(|c| c.contains(&"Scalars:scalars".to_string())), Some(true), "{e}: {:?}", f.entities.get(&e));
+            assert_eq!(f.rows.get(&e), Some(&samples), "{e}");
+            let name = &f.series_names[&e];
+            assert!(name.len() == 1 && name[0].contains(j.as_str()) && name[0].contains(&format!("[{unit}]")), "{e}: {name:?}");
+        }
+    }
+    for c in &run.contacts {
+        let e = format!("/normal_force_N/{c}");
+        assert!(f.rows.get(&e).is_some_and(|&n| n == samples), "{e}: {:?}", f.rows.get(&e));
+        assert!(f.series_names[&e][0].contains(c.as_str()));
+        // the contact in 3D: a marker and a force arrow
+        assert!(f.entities.contains_key(&format!("/world/contacts/{c}")), "{c}");
+        assert!(f.entities[&format!("/world/contacts/{c}/force")].contains(&"Arrows3D:vectors".to_string()));
+    }
+    for e in ["/energy_J/electric-in", "/energy_J/link-work", "/energy_residual_J"] {
+        assert_eq!(f.rows.get(e), Some(&samples), "{e}");
+    }
+    // the scene in 3D: the arm from the URDF, the table, the target path, the hand points
+    assert!(f.entities.keys().any(|e| e.starts_with("/world/") && f.entities[e].iter().any(|c| c.starts_with("Cylinders3D:") || c.starts_with("Boxes3D:"))));
+    assert!(f.entities.get("/world/table0").is_some_and(|c| c.contains(&"Boxes3D:half_sizes".to_string())));
+    assert!(f.entities.get("/world/target_path").is_some_and(|c| c.contains(&"LineStrips3D:strips".to_string())));
+    for e in ["/world/hand/actual", "/world/hand/desired"] {
+        assert!(f.entities.get(e).is_some_and(|c| c.contains(&"Points3D:positions".to_string()) && c.contains(&"Points3D:colors".to_string())), "{e}");
+    }
+    f
+}
+
+#[test]
+fn rerun_reads_the_blueprint_and_named_scalars_of_a_paper_and_a_unilateral_recording() {
+    let Some(python) = rerun_python() else { return };
+    let dir = tempfile::tempdir().unwrap();
+
+    // the paper's two-elbow run (bilateral: /constraints)
+    let paper = root().join("recordings/paper-archive-two-elbow.mcap");
+    let f = check(&python, &paper, &dir.path().join("paper-two-elbow.rrd"));
+    assert!(!view(&f, "TimeSeries", "/contact_mode"), "a bilateral run has no modes");
+
+    // a unilateral run, short (its modes, friction and events)
+    let o = run_sim(&[
+        "run",
+        &root().join("sim/scenes/paper_unilateral.json").to_string_lossy(),
+        "--run",
+        "two-elbow-unilateral",
+        "--duration",
+        "0.2",
+        "-q",
+        "-o",
+        &dir.path().to_string_lossy(),
+    ]);
+    assert!(o.status.success(), "sim: {}", String::from_utf8_lossy(&o.stderr));
+    let uni = dir.path().join("paper-unilateral-two-elbow-unilateral.mcap");
+    let f = check(&python, &uni, &dir.path().join("unilateral.rrd"));
+    for origin in ["/contact_mode", "/friction_force_N"] {
+        assert!(view(&f, "TimeSeries", origin), "no time series of {origin}: {:?}", f.views);
+    }
+    assert!(f.entities.contains_key("/contact_mode/elbow4") && f.entities.contains_key("/friction_force_N/elbow7"));
+}
