@@ -327,7 +327,7 @@ import pyarrow.parquet as pq
 d = sys.argv[1] + "/{}/format-v1-small-elbow/"
 t = pq.read_table(d.format("w") + "motors.parquet")
 units = {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in t.schema}
-file_units = json.loads(t.schema.metadata[b"units"])
+file_units = json.loads(pq.read_metadata(d.format("w") + "motors.parquet").metadata[b"units"])
 head = next(csv.reader(open(d.format("c") + "motors.csv", encoding="utf-8")))
 split = [re.fullmatch(r"(.*) \[(.*)\]", h).groups() if "[" in h else (h, "") for h in head]
 long = pq.read_table(d.format("l") + "motors.parquet").to_pydict()

@@ -259,6 +259,13 @@ impl Columns {
     }
 }
 
+fn join(path: &mut String, key: &str) {
+    if !path.is_empty() {
+        path.push('.');
+    }
+    path.push_str(key);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
