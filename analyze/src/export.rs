@@ -1,8 +1,24 @@
 //! `analyze export` as one call: a recording's topics ([`crate::frames`], feature `tables`) as
-//! Parquet or CSV tables and `metadata.json`, so that a caller needs no polars type and a build
-//! without the feature says what is missing. Every file goes through `schemas::atomic` (a lock on
-//! the final name, a temporary name of its own, a rename), so neither a killed export nor a
-//! second one at the same time ever leaves a half-written table under its final name.
+//! Parquet or CSV tables, wide or long, and `metadata.json`, so that a caller needs no polars
+//! type and a build without the feature says what is missing. Every file goes through
+//! `schemas::atomic` (a lock on the final name, a temporary name of its own, a rename), so
+//! neither a killed export nor a second one at the same time ever leaves a half-written table
+//! under its final name.
+//!
+//! Units (`schemas::units`, the one table) travel with the tables:
+//! - Parquet: each column's Arrow field metadata `unit` (`current.joint4` → `A`), which is how
+//!   Arrow carries per-column metadata into Parquet (the `ARROW:schema` key of the file's
+//!   key-value metadata, <https://arrow.apache.org/docs/format/Columnar.html#custom-application-metadata>
+//!   and the Parquet format's `FileMetaData.key_value_metadata`): pyarrow reads it as
+//!   `schema.field(name).metadata[b"unit"]`, polars (Rust) as the Arrow schema's field metadata.
+//!   polars' `ParquetWriter` builds the Arrow schema from the frame's dtypes alone (polars 0.55
+//!   fields have no metadata), so the key is written here, from the same dtypes with the units
+//!   added, through the writer's key-value metadata (which then takes the place of its own).
+//!   The file also has a key `units`: a JSON object column → unit, for readers that show only
+//!   the file's key-value metadata (`polars.read_parquet_metadata` in Python);
+//! - CSV: in the header, `name [unit]` (`current.joint4 [A]`, `time [s]`); a column without a
+//!   unit is its bare name. `re.fullmatch(r"(.*) \[(.*)\]", header)` splits them.
+//! - long layout: a `unit` column beside `value`.
 
 use std::path::Path;
 #[cfg(feature = "tables")]
@@ -12,7 +28,7 @@ use std::path::PathBuf;
 use polars::prelude::*;
 
 #[cfg(feature = "tables")]
-use crate::frames::RecordingFrames;
+use crate::frames::{self, RecordingFrames, TopicFrame};
 use crate::Error;
 
 /// File format of the tables.
@@ -31,6 +47,44 @@ impl ExportFormat {
     }
 }
 
+/// Shape of the tables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Layout {
+    /// One row per sample, one column per signal (`current.joint4`).
+    #[default]
+    Wide,
+    /// One row per sample and signal: `time, topic, signal, name, unit, value`
+    /// (`crate::frames::long`).
+    Long,
+}
+
+impl Layout {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Layout::Wide => "wide",
+            Layout::Long => "long",
+        }
+    }
+}
+
+/// What to export and how.
+#[derive(Debug, Clone, Copy)]
+pub struct ExportOptions<'a> {
+    pub format: ExportFormat,
+    pub layout: Layout,
+    /// Only these topics (viewer layouts too); empty: the default set (every decoded topic but
+    /// viewer layouts, `crate::frames::is_viewer_layout`).
+    pub topics: &'a [&'a str],
+    /// Viewer-layout topics to add to the default set (`tf`, `/hand_points`, `all`).
+    pub include: &'a [&'a str],
+}
+
+impl Default for ExportOptions<'_> {
+    fn default() -> Self {
+        Self { format: ExportFormat::Parquet, layout: Layout::Wide, topics: &[], include: &[] }
+    }
+}
+
 /// What [`export_file`] wrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Exported {
@@ -38,18 +92,19 @@ pub struct Exported {
     pub tables: usize,
     /// Rows over all tables.
     pub rows: usize,
-    /// Topics not decoded (their reasons are in `metadata.json`).
+    /// Topics not exported (their reasons are in `metadata.json`).
     pub skipped: usize,
 }
 
-/// Writes the topics of the recording at `path` (all, or `topics`) into `dir`. A topic asked
-/// for that the recording does not have (with messages) is an error naming it.
-pub fn export_file(path: &Path, dir: &Path, format: ExportFormat, topics: &[&str]) -> Result<Exported, Error> {
+/// Writes the topics of the recording at `path` into `dir`. A topic asked for (`topics`) that
+/// the recording does not have (with messages) is an error naming it.
+pub fn export_file(path: &Path, dir: &Path, options: &ExportOptions<'_>) -> Result<Exported, Error> {
     #[cfg(feature = "tables")]
     {
-        use crate::frames;
         let file = || path.display().to_string();
-        let mut f = frames::read_frames(path, (!topics.is_empty()).then_some(topics))?;
+        let topics = options.topics;
+        let select = frames::Selection { only: (!topics.is_empty()).then_some(topics), include: options.include };
+        let mut f = frames::read_frames(path, select)?;
         for t in topics {
             if f.get(t).is_none() {
                 let why = f.skipped.iter().find(|(s, _)| s == t).map(|(_, w)| w.clone());
@@ -60,17 +115,15 @@ pub fn export_file(path: &Path, dir: &Path, format: ExportFormat, topics: &[&str
                 return Err(Error::Table { file: file(), detail: format!("topic {t}: {why}") });
             }
         }
-        let files = write_tables(&mut f, dir, format)?;
-        let rows = f.topics.iter().map(|(_, df)| df.height()).sum();
-        Ok(Exported { tables: files.len() - 1, rows, skipped: f.skipped.len() })
+        let written = write_tables(&mut f, dir, options.format, options.layout)?;
+        Ok(Exported { tables: written.tables.len(), rows: written.rows, skipped: f.skipped.len() })
     }
     #[cfg(not(feature = "tables"))]
     {
-        let _ = (path, dir, format, topics);
+        let _ = (path, dir, options);
         Err(Error::TablesUnavailable)
     }
 }
-
 
 #[cfg(feature = "tables")]
 /// The file name of a topic's table: `/joint_states` -> `joint_states.parquet`.
@@ -92,8 +145,8 @@ fn file_names(frames: &RecordingFrames, format: ExportFormat) -> Vec<String> {
     frames
         .topics
         .iter()
-        .map(|(t, _)| {
-            let base = topic_file_name(t, format);
+        .map(|t| {
+            let base = topic_file_name(&t.topic, format);
             let mut name = base.clone();
             let mut k = 2;
             while !used.insert(name.clone()) {
@@ -106,41 +159,140 @@ fn file_names(frames: &RecordingFrames, format: ExportFormat) -> Vec<String> {
         .collect()
 }
 
-/// Writes one file per topic into `dir` (created if needed) plus `metadata.json` (the
-/// metadata records, and the topics skipped with the reason); returns the files written.
+/// What [`write_tables`] wrote.
 #[cfg(feature = "tables")]
-pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportFormat) -> Result<Vec<PathBuf>, Error> {
+#[derive(Debug, Clone)]
+pub struct Written {
+    /// The topic tables.
+    pub tables: Vec<PathBuf>,
+    /// Rows over all of them.
+    pub rows: usize,
+    /// `metadata.json`.
+    pub metadata: PathBuf,
+}
+
+/// The `time` column's description in `metadata.json`.
+#[cfg(feature = "tables")]
+const TIME_DOC: &str = "the sample's simulated time in s from the start of the run (the MCAP log time, whole ns); \
+     the only time column: every topic's times are equal where their samples are";
+
+/// Writes one file per topic into `dir` (created if needed), in `layout`, plus `metadata.json`
+/// (the metadata records typed, each table's columns and units, and the topics not exported
+/// with the reason).
+#[cfg(feature = "tables")]
+pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportFormat, layout: Layout) -> Result<Written, Error> {
     std::fs::create_dir_all(dir).map_err(|source| Error::Io {
         file: dir.display().to_string(),
         op: "creating",
         source,
     })?;
-    let mut written = Vec::new();
     let files = file_names(frames, format);
-    for ((_, df), name) in frames.topics.iter_mut().zip(&files) {
+    let mut tables = Vec::new();
+    let mut rows = 0;
+    let mut listed = Vec::new();
+    for (t, name) in frames.topics.iter().zip(&files) {
         let path = dir.join(name);
+        let table_err = |e: PolarsError| Error::Table { file: path.display().to_string(), detail: format!("building the table: {e}") };
+        let (mut df, units, text) = match layout {
+            Layout::Wide => (t.frame.clone(), wide_units(t), Vec::new()),
+            Layout::Long => {
+                let (df, text) = frames::long::long_frame(t).map_err(table_err)?;
+                (df, vec![(frames::TIME_COLUMN.to_string(), frames::TIME_UNIT)], text)
+            }
+        };
         write_atomic(&path, |f| match format {
-            ExportFormat::Parquet => ParquetWriter::new(f).finish(df).map(drop),
-            ExportFormat::Csv => CsvWriter::new(f).include_header(true).finish(df),
+            ExportFormat::Parquet => {
+                let kv = parquet_metadata(&df, &units);
+                ParquetWriter::new(f).with_key_value_metadata(Some(kv)).finish(&mut df).map(drop)
+            }
+            ExportFormat::Csv => {
+                let mut headed = df.clone();
+                headed.set_column_names(csv_header(&df, &units).as_slice())?;
+                CsvWriter::new(f).include_header(true).finish(&mut headed)
+            }
         })?;
-        written.push(path);
+        rows += df.height();
+        let mut entry = serde_json::json!({
+            "topic": t.topic,
+            "schema": t.schema_name,
+            "file": name,
+            "rows": df.height(),
+            "columns": df.get_column_names().iter().map(|c| c.as_str()).collect::<Vec<_>>(),
+            "units": wide_units(t).into_iter().map(|(c, u)| (c, serde_json::Value::from(u))).collect::<serde_json::Map<_, _>>(),
+        });
+        if !text.is_empty() {
+            entry["text_columns_left_out"] = serde_json::json!(text);
+        }
+        listed.push(entry);
+        tables.push(path);
     }
     let meta = serde_json::json!({
         "source": frames.source,
-        "metadata": frames.metadata,
-        "topics": frames.topics.iter().zip(&files).map(|((t, df), file)| serde_json::json!({
-            "topic": t,
-            "file": file,
-            "rows": df.height(),
-            "columns": df.get_column_names().iter().map(|c| c.as_str()).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
+        "format": format.extension(),
+        "layout": layout.as_str(),
+        "time": {"column": frames::TIME_COLUMN, "unit": frames::TIME_UNIT, "doc": TIME_DOC},
+        "units": "Parquet: each column's field metadata `unit` (and the file's key `units`); CSV: `name [unit]` in the header; long layout: the `unit` column; here: `topics[].units`",
+        "metadata": schemas::meta::typed_records(&frames.metadata),
+        "topics": listed,
         "skipped": frames.skipped.iter().map(|(t, why)| serde_json::json!({"topic": t, "reason": why})).collect::<Vec<_>>(),
     });
     let path = dir.join("metadata.json");
     let text = serde_json::to_string_pretty(&meta).unwrap_or_default() + "\n";
     schemas::atomic::write_file(&path, text)?;
-    written.push(path);
-    Ok(written)
+    Ok(Written { tables, rows, metadata: path })
+}
+
+/// `(column, unit)` of the wide table's columns that have a unit.
+#[cfg(feature = "tables")]
+fn wide_units(t: &TopicFrame) -> Vec<(String, &'static str)> {
+    t.columns.iter().filter_map(|c| Some((c.name.clone(), c.unit?))).collect()
+}
+
+#[cfg(feature = "tables")]
+fn unit_of(units: &[(String, &'static str)], column: &str) -> Option<&'static str> {
+    units.iter().find(|(n, _)| n == column).map(|(_, u)| *u)
+}
+
+/// The CSV header: `name [unit]` where the column has a unit.
+#[cfg(feature = "tables")]
+pub fn csv_header(df: &DataFrame, units: &[(String, &'static str)]) -> Vec<String> {
+    df.get_column_names()
+        .iter()
+        .map(|c| match unit_of(units, c.as_str()) {
+            Some(u) => format!("{c} [{u}]"),
+            None => c.to_string(),
+        })
+        .collect()
+}
+
+/// The Parquet field-metadata key of a column's unit.
+#[cfg(feature = "tables")]
+pub const PARQUET_UNIT_KEY: &str = "unit";
+
+/// The file's key-value metadata: `ARROW:schema` (the Arrow schema polars' writer would
+/// write, built the same way from the frame's dtypes, with each column's unit as field
+/// metadata [`PARQUET_UNIT_KEY`]) and `units` (JSON: column → unit).
+#[cfg(feature = "tables")]
+fn parquet_metadata(df: &DataFrame, units: &[(String, &'static str)]) -> KeyValueMetadata {
+    let schema: ArrowSchema = df
+        .schema()
+        .to_arrow(CompatLevel::newest())
+        .into_iter()
+        .map(|(name, field)| {
+            let field = match unit_of(units, &name) {
+                Some(u) => field.with_metadata([(PlSmallStr::from_static(PARQUET_UNIT_KEY), PlSmallStr::from_static(u))].into()),
+                None => field,
+            };
+            (name, field)
+        })
+        .collect();
+    let arrow = polars_parquet::write::schema_to_metadata_key(&schema);
+    let json: serde_json::Map<String, serde_json::Value> = units.iter().map(|(c, u)| (c.clone(), (*u).into())).collect();
+    let mut kv = vec![("units".to_string(), serde_json::Value::Object(json).to_string())];
+    if let Some(value) = arrow.value {
+        kv.insert(0, (arrow.key, value));
+    }
+    KeyValueMetadata::from_static(kv)
 }
 
 /// Writes `path` with `write` atomically and exclusively (`schemas::atomic`); errors name the

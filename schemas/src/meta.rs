@@ -39,6 +39,8 @@ use serde::{Deserialize, Serialize};
 
 mod contacts;
 pub use contacts::{ContactInfo, ContactsRecord};
+mod typed;
+pub use typed::{typed_records, typed_value};
 
 /// A metadata record: its MCAP name and its keys (the struct's fields, every value text).
 pub trait MetadataRecord: Serialize + DeserializeOwned {

@@ -6,9 +6,13 @@
 //! - an array is expanded, one column per entry, named by its *label*: the joint or contact
 //!   name for our arrays ([`schemas::topics::array_index`] and the names in the metadata:
 //!   `current.joint4`, `normal_force.elbow7`); the entry of the message's own `name` list for
-//!   arrays beside one (`sensor_msgs/JointState`: `position.joint4`); the `child_frame_id` of a
+//!   arrays beside one (`sensor_msgs/JointState`: `position.joint4`; since format version 3 also
+//!   `/motors`, `/energy` and `/constraints`, whose `name` is the run's joint or contact names in
+//!   array order, so a format-2 file without it gets the same columns); the `child_frame_id` of a
 //!   list of transforms (`transforms.link4.translation.z`); else the index (`data.0`);
-//! - a list that provided labels (JointState's `name`) is not a column itself;
+//! - a list that provided labels (the `name` above) is not a column itself;
+//! - each column also knows its field (the path without labels: `current`, as
+//!   `schemas::units` spells it) and its entry's label, for units and the long layout;
 //! - `bytes` fields (a point cloud's packed data) are left out: they are not per-field values.
 //!
 //! A column first seen at a later message, or missing from one, holds nulls there (a run whose
@@ -114,20 +118,58 @@ fn text(x: &Value) -> String {
 /// Labels of the entries of an array at a field path (`None`: label by index).
 pub type Labeller<'a> = dyn Fn(&str) -> Option<&'a [String]> + 'a;
 
+/// What a column holds: the message field (its path without array labels, as
+/// `schemas::units` spells it: `current`, `actual.x`, `transforms.translation.z`) and the label
+/// of the array entry (`joint4`, `elbow7`, `link3`, `0`; several joined with `.` for arrays in
+/// arrays), `None` for a field outside any array.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ColumnField {
+    pub field: String,
+    pub label: Option<String>,
+}
+
 /// Columns built row by row, in the order their fields first appear.
 #[derive(Debug, Default)]
 pub struct Columns {
     names: Vec<String>,
+    fields: Vec<ColumnField>,
     index: HashMap<String, usize>,
     data: Vec<ColumnData>,
     rows: usize,
 }
 
+/// Where the visit is: the column name, the field path and the labels so far.
+#[derive(Default)]
+struct Cursor {
+    name: String,
+    field: String,
+    label: String,
+}
+
+impl Cursor {
+    fn lens(&self) -> (usize, usize, usize) {
+        (self.name.len(), self.field.len(), self.label.len())
+    }
+    fn truncate(&mut self, (a, b, c): (usize, usize, usize)) {
+        self.name.truncate(a);
+        self.field.truncate(b);
+        self.label.truncate(c);
+    }
+    fn key(&mut self, key: &str) {
+        join(&mut self.name, key);
+        join(&mut self.field, key);
+    }
+    fn entry(&mut self, label: &str) {
+        join(&mut self.name, label);
+        join(&mut self.label, label);
+    }
+}
+
 impl Columns {
     /// Appends one message as a row; `labels` names the entries of arrays by field path.
     pub fn push_row(&mut self, msg: &Value, labels: &Labeller<'_>) {
-        let mut path = String::new();
-        self.visit(msg, &mut path, labels);
+        let mut at = Cursor::default();
+        self.visit(msg, &mut at, labels);
         self.rows += 1;
         for col in &mut self.data {
             if col.len() < self.rows {
@@ -141,20 +183,22 @@ impl Columns {
         self.rows
     }
 
-    /// `(name, values)` in first-appearance order.
-    pub fn into_columns(self) -> impl Iterator<Item = (String, ColumnData)> {
-        self.names.into_iter().zip(self.data)
+    /// `(name, what it holds, values)` in first-appearance order.
+    pub fn into_columns(self) -> impl Iterator<Item = (String, ColumnField, ColumnData)> {
+        self.names.into_iter().zip(self.fields).zip(self.data).map(|((n, f), d)| (n, f, d))
     }
 
-    fn scalar(&mut self, path: &str, x: &Value) {
-        let k = match self.index.get(path) {
+    fn scalar(&mut self, at: &Cursor, x: &Value) {
+        let k = match self.index.get(&at.name) {
             Some(&k) => k,
             None => {
                 let Some(col) = ColumnData::empty_like(x, self.rows) else {
                     return;
                 };
-                self.names.push(path.to_string());
-                self.index.insert(path.to_string(), self.data.len());
+                self.names.push(at.name.clone());
+                let label = (!at.label.is_empty()).then(|| at.label.clone());
+                self.fields.push(ColumnField { field: at.field.clone(), label });
+                self.index.insert(at.name.clone(), self.data.len());
                 self.data.push(col);
                 self.data.len() - 1
             }
@@ -166,56 +210,51 @@ impl Columns {
         col.push(x);
     }
 
-    fn visit(&mut self, v: &Value, path: &mut String, labels: &Labeller<'_>) {
+    fn visit(&mut self, v: &Value, at: &mut Cursor, labels: &Labeller<'_>) {
         match v {
             Value::Bytes(_) => {}
             Value::Struct(fields) => {
-                // sensor_msgs/JointState: `name` labels its sibling arrays
+                // sensor_msgs/JointState, and since format 3 /motors, /energy, /constraints:
+                // `name` labels its sibling arrays
                 let names: Option<Vec<String>> = fields
                     .iter()
                     .find(|(k, _)| k == schemas::topics::LABEL_LIST_FIELD)
                     .and_then(|(_, v)| v.as_list())
                     .and_then(|l| l.iter().map(|x| x.as_str().map(String::from)).collect());
-                let len = path.len();
+                let len = at.lens();
                 for (key, field) in fields {
                     if key == schemas::topics::LABEL_LIST_FIELD && names.is_some() && field.as_list().is_some() {
                         continue;
                     }
-                    join(path, key);
+                    at.key(key);
                     match (field, &names) {
                         (Value::List(items), Some(n)) if items.len() == n.len() => {
-                            self.list(items, path, Some(n), labels);
+                            self.list(items, at, Some(n), labels);
                         }
-                        _ => self.visit(field, path, labels),
+                        _ => self.visit(field, at, labels),
                     }
-                    path.truncate(len);
+                    at.truncate(len);
                 }
             }
             Value::List(items) => {
-                let own = labels(path);
-                self.list(items, path, own, labels);
+                let own = labels(&at.field);
+                self.list(items, at, own, labels);
             }
-            scalar => self.scalar(path, scalar),
+            scalar => self.scalar(at, scalar),
         }
     }
 
-    fn list(
-        &mut self,
-        items: &[Value],
-        path: &mut String,
-        names: Option<&[String]>,
-        labels: &Labeller<'_>,
-    ) {
+    fn list(&mut self, items: &[Value], at: &mut Cursor, names: Option<&[String]>, labels: &Labeller<'_>) {
         let names = names.filter(|n| n.len() == items.len());
-        let len = path.len();
+        let len = at.lens();
         for (k, item) in items.iter().enumerate() {
             match (names, schemas::topics::entry_label(item)) {
-                (Some(n), _) => join(path, &n[k]),
-                (None, Some(label)) => join(path, label),
-                _ => join(path, &k.to_string()),
+                (Some(n), _) => at.entry(&n[k]),
+                (None, Some(label)) => at.entry(label),
+                _ => at.entry(&k.to_string()),
             }
-            self.visit(item, path, labels);
-            path.truncate(len);
+            self.visit(item, at, labels);
+            at.truncate(len);
         }
     }
 }
@@ -251,10 +290,16 @@ mod tests {
             ("hand", s(&[("x", Value::F64(4.0))])),
         ]);
         c.push_row(&msg, &labels);
-        let cols: Vec<(String, ColumnData)> = c.into_columns().collect();
-        let names: Vec<&str> = cols.iter().map(|(n, _)| n.as_str()).collect();
+        let cols: Vec<(String, ColumnField, ColumnData)> = c.into_columns().collect();
+        let names: Vec<&str> = cols.iter().map(|(n, _, _)| n.as_str()).collect();
         assert_eq!(names, ["time", "current.joint1", "current.joint2", "other.0", "hand.x"]);
-        assert_eq!(cols[2].1, ColumnData::F64(vec![Some(2.0)]));
+        assert_eq!(cols[2].2, ColumnData::F64(vec![Some(2.0)]));
+        // the field and the entry of each column, for units and the long layout
+        let field = |k: usize| (cols[k].1.field.as_str(), cols[k].1.label.as_deref());
+        assert_eq!(field(0), ("time", None));
+        assert_eq!(field(2), ("current", Some("joint2")));
+        assert_eq!(field(3), ("other", Some("0")));
+        assert_eq!(field(4), ("hand.x", None));
     }
 
     #[test]
@@ -272,11 +317,14 @@ mod tests {
         ]);
         let mut c = Columns::default();
         c.push_row(&msg, &|_| None);
-        let names: Vec<String> = c.into_columns().map(|(n, _)| n).collect();
+        let cols: Vec<(String, ColumnField, ColumnData)> = c.into_columns().collect();
+        let names: Vec<&str> = cols.iter().map(|(n, _, _)| n.as_str()).collect();
         assert_eq!(
             names,
             ["position.a", "position.b", "transforms.link1.child_frame_id", "transforms.link1.translation.z"]
         );
+        assert_eq!(cols[3].1, ColumnField { field: "transforms.translation.z".into(), label: Some("link1".into()) });
+        assert_eq!(cols[1].1, ColumnField { field: "position".into(), label: Some("b".into()) });
     }
 
     /// A field missing from a message is null there; a field appearing late is null before;
@@ -289,7 +337,7 @@ mod tests {
         c.push_row(&s(&[("a", Value::F64(2.5)), ("c", Value::Bool(true))]), &none);
         c.push_row(&s(&[("b", Value::String("x".into()))]), &none);
         assert_eq!(c.rows(), 3);
-        let cols: HashMap<String, ColumnData> = c.into_columns().collect();
+        let cols: HashMap<String, ColumnData> = c.into_columns().map(|(n, _, d)| (n, d)).collect();
         assert_eq!(cols["a"], ColumnData::F64(vec![Some(1.0), Some(2.5), None]));
         assert_eq!(cols["b"], ColumnData::Str(vec![Some("7".into()), None, Some("x".into())]));
         assert_eq!(cols["c"], ColumnData::Bool(vec![None, Some(true), None]));

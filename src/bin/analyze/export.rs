@@ -1,25 +1,34 @@
-//! `analyze export`: every topic of recordings as Parquet or CSV tables (`analyze::frames`).
+//! `analyze export`: the topics of recordings as Parquet or CSV tables, wide or long, with
+//! their units (`analyze::frames`, `analyze::export`).
 
 use std::path::PathBuf;
 
-use analyze::export::{export_file, ExportFormat};
+use analyze::export::{export_file, ExportFormat, ExportOptions, Layout};
 use anyhow::{bail, Context, Result};
 use cli::{exit, Verbosity};
 
-/// Every topic of recordings as tables for Python and spreadsheets: one Parquet or CSV file per
-/// topic (time column `t` in s, one column per field, arrays expanded per joint or contact
-/// name) and metadata.json, in OUT/<recording name>/.
+/// The topics of recordings as tables for Python and spreadsheets: one Parquet or CSV file per
+/// topic (one time column `time` in s; one column per field, arrays expanded per joint or
+/// contact name; or, with --layout long, one row per sample and signal) with each column's unit,
+/// and metadata.json (the recording's metadata, typed), in OUT/<recording name>/.
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 Output: DIR/<recording stem>/<topic>.parquet (or .csv) and metadata.json; a line per recording on
-stderr.
+stderr. Units: Parquet field metadata `unit`; CSV headers `name [unit]` (`current.joint4 [A]`);
+long layout: a `unit` column. Left out unless asked for (--include or --topics): the viewers'
+layout topics (/tf, /hand_points, /scene, /contact_markers: any foxglove.* schema).
 
 Examples:
   analyze export out/paper-two-elbow.mcap -o tables/       -> tables/paper-two-elbow/*.parquet
   analyze export out/ -f csv -o tables/                    every recording, CSV
+  analyze export out/paper-two-elbow.mcap --layout long    time, topic, signal, name, unit, value
   analyze export out/paper-two-elbow.mcap --topics /motors,/energy -o t/   only these topics
+  analyze export out/paper-two-elbow.mcap --include tf,hand_points         the transforms too
 
-In Python: pandas.read_parquet('tables/paper-two-elbow/motors.parquet')")]
+In Python:
+  import pandas, pyarrow.parquet as pq
+  m = pandas.read_parquet('tables/paper-two-elbow/motors.parquet')
+  unit = pq.read_schema('tables/paper-two-elbow/motors.parquet').field('current.joint4').metadata[b'unit']")]
 pub struct ExportArgs {
     /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
     #[arg(required = true, value_name = "FILES_OR_DIRS")]
@@ -30,9 +39,25 @@ pub struct ExportArgs {
     /// File format of the tables.
     #[arg(short = 'f', long = "format", value_name = "FORMAT", value_enum, default_value = "parquet")]
     pub format: TableFile,
-    /// Only these topics (comma-separated, e.g. /motors,/energy) [default: every decoded topic].
+    /// Only these topics (comma-separated, e.g. /motors,/energy), viewer layouts too [default:
+    /// every decoded topic but the viewers' layout topics].
     #[arg(long, value_name = "TOPICS", value_delimiter = ',')]
     pub topics: Vec<String>,
+    /// Also export these viewer-layout topics (comma-separated, `/` optional: tf,hand_points,
+    /// scene,contact_markers, or all); those a recording does not have are ignored.
+    #[arg(long, value_name = "TOPICS", value_delimiter = ',', conflicts_with = "topics")]
+    pub include: Vec<String>,
+    /// Table shape: wide (a row per sample, a column per signal) or long (a row per sample and
+    /// signal: time, topic, signal, name, unit, value).
+    #[arg(long, value_name = "LAYOUT", value_enum, default_value = "wide")]
+    pub layout: TableLayout,
+}
+
+/// Table shape of `analyze export`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TableLayout {
+    Wide,
+    Long,
 }
 
 /// File format of `analyze export`.
@@ -50,6 +75,12 @@ pub fn run(a: &ExportArgs, v: Verbosity) -> Result<u8> {
         TableFile::Csv => ExportFormat::Csv,
     };
     let topics: Vec<&str> = a.topics.iter().map(String::as_str).collect();
+    let include: Vec<&str> = a.include.iter().map(String::as_str).collect();
+    let layout = match a.layout {
+        TableLayout::Wide => Layout::Wide,
+        TableLayout::Long => Layout::Long,
+    };
+    let options = ExportOptions { format, layout, topics: &topics, include: &include };
     let stem = |p: &PathBuf| p.file_stem().map_or_else(|| "recording".into(), |s| s.to_string_lossy().into_owned());
     // every output directory is distinct before anything is written
     let mut stems = std::collections::BTreeMap::new();
@@ -65,9 +96,9 @@ pub fn run(a: &ExportArgs, v: Verbosity) -> Result<u8> {
     }
     for path in &paths {
         let dir = a.out.join(stem(path));
-        let e = export_file(path, &dir, format, &topics).with_context(|| format!("exporting {}", path.display()))?;
+        let e = export_file(path, &dir, &options).with_context(|| format!("exporting {}", path.display()))?;
         if !v.quiet {
-            let skipped = if e.skipped == 0 { String::new() } else { format!(", {} topics not decoded: see metadata.json", e.skipped) };
+            let skipped = if e.skipped == 0 { String::new() } else { format!(", {} topics not exported: see metadata.json", e.skipped) };
             eprintln!("analyze: {} -> {} ({} tables, {} rows{skipped})", path.display(), dir.display(), e.tables, e.rows);
         }
     }
