@@ -61,6 +61,7 @@ pub fn content(n: usize) -> Content {
                 back_emf: vals(k, 2, 2),
                 electric_power: vals(k, 2, 3),
                 torque: vals(k, 2, 4),
+                name: vec!["shoulder".into(), "elbow".into()],
             })
             .collect(),
         constraints: (0..n)
@@ -69,6 +70,7 @@ pub fn content(n: usize) -> Content {
                 normal_force: vals(k, 3, 0),
                 position: vals(k, 3, 1),
                 velocity: if k == 0 { vec![] } else { vals(k, 3, 2) },
+                name: vec!["c1".into(), "c2".into(), "c3".into()],
             })
             .collect(),
         hands: (0..n)
@@ -94,6 +96,7 @@ pub fn content(n: usize) -> Content {
                 friction_loss: val(k, 8),
                 balance_residual: val(k, 9),
                 gear_friction_loss: val(k, 10),
+                name: vec!["shoulder".into(), "elbow".into()],
             })
             .collect(),
         joints: (0..n)
