@@ -57,7 +57,7 @@ pub use reader::{
 #[cfg(feature = "synth")]
 pub use reader::regroup_chunks;
 pub use value::Value;
-pub use writer::{Compression, RecordingWriter, WriterOptions};
+pub use writer::{Compression, Mirror, RecordingWriter, WriterOptions};
 
 /// Foxglove's generated message types (all of them, e.g. `SceneUpdate`).
 pub use foxglove::messages as foxglove_messages;

@@ -40,6 +40,11 @@ pub const SCENE: &str = "/scene";
 /// the actual and desired hand as spheres coloured apart. Since format version 3.
 pub const CONTACT_MARKERS: &str = "/contact_markers";
 
+/// The topics written once, at t = 0 (what does not change in a run: the URDF, the table and
+/// the target path): a live viewer that connects after they were sent must still get them
+/// (`sim --live` sends them again to every new subscriber, as ROS latches such topics).
+pub const LATCHED: [&str; 2] = [ROBOT_DESCRIPTION, SCENE];
+
 /// The topics only runs with a non-bilateral (unilateral or compliant) contact have, in the
 /// order they are registered (after [`ALL`]).
 pub const CONTACT_TOPICS: [&str; 2] = [CONTACTS, CONTACT_EVENTS];

@@ -34,6 +34,10 @@
 //!   writer's thread, to the reader's own record consumer ([`crate::Tap`]), which hands the
 //!   messages of the chosen topics to a [`crate::Visitor`] exactly as a read of the finished
 //!   file would: `sim` prints its table from what it wrote without reading it back.
+//! - **A mirror** ([`RecordingWriter::create_mirrored`]): every record written is also handed,
+//!   as written, to a [`Mirror`] (the tap is one; `sim --live` streams them to Foxglove). It
+//!   only observes, so the file's bytes do not depend on it; with none, nothing is done or
+//!   allocated per message for it.
 //! - **Format version.** The `recording` metadata record ([`RecordingInfo`]) always carries
 //!   `format_version = FORMAT_VERSION`: the caller's, checked, or written alone by `finish` if
 //!   the caller wrote none.
@@ -54,7 +58,9 @@ use crate::meta::{to_entries, MetadataRecord, RecordingInfo};
 use crate::reader::{Tap, Tapped};
 use crate::{Error, FORMAT_VERSION};
 
+mod mirror;
 mod worker;
+pub use mirror::Mirror;
 use worker::{Done, Job, Worker};
 
 /// The MCAP header's library string (fixed, so files do not depend on the build).
@@ -181,6 +187,13 @@ impl RecordingWriter {
     /// ([`Tap`]: the reader's own consumer of records, on the writer's thread); its
     /// [`Tapped`] comes back from [`finish_tapped`](Self::finish_tapped).
     pub fn create_tapped(path: &Path, options: WriterOptions, tap: Option<Tap>) -> Result<Self, Error> {
+        Self::create_mirrored(path, options, tap, None)
+    }
+
+    /// [`create_tapped`](Self::create_tapped), and every record written is also handed to
+    /// `mirror` ([`Mirror`]: after the tap, on the writer's thread, with the bytes written), up
+    /// to [`Mirror::finish`] when the writer finishes or stops.
+    pub fn create_mirrored(path: &Path, options: WriterOptions, tap: Option<Tap>, mirror: Option<Box<dyn Mirror>>) -> Result<Self, Error> {
         let file = path.display().to_string();
         let (output, out) = Output::create(path)?;
         // Profile "": the MCAP registry's "ros2" profile means every channel is cdr/ros2msg,
@@ -201,7 +214,7 @@ impl RecordingWriter {
             .chunk_size((!options.chunk_per_topic).then_some(options.chunk_size));
         // (an error drops `output`, which deletes the temporary file)
         let mcap = mcap_options.create(BufWriter::new(out)).map_err(|source| write_error(&file, source))?;
-        let worker = Worker::new(mcap, file.clone(), options, tap);
+        let worker = Worker::new(mcap, file.clone(), options, tap, mirror);
         let backend = if options.background {
             let queue = options.queue.max(1);
             let (jobs, inbox) = mpsc::sync_channel(queue);

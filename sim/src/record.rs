@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use schemas::{
     frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactInfo, ContactState,
     ContactsRecord, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
-    JointState, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
+    JointState, Mirror, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
 use schemas::{Quaternion, Vector3};
@@ -150,23 +150,32 @@ impl<'a> Recorder<'a> {
     /// the bench `record` compares them).
     #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
     pub fn create_with(path: &Path, scene: &'a Scene, run: &Run, options: WriterOptions, tap: Option<Tap>) -> Result<Self, RunError> {
-        Self::create_described(path, scene, run, options, tap, &run_contacts(scene, run), &scene.contact_settings())
+        Self::create_described(path, scene, run, options, tap, None, &run_contacts(scene, run), &scene.contact_settings())
+    }
+
+    /// [`Recorder::create_tapped`], every record also handed to `mirror` as it is written (see
+    /// [`RecordingWriter::create_mirrored`]: `sim --live`); the file does not depend on it.
+    #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
+    pub fn create_mirrored(path: &Path, scene: &'a Scene, run: &Run, tap: Option<Tap>, mirror: Option<Box<dyn Mirror>>) -> Result<Self, RunError> {
+        Self::create_described(path, scene, run, WriterOptions::default(), tap, mirror, &run_contacts(scene, run), &scene.contact_settings())
     }
 
     /// [`Recorder::create_with`] for the run's `contacts` (in its order, with their models) and
     /// event `settings`: a run with a non-bilateral contact also gets the record `contacts`.
     #[allow(clippy::result_large_err)] // RunError carries schemas::Error, as `create`
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn create_described(
         path: &Path,
         scene: &'a Scene,
         run: &Run,
         options: WriterOptions,
         tap: Option<Tap>,
+        mirror: Option<Box<dyn Mirror>>,
         contacts: &[Contact],
         settings: &ContactSettings,
     ) -> Result<Self, RunError> {
         let err = |source| RunError::Recording { path: path.to_path_buf(), source };
-        let mut writer = RecordingWriter::create_tapped(path, options, tap).map_err(err)?;
+        let mut writer = RecordingWriter::create_mirrored(path, options, tap, mirror).map_err(err)?;
         let joint_names = scene.model.joint_names();
         let contact_names: Vec<String> = contacts.iter().map(|c| c.name().to_string()).collect();
         let hybrid = contacts.iter().any(|c| c.model != ContactModel::Bilateral);

@@ -198,9 +198,24 @@ pub fn run_to_file_tapped(
     path: &std::path::Path,
     budget: Budget,
     tap: Option<schemas::Tap>,
+    progress: impl FnMut(f64),
+) -> Result<(FileReport, Option<schemas::Tapped>), RunError> {
+    run_to_file_mirrored(scene, run, path, budget, tap, None, progress)
+}
+
+/// [`run_to_file_tapped`], every record written also handed to `mirror` ([`schemas::Mirror`],
+/// after the tap, with the bytes written: `sim --live`); the recording does not depend on it.
+#[allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `run_to_file`
+pub fn run_to_file_mirrored(
+    scene: &Scene,
+    run: &Run,
+    path: &std::path::Path,
+    budget: Budget,
+    tap: Option<schemas::Tap>,
+    mirror: Option<Box<dyn schemas::Mirror>>,
     mut progress: impl FnMut(f64),
 ) -> Result<(FileReport, Option<schemas::Tapped>), RunError> {
-    let mut rec = crate::record::Recorder::create_tapped(path, scene, run, tap)?;
+    let mut rec = crate::record::Recorder::create_mirrored(path, scene, run, tap, mirror)?;
     let result = simulate_within(scene, run, budget, |o| {
         progress(o.t);
         rec.record(o)

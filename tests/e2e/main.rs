@@ -10,6 +10,7 @@ mod analyze_tables;
 mod bounded_memory;
 mod cli_voice;
 mod format_ownership;
+mod live;
 mod pipeline;
 mod rerun_view;
 mod sampled_energy;

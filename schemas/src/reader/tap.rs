@@ -15,6 +15,7 @@ use std::collections::BTreeMap;
 use mcap::records::{Channel, MessageHeader, Metadata, Record, SchemaHeader};
 
 use super::{State, Visitor};
+use crate::writer::Mirror;
 use crate::{Error, Recording};
 
 /// Feeds written records to the reader's state and its messages to a visitor. The first
@@ -48,24 +49,31 @@ impl Tap {
         }
     }
 
-    pub(crate) fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
+}
+
+/// The records as written, to the reader's state (the tap is the writer's first [`Mirror`]).
+impl Mirror for Tap {
+    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
         let header = SchemaHeader { id, name: name.into(), encoding: encoding.into() };
         self.feed(Record::Schema { header, data: Cow::Borrowed(data) });
     }
 
-    pub(crate) fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str) {
-        let ch = Channel { id, schema_id, topic: topic.into(), message_encoding: message_encoding.into(), metadata: BTreeMap::new() };
+    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str, metadata: &BTreeMap<String, String>) {
+        let ch = Channel { id, schema_id, topic: topic.into(), message_encoding: message_encoding.into(), metadata: metadata.clone() };
         self.feed(Record::Channel(ch));
     }
 
-    pub(crate) fn metadata(&mut self, m: &Metadata) {
-        self.feed(Record::Metadata(m.clone()));
+    fn metadata(&mut self, name: &str, entries: &BTreeMap<String, String>) {
+        self.feed(Record::Metadata(Metadata { name: name.into(), metadata: entries.clone() }));
     }
 
-    pub(crate) fn message(&mut self, header: &MessageHeader, data: &[u8]) {
-        self.feed(Record::Message { header: *header, data: Cow::Borrowed(data) });
+    fn message(&mut self, channel_id: u16, sequence: u32, log_time_ns: u64, data: &[u8]) {
+        let header = MessageHeader { channel_id, sequence, log_time: log_time_ns, publish_time: log_time_ns };
+        self.feed(Record::Message { header, data: Cow::Borrowed(data) });
     }
+}
 
+impl Tap {
     /// The recording as read (metadata, channels with their message counts), or the first
     /// error; and the visitor back.
     pub fn finish(self) -> Tapped {

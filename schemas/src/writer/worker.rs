@@ -21,7 +21,7 @@ use std::sync::Arc;
 
 use mcap::records::{MessageHeader, Metadata};
 
-use super::{write_error, WriterOptions};
+use super::{write_error, Mirror, WriterOptions};
 use crate::reader::{Tap, Tapped};
 use crate::Error;
 
@@ -48,6 +48,8 @@ struct Chan {
     schema_id: u16,
     topic: String,
     encoding: &'static str,
+    /// The channel's metadata record entries (its `units`: [`crate::units::channel_metadata`]).
+    metadata: BTreeMap<String, String>,
     registered: bool,
     /// The staged messages (chunks per topic): headers with their end in `bytes`.
     staged: Vec<(MessageHeader, usize)>,
@@ -72,6 +74,8 @@ pub(super) struct Worker {
     schemas: BTreeMap<u16, Schema>,
     channels: BTreeMap<u16, Chan>,
     tap: Option<Tap>,
+    /// Another consumer of the records (a live view), after the tap.
+    mirror: Option<Box<dyn Mirror>>,
 }
 
 /// Bytes of a message record in a chunk besides its data: opcode, length, channel id,
@@ -79,8 +83,14 @@ pub(super) struct Worker {
 const MESSAGE_RECORD_OVERHEAD: u64 = 1 + 8 + 2 + 4 + 8 + 8;
 
 impl Worker {
-    pub(super) fn new(mcap: mcap::Writer<BufWriter<File>>, file: String, options: WriterOptions, tap: Option<Tap>) -> Self {
-        Worker { mcap: Some(mcap), file, options, schemas: BTreeMap::new(), channels: BTreeMap::new(), tap }
+    pub(super) fn new(mcap: mcap::Writer<BufWriter<File>>, file: String, options: WriterOptions, tap: Option<Tap>, mirror: Option<Box<dyn Mirror>>) -> Self {
+        Worker { mcap: Some(mcap), file, options, schemas: BTreeMap::new(), channels: BTreeMap::new(), tap, mirror }
+    }
+
+    /// The tap and the mirror, those there are (none: nothing to do, nothing allocated).
+    fn mirrors(&mut self) -> impl Iterator<Item = &mut (dyn Mirror + 'static)> {
+        let tap = self.tap.as_mut().map(|t| t as &mut (dyn Mirror + 'static));
+        tap.into_iter().chain(self.mirror.as_deref_mut())
     }
 
     fn err(&self, source: mcap::McapError) -> Error {
@@ -97,24 +107,25 @@ impl Worker {
     pub(super) fn job(&mut self, job: Job, recycle: &mut dyn FnMut(Vec<u8>)) -> Result<(), Error> {
         match job {
             Job::Schema { id, name, encoding, data } => {
-                if let Some(tap) = &mut self.tap {
-                    tap.schema(id, &name, encoding, &data);
+                for m in self.mirrors() {
+                    m.schema(id, &name, encoding, &data);
                 }
                 self.schemas.insert(id, Schema { name, encoding, data, registered: false });
             }
             Job::Channel { id, schema_id, topic, encoding } => {
-                if let Some(tap) = &mut self.tap {
-                    tap.channel(id, schema_id, &topic, encoding);
+                let metadata = crate::units::channel_metadata(&topic);
+                for m in self.mirrors() {
+                    m.channel(id, schema_id, &topic, encoding, &metadata);
                 }
-                let chan = Chan { schema_id, topic, encoding, registered: false, staged: Vec::new(), bytes: Vec::new(), chunk_bytes: 0 };
+                let chan = Chan { schema_id, topic, encoding, metadata, registered: false, staged: Vec::new(), bytes: Vec::new(), chunk_bytes: 0 };
                 self.channels.insert(id, chan);
                 if !self.options.chunk_per_topic {
                     self.register(id)?;
                 }
             }
             Job::Metadata(m) => {
-                if let Some(tap) = &mut self.tap {
-                    tap.metadata(&m);
+                for mirror in self.mirrors() {
+                    mirror.metadata(&m.name, &m.metadata);
                 }
                 // after every message written before it
                 self.flush_all()?;
@@ -122,8 +133,8 @@ impl Worker {
                 r.map_err(|e| self.err(e))?;
             }
             Job::Message { header, data } => {
-                if let Some(tap) = &mut self.tap {
-                    tap.message(&header, &data);
+                for m in self.mirrors() {
+                    m.message(header.channel_id, header.sequence, header.log_time, &data);
                 }
                 let result = self.message(&header, &data);
                 recycle(data);
@@ -163,8 +174,7 @@ impl Worker {
             s.registered = true;
             w.add_schema_with_id(chan.schema_id, &s.name, s.encoding, &s.data).map_err(|e| write_error(&self.file, e))?;
         }
-        let metadata = crate::units::channel_metadata(&chan.topic);
-        w.add_channel_with_id(id, chan.schema_id, &chan.topic, chan.encoding, &metadata).map_err(|e| write_error(&self.file, e))?;
+        w.add_channel_with_id(id, chan.schema_id, &chan.topic, chan.encoding, &chan.metadata).map_err(|e| write_error(&self.file, e))?;
         Ok(())
     }
 
@@ -215,11 +225,17 @@ impl Worker {
         r.map_err(|e| self.err(e))?;
         let Some(w) = self.mcap.take() else { unreachable!("finish consumes the worker") };
         let file = w.into_inner().into_inner().map_err(|e| Error::Io { file: self.file.clone(), op: "writing", source: e.into_error() })?;
+        if let Some(m) = &mut self.mirror {
+            m.finish();
+        }
         Ok(Done { file: Some(file), tapped: self.tap.take().map(Tap::finish) })
     }
 
     /// Leaves the file without its summary (the caller deletes it).
     pub(super) fn abandon(mut self) -> Done {
+        if let Some(m) = &mut self.mirror {
+            m.finish();
+        }
         Done { file: None, tapped: self.tap.take().map(Tap::finish) }
     }
 }

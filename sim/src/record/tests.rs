@@ -64,7 +64,7 @@ fn contact_states_events_and_records_read_back_equal() {
     let settings = ContactSettings { rest_velocity: 2e-4, ..Default::default() };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("unilateral.mcap");
-    let mut rec = Recorder::create_described(&path, &scene, &run, WriterOptions::default(), None, &contacts, &settings).unwrap();
+    let mut rec = Recorder::create_described(&path, &scene, &run, WriterOptions::default(), None, None, &contacts, &settings).unwrap();
     let outs = samples(&scene, &run);
     for o in &outs {
         rec.record(o).unwrap();

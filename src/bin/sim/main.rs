@@ -6,6 +6,7 @@
 mod check;
 mod export_scene;
 mod list;
+mod live;
 mod precision;
 mod replay;
 mod run;
@@ -31,7 +32,9 @@ Examples:
   sim export-scene -o scenes/           the built-in scene and URDF, to edit
   sim replay out/paper-two-elbow.mcap   re-run a recording from its own metadata
   sim sweep sim/scenes/sweeps/paper-gains.json -j 2
-  sim precision --duration 1            speed against error of every integrator";
+  sim precision --duration 1            speed against error of every integrator
+  sim --live                            also stream each run to the Foxglove app, paced to real
+                                        time (build with --features live): ws://localhost:8765";
 
 /// Simulate motor-driven arms that rest their elbows on a table; record every run to MCAP.
 ///

@@ -15,7 +15,9 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use cli::{exit, print_out, Jobs, TableFormat, Verbosity};
 use rayon::prelude::*;
-use sim::run::{run_to_file_tapped, Budget};
+use sim::run::{run_to_file_mirrored, Budget};
+
+use crate::live::{self, LiveArgs};
 use sim::scene::{Run, Scene};
 
 /// The options of a run, with `sim` alone or `sim run`.
@@ -40,6 +42,8 @@ pub struct RunArgs {
     pub duration: Option<f64>,
     #[command(flatten)]
     pub wall_time: WallTime,
+    #[command(flatten)]
+    pub live: LiveArgs,
 }
 
 /// `--max-wall-time`: the wall-clock budget of each run (`sim run`, `sweep`, `replay`).
@@ -72,7 +76,10 @@ Examples:
   sim run                                    the built-in paper scene (same as `sim`)
   sim run my_scene.json --max-wall-time 60   fail any run still going after a minute
   sim run sim/scenes/small/small.json -o /tmp/small
-  sim run --run two-elbow --duration 1 -f csv")]
+  sim run --run two-elbow --duration 1 -f csv
+  sim run --run two-elbow --live --wait      stream it to Foxglove (feature live) once a viewer is
+                                             connected to ws://localhost:8765
+  sim run --live --pace fast --live-port 0   as fast as it computes, on any free port")]
 pub struct RunCommand {
     /// Scene JSON file, or the name of a built-in scene (`sim list`) [default: the built-in paper
     /// scene].
@@ -99,8 +106,15 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     };
     let runs = select_runs(&scene, &a.runs)?;
     cli::create_dir(&a.out)?;
-    let done = run_all(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, a.wall_time.budget(), v);
-    finish(&done, a.format, a.baseline.as_deref())
+    let names = runs.iter().map(|r| r.name.clone()).collect();
+    let live = live::Session::start(&a.live, &live::about(&[(&scene, names)], &a.out), v.quiet)?;
+    let budget = a.live.budget(a.wall_time.budget(), scene.duration());
+    let done = run_all_live(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
+    let code = finish(&done, a.format, a.baseline.as_deref());
+    if let Some(live) = live {
+        live.close();
+    }
+    code
 }
 
 /// `sim` with no scene: the paper's scene and the same arm over a real table
@@ -130,11 +144,18 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
         anyhow::bail!("no run `{n}` in the built-in scenes paper and paper-unilateral (runs: {})", all.join(", "));
     }
     cli::create_dir(&a.out)?;
+    let about: Vec<_> = scenes.iter().zip(&picked).map(|(s, r)| (s, r.iter().map(|r| r.name.clone()).collect())).collect();
+    let live = live::Session::start(&a.live, &live::about(&about, &a.out), v.quiet)?;
     let mut done = Vec::new();
     for (scene, runs) in scenes.iter().zip(&picked).filter(|(_, r)| !r.is_empty()) {
-        done.extend(run_all(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, a.wall_time.budget(), v));
+        let budget = a.live.budget(a.wall_time.budget(), scene.duration());
+        done.extend(run_all_live(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref()));
     }
-    finish(&done, a.format, a.baseline.as_deref())
+    let code = finish(&done, a.format, a.baseline.as_deref());
+    if let Some(live) = live {
+        live.close();
+    }
+    code
 }
 
 /// The runs called `names` (all when empty), in that order.
@@ -206,49 +227,69 @@ impl MetricsTap {
 
 /// Runs `runs` of `scene` on `jobs` threads, run `r` to `path(r)`, with a progress bar each.
 pub fn run_all(scene: &Scene, runs: &[Run], path: impl Fn(&Run) -> PathBuf + Sync, jobs: &Jobs, budget: Budget, v: Verbosity) -> Vec<Done> {
+    run_all_live(scene, runs, path, jobs, budget, v, None)
+}
+
+/// [`run_all`], and with a `live` session (`--live`) one run at a time, in order, each streamed
+/// as it is written.
+pub fn run_all_live(
+    scene: &Scene,
+    runs: &[Run],
+    path: impl Fn(&Run) -> PathBuf + Sync,
+    jobs: &Jobs,
+    budget: Budget,
+    v: Verbosity,
+    live: Option<&live::Session>,
+) -> Vec<Done> {
     let bars = cli::progress::RunBars::new(v.quiet);
     let bars: Vec<_> = runs.iter().map(|r| bars.add(&r.name, scene.duration())).collect();
-    let threads = jobs.threads(runs.len());
+    let threads = if live.is_some() { 1 } else { jobs.threads(runs.len()) };
     let started = Instant::now();
-    let work = || -> Vec<Done> {
-        runs.par_iter()
-            .zip(&bars)
-            .map(|(run, bar)| {
-                let target = path(run);
-                let t0 = Instant::now();
-                let mut count = 0u32;
-                let (tap, metrics) = MetricsTap::new(&target);
-                let res = run_to_file_tapped(scene, run, &target, budget, Some(tap), |t| {
-                    count += 1;
-                    if count.is_multiple_of(64) {
-                        cli::progress::set_time(bar, t);
-                    }
-                });
-                let wall = t0.elapsed().as_secs_f64();
-                match res {
-                    Ok((r, tapped)) => {
-                        bar.finish_with_message(format!("{:.3} s", scene.duration()));
-                        if v.verbose > 0 {
-                            let s = r.report.stats;
-                            // (suspend the bars: `println` on a bar is dropped when stderr is no terminal)
-                            bar.suspend(|| {
-                                eprintln!(
-                                    "sim: {}: {} steps ({} rejected), {} right-hand sides, {:.2} s wall, {:.0}x real time",
-                                    run.name, s.steps, s.rejected, s.rhs_evals, wall, scene.duration() / wall.max(1e-9)
-                                )
-                            });
-                        }
-                        Done { path: Some(r.path), error: None, io_error: false, metrics: Some(metrics.metrics(tapped)) }
-                    }
-                    Err(e) => {
-                        bar.abandon_with_message(format!("failed at {}", e.time().map_or("?".into(), |t| format!("{t:.3} s"))));
-                        // a numerical failure still leaves a recording that says when and why
-                        let written = e.time().is_some() && target.is_file();
-                        Done { path: written.then_some(target), error: Some(format!("run `{}`: {e}", run.name)), io_error: e.is_io(), metrics: None }
-                    }
+    let one = |(run, bar): (&Run, &indicatif::ProgressBar)| -> Done {
+        let target = path(run);
+        let t0 = Instant::now();
+        let mut count = 0u32;
+        let (tap, metrics) = MetricsTap::new(&target);
+        let mirror = live.map(|l| {
+            l.before_run(&format!("{}-{}", scene.spec().name, run.name));
+            l.mirror()
+        });
+        let res = run_to_file_mirrored(scene, run, &target, budget, Some(tap), mirror, |t| {
+            count += 1;
+            if count.is_multiple_of(64) {
+                cli::progress::set_time(bar, t);
+            }
+        });
+        let wall = t0.elapsed().as_secs_f64();
+        match res {
+            Ok((r, tapped)) => {
+                bar.finish_with_message(format!("{:.3} s", scene.duration()));
+                if v.verbose > 0 {
+                    let s = r.report.stats;
+                    // (suspend the bars: `println` on a bar is dropped when stderr is no terminal)
+                    bar.suspend(|| {
+                        eprintln!(
+                            "sim: {}: {} steps ({} rejected), {} right-hand sides, {:.2} s wall, {:.0}x real time",
+                            run.name, s.steps, s.rejected, s.rhs_evals, wall, scene.duration() / wall.max(1e-9)
+                        )
+                    });
                 }
-            })
-            .collect()
+                Done { path: Some(r.path), error: None, io_error: false, metrics: Some(metrics.metrics(tapped)) }
+            }
+            Err(e) => {
+                bar.abandon_with_message(format!("failed at {}", e.time().map_or("?".into(), |t| format!("{t:.3} s"))));
+                // a numerical failure still leaves a recording that says when and why
+                let written = e.time().is_some() && target.is_file();
+                Done { path: written.then_some(target), error: Some(format!("run `{}`: {e}", run.name)), io_error: e.is_io(), metrics: None }
+            }
+        }
+    };
+    let work = || -> Vec<Done> {
+        if live.is_some() {
+            runs.iter().zip(&bars).map(&one).collect()
+        } else {
+            runs.par_iter().zip(&bars).map(&one).collect()
+        }
     };
     let done = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
         Ok(pool) => pool.install(work),

@@ -1,0 +1,276 @@
+//! The live server (feature `live`): the `foxglove` crate's `WebSocketServer` on a context of
+//! its own, a [`Hub`] of the current run's channels shared by the writer's mirror
+//! ([`LiveMirror`], on the writer's thread) and the server's subscription callbacks
+//! ([`HubListener`], on the server's threads). See the parent module for what is streamed when.
+//!
+//! Messages go to each subscribed client by its sink id, chosen under the hub's lock: a client
+//! gets the kept messages (latched, or all until the first subscription with `--wait`) before
+//! any newer one, each once. Lock order: hub, then the SDK's own (never the reverse: channels
+//! are closed outside the hub's lock, since closing calls `on_unsubscribe`).
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use std::time::{Duration, Instant};
+
+use foxglove::websocket::{ChannelView, Client, ServerListener, Status};
+use foxglove::{ChannelBuilder, ChannelId, Context, PartialMetadata, RawChannel, Schema, SinkId, WebSocketServer, WebSocketServerHandle};
+
+use super::{LiveArgs, Pace};
+
+/// Bytes of messages kept per channel until its first subscription (`--wait`); beyond, the
+/// oldest are dropped. A paper run's largest channel (`/tf`, 5 s at 1 kHz) is about 6 MB.
+pub const KEPT_BYTES: usize = 64 << 20;
+
+/// Messages queued per client by the server before it drops the oldest (the crate's default
+/// is 1024): a fast run writes thousands of messages in a burst.
+const BACKLOG_FAST: usize = 1 << 17;
+
+/// One MCAP channel of the current run, as advertised.
+struct LiveChannel {
+    raw: Arc<RawChannel>,
+    /// Every message of a latched topic, for later subscribers.
+    latched: Option<Vec<(u64, Vec<u8>)>>,
+    /// With `--wait`, the messages written before the first subscription.
+    pending: VecDeque<(u64, Vec<u8>)>,
+    pending_bytes: usize,
+    subscribed_once: bool,
+    /// The clients subscribed, by sink.
+    sinks: Vec<SinkId>,
+}
+
+impl LiveChannel {
+    fn send(&self, log_time_ns: u64, data: &[u8], sink: SinkId) {
+        self.raw.log_with_meta_to_sink(data, PartialMetadata { log_time: Some(log_time_ns) }, Some(sink));
+    }
+}
+
+/// The channels of the run being streamed.
+#[derive(Default)]
+struct Hub {
+    /// By MCAP channel id.
+    channels: HashMap<u16, LiveChannel>,
+    /// The SDK's channel id → MCAP channel id.
+    by_sdk_id: HashMap<ChannelId, u16>,
+    /// `--wait`: keep every message until its channel's first subscription.
+    keep_until_subscribed: bool,
+}
+
+fn lock(hub: &Mutex<Hub>) -> MutexGuard<'_, Hub> {
+    hub.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// The server's subscription callbacks.
+struct HubListener(Arc<Mutex<Hub>>);
+
+impl ServerListener for HubListener {
+    fn on_subscribe(&self, client: Client, channel: ChannelView) {
+        let Some(sink) = client.sink_id() else { return };
+        let mut hub = lock(&self.0);
+        let keep = hub.keep_until_subscribed;
+        let Some(id) = hub.by_sdk_id.get(&channel.id()).copied() else { return };
+        let Some(ch) = hub.channels.get_mut(&id) else { return };
+        if keep && !ch.subscribed_once {
+            for (t, data) in std::mem::take(&mut ch.pending) {
+                ch.send(t, &data, sink);
+            }
+            ch.pending_bytes = 0;
+        } else if let Some(kept) = &ch.latched {
+            for (t, data) in kept {
+                ch.send(*t, data, sink);
+            }
+        }
+        ch.subscribed_once = true;
+        if !ch.sinks.contains(&sink) {
+            ch.sinks.push(sink);
+        }
+    }
+
+    fn on_unsubscribe(&self, client: Client, channel: ChannelView) {
+        let Some(sink) = client.sink_id() else { return };
+        let mut hub = lock(&self.0);
+        let Some(id) = hub.by_sdk_id.get(&channel.id()).copied() else { return };
+        if let Some(ch) = hub.channels.get_mut(&id) {
+            ch.sinks.retain(|s| *s != sink);
+        }
+    }
+}
+
+/// The live server, for the whole command.
+pub struct Session {
+    server: Option<WebSocketServerHandle>,
+    context: Arc<Context>,
+    hub: Arc<Mutex<Hub>>,
+    pace: Pace,
+    speed: f64,
+    wait: bool,
+    quiet: bool,
+    /// Runs started.
+    runs: AtomicUsize,
+}
+
+impl Session {
+    /// Starts the server when `--live` is given (`None` without it), on 127.0.0.1:`--live-port`,
+    /// and prints its address; with `--wait`, waits for a client.
+    pub fn start(a: &LiveArgs, about: &[(&str, String)], quiet: bool) -> anyhow::Result<Option<Session>> {
+        if !a.live {
+            return Ok(None);
+        }
+        let context = Context::new();
+        let hub = Arc::new(Mutex::new(Hub { keep_until_subscribed: a.wait, ..Hub::default() }));
+        let info: HashMap<String, String> = about.iter().map(|(k, v)| (k.to_string(), v.clone())).collect();
+        let mut server = WebSocketServer::new()
+            .name("elbow-sim")
+            .bind("127.0.0.1", a.port)
+            .context(&context)
+            .server_info(info)
+            .listener(Arc::new(HubListener(hub.clone())));
+        if a.pace == Pace::Fast || a.wait {
+            server = server.message_backlog_size(BACKLOG_FAST);
+        }
+        let handle = server
+            .start_blocking()
+            .map_err(|e| anyhow::anyhow!("--live: cannot serve on 127.0.0.1:{}: {e}", a.port))?;
+        let port = handle.port();
+        // the address, always (a caller that asked for any port must learn which)
+        eprintln!("sim: live: ws://127.0.0.1:{port} (Foxglove: Open connection → Foxglove WebSocket → ws://localhost:{port})");
+        let session = Session { server: Some(handle), context, hub, pace: a.pace, speed: a.speed, wait: a.wait, quiet, runs: AtomicUsize::new(0) };
+        if a.wait {
+            if !quiet {
+                eprintln!("sim: live: waiting for a client before running");
+            }
+            while session.clients() == 0 {
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        }
+        Ok(Some(session))
+    }
+
+    fn clients(&self) -> usize {
+        self.server.as_ref().map_or(0, WebSocketServerHandle::client_count)
+    }
+
+    /// Before each run: the previous run's channels unadvertised and a new session, so a
+    /// viewer starts over at t = 0 (the last run's channels stay until the server stops).
+    pub fn before_run(&self, name: &str) {
+        let n = self.runs.fetch_add(1, Ordering::Relaxed);
+        if let Some(s) = &self.server {
+            if n > 0 {
+                self.close_channels();
+                s.clear_session(None);
+            }
+            s.publish_status(Status::info(format!("run {name}")).with_id("run"));
+        }
+        if !self.quiet {
+            eprintln!("sim: live: streaming {name}");
+        }
+    }
+
+    /// Unadvertises the channels of the run streamed last (outside the hub's lock: closing a
+    /// channel calls the listener).
+    fn close_channels(&self) {
+        let channels: Vec<LiveChannel> = {
+            let mut hub = lock(&self.hub);
+            hub.by_sdk_id.clear();
+            hub.channels.drain().map(|(_, c)| c).collect()
+        };
+        for c in channels {
+            c.raw.close();
+        }
+    }
+
+    /// The mirror of one run's writer.
+    pub fn mirror(&self) -> Box<dyn schemas::Mirror> {
+        Box::new(LiveMirror {
+            hub: self.hub.clone(),
+            context: self.context.clone(),
+            schemas: BTreeMap::new(),
+            pace: self.pace,
+            speed: self.speed,
+            start: None,
+        })
+    }
+
+    /// After the runs: with `--wait`, serves until the clients disconnect; then stops.
+    pub fn close(mut self) {
+        if self.wait && self.clients() > 0 {
+            if !self.quiet {
+                eprintln!("sim: live: the runs are done; serving until the viewer disconnects (Ctrl-C to stop)");
+            }
+            while self.clients() > 0 {
+                std::thread::sleep(Duration::from_millis(50));
+            }
+        }
+        self.close_channels();
+        if let Some(s) = self.server.take() {
+            drop(s.stop());
+        }
+    }
+}
+
+/// One run's mirror: advertises its channels, paces and sends its messages.
+struct LiveMirror {
+    hub: Arc<Mutex<Hub>>,
+    context: Arc<Context>,
+    /// By id: name, encoding, data.
+    schemas: BTreeMap<u16, (String, String, Vec<u8>)>,
+    pace: Pace,
+    speed: f64,
+    /// Wall-clock time of the run's first message.
+    start: Option<Instant>,
+}
+
+impl schemas::Mirror for LiveMirror {
+    fn schema(&mut self, id: u16, name: &str, encoding: &str, data: &[u8]) {
+        self.schemas.insert(id, (name.into(), encoding.into(), data.into()));
+    }
+
+    fn channel(&mut self, id: u16, schema_id: u16, topic: &str, message_encoding: &str, metadata: &BTreeMap<String, String>) {
+        let schema = self.schemas.get(&schema_id).map(|(n, e, d)| Schema::new(n.clone(), e.clone(), d.clone()));
+        // advertised under the hub's lock, so that a subscription finds it
+        let mut hub = lock(&self.hub);
+        let built = ChannelBuilder::new(topic)
+            .context(&self.context)
+            .message_encoding(message_encoding)
+            .schema(schema)
+            .metadata(metadata.clone())
+            .build_raw();
+        match built {
+            Ok(raw) => {
+                hub.by_sdk_id.insert(raw.id(), id);
+                let latched = schemas::topics::LATCHED.contains(&topic).then(Vec::new);
+                hub.channels.insert(id, LiveChannel { raw, latched, pending: VecDeque::new(), pending_bytes: 0, subscribed_once: false, sinks: Vec::new() });
+            }
+            // (the recording is unaffected; the viewer misses this topic)
+            Err(e) => eprintln!("sim: live: warning: {topic} is not streamed: {e}"),
+        }
+    }
+
+    fn message(&mut self, channel_id: u16, _sequence: u32, log_time_ns: u64, data: &[u8]) {
+        if self.pace == Pace::Realtime {
+            let start = *self.start.get_or_insert_with(Instant::now);
+            let after = Duration::try_from_secs_f64(log_time_ns as f64 * 1e-9 / self.speed).unwrap_or(Duration::MAX);
+            if let Some(wait) = start.checked_add(after).and_then(|due| due.checked_duration_since(Instant::now())) {
+                std::thread::sleep(wait);
+            }
+        }
+        let mut hub = lock(&self.hub);
+        let keep = hub.keep_until_subscribed;
+        let Some(ch) = hub.channels.get_mut(&channel_id) else { return };
+        if let Some(kept) = &mut ch.latched {
+            kept.push((log_time_ns, data.to_vec()));
+        }
+        if keep && !ch.subscribed_once {
+            ch.pending.push_back((log_time_ns, data.to_vec()));
+            ch.pending_bytes += data.len();
+            while ch.pending_bytes > KEPT_BYTES {
+                let Some((_, old)) = ch.pending.pop_front() else { break };
+                ch.pending_bytes -= old.len();
+            }
+            return;
+        }
+        for sink in &ch.sinks {
+            ch.send(log_time_ns, data, *sink);
+        }
+    }
+}
