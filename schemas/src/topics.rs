@@ -40,6 +40,10 @@ pub const SCENE: &str = "/scene";
 /// the actual and desired hand as spheres coloured apart. Since format version 3.
 pub const CONTACT_MARKERS: &str = "/contact_markers";
 
+/// The scene topics for the viewers, written by every recording since format version 3 (older
+/// files lack them); not in [`ALL`].
+pub const VIEWER_TOPICS: [&str; 2] = [SCENE, CONTACT_MARKERS];
+
 /// The topics only runs with a non-bilateral (unilateral or compliant) contact have, in the
 /// order they are registered (after [`ALL`]).
 pub const CONTACT_TOPICS: [&str; 2] = [CONTACTS, CONTACT_EVENTS];

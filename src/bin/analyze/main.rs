@@ -6,6 +6,7 @@ mod compare;
 mod diff;
 mod export;
 mod figures;
+mod layout;
 mod load;
 mod report;
 mod summary;
@@ -25,7 +26,8 @@ Examples:
   analyze report out/ -o out/report         the comparison as a document, with the figures
   analyze summary 'out/*.mcap' --sort E_total_j   many runs as one table
   analyze export out/ -o out/tables         every topic as Parquet, for Python
-  analyze diff recordings/ out/             what moved between two versions";
+  analyze diff recordings/ out/             what moved between two versions
+  analyze layout out/ -o out                the Foxglove layout of the recordings";
 
 /// Reads recordings of `sim` runs: hand error, link work W_j, motor electric energy E_j,
 /// contact forces, the energy balance; compares runs, draws figures, exports tables.
@@ -47,6 +49,7 @@ enum Command {
     Report(report::ReportArgs),
     Figures(figures::FiguresArgs),
     Export(export::ExportArgs),
+    Layout(layout::LayoutArgs),
     /// Print the shell completion script (bash, zsh, fish, elvish, powershell).
     #[command(after_help = "Example:\n  analyze completions bash > ~/.local/share/bash-completion/completions/analyze")]
     Completions(CompletionsArgs),
@@ -66,6 +69,7 @@ fn main() -> ExitCode {
         Command::Report(a) => report::run(&a, v),
         Command::Figures(a) => figures::run(&a, v),
         Command::Export(a) => export::run(&a, v),
+        Command::Layout(a) => layout::run(&a, v),
         Command::Completions(a) => cli::extras::completions(Cli::command(), a.shell).map(|()| exit::SUCCESS),
         Command::Man(a) => cli::extras::man_pages(Cli::command(), &a.out).map(|n| {
             if !v.quiet {
