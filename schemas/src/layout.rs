@@ -106,10 +106,18 @@ fn contact_label(input: &LayoutInput, k: usize, contact_topic: bool) -> String {
     let runs: Vec<&LayoutRun> = input.runs.iter().filter(|r| r.has_contact_topic == contact_topic && k < r.contacts.len()).collect();
     let first = runs.first().map(|r| r.contacts[k].as_str()).unwrap_or("");
     if runs.iter().all(|r| r.contacts[k] == first) {
-        first.to_string()
-    } else {
-        runs.iter().map(|r| format!("{} in {}", r.contacts[k], r.run)).collect::<Vec<_>>().join(", ")
+        return first.to_string();
     }
+    // each name once, with the runs that give entry k that name
+    let mut names: Vec<(&str, Vec<&str>)> = Vec::new();
+    for r in &runs {
+        let n = r.contacts[k].as_str();
+        match names.iter_mut().find(|(m, _)| *m == n) {
+            Some((_, rs)) => rs.push(&r.run),
+            None => names.push((n, vec![&r.run])),
+        }
+    }
+    names.iter().map(|(n, rs)| format!("{n} in {}", rs.join(", "))).collect::<Vec<_>>().join("; ")
 }
 
 /// How many entries the contact arrays of the runs that record `/contacts` (or not) have, at most.
@@ -413,7 +421,7 @@ mod tests {
         assert_eq!(f[0]["label"], "elbow4 f_n [N]");
         assert_eq!(f[1]["label"], "elbow7 f_n [N]");
         let c = &configs["Plot!contact_forces"]["paths"];
-        assert_eq!(c[0]["label"], "joint3 in uni, elbow4 in uni2 f_n [N]");
+        assert_eq!(c[0]["label"], "joint3 in uni; elbow4 in uni2 f_n [N]");
         assert_eq!(configs["3D!arm"]["topics"]["/robot_description"]["visible"], true);
         let named = topics_named(&l);
         for t in ["/contacts", "/constraints", "/motors", "/energy", "/hand", "/scene", "/contact_markers", "/hand_points", "/robot_description"] {

@@ -37,9 +37,9 @@ use crate::topics;
 /// The world frame of `/tf`, the frame of every entity (`sim` records `world -> root link`).
 pub const WORLD_FRAME: &str = "world";
 
-/// Length of a force arrow per newton of contact force, m/N (100 N → 0.1 m: the paper's elbow
-/// forces, tens of newtons, give arrows of a few centimetres to a link's length, 0.3 m).
-pub const FORCE_SCALE_M_PER_N: f64 = 1e-3;
+/// Length of a force arrow per newton of contact force, m/N: 5 mm per newton, so the paper's
+/// elbow forces (|f_n| ≤ 32 N) draw arrows up to 0.16 m, half a link (0.3 m).
+pub const FORCE_SCALE_M_PER_N: f64 = 5e-3;
 /// Radius of a contact marker sphere, m (the paper arm's elbow spheres are 0.02 m).
 pub const CONTACT_MARKER_RADIUS_M: f64 = 0.025;
 /// Radius of the actual hand's sphere, m (the URDF's hand sphere is 0.015 m: this one shows
