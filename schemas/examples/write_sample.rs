@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use schemas::{
-    frame_transform, hand_points, to_log_time, topics, ConstraintState, EnergyState,
+    frame_transform, hand_points, to_log_time, topics, ConstraintState, EnergyState, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA,
     FrameTransforms, HandState, JointState, MotorState, RecordingWriter, RosString, Vec3,
 };
 
@@ -183,8 +183,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         )?;
         let points = [
-            [actual.x, actual.y, actual.z],
-            [desired.x, desired.y, desired.z],
+            ([actual.x, actual.y, actual.z], HAND_ACTUAL_RGBA),
+            ([desired.x, desired.y, desired.z], HAND_DESIRED_RGBA),
         ];
         w.write(topics::HAND_POINTS, ns, &hand_points(ns, "world", &points))?;
 

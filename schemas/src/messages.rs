@@ -469,22 +469,33 @@ pub fn frame_transform(
     }
 }
 
-/// Bytes per point of [`hand_points`]: x, y, z as little-endian float64.
-pub const HAND_POINT_STRIDE: u32 = 24;
+/// Bytes per point of [`hand_points`]: x, y, z as little-endian float64, then red, green,
+/// blue, alpha as uint8.
+pub const HAND_POINT_STRIDE: u32 = 28;
 
-/// A point cloud of `points` (m, in `frame_id`) with float64 fields `x`, `y`, `z`, stride 24 B,
-/// identity pose. Used for the actual and desired hand on [`crate::topics::HAND_POINTS`].
-pub fn hand_points(t_ns: u64, frame_id: &str, points: &[[f64; 3]]) -> PointCloud {
+/// The colour of the actual hand's point, RGBA bytes (blue `#1f77b4`, [`crate::markers::colors`]).
+pub const HAND_ACTUAL_RGBA: [u8; 4] = [0x1f, 0x77, 0xb4, 255];
+/// The colour of the desired hand's point, RGBA bytes (orange `#ff7f0e`).
+pub const HAND_DESIRED_RGBA: [u8; 4] = [0xff, 0x7f, 0x0e, 255];
+
+/// A `foxglove.PointCloud` of `points` (position in `frame_id`, m; colour as RGBA bytes) at
+/// `t_ns`. The colour is in the four uint8 fields `red`, `green`, `blue`, `alpha`: Foxglove's 3D
+/// panel colours a point cloud that has these four fields by them (its "RGBA (separate fields)"
+/// colour mode, chosen automatically: `autoSelectColorSettings` / `hasSeparateRgbaFields` in
+/// `packages/suite-base/src/panels/ThreeDeeRender/renderables/colorMode.ts` of the open-source
+/// Foxglove Studio, now Lichtblick; integer fields are normalised by 255, `PointClouds.ts`).
+pub fn hand_points(t_ns: u64, frame_id: &str, points: &[([f64; 3], [u8; 4])]) -> PointCloud {
     let mut data = Vec::with_capacity(points.len() * HAND_POINT_STRIDE as usize);
-    for p in points {
+    for (p, rgba) in points {
         for c in p {
             data.extend_from_slice(&c.to_le_bytes());
         }
+        data.extend_from_slice(rgba);
     }
-    let field = |name: &str, offset: u32| PackedElementField {
+    let field = |name: &str, offset: u32, t: NumericType| PackedElementField {
         name: name.to_string(),
         offset,
-        r#type: NumericType::Float64 as i32,
+        r#type: t as i32,
     };
     PointCloud {
         timestamp: Some(timestamp(t_ns)),
@@ -503,7 +514,15 @@ pub fn hand_points(t_ns: u64, frame_id: &str, points: &[[f64; 3]]) -> PointCloud
             }),
         }),
         point_stride: HAND_POINT_STRIDE,
-        fields: vec![field("x", 0), field("y", 8), field("z", 16)],
+        fields: vec![
+            field("x", 0, NumericType::Float64),
+            field("y", 8, NumericType::Float64),
+            field("z", 16, NumericType::Float64),
+            field("red", 24, NumericType::Uint8),
+            field("green", 25, NumericType::Uint8),
+            field("blue", 26, NumericType::Uint8),
+            field("alpha", 27, NumericType::Uint8),
+        ],
         data: data.into(),
     }
 }
@@ -532,9 +551,13 @@ mod tests {
 
     #[test]
     fn hand_points_packs_little_endian_f64() {
-        let pc = hand_points(5, "world", &[[1.0, 2.0, 3.0], [4.0, 5.0, -6.5]]);
-        assert_eq!(pc.data.len(), 48);
-        assert_eq!(&pc.data[40..48], &(-6.5f64).to_le_bytes());
+        let pc = hand_points(5, "world", &[([1.0, 2.0, 3.0], HAND_ACTUAL_RGBA), ([4.0, 5.0, -6.5], HAND_DESIRED_RGBA)]);
+        assert_eq!(pc.data.len(), 56);
+        assert_eq!(&pc.data[28 + 16..28 + 24], &(-6.5f64).to_le_bytes());
+        assert_eq!(&pc.data[24..28], &HAND_ACTUAL_RGBA);
+        assert_eq!(&pc.data[52..56], &HAND_DESIRED_RGBA);
         assert_eq!(pc.fields[2].offset, 16);
+        let names: Vec<&str> = pc.fields.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(names, ["x", "y", "z", "red", "green", "blue", "alpha"]);
     }
 }

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use crate::meta::{ContactsRecord, EnergyTermsRecord, RecordingInfo, RunInfo, RunNames, RunResult, Setup};
 use crate::{
-    hand_points, to_log_time, topics, ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, MotorState,
+    hand_points, to_log_time, topics, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA, ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, MotorState,
     RecordingWriter, Vec3,
 };
 
@@ -160,7 +160,7 @@ impl Synth {
                 w.write(topics::HAND, ns, &h).expect("hand");
                 if self.hand_points {
                     let p = |v: &Vec3| [v.x, v.y, v.z];
-                    w.write(topics::HAND_POINTS, ns, &hand_points(ns, "world", &[p(&h.actual), p(&h.desired)])).expect("hand points");
+                    w.write(topics::HAND_POINTS, ns, &hand_points(ns, "world", &[(p(&h.actual), HAND_ACTUAL_RGBA), (p(&h.desired), HAND_DESIRED_RGBA)])).expect("hand points");
                 }
             }
             if let Some(f) = &self.motors {

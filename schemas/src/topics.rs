@@ -44,6 +44,9 @@ pub const CONTACT_MARKERS: &str = "/contact_markers";
 /// the target path): a live viewer that connects after they were sent must still get them
 /// (`sim --live` sends them again to every new subscriber, as ROS latches such topics).
 pub const LATCHED: [&str; 2] = [ROBOT_DESCRIPTION, SCENE];
+/// The scene topics for the viewers, written by every recording since format version 3 (older
+/// files lack them); not in [`ALL`].
+pub const VIEWER_TOPICS: [&str; 2] = [SCENE, CONTACT_MARKERS];
 
 /// The topics only runs with a non-bilateral (unilateral or compliant) contact have, in the
 /// order they are registered (after [`ALL`]).

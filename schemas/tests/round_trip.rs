@@ -7,7 +7,7 @@ mod common;
 
 use common::{bits, content, f, fv, tf, val, write_all, URDF};
 use schemas::{
-    from_log_time, read_recording, topics, ArraySizes, ConstraintState, EnergyState, HandState, JointState,
+    from_log_time, read_recording, topics, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA, ArraySizes, ConstraintState, EnergyState, HandState, JointState,
     MotorState, RecordingWriter, Value,
 };
 
@@ -224,23 +224,26 @@ fn every_message_type_round_trips_through_the_generic_reader() {
 
         let m = &r.messages("/hand_points").unwrap()[k].1;
         assert_eq!(m.get("frame_id").and_then(Value::as_str), Some("world"));
-        assert_eq!(m.get("point_stride").and_then(Value::as_f64), Some(24.0));
-        let names: Vec<&str> = (0..3)
+        assert_eq!(m.get("point_stride").and_then(Value::as_f64), Some(28.0));
+        let names: Vec<&str> = (0..7)
             .map(|i| {
                 m.get(&format!("fields.{i}.name"))
                     .and_then(Value::as_str)
                     .unwrap()
             })
             .collect();
-        assert_eq!(names, ["x", "y", "z"]);
+        assert_eq!(names, ["x", "y", "z", "red", "green", "blue", "alpha"]);
         let Some(Value::Bytes(data)) = m.get("data") else {
             panic!("no point data")
         };
+        // per point: x, y, z as f64, then the colour as 4 bytes
         let pts: Vec<u64> = data
-            .chunks_exact(8)
-            .map(|b| u64::from_le_bytes(b.try_into().unwrap()))
+            .chunks_exact(28)
+            .flat_map(|p| p[..24].chunks_exact(8).map(|b| u64::from_le_bytes(b.try_into().unwrap())))
             .collect();
         assert_eq!(pts, bits(&[1.0, 2.0, 3.0, val(k, 0), -0.0, 9.5]));
+        let colours: Vec<&[u8]> = data.chunks_exact(28).map(|p| &p[24..]).collect();
+        assert_eq!(colours, [&HAND_ACTUAL_RGBA[..], &HAND_DESIRED_RGBA[..]]);
     }
 
     // typed reading: times from the log times, every field bit for bit

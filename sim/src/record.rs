@@ -5,6 +5,14 @@
 //! `/hand_points`; and metadata with everything needed to reproduce the run (scene, URDF,
 //! tool version, integrator), nothing that differs between two identical runs.
 //!
+//! Every recording also has the scene entities for Foxglove's 3D panel (format version 3,
+//! `schemas::markers`): `/scene` at t = 0 (the table: every distinct contact plane of the scene,
+//! drawn fainter when this run has no contact on it, so that the no-elbow arm's sinking below
+//! the table shows; the hand's target path, sampled on the output grid before the run) and
+//! `/contact_markers` every sample (the contact points coloured by mode, the contact force
+//! arrows, the actual and desired hand), from [`Outputs::contact_point`], `normal_force` and
+//! `contacts`.
+//!
 //! Runs with a non-bilateral contact (issue 11: rigid unilateral contacts after Pfeiffer &
 //! Glocker, *Multibody Dynamics with Unilateral Contacts*, 1996; compliant ones) also get
 //! `/contacts` (mode, gap, forces, slip, cumulative contact losses per contact, every sample),
@@ -21,7 +29,8 @@ use schemas::{
     JointState, Mirror, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
-use schemas::{Quaternion, Vector3};
+use schemas::markers::{self, ContactMarkers, ContactSample, MarkerMode, SceneDescription, TablePlane};
+use schemas::{Quaternion, Vector3, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA};
 
 use crate::dynamics::contact::{Contact, ContactEvent, ContactModel, ContactOutput, ContactSettings};
 use crate::error::RunError;
@@ -57,6 +66,79 @@ fn set_with<T>(dst: &mut Vec<T>, src: &[ContactOutput], f: impl Fn(&ContactOutpu
 /// The contacts of `run`, in its order, with their models.
 fn run_contacts(scene: &Scene, run: &Run) -> Vec<Contact> {
     scene.run_contact_models(run)
+}
+
+/// Most points of the target path on `/scene`: the output grid, every k-th sample when it has
+/// more (a line strip of 1 000 points draws the paper's 0.1 m circle with chords of 0.3 mm).
+pub const TARGET_PATH_MAX_POINTS: usize = 1000;
+
+/// The hand's target path sampled on the output grid (every k-th sample, at most
+/// [`TARGET_PATH_MAX_POINTS`] points, the last sample included), world frame, m, and the time
+/// between two points, s: the same function the run's `/hand` desired position comes from.
+pub fn target_path(scene: &Scene) -> (Vec<[f64; 3]>, f64) {
+    let dt = 1.0 / scene.output_rate;
+    let n = (scene.duration * scene.output_rate).round().max(0.0) as usize;
+    let stride = (n + 1).div_ceil(TARGET_PATH_MAX_POINTS).max(1);
+    let mut scratch = crate::control::target::TargetScratch::new(&scene.model);
+    let mut ks: Vec<usize> = (0..=n).step_by(stride).collect();
+    if ks.last() != Some(&n) {
+        ks.push(n);
+    }
+    let points = ks
+        .iter()
+        .map(|&k| {
+            let p = scene.target.hand_desired(k as f64 * dt, &scene.model, &scene.hand, &mut scratch);
+            [p.x, p.y, p.z]
+        })
+        .collect();
+    (points, dt * stride as f64)
+}
+
+/// The arm's reach from its base, m: the lengths of every URDF joint origin and of the hand
+/// point's offset, summed (an upper bound).
+pub fn reach(scene: &Scene) -> f64 {
+    scene.model.urdf_joints.iter().map(|j| j.origin.translation.vector.norm()).sum::<f64>() + scene.hand.p_body.norm()
+}
+
+/// The distinct contact planes of `scene` (every run's), each with the contacts of `run` on it.
+pub fn table_planes(scene: &Scene, run: &Run) -> Vec<TablePlane> {
+    let mut planes: Vec<TablePlane> = Vec::new();
+    for (k, c) in scene.contact_models.iter().enumerate() {
+        let n = c.plane.normal_world;
+        let normal = [n.x, n.y, n.z];
+        let idx = match planes.iter().position(|p| p.normal == normal && p.offset == c.plane.offset) {
+            Some(i) => i,
+            None => {
+                planes.push(TablePlane { normal, offset: c.plane.offset, contacts: Vec::new() });
+                planes.len() - 1
+            }
+        };
+        if run.contacts.contains(&k) {
+            planes[idx].contacts.push(c.name().to_string());
+        }
+    }
+    planes
+}
+
+/// The Foxglove layout's input for the runs of `scene` (`schemas::layout`).
+pub fn layout_input(scene: &Scene) -> schemas::layout::LayoutInput {
+    let (path, _) = target_path(scene);
+    let (focus, camera_distance_m) = schemas::layout::camera_for(&path);
+    schemas::layout::LayoutInput {
+        title: scene.spec.name.clone(),
+        joint_names: scene.model.joint_names(),
+        runs: scene
+            .runs()
+            .iter()
+            .map(|r| schemas::layout::LayoutRun {
+                run: r.name.clone(),
+                contacts: run_contacts(scene, r).iter().map(|c| c.name().to_string()).collect(),
+                has_contact_topic: scene.run_is_hybrid(r),
+            })
+            .collect(),
+        focus,
+        camera_distance_m,
+    }
 }
 
 /// Record `contacts`: every contact of the run (its model and parameters, plane, tangent basis)
@@ -130,6 +212,10 @@ pub struct Recorder<'a> {
     /// The last sample's impact loss, friction work and damping loss summed over the contacts
     /// (record `energy_terms`, hybrid runs).
     contact_terms: [f64; 3],
+    /// `/contact_markers`, built once, updated in place every sample.
+    markers: ContactMarkers,
+    /// Each contact's plane normal and tangents `(n, t1, t2)`, world frame, in the run's order.
+    contact_frames: Vec<[nalgebra::Vector3<f64>; 3]>,
 }
 
 impl<'a> Recorder<'a> {
@@ -222,6 +308,17 @@ impl<'a> Recorder<'a> {
         writer
             .write(topics::ROBOT_DESCRIPTION, 0, &RosString { data: scene.urdf_xml.clone() })
             .map_err(err)?;
+        // the table and the target path, once
+        let planes = table_planes(scene, run);
+        let (path_points, path_dt) = target_path(scene);
+        let scene_msg = markers::scene_update(&SceneDescription {
+            frame_id: WORLD_FRAME,
+            planes: &planes,
+            half_size_m: reach(scene).max(0.25),
+            target_path: &path_points,
+            target_dt_s: path_dt,
+        });
+        writer.write(topics::SCENE, 0, &scene_msg).map_err(err)?;
         // world -> root, then every URDF joint (fixed ones too), in this order every sample
         let mut tf = FrameTransforms { transforms: Vec::with_capacity(scene.model.urdf_joints.len() + 1) };
         tf.transforms.push(frame_transform(0, WORLD_FRAME, &scene.model.root_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
@@ -241,9 +338,11 @@ impl<'a> Recorder<'a> {
             monitor: LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, 1.0 / scene.output_rate),
             terms: [0.0; 3],
             hybrid,
+            markers: ContactMarkers::new(WORLD_FRAME, &contact_names),
             contact_state: ContactState { name: contact_names, ..Default::default() },
             contact_event: ContactEventMsg::default(),
             contact_terms: [0.0; 3],
+            contact_frames: contacts.iter().map(|c| [c.plane.normal_world.into_inner(), c.t1, c.t2]).collect(),
         })
     }
 
@@ -306,8 +405,23 @@ impl<'a> Recorder<'a> {
         let e = o.hand - o.hand_desired;
         let hand = HandState { time: o.t, actual: v3(&o.hand), desired: v3(&o.hand_desired), error: v3(&e), error_norm: e.norm() };
         self.writer.write(topics::HAND, t_ns, &hand).map_err(&err)?;
-        let pts = [[o.hand.x, o.hand.y, o.hand.z], [o.hand_desired.x, o.hand_desired.y, o.hand_desired.z]];
+        let pts = [([o.hand.x, o.hand.y, o.hand.z], HAND_ACTUAL_RGBA), ([o.hand_desired.x, o.hand_desired.y, o.hand_desired.z], HAND_DESIRED_RGBA)];
         self.writer.write(topics::HAND_POINTS, t_ns, &hand_points(t_ns, WORLD_FRAME, &pts)).map_err(&err)?;
+
+        // contact markers: the force of the table on the arm, f_n n + f_t1 t1 + f_t2 t2
+        let hybrid = self.hybrid;
+        let frames = &self.contact_frames;
+        let samples = o.contact_point.iter().zip(frames).enumerate().map(|(k, (p, [n, t1, t2]))| {
+            let f_n = o.normal_force.get(k).copied().unwrap_or(0.0);
+            let (f_t, mode) = match o.contacts.get(k) {
+                Some(c) if hybrid => (c.friction_force, MarkerMode::from_code(c.mode.code(), c.normal_force)),
+                _ => ([0.0; 2], MarkerMode::bilateral(f_n)),
+            };
+            let f = n * f_n + t1 * f_t[0] + t2 * f_t[1];
+            ContactSample { point: [p.x, p.y, p.z], force: [f.x, f.y, f.z], mode }
+        });
+        let msg = self.markers.update(t_ns, samples, [o.hand.x, o.hand.y, o.hand.z], [o.hand_desired.x, o.hand_desired.y, o.hand_desired.z]);
+        self.writer.write(topics::CONTACT_MARKERS, t_ns, msg).map_err(&err)?;
 
         let en = &mut self.energy;
         en.time = o.t;

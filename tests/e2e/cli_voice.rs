@@ -55,13 +55,13 @@ fn shared_flags_mean_the_same_in_both_tools() {
     for (name, cmd) in [("sim", "run"), ("sim", "sweep"), ("analyze", "summary")] {
         assert!(stdout(&tool(name, &[cmd, "--help"])).contains("-j, --jobs <N>"), "{name} {cmd}");
     }
-    for (name, cmd) in [("sim", "run"), ("sim", "replay"), ("sim", "precision"), ("analyze", "report"), ("analyze", "figures"), ("analyze", "export")] {
+    for (name, cmd) in [("sim", "run"), ("sim", "replay"), ("sim", "precision"), ("analyze", "report"), ("analyze", "figures"), ("analyze", "export"), ("analyze", "layout")] {
         assert!(stdout(&tool(name, &[cmd, "--help"])).contains("-o, --out <DIR>"), "{name} {cmd}");
     }
     // every command's help says what it outputs and gives examples
     for (name, cmds) in [
         ("sim", &["run", "check", "replay", "sweep", "precision", "export-scene"][..]),
-        ("analyze", &["compare", "metrics", "summary", "diff", "report", "figures", "export"][..]),
+        ("analyze", &["compare", "metrics", "summary", "diff", "report", "figures", "export", "layout"][..]),
     ] {
         for cmd in cmds {
             let help = stdout(&tool(name, &[cmd, "--help"]));

@@ -10,6 +10,7 @@ mod analyze_tables;
 mod bounded_memory;
 mod cli_voice;
 mod format_ownership;
+mod foxglove_layout;
 mod live;
 mod pipeline;
 mod rerun_view;

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use schemas::{
-    frame_transform, hand_points, to_log_time, topics, ConstraintState, EnergyState,
+    frame_transform, hand_points, to_log_time, topics, ConstraintState, EnergyState, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA,
     FrameTransforms, HandState, JointState, MotorState, RecordingWriter, RosString, Value, Vec3,
 };
 
@@ -174,7 +174,7 @@ pub fn write_all_with(_path: &Path, c: &Content, mut w: RecordingWriter) -> std:
         w.write(
             topics::HAND_POINTS,
             t,
-            &hand_points(t, "world", &[[1.0, 2.0, 3.0], [val(k, 0), -0.0, 9.5]]),
+            &hand_points(t, "world", &[([1.0, 2.0, 3.0], HAND_ACTUAL_RGBA), ([val(k, 0), -0.0, 9.5], HAND_DESIRED_RGBA)]),
         )
         .unwrap();
     }

@@ -7,7 +7,7 @@
 //! |---|---|
 //! | t, q, q̇, W_j, E_j, E_R, E_D + E_Dm, i (inductive motors) | the state y alone |
 //! | back EMF `K_e k q̇` (= `K_m q̇` unless the scene gives K_e) | the state |
-//! | hand position, constraint positions C, potential energy V | forward kinematics at q (placements) |
+//! | hand position, constraint positions C, contact points, potential energy V | forward kinematics at q (placements) |
 //! | constraint velocities Ċ | forward kinematics and velocities at (q, q̇) |
 //! | desired hand position | the target's hand path at t (for a joint target: FK of q_d(t)) |
 //! | voltages, electric power `i v`, i (quasi-static motors), ½ L i² then | the IK targets and the PD law (eqs 27–29) |
@@ -43,6 +43,9 @@ pub struct Outputs {
     pub normal_force: Vec<f64>,
     pub constraint_position: Vec<f64>,
     pub constraint_velocity: Vec<f64>,
+    /// World position of each contact point of the run, in its order, m (forward kinematics at
+    /// q; for the viewers' contact markers).
+    pub contact_point: Vec<Vector3<f64>>,
     pub hand: Vector3<f64>,
     pub hand_desired: Vector3<f64>,
     pub link_work: Vec<f64>,
@@ -139,6 +142,8 @@ impl ArmSystem<'_> {
         out.constraint_position.extend(self.contacts.iter().map(|c| c.position(data)));
         out.constraint_velocity.clear();
         out.constraint_velocity.extend(self.contacts.iter().map(|c| c.velocity(data)));
+        out.contact_point.clear();
+        out.contact_point.extend(self.contacts.iter().map(|c| c.point.position(data)));
         if level == OutputLevel::Kinematic {
             for v in [&mut out.qdd, &mut out.voltage, &mut out.electric_power, &mut out.tau_motor, &mut out.normal_force, &mut out.voltage_command] {
                 v.clear();
@@ -240,6 +245,8 @@ mod tests {
                 assert_eq!((kin.t, &kin.q, &kin.qd), (full.t, &full.q, &full.qd), "{name}");
                 assert_eq!((kin.hand, kin.hand_desired, kin.potential), (full.hand, full.hand_desired, full.potential), "{name}");
                 assert_eq!((&kin.constraint_position, &kin.constraint_velocity), (&full.constraint_position, &full.constraint_velocity), "{name}");
+                assert_eq!(&kin.contact_point, &full.contact_point, "{name}");
+                assert_eq!(full.contact_point.len(), run.contacts.len(), "{name}");
                 assert_eq!((&kin.link_work, &kin.electric_energy, &kin.back_emf), (&full.link_work, &full.electric_energy, &full.back_emf), "{name}");
                 assert_eq!(
                     (kin.loss_resistance, kin.loss_friction, kin.loss_gear_friction),

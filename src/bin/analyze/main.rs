@@ -6,6 +6,7 @@ mod compare;
 mod diff;
 mod export;
 mod figures;
+mod layout;
 mod load;
 mod report;
 mod summary;
@@ -27,6 +28,7 @@ Examples:
   analyze summary 'out/*.mcap' --sort E_total_j   many runs as one table
   analyze export out/ -o out/tables         every topic as Parquet, for Python
   analyze view out/paper-two-elbow.mcap     as a Rerun .rrd with a blueprint (feature rerun)
+  analyze layout out/ -o out                the Foxglove layout of the recordings
   analyze diff recordings/ out/             what moved between two versions";
 
 /// Reads recordings of `sim` runs: hand error, link work W_j, motor electric energy E_j,
@@ -50,6 +52,7 @@ enum Command {
     Figures(figures::FiguresArgs),
     Export(export::ExportArgs),
     View(view::ViewArgs),
+    Layout(layout::LayoutArgs),
     /// Print the shell completion script (bash, zsh, fish, elvish, powershell).
     #[command(after_help = "Example:\n  analyze completions bash > ~/.local/share/bash-completion/completions/analyze")]
     Completions(CompletionsArgs),
@@ -70,6 +73,7 @@ fn main() -> ExitCode {
         Command::Figures(a) => figures::run(&a, v),
         Command::Export(a) => export::run(&a, v),
         Command::View(a) => view::run(&a, v),
+        Command::Layout(a) => layout::run(&a, v),
         Command::Completions(a) => cli::extras::completions(Cli::command(), a.shell).map(|()| exit::SUCCESS),
         Command::Man(a) => cli::extras::man_pages(Cli::command(), &a.out).map(|n| {
             if !v.quiet {

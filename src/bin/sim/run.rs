@@ -109,7 +109,9 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     let names = runs.iter().map(|r| r.name.clone()).collect();
     let live = live::Session::start(&a.live, &live::about(&[(&scene, names)], &a.out), v.quiet)?;
     let budget = a.live.budget(a.wall_time.budget(), scene.duration());
+    let layout = write_layout(&scene, &a.out, v)?;
     let done = run_all_live(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
+    report_layouts(&[layout], v);
     let code = finish(&done, a.format, a.baseline.as_deref());
     if let Some(live) = live {
         live.close();
@@ -147,15 +149,39 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
     let about: Vec<_> = scenes.iter().zip(&picked).map(|(s, r)| (s, r.iter().map(|r| r.name.clone()).collect())).collect();
     let live = live::Session::start(&a.live, &live::about(&about, &a.out), v.quiet)?;
     let mut done = Vec::new();
+    let mut layouts = Vec::new();
     for (scene, runs) in scenes.iter().zip(&picked).filter(|(_, r)| !r.is_empty()) {
         let budget = a.live.budget(a.wall_time.budget(), scene.duration());
+        layouts.push(write_layout(scene, &a.out, v)?);
         done.extend(run_all_live(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref()));
     }
+    report_layouts(&layouts, v);
     let code = finish(&done, a.format, a.baseline.as_deref());
     if let Some(live) = live {
         live.close();
     }
     code
+}
+
+/// Write the Foxglove layout of `scene`'s recordings, `<out>/<scene>.foxglove-layout.json`
+/// (`schemas::layout`): one per scene, for every run of the scene (the runs of a scene share
+/// their joints; contact series the runs name differently are labelled per run), so a user
+/// imports it once and opens any of the scene's recordings with it. Written atomically
+/// (`schemas::atomic`), before the runs, whichever runs are selected.
+pub fn write_layout(scene: &Scene, out: &Path, _v: Verbosity) -> Result<PathBuf> {
+    let layout = schemas::layout::foxglove(&sim::record::layout_input(scene));
+    let path = out.join(schemas::layout::file_name(&scene.spec().name));
+    let text = serde_json::to_string_pretty(&layout).context("the Foxglove layout as JSON")?;
+    schemas::atomic::write_file(&path, text + "\n").with_context(|| format!("cannot write the Foxglove layout {}", path.display()))
+}
+
+/// Say where the layouts are (after the runs' own lines, unless quiet).
+fn report_layouts(paths: &[PathBuf], v: Verbosity) {
+    if !v.quiet {
+        for p in paths {
+            eprintln!("wrote {} (Foxglove: Layouts -> Import from file, then open a recording)", p.display());
+        }
+    }
 }
 
 /// The runs called `names` (all when empty), in that order.

@@ -1,0 +1,56 @@
+//! `/contact_markers` costs no allocation per sample: after the first update, updating the
+//! message (every mode, forces of both signs, zero force, moving points and hands) allocates
+//! nothing (a counting global allocator, per thread).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use schemas::markers::{ContactMarkers, ContactSample, MarkerMode};
+
+struct Counting;
+
+thread_local! {
+    static ALLOCS: Cell<u64> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocs() -> u64 {
+    ALLOCS.with(|c| c.get())
+}
+
+#[test]
+fn updating_the_contact_markers_does_not_allocate() {
+    let names: Vec<String> = ["elbow4", "elbow7", "hand"].iter().map(|s| s.to_string()).collect();
+    let mut m = ContactMarkers::new("world", &names);
+    let modes = [MarkerMode::Separated, MarkerMode::Sticking, MarkerMode::Sliding, MarkerMode::Pushing, MarkerMode::Pulling];
+    let sample = |k: usize, i: usize| ContactSample {
+        point: [0.1 * k as f64, 0.01 * i as f64, 0.0],
+        force: if i % 7 == 0 { [0.0; 3] } else { [0.5 * i as f64, -1.0, 30.0 - i as f64] },
+        mode: modes[(i + k) % modes.len()],
+    };
+    m.update(0, (0..3).map(|k| sample(k, 0)), [0.0; 3], [0.0; 3]);
+    let before = allocs();
+    let mut entities = 0;
+    for i in 1..200 {
+        let msg = m.update(i as u64 * 1_000_000, (0..3).map(|k| sample(k, i)), [0.01 * i as f64, 0.0, 0.4], [0.0, 0.01 * i as f64, 0.4]);
+        entities += msg.entities.len();
+    }
+    assert_eq!(allocs() - before, 0, "allocations in 199 updates");
+    assert_eq!(entities, 199 * 8);
+}

@@ -1,0 +1,111 @@
+//! The Foxglove view of the recordings, checked with Foxglove's own libraries (issue 13,
+//! acceptance): `sim` writes one layout per scene beside its recordings and `analyze layout`
+//! writes one for any recordings; `tests/foxglove/check.mjs` (node: ajv, @mcap/core, protobufjs,
+//! @foxglove/schemas, pinned in its package-lock.json) validates each layout against the schema
+//! derived from Foxglove's types, resolves every topic and plot path in the recordings, and
+//! decodes every `/scene` and `/contact_markers` message (entity counts, mode colours, arrow
+//! lengths = |F| × scale within 1e-9 m, spheres on the contact points and the hand).
+//!
+//! Needs node (on PATH) and `npm ci --prefix tests/foxglove` (or `ELBOW_NODE_DIR` = a directory
+//! with check.mjs and its node_modules). Missing: the test fails when `CI` is set, else it says
+//! why and passes without checking.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::{run_analyze, run_sim};
+
+/// The checker's directory, or why it cannot run (node or node_modules missing).
+fn checker() -> Result<PathBuf, String> {
+    let dir = std::env::var_os("ELBOW_NODE_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/foxglove"));
+    if !dir.join("node_modules").is_dir() {
+        return Err(format!("no {}/node_modules: run `npm ci --prefix {}`", dir.display(), dir.display()));
+    }
+    match Command::new("node").arg("--version").output() {
+        Ok(o) if o.status.success() => Ok(dir),
+        _ => Err("`node` is not on PATH (node 20 or later)".into()),
+    }
+}
+
+/// The checker's directory; `None` (with a message) when it cannot run outside CI.
+fn checker_or_skip() -> Option<PathBuf> {
+    match checker() {
+        Ok(d) => Some(d),
+        Err(why) if std::env::var_os("CI").is_some() => panic!("the Foxglove check cannot run in CI: {why}"),
+        Err(why) => {
+            eprintln!("skipped: the Foxglove check needs node and tests/foxglove/node_modules ({why})");
+            None
+        }
+    }
+}
+
+/// Runs check.mjs on `layout` and `recordings`: (exit code, stdout, stderr).
+fn check(dir: &Path, layout: &Path, recordings: &[PathBuf]) -> (i32, String, String) {
+    let out = Command::new("node").arg(dir.join("check.mjs")).arg(layout).args(recordings).output().expect("node starts");
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+fn mcaps(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "mcap") && p.file_name().unwrap().to_string_lossy().starts_with(prefix))
+        .collect();
+    v.sort();
+    v
+}
+
+/// The six default runs (0.2 s each): both scenes' layouts pass with their recordings; the
+/// layout `analyze layout` writes for one recording passes; a layout with a misspelt plot path
+/// or a topic the recording lacks fails, naming it.
+#[test]
+fn layouts_and_scene_entities_pass_foxglove_checks() {
+    let Some(node_dir) = checker_or_skip() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path();
+    let o = run_sim(&["--duration", "0.2", "-q", "-f", "csv", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "sim: {}", String::from_utf8_lossy(&o.stderr));
+
+    let paper = mcaps(out, "paper-").into_iter().filter(|p| !p.to_string_lossy().contains("unilateral")).collect::<Vec<_>>();
+    let unilateral = mcaps(out, "paper-unilateral-");
+    assert_eq!((paper.len(), unilateral.len()), (3, 3));
+    for (layout, recs) in [("paper.foxglove-layout.json", &paper), ("paper-unilateral.foxglove-layout.json", &unilateral)] {
+        let (code, stdout, stderr) = check(&node_dir, &out.join(layout), recs);
+        assert_eq!(code, 0, "{layout}: {stderr}\n{stdout}");
+        let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        assert_eq!(summary["failures"], 0);
+        // every contact of every sample had its arrow checked
+        for r in summary["recordings"].as_array().unwrap() {
+            let samples = r["contact_marker_messages"].as_u64().unwrap();
+            assert_eq!(samples, 201, "{r}");
+            assert_eq!(r["arrows_checked"].as_u64().unwrap(), samples * r["contacts"].as_u64().unwrap(), "{r}");
+        }
+    }
+
+    // analyze layout, for one recording
+    let two = out.join("paper-two-elbow.mcap");
+    let dir = out.join("layouts");
+    let o = run_analyze(&[OsStr("layout"), two.as_os_str().into(), OsStr("-o"), dir.as_os_str().into()]);
+    assert!(o.status.success(), "analyze layout: {}", String::from_utf8_lossy(&o.stderr));
+    let written = dir.join("paper.foxglove-layout.json");
+    let (code, stdout, stderr) = check(&node_dir, &written, std::slice::from_ref(&two));
+    assert_eq!(code, 0, "{stderr}\n{stdout}");
+
+    // the checker fails on a bad path and on a missing topic
+    let text = std::fs::read_to_string(&written).unwrap();
+    for (from, to, says) in [("/motors.current[3]", "/motors.curent[3]", "no field curent"), ("/energy.balance_residual", "/energies.balance_residual", "/energies")] {
+        assert!(text.contains(from));
+        let bad = out.join("bad.json");
+        std::fs::write(&bad, text.replace(from, to)).unwrap();
+        let (code, _, stderr) = check(&node_dir, &bad, std::slice::from_ref(&two));
+        assert_eq!(code, 1, "{to}: {stderr}");
+        assert!(stderr.contains(says), "{to}: {stderr}");
+    }
+}
+
+#[allow(non_snake_case)]
+fn OsStr(s: &str) -> std::ffi::OsString {
+    s.into()
+}
