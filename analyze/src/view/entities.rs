@@ -61,26 +61,36 @@ pub fn palette(k: usize) -> u32 {
     rgba(r, g, b, 255)
 }
 
+/// A colour of [`schemas::markers::colors`] (the one owner of the viewers' colours, so Rerun
+/// and Foxglove draw the same thing in the same colour) as Rerun's packed RGBA.
+fn shared(hex: &str) -> u32 {
+    let [r, g, b, a] = schemas::markers::colors::rgba8(hex, 255);
+    rgba(r, g, b, a)
+}
+
 /// Contact mode colours ([`schemas::contact_mode`] codes, then bilateral pulling).
-pub const SEPARATED_COLOR: u32 = rgba(150, 150, 150, 255);
-pub const STICKING_COLOR: u32 = rgba(40, 170, 60, 255);
-pub const SLIDING_COLOR: u32 = rgba(255, 150, 0, 255);
-pub const PUSHING_COLOR: u32 = rgba(40, 110, 230, 255);
-pub const PULLING_COLOR: u32 = rgba(220, 30, 30, 255);
-/// The hand: actual orange-red, desired (the target) green.
-pub const HAND_ACTUAL: u32 = rgba(230, 85, 13, 255);
-pub const HAND_DESIRED: u32 = rgba(30, 160, 60, 255);
+fn mode_colors() -> [u32; 5] {
+    use schemas::markers::colors::{PULLING, PUSHING, SEPARATED, SLIDING, STICKING};
+    [shared(SEPARATED), shared(STICKING), shared(SLIDING), shared(PUSHING), shared(PULLING)]
+}
+/// The hand: actual blue, desired (the target) orange, as in Foxglove's `/contact_markers`.
+fn hand_actual() -> u32 {
+    shared(schemas::markers::colors::HAND_ACTUAL)
+}
+fn hand_desired() -> u32 {
+    shared(schemas::markers::colors::HAND_DESIRED)
+}
 const TABLE: u32 = rgba(176, 140, 96, 70);
 const ARM: u32 = rgba(170, 180, 200, 255);
 
 fn mode_color(mode: Option<u32>, f_n: f64) -> u32 {
     use schemas::contact_mode::{SEPARATED, SLIDING, STICKING};
     match mode {
-        Some(SEPARATED) => SEPARATED_COLOR,
-        Some(STICKING) => STICKING_COLOR,
-        Some(SLIDING) => SLIDING_COLOR,
-        _ if f_n < 0.0 => PULLING_COLOR,
-        _ => PUSHING_COLOR,
+        Some(SEPARATED) => mode_colors()[0],
+        Some(STICKING) => mode_colors()[1],
+        Some(SLIDING) => mode_colors()[2],
+        _ if f_n < 0.0 => mode_colors()[4],
+        _ => mode_colors()[3],
     }
 }
 
@@ -299,18 +309,18 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
     if !run.hand.is_empty() {
         out.push(
             Chunk::new(format!("{world}/target_path"), Index::Static)
-                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![HAND_DESIRED]]))
+                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_desired()]]))
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.002]]))
                 .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![desired.iter().copied().map(f3).collect()]])),
         );
         out.push(
             Chunk::new(format!("{world}/hand_trail"), Index::Static)
-                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![HAND_ACTUAL]]))
+                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_actual()]]))
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.0015]]))
                 .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![actual.iter().copied().map(f3).collect()]])),
         );
         for (name, pts, color, label, r) in
-            [("actual", &actual, HAND_ACTUAL, "hand (actual)", r_point), ("desired", &desired, HAND_DESIRED, "target (desired)", 0.75 * r_point)]
+            [("actual", &actual, hand_actual(), "hand (actual)", r_point), ("desired", &desired, hand_desired(), "target (desired)", 0.75 * r_point)]
         {
             out.push(
                 Chunk::new(format!("{world}/hand/{name}"), Index::SimTime(hand_times.clone()))
