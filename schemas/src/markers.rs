@@ -14,7 +14,8 @@
 //! Colours (issue 13, the lead's decisions): contact mode separated = grey `#9e9e9e`, sticking =
 //! green `#2ca02c`, sliding = orange `#ff7f0e`, bilateral pushing (`f_n ≥ 0`) = blue `#1f77b4`,
 //! bilateral pulling (`f_n < 0`: the table holds the arm down) = red `#d62728`; hand actual =
-//! blue `#1f77b4`, desired/target = orange `#ff7f0e`.
+//! purple `#9467bd` (a colour no link of the built-in arms has: the paper arm's links are blue),
+//! desired/target = orange `#ff7f0e`.
 //!
 //! Force arrows: the force of the table on the arm at the contact point, `f_n n + f_t1 t1 +
 //! f_t2 t2` (N, world frame; sign conventions of the contact modules: `f_n > 0` pushes the point
@@ -71,7 +72,7 @@ pub mod colors {
     /// Bilateral contact, the table pulls (`f_n < 0`).
     pub const PULLING: &str = "#d62728";
     /// The hand, actual.
-    pub const HAND_ACTUAL: &str = "#1f77b4";
+    pub const HAND_ACTUAL: &str = "#9467bd";
     /// The hand, desired (and the target path).
     pub const HAND_DESIRED: &str = "#ff7f0e";
     /// The table.

@@ -473,8 +473,8 @@ pub fn frame_transform(
 /// blue, alpha as uint8.
 pub const HAND_POINT_STRIDE: u32 = 28;
 
-/// The colour of the actual hand's point, RGBA bytes (blue `#1f77b4`, [`crate::markers::colors`]).
-pub const HAND_ACTUAL_RGBA: [u8; 4] = [0x1f, 0x77, 0xb4, 255];
+/// The colour of the actual hand's point, RGBA bytes (purple `#9467bd`, [`crate::markers::colors`]).
+pub const HAND_ACTUAL_RGBA: [u8; 4] = [0x94, 0x67, 0xbd, 255];
 /// The colour of the desired hand's point, RGBA bytes (orange `#ff7f0e`).
 pub const HAND_DESIRED_RGBA: [u8; 4] = [0xff, 0x7f, 0x0e, 255];
 

@@ -14,7 +14,7 @@
 //     .proto text @foxglove/schemas generates), with the entity counts, the mode colours, the
 //     arrow lengths |F| x scale (1e-9 m), the arrows' normal component f_n (1e-9 N), the contact
 //     spheres on their constraint value C or gap (1e-9 m), the hand spheres on /hand (exact),
-//     and /hand_points coloured blue (actual) and orange (desired).
+//     and /hand_points coloured purple (actual) and orange (desired).
 //
 // Prints one JSON summary on stdout; exit 0 if every check passed, 1 if one failed (each
 // failure on stderr), 2 on bad input.
@@ -46,7 +46,7 @@ const MODE_COLORS = {
   pulling: hex("#d62728"),
 };
 const MODE_BY_CODE = ["separated", "sticking", "sliding"];
-const HAND_ACTUAL = [0x1f, 0x77, 0xb4, 255];
+const HAND_ACTUAL = [0x94, 0x67, 0xbd, 255];
 const HAND_DESIRED = [0xff, 0x7f, 0x0e, 255];
 
 const NUMERIC = new Set(["double", "float", "int32", "uint32", "sint32", "fixed32", "sfixed32", "int64", "uint64", "sint64", "fixed64", "sfixed64"]);
@@ -334,7 +334,7 @@ function checkScene(rec) {
     const pd = desired.spheres[0].pose.position;
     if (!(pa.x === h.actual.x && pa.y === h.actual.y && pa.z === h.actual.z)) fail(`${rec.path}: hand/actual at ${logTime} is not /hand actual`);
     if (!(pd.x === h.desired.x && pd.y === h.desired.y && pd.z === h.desired.z)) fail(`${rec.path}: hand/desired at ${logTime} is not /hand desired`);
-    if (!sameRgb(actual.spheres[0].color, hex("#1f77b4")) || !sameRgb(desired.spheres[0].color, hex("#ff7f0e"))) fail(`${rec.path}: hand colours at ${logTime}`);
+    if (!sameRgb(actual.spheres[0].color, hex("#9467bd")) || !sameRgb(desired.spheres[0].color, hex("#ff7f0e"))) fail(`${rec.path}: hand colours at ${logTime}`);
     if (!(actual.spheres[0].size.x / 2 > 0.015)) fail(`${rec.path}: the actual hand's sphere is not larger than the URDF's hand sphere (0.015 m)`);
   }
   out.contact_marker_messages = markers.length;
@@ -342,7 +342,7 @@ function checkScene(rec) {
   out.max_arrow_length_error_m = maxArrowErr;
   out.modes = modesSeen;
 
-  // /hand_points: separate RGBA fields, blue then orange
+  // /hand_points: separate RGBA fields, purple then orange
   const pts = decodeAll(rec, "/hand_points");
   for (const { logTime, msg } of pts) {
     const field = (n) => msg.fields.find((f) => f.name === n);

@@ -73,7 +73,7 @@ fn mode_colors() -> [u32; 5] {
     use schemas::markers::colors::{PULLING, PUSHING, SEPARATED, SLIDING, STICKING};
     [shared(SEPARATED), shared(STICKING), shared(SLIDING), shared(PUSHING), shared(PULLING)]
 }
-/// The hand: actual blue, desired (the target) orange, as in Foxglove's `/contact_markers`.
+/// The hand: actual purple, desired (the target) orange, as in Foxglove's `/contact_markers`.
 fn hand_actual() -> u32 {
     shared(schemas::markers::colors::HAND_ACTUAL)
 }

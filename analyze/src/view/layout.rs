@@ -120,7 +120,7 @@ fn plots(run: &Run, paths: &Paths) -> Vec<Plot> {
 pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     let world = paths.world();
     let arm = View::new(ViewClass::Spatial3D, "arm, side view", &world).eye(side_eye(bounds));
-    let hand = View::new(ViewClass::Spatial3D, "hand close-up (blue: actual, orange: target)", &world).eye(hand_eye(bounds));
+    let hand = View::new(ViewClass::Spatial3D, "hand close-up (purple: actual, orange: target)", &world).eye(hand_eye(bounds));
     let mut grid: Vec<Node> = plots(run, paths).iter().map(|p| p.node(&p.title)).collect();
     grid.push(plot("energy totals [J]", format!("/{}", signal::ENERGY)));
     grid.push(plot("energy balance residual [J]", paths.signal(signal::RESIDUAL)));
