@@ -43,7 +43,7 @@ pub mod writer;
 
 pub use error::Error;
 pub use messages::{
-    frame_transform, hand_points, timestamp, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA, ConstraintState, EnergyState, HandState, JointState,
+    frame_transform, hand_points, set_hand_points, timestamp, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA, ConstraintState, EnergyState, HandState, JointState,
     Message, MotorState, Quat, RosString, TopicMessage, TransformEntry, Transforms, Vec3, contact_event_kind, contact_mode, ContactEventMsg, ContactState, CONTACT_EVENT_KINDS,
 };
 pub use meta::{

@@ -485,20 +485,13 @@ pub const HAND_DESIRED_RGBA: [u8; 4] = [0xff, 0x7f, 0x0e, 255];
 /// `packages/suite-base/src/panels/ThreeDeeRender/renderables/colorMode.ts` of the open-source
 /// Foxglove Studio, now Lichtblick; integer fields are normalised by 255, `PointClouds.ts`).
 pub fn hand_points(t_ns: u64, frame_id: &str, points: &[([f64; 3], [u8; 4])]) -> PointCloud {
-    let mut data = Vec::with_capacity(points.len() * HAND_POINT_STRIDE as usize);
-    for (p, rgba) in points {
-        for c in p {
-            data.extend_from_slice(&c.to_le_bytes());
-        }
-        data.extend_from_slice(rgba);
-    }
     let field = |name: &str, offset: u32, t: NumericType| PackedElementField {
         name: name.to_string(),
         offset,
         r#type: t as i32,
     };
-    PointCloud {
-        timestamp: Some(timestamp(t_ns)),
+    let mut cloud = PointCloud {
+        timestamp: None,
         frame_id: frame_id.to_string(),
         pose: Some(Pose {
             position: Some(Vector3 {
@@ -523,8 +516,25 @@ pub fn hand_points(t_ns: u64, frame_id: &str, points: &[([f64; 3], [u8; 4])]) ->
             field("blue", 26, NumericType::Uint8),
             field("alpha", 27, NumericType::Uint8),
         ],
-        data: data.into(),
+        data: Default::default(),
+    };
+    set_hand_points(&mut cloud, t_ns, points);
+    cloud
+}
+
+/// Moves the points of a cloud made by [`hand_points`] to `points` at `t_ns`: the frame, pose
+/// and fields are kept, so a recorder builds the cloud once and pays one allocation per sample
+/// (the point bytes) instead of one per field name.
+pub fn set_hand_points(cloud: &mut PointCloud, t_ns: u64, points: &[([f64; 3], [u8; 4])]) {
+    let mut data = Vec::with_capacity(points.len() * HAND_POINT_STRIDE as usize);
+    for (p, rgba) in points {
+        for c in p {
+            data.extend_from_slice(&c.to_le_bytes());
+        }
+        data.extend_from_slice(rgba);
     }
+    cloud.timestamp = Some(timestamp(t_ns));
+    cloud.data = data.into();
 }
 
 #[cfg(test)]

@@ -24,7 +24,7 @@
 use std::path::{Path, PathBuf};
 
 use schemas::{
-    frame_transform, hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactInfo, ContactState,
+    frame_transform, hand_points, set_hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactInfo, ContactState,
     ContactsRecord, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
     JointState, Mirror, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
@@ -198,6 +198,8 @@ pub struct Recorder<'a> {
     joint_state: JointState,
     /// `/tf`, built once (frame names), its poses and stamps updated every sample.
     tf: FrameTransforms,
+    /// `/hand_points`, built once (frame, fields), its points and stamp updated every sample.
+    hand_cloud: schemas::PointCloud,
     /// The limits monitor, when the scene monitors limits: its verdict is written at the end
     /// (record `limits`, and counts in `result`), for failed runs too.
     monitor: Option<LimitMonitor>,
@@ -329,6 +331,7 @@ impl<'a> Recorder<'a> {
             scene,
             writer,
             tf,
+            hand_cloud: hand_points(0, WORLD_FRAME, &[]),
             path: path.to_path_buf(),
 
             motors: MotorState { name: joint_names.clone(), ..Default::default() },
@@ -406,7 +409,8 @@ impl<'a> Recorder<'a> {
         let hand = HandState { time: o.t, actual: v3(&o.hand), desired: v3(&o.hand_desired), error: v3(&e), error_norm: e.norm() };
         self.writer.write(topics::HAND, t_ns, &hand).map_err(&err)?;
         let pts = [([o.hand.x, o.hand.y, o.hand.z], HAND_ACTUAL_RGBA), ([o.hand_desired.x, o.hand_desired.y, o.hand_desired.z], HAND_DESIRED_RGBA)];
-        self.writer.write(topics::HAND_POINTS, t_ns, &hand_points(t_ns, WORLD_FRAME, &pts)).map_err(&err)?;
+        set_hand_points(&mut self.hand_cloud, t_ns, &pts);
+        self.writer.write(topics::HAND_POINTS, t_ns, &self.hand_cloud).map_err(&err)?;
 
         // contact markers: the force of the table on the arm, f_n n + f_t1 t1 + f_t2 t2
         let hybrid = self.hybrid;

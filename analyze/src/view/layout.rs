@@ -109,7 +109,7 @@ fn plots(run: &Run, paths: &Paths) -> Vec<Plot> {
     }
     if run.contact_states.is_some() && !run.contacts.is_empty() {
         v.push(p(signal::FRICTION_FORCE, "friction forces |f_t| [N]", None));
-        v.push(p(signal::CONTACT_MODE, "contact modes (0 separated, 1 sticking, 2 sliding)", Some([-0.2, 2.2])));
+        v.push(p(signal::CONTACT_MODE, "contact modes (0 separated, 1 sticking, 2 sliding, 3 bilateral)", Some([-0.2, 3.2])));
     }
     v.push(p(signal::ELECTRIC_ENERGY, "electric energy per motor E_j [J]", None));
     v.push(p(signal::LINK_WORK, "link work per joint W_j [J]", None));

@@ -72,8 +72,9 @@ fn positive_factor(s: &str) -> Result<f64, String> {
 }
 
 impl LiveArgs {
-    /// The wall-clock budget of a run of `duration_s` simulated seconds: `budget` plus the
-    /// time pacing takes (so `--max-wall-time` bounds the computing, not the watching).
+    /// The wall-clock budget of a run of `duration_s` simulated seconds: `budget` plus the most
+    /// time pacing can take, `duration_s / speed` (an upper bound: a run slower than real time
+    /// gets that much more time than without `--live`; README, "Watch a run live").
     pub fn budget(&self, budget: sim::run::Budget, duration_s: f64) -> sim::run::Budget {
         if !self.live || self.pace == Pace::Fast {
             return budget;
