@@ -42,6 +42,9 @@ fn percent(part: f64, whole: f64) -> String {
     let p = 100.0 * part / whole;
     if p > 0.0 && p < 1.0 {
         "under 1 %".into()
+    } else if p >= 99.5 && p < 100.0 {
+        // rounding would say "100 %" of a run the table did not pull for throughout
+        "over 99 %".into()
     } else {
         format!("{p:.0} %")
     }
@@ -177,6 +180,8 @@ mod tests {
         let got: Vec<String> = [3194.536, 113.99, 13.758, 0.019, -6.905, 1.0].map(num).to_vec();
         assert_eq!(got, ["3195", "114", "13.8", "0.0190", "−6.91", "1.00"]);
         assert_eq!(percent(4.964, 5.0), "99 %");
+        assert_eq!(percent(4.999, 5.0), "over 99 %");
+        assert_eq!(percent(5.0, 5.0), "100 %");
         assert_eq!(percent(0.001, 5.0), "under 1 %");
     }
 

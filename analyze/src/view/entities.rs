@@ -148,7 +148,7 @@ pub const ENERGY_TERMS: [(&str, &str, fn(&schemas::EnergyState) -> f64); 8] = [
     ("potential", "potential V", |e| e.potential),
     ("magnetic", "magnetic L i²/2", |e| e.magnetic),
     ("resistive-loss", "resistive loss", |e| e.resistive_loss),
-    ("friction-loss", "friction loss", |e| e.friction_loss),
+    ("friction-loss", "friction loss (joints D and gears D_m)", |e| e.friction_loss),
     ("gear-friction-loss", "gear friction loss", |e| e.gear_friction_loss),
 ];
 
