@@ -83,7 +83,9 @@ fn racing_writers_never_leave_a_corrupt_file() {
         let rec = schemas::read_recording(&final_path);
         assert!(rec.is_ok(), "trial {trial}: the final file does not read: {:?}", rec.err());
         assert!(std::fs::read(&final_path).unwrap() == reference, "trial {trial}: the final file differs from a lone run's");
-        assert_eq!(listing(dir.path()), ["small-free.mcap"], "trial {trial}: temporary or lock files left");
+        // the recording and the scene's Foxglove layout (one racer wrote it, the others left it)
+        assert_eq!(listing(dir.path()), ["small-free.mcap", "small.foxglove-layout.json"], "trial {trial}: temporary or lock files left");
+        serde_json::from_slice::<serde_json::Value>(&std::fs::read(dir.path().join("small.foxglove-layout.json")).unwrap()).unwrap();
     }
     eprintln!(
         "{RACE_TRIALS} trials x {RACERS} processes: {wrote} wrote the file, {refused} refused, {:.1} s",
@@ -124,11 +126,12 @@ fn a_killed_writer_leaves_no_final_file_and_the_next_run_cleans_up() {
         left.iter().any(|n| *n == format!(".long-60s-plain-two-elbow.mcap.{pid}-0.partial")),
         "the killed run's temporary file is not there: {left:?}"
     );
-    assert!(!left.iter().any(|n| n.ends_with(".mcap")), "a final file after a kill: {left:?}");
+    assert!(!left.iter().any(|n| n.ends_with(".mcap") || n.ends_with(".json")), "a final file (or a layout) after a kill: {left:?}");
     // the next writer of the same name: a short run of the same scene
     let o = sim().arg("run").arg(&scene).args(["--duration", "0.02", "--quiet", "-o"]).arg(dir.path()).output().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(listing(dir.path()), ["long-60s-plain-two-elbow.mcap"]);
+    // the killed run wrote no layout (it is written after the runs); the next one did
+    assert_eq!(listing(dir.path()), ["long-60s-plain-two-elbow.mcap", "long-60s-plain.foxglove-layout.json"]);
     schemas::read_recording(&dir.path().join("long-60s-plain-two-elbow.mcap")).unwrap();
 }
 

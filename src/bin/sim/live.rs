@@ -130,7 +130,7 @@ pub use server::Session;
 /// What the server says about itself (`serverInfo` metadata): the tool, and for each scene
 /// its runs.
 pub fn about(scenes: &[(&sim::scene::Scene, Vec<String>)], out: &Path) -> Vec<(&'static str, String)> {
-    let mut v = vec![("tool", sim::record::TOOL.to_string()), ("format_version", schemas::FORMAT_VERSION.to_string())];
+    let mut v = vec![("tool", sim::record::TOOL.to_string()), ("recording_format", schemas::FORMAT_VERSION.to_string())];
     let names: Vec<String> = scenes.iter().flat_map(|(s, runs)| runs.iter().map(move |r| format!("{}-{r}", s.spec().name))).collect();
     v.push(("runs", names.join(", ")));
     v.push(("out", out.display().to_string()));

@@ -109,10 +109,10 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     let names = runs.iter().map(|r| r.name.clone()).collect();
     let live = live::Session::start(&a.live, &live::about(&[(&scene, names)], &a.out), v.quiet)?;
     let budget = a.live.budget(a.wall_time.budget(), scene.duration());
-    let layout = write_layout(&scene, &a.out, v)?;
     let done = run_all_live(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
+    let layout = write_layout(&scene, &done, &a.out, v);
+    let code = finish(&done, a.format, a.baseline.as_deref()).map(|c| if layout.is_err() { c.max(exit::BAD_INPUT) } else { c });
     report_layouts(&[layout], v);
-    let code = finish(&done, a.format, a.baseline.as_deref());
     if let Some(live) = live {
         live.close();
     }
@@ -152,11 +152,13 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
     let mut layouts = Vec::new();
     for (scene, runs) in scenes.iter().zip(&picked).filter(|(_, r)| !r.is_empty()) {
         let budget = a.live.budget(a.wall_time.budget(), scene.duration());
-        layouts.push(write_layout(scene, &a.out, v)?);
-        done.extend(run_all_live(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref()));
+        let scene_done = run_all_live(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
+        layouts.push(write_layout(scene, &scene_done, &a.out, v));
+        done.extend(scene_done);
     }
+    let failed = layouts.iter().any(Result::is_err);
+    let code = finish(&done, a.format, a.baseline.as_deref()).map(|c| if failed { c.max(exit::BAD_INPUT) } else { c });
     report_layouts(&layouts, v);
-    let code = finish(&done, a.format, a.baseline.as_deref());
     if let Some(live) = live {
         live.close();
     }
@@ -167,19 +169,36 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
 /// (`schemas::layout`): one per scene, for every run of the scene (the runs of a scene share
 /// their joints; contact series the runs name differently are labelled per run), so a user
 /// imports it once and opens any of the scene's recordings with it. Written atomically
-/// (`schemas::atomic`), before the runs, whichever runs are selected.
-pub fn write_layout(scene: &Scene, out: &Path, _v: Verbosity) -> Result<PathBuf> {
+/// (`schemas::atomic`) after the runs, and only when one of them wrote a recording (a run that
+/// wrote nothing leaves nothing behind). Another `sim` writing the same layout at the same moment
+/// (two runs of one scene into one directory) writes the same bytes: it is left to that one
+/// (`Ok(None)`). Any other failure is the error's text (reported, exit status 2).
+pub fn write_layout(scene: &Scene, done: &[Done], out: &Path, v: Verbosity) -> Result<Option<PathBuf>, String> {
+    if !done.iter().any(|d| d.path.is_some()) {
+        return Ok(None);
+    }
     let layout = schemas::layout::foxglove(&sim::record::layout_input(scene));
     let path = out.join(schemas::layout::file_name(&scene.spec().name));
-    let text = serde_json::to_string_pretty(&layout).context("the Foxglove layout as JSON")?;
-    schemas::atomic::write_file(&path, text + "\n").with_context(|| format!("cannot write the Foxglove layout {}", path.display()))
+    let text = serde_json::to_string_pretty(&layout).map_err(|e| format!("the Foxglove layout as JSON: {e}"))?;
+    match schemas::atomic::write_file(&path, text + "\n") {
+        Ok(p) => Ok(Some(p)),
+        Err(schemas::Error::Busy { .. }) => {
+            if !v.quiet {
+                eprintln!("note: another sim is writing {} (the same layout): left to it", path.display());
+            }
+            Ok(None)
+        }
+        Err(e) => Err(format!("cannot write the Foxglove layout {}: {e}", path.display())),
+    }
 }
 
-/// Say where the layouts are (after the runs' own lines, unless quiet).
-fn report_layouts(paths: &[PathBuf], v: Verbosity) {
-    if !v.quiet {
-        for p in paths {
-            eprintln!("wrote {} (Foxglove: Layouts -> Import from file, then open a recording)", p.display());
+/// Say where the layouts are, or why one is missing (after the runs' own lines; errors always).
+fn report_layouts(layouts: &[Result<Option<PathBuf>, String>], v: Verbosity) {
+    for l in layouts {
+        match l {
+            Ok(Some(p)) if !v.quiet => eprintln!("wrote {} (Foxglove: Layouts -> Import from file, then open a recording)", p.display()),
+            Err(e) => eprintln!("sim: error: {e}"),
+            _ => {}
         }
     }
 }
