@@ -68,11 +68,6 @@ fn shared(hex: &str) -> u32 {
     rgba(r, g, b, a)
 }
 
-/// Contact mode colours ([`schemas::contact_mode`] codes, then bilateral pulling).
-fn mode_colors() -> [u32; 5] {
-    use schemas::markers::colors::{PULLING, PUSHING, SEPARATED, SLIDING, STICKING};
-    [shared(SEPARATED), shared(STICKING), shared(SLIDING), shared(PUSHING), shared(PULLING)]
-}
 /// The hand: actual purple, desired (the target) orange, as in Foxglove's `/contact_markers`.
 fn hand_actual() -> u32 {
     shared(schemas::markers::colors::HAND_ACTUAL)
@@ -83,15 +78,12 @@ fn hand_desired() -> u32 {
 const TABLE: u32 = rgba(176, 140, 96, 70);
 const ARM: u32 = rgba(170, 180, 200, 255);
 
+/// A contact marker's colour: the mode the Foxglove markers give it ([`schemas::markers::MarkerMode`]:
+/// a `/contacts` code, else a bilateral contact pushing or pulling by the sign of f_n).
 fn mode_color(mode: Option<u32>, f_n: f64) -> u32 {
-    use schemas::contact_mode::{SEPARATED, SLIDING, STICKING};
-    match mode {
-        Some(SEPARATED) => mode_colors()[0],
-        Some(STICKING) => mode_colors()[1],
-        Some(SLIDING) => mode_colors()[2],
-        _ if f_n < 0.0 => mode_colors()[4],
-        _ => mode_colors()[3],
-    }
+    use schemas::markers::MarkerMode;
+    let marker = mode.map_or_else(|| MarkerMode::bilateral(f_n), |code| MarkerMode::from_code(code, f_n));
+    shared(marker.hex())
 }
 
 fn f3(p: [f64; 3]) -> [f32; 3] {
