@@ -6,7 +6,7 @@
 //! | `-o, --out DIR` | the directory a command writes its files into |
 //! | `-j, --jobs N` | worker threads (default: one per core); results never depend on it |
 //! | `-q, --quiet` | no progress bars or notes on standard error |
-//! | `-v, --verbose` | more detail on standard error (repeat for more) |
+//! | `-v, --verbose` | more detail on standard error (repeat for more); `sim`'s comparison in full |
 //!
 //! Tables always go to standard output (redirect to save them); files always go into `-o DIR`.
 
@@ -19,7 +19,8 @@ pub struct Verbosity {
     /// No progress bars or notes on standard error (errors are still printed).
     #[arg(short, long, global = true, conflicts_with = "verbose")]
     pub quiet: bool,
-    /// More detail on standard error: each run's solver work and timing, each file read.
+    /// More detail: on standard error each run's solver work and timing, each file read; on
+    /// standard output `sim`'s comparison in full (every table and finding), not the brief one.
     #[arg(short, long, global = true, action = clap::ArgAction::Count)]
     pub verbose: u8,
 }

@@ -15,4 +15,4 @@ pub mod output;
 pub mod progress;
 
 pub use args::{Jobs, TableFormat, Verbosity, VERSION};
-pub use output::{create_dir, print_out, write_file};
+pub use output::{create_dir, print_out, terminal_width, write_file, TEXT_WIDTH};

@@ -52,5 +52,5 @@ pub use metrics::{
     read_run_metrics, read_run_metrics_recover, run_metrics, run_metrics_recovered,
     stream_run_metrics, LimitsMetrics, Reductions, RunMetrics, Status,
 };
-pub use render::{render_comparison, render_metrics, Format};
+pub use render::{render_comparison, render_comparison_brief, render_comparison_fitted, render_metrics, render_metrics_fitted, Format};
 pub use schemas::RecoverReport;

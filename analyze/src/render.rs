@@ -17,6 +17,12 @@
 //!   `damping_loss.…_j`, `mu_stick.elbow4_ratio`, `mu_contact.…_ratio`, `fn_contact_min.…_n`,
 //!   `fn_contact_max.…_n`. Empty cells where a run lacks the joint or contact or the value does
 //!   not exist. Numbers use Rust's shortest round-trip form.
+//!
+//! Text fits a width when asked ([`render_comparison_fitted`], [`render_metrics_fitted`]: a
+//! terminal's): a wide table is split into column groups that each fit, titles and findings
+//! are wrapped; no cell changes. [`render_comparison_brief`] is the short form (`sim`'s
+//! default): the headline findings and one table of the runs, every number as the full tables
+//! print it.
 
 use std::fmt;
 use std::str::FromStr;
@@ -25,11 +31,13 @@ use crate::compare::{Comparison, Ratios};
 use crate::metrics::{RunMetrics, Status};
 use crate::Error;
 
+mod brief;
 mod csv;
 mod table;
 mod text;
 
-pub use text::TextTable;
+pub use brief::FINDINGS;
+pub use text::{wrap, TextTable};
 
 /// Output format. `FromStr` accepts `table`, `json`, `csv` (any case); `Display` writes them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -81,9 +89,15 @@ impl FromStr for Format {
 
 /// Renders a comparison; text ends with a newline.
 pub fn render_comparison(cmp: &Comparison, format: Format) -> Result<String, Error> {
+    render_comparison_fitted(cmp, format, None)
+}
+
+/// [`render_comparison`], the text's lines fitted to `width` columns when given (JSON and CSV
+/// are never changed by it).
+pub fn render_comparison_fitted(cmp: &Comparison, format: Format, width: Option<usize>) -> Result<String, Error> {
     let runs: Vec<&RunMetrics> = cmp.runs.iter().map(|r| &r.metrics).collect();
     Ok(match format {
-        Format::Table => table::render(&runs, Some(cmp), false),
+        Format::Table => table::render(&runs, Some(cmp), false, width),
         Format::Json => serde_json::to_string_pretty(cmp)? + "\n",
         Format::Csv => {
             let ratios: Vec<&Ratios> = cmp.runs.iter().map(|r| &r.to_baseline).collect();
@@ -96,14 +110,26 @@ pub fn render_comparison(cmp: &Comparison, format: Format) -> Result<String, Err
 /// which the report puts first), for the report document.
 pub fn render_comparison_markdown(cmp: &Comparison) -> String {
     let runs: Vec<&RunMetrics> = cmp.runs.iter().map(|r| &r.metrics).collect();
-    table::render(&runs, Some(cmp), true)
+    table::render(&runs, Some(cmp), true, None)
+}
+
+/// The brief comparison as text fitted to `width` columns (module `brief`): the headline
+/// findings (at most [`FINDINGS`]), then one table with a row per run (E, E / E_base, hand error
+/// RMS and max, what each contact did); ends with a newline.
+pub fn render_comparison_brief(cmp: &Comparison, width: usize) -> String {
+    brief::render(cmp, width)
 }
 
 /// Renders per-run metrics (JSON: an array of [`RunMetrics`]); text ends with a newline.
 pub fn render_metrics(runs: &[RunMetrics], format: Format) -> Result<String, Error> {
+    render_metrics_fitted(runs, format, None)
+}
+
+/// [`render_metrics`], the text's lines fitted to `width` columns when given.
+pub fn render_metrics_fitted(runs: &[RunMetrics], format: Format, width: Option<usize>) -> Result<String, Error> {
     let refs: Vec<&RunMetrics> = runs.iter().collect();
     Ok(match format {
-        Format::Table => table::render(&refs, None, false),
+        Format::Table => table::render(&refs, None, false, width),
         Format::Json => serde_json::to_string_pretty(runs)? + "\n",
         Format::Csv => csv::render(&refs, None),
     })

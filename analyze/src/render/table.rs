@@ -1,5 +1,7 @@
-//! Aligned text tables in sections, for people.
+//! Aligned text tables in sections, for people: as wide as they come (a file, a pipe), or fitted
+//! to a width (a terminal's: [`TextTable::fitted`], titles and findings wrapped).
 
+use super::text::wrap;
 use super::{contacts, joints, TextTable};
 use crate::compare::{Comparison, Ratios};
 use crate::metrics::RunMetrics;
@@ -15,10 +17,13 @@ impl Table {
         Self { title: title.into(), table: TextTable::new(head) }
     }
 
-    /// As aligned text, or (`markdown`) as a heading and a GitHub pipe table.
-    fn write(&self, out: &mut String, markdown: bool) {
+    /// As aligned text (fitted to `width` columns when given), or (`markdown`) as a heading and
+    /// a GitHub pipe table.
+    fn write(&self, out: &mut String, markdown: bool, width: Option<usize>) {
         if markdown {
             out.push_str(&format!("### {}\n\n{}\n", self.title, self.table.markdown()));
+        } else if let Some(w) = width {
+            out.push_str(&format!("{}{}\n", wrap(&self.title, w, "", ""), self.table.fitted(w)));
         } else {
             out.push_str(&format!("{}\n{}\n", self.title, self.table.aligned()));
         }
@@ -26,12 +31,12 @@ impl Table {
 }
 
 /// `x` with `d` decimals.
-fn f(x: f64, d: usize) -> String {
+pub(super) fn f(x: f64, d: usize) -> String {
     format!("{x:.d$}")
 }
 
 /// In mm with 3 decimals, from m.
-fn mm(x_m: f64) -> String {
+pub(super) fn mm(x_m: f64) -> String {
     f(x_m * 1e3, 3)
 }
 
@@ -41,12 +46,13 @@ fn e(x: f64) -> String {
 }
 
 /// A ratio with 3 decimals, `-` when it does not exist.
-fn q(x: Option<f64>) -> String {
+pub(super) fn q(x: Option<f64>) -> String {
     x.map_or("-".into(), |x| f(x, 3))
 }
 
-/// The sections as aligned text, or (`markdown`) as Markdown headings and pipe tables.
-pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: bool) -> String {
+/// The sections as aligned text (fitted to `width` columns when given), or (`markdown`) as
+/// Markdown headings and pipe tables.
+pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: bool, width: Option<usize>) -> String {
     let ratios: Option<Vec<&Ratios>> = cmp.map(|c| c.runs.iter().map(|r| &r.to_baseline).collect());
     let base = cmp.map(|c| c.baseline_index);
     let labels = super::run_labels(runs);
@@ -107,7 +113,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
             joint,
         ]);
     }
-    t.write(&mut out, markdown);
+    t.write(&mut out, markdown, width);
 
     // hand error
     let mut head = vec![
@@ -135,7 +141,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         }
         t.table.rows.push(row);
     }
-    t.write(&mut out, markdown);
+    t.write(&mut out, markdown, width);
 
     // energy totals
     let mut head = vec!["run", "E = Σ ∫ i v dt [J]", "W = Σ ∫ τ q' dt [J]"];
@@ -154,7 +160,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         }
         t.table.rows.push(row);
     }
-    t.write(&mut out, markdown);
+    t.write(&mut out, markdown, width);
 
     // per-link energy
     let mut head: Vec<String> = vec!["joint".into()];
@@ -199,7 +205,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         }
         t.table.rows.push(row);
     }
-    t.write(&mut out, markdown);
+    t.write(&mut out, markdown, width);
 
     // contacts
     if !contacts(runs).is_empty() {
@@ -241,7 +247,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
                 ]);
             }
         }
-        t.write(&mut out, markdown);
+        t.write(&mut out, markdown, width);
     }
 
     // contact models (runs with `/contacts`)
@@ -296,7 +302,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
                 ]);
             }
         }
-        t.write(&mut out, markdown);
+        t.write(&mut out, markdown, width);
     }
 
     // energy balance
@@ -341,14 +347,17 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
             row.extend([e(a.residual_j), e(a.max_abs_residual_j), rel]);
             t.table.rows.push(row);
         }
-        t.write(&mut out, markdown);
+        t.write(&mut out, markdown, width);
     }
 
     // findings
     if let Some(c) = cmp.filter(|_| !markdown) {
         out.push_str("Findings\n");
         for s in &c.findings {
-            out.push_str(&format!("- {s}\n"));
+            match width {
+                Some(w) => out.push_str(&wrap(s, w, "- ", "  ")),
+                None => out.push_str(&format!("- {s}\n")),
+            }
         }
     }
     while out.ends_with("\n\n") {

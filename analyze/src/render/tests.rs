@@ -181,3 +181,56 @@ fn contact_states_get_rows_columns_and_json() {
     let json = render_metrics(&all, Format::Json).unwrap();
     assert_eq!(serde_json::from_str::<Vec<RunMetrics>>(&json).unwrap(), all);
 }
+
+/// The numbers in `text`: every piece between characters no number has that parses as one.
+pub(crate) fn numbers(text: &str) -> std::collections::BTreeSet<String> {
+    text.split(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e')))
+        .filter(|t| t.chars().any(|c| c.is_ascii_digit()) && t.parse::<f64>().is_ok())
+        .map(String::from)
+        .collect()
+}
+
+/// The brief comparison: the findings first, then one row per run, at most 100 columns; every
+/// number of its table is printed as the full tables print it (so found there); a unilateral
+/// run's contacts say how long they stayed closed.
+#[test]
+fn every_number_of_the_brief_is_in_the_full_tables() {
+    let dir = tempfile::tempdir().unwrap();
+    let (s, _) = schemas::synth::unilateral();
+    let uni = crate::metrics::read_run_metrics(&s.write_in(dir.path())).unwrap();
+    let mut runs = paper_runs();
+    runs[0].contact_forces[0].pull_time_s = 0.31;
+    runs[0].contact_forces[0].min_normal_force_n = -4.0;
+    runs.push(uni);
+    let cmp = Comparison::new(&runs, None).unwrap();
+    let brief = render_comparison_brief(&cmp, 100);
+    assert!(brief.starts_with("Findings\n- "), "{brief}");
+    assert!(brief.lines().all(|l| unicode_width::UnicodeWidthStr::width(l) <= 100), "{brief}");
+    let table = &brief[brief.find("\nrun ").unwrap()..];
+    assert!(table.contains("E_j") && table.contains("E_ratio") && table.contains("e_rms_mm") && table.contains("e_max_mm"), "{table}");
+    assert!(table.contains("no-elbow *"), "{table}");
+    assert!(table.contains("elbow4 pulls 0.310 s, min -4.000 N"), "{table}");
+    assert!(table.contains(" closed "), "{table}");
+    let full = render_comparison(&cmp, Format::Table).unwrap();
+    let missing: Vec<String> = numbers(table).difference(&numbers(&full)).cloned().collect();
+    assert!(missing.is_empty(), "{missing:?} of the brief not in the full tables:\n{table}\n{full}");
+    // narrower: split into column groups, nothing lost
+    let narrow = render_comparison_brief(&cmp, 60);
+    assert!(narrow.lines().all(|l| unicode_width::UnicodeWidthStr::width(l) <= 60), "{narrow}");
+    assert_eq!(numbers(&narrow[narrow.find("\nrun ").unwrap()..]), numbers(table));
+}
+
+/// The full tables fitted to a width keep every number (every cell), each line within it;
+/// without a width they are as wide as they come.
+#[test]
+fn full_tables_fitted_to_a_width_keep_every_number() {
+    let cmp = comparison();
+    let wide = render_comparison(&cmp, Format::Table).unwrap();
+    assert_eq!(render_comparison_fitted(&cmp, Format::Table, None).unwrap(), wide);
+    for width in [60, 80, 120] {
+        let text = render_comparison_fitted(&cmp, Format::Table, Some(width)).unwrap();
+        assert!(text.lines().all(|l| unicode_width::UnicodeWidthStr::width(l) <= width), "{width}:\n{text}");
+        assert_eq!(numbers(&text), numbers(&wide), "{width}:\n{text}");
+    }
+    assert_eq!(render_comparison_fitted(&cmp, Format::Json, Some(60)).unwrap(), render_comparison(&cmp, Format::Json).unwrap());
+}

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use analyze::{render_comparison, render_metrics, Comparison};
+use analyze::{render_comparison_fitted, render_metrics_fitted, Comparison};
 use anyhow::Result;
 use cli::{exit, print_out, TableFormat, Verbosity};
 
@@ -18,6 +18,8 @@ fn_min.elbow4_n; for contacts with a contact model in_contact.elbow4_s, impacts.
 friction_work.elbow4_j, mu_stick.elbow4_ratio ...). Contact states: unilateral and compliant
 contacts (recordings with /contacts): time in contact, lift-offs, touch-downs, impacts, rests,
 stick/slip transitions, impact loss, friction work, damping loss, the friction needed to stick.
+In a terminal every table fits its width (a wide one split into column groups, each repeating
+the run); in a pipe or a file the tables keep their full width.
 
 Examples:
   analyze compare out/
@@ -69,12 +71,12 @@ pub struct MetricsArgs {
 pub fn compare(a: &CompareArgs, v: Verbosity) -> Result<u8> {
     let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
     let cmp = Comparison::new(&runs, a.baseline.as_deref())?;
-    print_out(&render_comparison(&cmp, a.format.format)?)?;
+    print_out(&render_comparison_fitted(&cmp, a.format.format, cli::terminal_width())?)?;
     Ok(if damaged { exit::FAILED } else { exit::SUCCESS })
 }
 
 pub fn metrics(a: &MetricsArgs, v: Verbosity) -> Result<u8> {
     let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
-    print_out(&render_metrics(&runs, a.format.format)?)?;
+    print_out(&render_metrics_fitted(&runs, a.format.format, cli::terminal_width())?)?;
     Ok(if damaged { exit::FAILED } else { exit::SUCCESS })
 }

@@ -41,8 +41,8 @@ Examples:
 /// With no command, runs the built-in paper scene (three elbow configurations, 5 s each, a table
 /// that holds the elbows bilaterally, as the paper) and the same arm over a real table that only
 /// pushes (`paper-unilateral`: the elbows rest unilaterally with friction, and the no-elbow arm
-/// over a table under the whole arm), writes out/<scene>-<run>.mcap and prints one table
-/// comparing the six runs. With a scene (`--scene`, `sim run SCENE`), runs that scene. With the
+/// over a table under the whole arm), writes out/<scene>-<run>.mcap and prints the findings that
+/// matter and one table comparing the six runs (`-v`: every table and finding). With a scene (`--scene`, `sim run SCENE`), runs that scene. With the
 /// name of a built-in scene instead of a command (`sim list` shows them), runs that scene.
 #[derive(Debug, Parser)]
 #[command(name = "sim", version = cli::VERSION, after_help = EXAMPLES, args_conflicts_with_subcommands = true, propagate_version = true)]

@@ -41,5 +41,5 @@ pub fn run(a: &ReplayArgs, v: Verbosity) -> Result<u8> {
         bail!("{}: replaying into the same file would overwrite the original; choose another -o", path.display());
     }
     let done = crate::run::run_all(&scene, &[run], |_| path.clone(), &Jobs { jobs: Some(1) }, a.wall_time.budget(), v);
-    crate::run::finish(&done, a.format, None)
+    crate::run::finish(&done, a.format, None, v)
 }

@@ -1,5 +1,8 @@
 //! `sim run` (and `sim` with no command): run the selected runs of a scene in parallel, each to
-//! its recording, and print the comparison of the runs.
+//! its recording, and print the comparison of the runs: by default the brief one (the headline
+//! findings and one table, a row per run, fitted to the terminal and never wider than
+//! [`cli::TEXT_WIDTH`] columns), with `-v` every table and finding, as `analyze compare` prints
+//! them (fitted to the terminal when standard output is one); `-f json|csv` always complete.
 //!
 //! The comparison is made by the `analyze` library from what each run wrote, without reading
 //! the files back: the writer feeds every record it writes to the reader's own record consumer
@@ -68,9 +71,12 @@ impl WallTime {
 /// Run a scene (the default command): every run to <out>/<scene>-<run>.mcap, then the table.
 #[derive(Debug, Clone, clap::Args)]
 #[command(after_help = "\
-Output: out/<scene>-<run>.mcap per run; on stdout the table comparing the runs (hand error,
-energy totals and ratios to the baseline, per-link energy, contacts, energy balance, findings),
--f json|csv for machines; a progress bar per run on stderr.
+Output: out/<scene>-<run>.mcap per run; on stdout the comparison of the runs: the findings that
+matter, then one table (a row per run: electric energy E and E / E_base, hand error RMS and max,
+what each contact did), at most 100 columns wide. -v: every table (hand error per axis, energy
+totals, per-link energy, contacts, contact states, energy balance) and every finding, as
+`analyze compare` prints them; in a terminal every table fits its width. -f json|csv: every
+number, for machines. A progress bar per run on stderr.
 
 Examples:
   sim run                                    the built-in paper scene (same as `sim`)
@@ -111,7 +117,7 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     let budget = a.live.budget(a.wall_time.budget(), scene.duration());
     let done = run_all_live(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
     let layout = write_layout(&scene, &done, &a.out, v);
-    let code = finish(&done, a.format, a.baseline.as_deref()).map(|c| if layout.is_err() { c.max(exit::BAD_INPUT) } else { c });
+    let code = finish(&done, a.format, a.baseline.as_deref(), v).map(|c| if layout.is_err() { c.max(exit::BAD_INPUT) } else { c });
     report_layouts(&[layout], v);
     if let Some(live) = live {
         live.close();
@@ -157,7 +163,7 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
         done.extend(scene_done);
     }
     let failed = layouts.iter().any(Result::is_err);
-    let code = finish(&done, a.format, a.baseline.as_deref()).map(|c| if failed { c.max(exit::BAD_INPUT) } else { c });
+    let code = finish(&done, a.format, a.baseline.as_deref(), v).map(|c| if failed { c.max(exit::BAD_INPUT) } else { c });
     report_layouts(&layouts, v);
     if let Some(live) = live {
         live.close();
@@ -351,13 +357,13 @@ pub fn run_all_live(
     done
 }
 
-/// Prints the comparison of the complete runs and the failures; the exit status: 2 if a
-/// recording could not be written (an I/O error: its run's result is lost), else 1 if a run
-/// failed numerically (its recording says when and why), else 0.
-pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>) -> Result<u8> {
+/// Prints the comparison of the complete runs (brief, or with `-v` in full) and the failures;
+/// the exit status: 2 if a recording could not be written (an I/O error: its run's result is
+/// lost), else 1 if a run failed numerically (its recording says when and why), else 0.
+pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>, v: Verbosity) -> Result<u8> {
     let complete: Vec<&Done> = done.iter().filter(|d| d.error.is_none() && d.path.is_some()).collect();
     if !complete.is_empty() {
-        print_comparison(&complete, format.format, baseline)?;
+        print_comparison(&complete, format.format, baseline, v.verbose > 0)?;
     }
     let failures: Vec<&str> = done.iter().filter_map(|d| d.error.as_deref()).collect();
     for f in &failures {
@@ -373,8 +379,9 @@ pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>) -> Res
 }
 
 /// Prints the comparison of the runs, from the metrics computed as they were written (a run
-/// without them, which no caller makes, is read back).
-fn print_comparison(done: &[&Done], format: analyze::Format, baseline: Option<&str>) -> Result<()> {
+/// without them, which no caller makes, is read back): as text the brief one, or (`full`) every
+/// section; JSON and CSV always whole.
+fn print_comparison(done: &[&Done], format: analyze::Format, baseline: Option<&str>, full: bool) -> Result<()> {
     let metrics = done
         .iter()
         .filter_map(|d| d.path.as_deref().map(|p| (p, d.metrics.as_ref())))
@@ -385,5 +392,14 @@ fn print_comparison(done: &[&Done], format: analyze::Format, baseline: Option<&s
         })
         .collect::<Result<Vec<_>>>()?;
     let cmp = analyze::Comparison::new(&metrics, baseline)?;
-    print_out(&analyze::render_comparison(&cmp, format)?)
+    let width = cli::terminal_width();
+    if format == analyze::Format::Table && !full {
+        let width = width.map_or(cli::TEXT_WIDTH, |w| w.min(cli::TEXT_WIDTH));
+        let more = analyze::render::wrap(BRIEF_MORE, width, "", "");
+        return print_out(&(analyze::render_comparison_brief(&cmp, width) + "\n" + &more));
+    }
+    print_out(&analyze::render_comparison_fitted(&cmp, format, width)?)
 }
+
+/// The last line of the brief comparison: where the rest is.
+const BRIEF_MORE: &str = "-v: every table (hand error per axis, per link, per contact, energy balance) and every finding.";
