@@ -28,7 +28,7 @@ and its timing against `rhs_profile` (ours). Pinocchio's timing through Python i
 (each call crosses the Python/C++ boundary: ~0.3-1 us), so the ratio is a lower bound of ours
 relative to its C++.
 
-Usage (from the repository root; see /tmp/i14-peers-notes.md or BENCHMARKS.md):
+Usage (from the repository root; see BENCHMARKS.md):
   python bench/peers/peers.py [--sim target/release/sim] [--dump target/release/examples/peers_dump]
                               [--rhs target/release/examples/rhs_profile] [--repeats 3] [--quick]
 The venv: ~/.cache/elbow-sim/venv-peers with mujoco==4.0.0, pin==4.1.0 (bench/peers/requirements.txt).

@@ -1,5 +1,5 @@
 //! Writes a sample recording with every channel for a 2-joint planar arm, for checking with
-//! `/work/shared/tools/check_mcap.py` (Foxglove and Rerun compatibility).
+//! `../shared/tools/check_mcap.py` (beside the repository; Foxglove and Rerun compatibility).
 //!
 //! `cargo run -p schemas --example write_sample -- /tmp/sample.mcap`
 //!

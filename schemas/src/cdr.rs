@@ -1,7 +1,7 @@
 //! ROS 2 CDR: encoding of [`RosString`] and [`JointState`], and generic decoding of any
 //! `ros2msg`-described message into a [`Value`].
 //!
-//! Layout (OMG CDR as used by ROS 2 / Fast-CDR, "plain" XCDR1; `/work/shared/VIEWERS.md`):
+//! Layout (OMG CDR as used by ROS 2 / Fast-CDR, "plain" XCDR1; `../shared/VIEWERS.md` (the workplace notes beside the repository)):
 //! a 4-byte encapsulation header `00 01 00 00` (CDR, little-endian), then every field
 //! little-endian and aligned to its own size (4 for `u32`/`i32` and string or sequence lengths,
 //! 8 for `f64`; at most 8), counted from the byte after the header. A string is a `u32` length

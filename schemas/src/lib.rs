@@ -13,7 +13,7 @@
 //!   timestamp (`time` field, header stamp, Foxglove `timestamp`) equals it.
 //! - SI units everywhere; arrays are indexed by actuated joint (0-based, URDF order of the
 //!   revolute joints) or by constraint; positions in the world frame unless a frame is named.
-//! - Which encoding for which topic follows `/work/shared/VIEWERS.md` so that recordings open
+//! - Which encoding for which topic follows `../shared/VIEWERS.md` (the workplace notes beside the repository) so that recordings open
 //!   in both Foxglove and Rerun: URDF and joint states as ROS 2 CDR, transforms and point
 //!   clouds as Foxglove protobuf schemas, our own signals as derived protobuf.
 //! - Metadata records are typed ([`meta`]): [`RecordingInfo`] carries [`FORMAT_VERSION`]; bump the
@@ -37,6 +37,7 @@ mod ros2msg;
 #[cfg(feature = "synth")]
 pub mod synth;
 pub mod topics;
+pub mod reference;
 pub mod units;
 pub mod value;
 pub mod writer;

@@ -1,6 +1,6 @@
 //! Topic names of a recording and the message type each one carries.
 //!
-//! The layout follows `/work/shared/VIEWERS.md` ("A recipe that worked in both"): the URDF and
+//! The layout follows `../shared/VIEWERS.md` (the workplace notes beside the repository) ("A recipe that worked in both"): the URDF and
 //! the joint states as ROS 2 CDR (which Foxglove and Rerun both understand natively), transforms
 //! and the hand point cloud as Foxglove well-known protobuf schemas, our own signals as derived
 //! protobuf messages.

@@ -3,7 +3,7 @@
 //! by field (bit for bit), and reading only the chunks that hold the wanted topics against
 //! reading every chunk, with the file's checks still made on the chunks skipped.
 
-mod common;
+use crate::common;
 
 use schemas::{regroup_chunks, topics, Body, DecodedMessage, Error, Value, Visitor};
 

@@ -2,12 +2,11 @@
 //! metadata, metadata records and message bytes of the finished file, read back with the `mcap`
 //! crate), and the file does not depend on it (byte-identical to one written without).
 
-mod common;
 
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
-use common::{content, write_all_with};
+use crate::common::{content, write_all_with};
 use schemas::{Mirror, RecordingWriter, WriterOptions};
 
 #[derive(Default)]

@@ -3,9 +3,8 @@
 //! and CDR `float64` are the IEEE bits, so f64s are compared bit for bit (`to_bits`), which
 //! also distinguishes -0.0 and keeps NaN payloads.
 
-mod common;
 
-use common::{bits, content, f, fv, tf, val, write_all, URDF};
+use crate::common::{bits, content, f, fv, tf, val, write_all, URDF};
 use schemas::{
     from_log_time, read_recording, topics, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA, ArraySizes, ConstraintState, EnergyState, HandState, JointState,
     MotorState, RecordingWriter, Value,

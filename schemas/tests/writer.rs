@@ -2,11 +2,10 @@
 //! unless `finish` succeeded, no leftover temporary file, one writer per path at a time, I/O
 //! errors and misuse reported with the file named (and the OS reason).
 
-mod common;
 
 use std::collections::BTreeMap;
 
-use common::{content, write_all};
+use crate::common::{content, write_all};
 use schemas::{read_recording, topics, EnergyState, HandState, MotorState, RecordingWriter};
 
 #[test]

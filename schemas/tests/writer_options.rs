@@ -4,11 +4,10 @@
 // the visitor closures return schemas::Error, whose size is the library's choice
 #![allow(clippy::result_large_err)]
 
-mod common;
 
 use std::sync::{Arc, Mutex};
 
-use common::{content, write_all_with};
+use crate::common::{content, write_all_with};
 use schemas::{read_recording, stream_recording, Compression, DecodedMessage, RecordingWriter, Tap, Value, WriterOptions};
 
 fn settings() -> Vec<(&'static str, WriterOptions)> {

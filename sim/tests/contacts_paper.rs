@@ -12,11 +12,10 @@
 
 #![allow(clippy::needless_range_loop)] // per-contact arrays indexed together
 
-mod contacts_support;
 
 use std::path::Path;
 
-use contacts_support::*;
+use crate::contacts_support::*;
 use sim::dynamics::contact::{ContactEventKind, ContactMode};
 use sim::scene::spec::IntegratorSpec;
 use sim::scene::Scene;

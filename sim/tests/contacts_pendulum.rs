@@ -17,9 +17,8 @@
 //! `N l1 cos α1` on α1). In contact α1 is fixed: link2 is a pendulum about the elbow and the
 //! first equation gives N; after lift-off (N = 0) both equations with N = 0.
 
-mod contacts_support;
 
-use contacts_support::*;
+use crate::contacts_support::*;
 use serde_json::json;
 use sim::dynamics::contact::{ContactEventKind, ContactMode};
 

@@ -19,9 +19,8 @@
 //! (order 4) reproduce to round-off, so the tolerances are set by the event location
 //! (`time_tolerance` 1e-12 s) and round-off, with margin.
 
-mod contacts_support;
 
-use contacts_support::*;
+use crate::contacts_support::*;
 use serde_json::json;
 use sim::dynamics::contact::{ContactEventKind, ContactMode};
 use sim::error::RunError;

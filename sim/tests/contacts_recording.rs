@@ -5,9 +5,8 @@
 //! one message per sample with the mode codes (0 separated in flight, 1 or 2 in touch after the
 //! rest); `/constraints` is still written for old readers.
 
-mod contacts_support;
 
-use contacts_support::*;
+use crate::contacts_support::*;
 use schemas::{ConstraintState, ContactEventMsg, ContactState};
 use serde_json::json;
 

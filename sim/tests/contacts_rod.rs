@@ -20,9 +20,8 @@
 
 #![allow(clippy::needless_range_loop)] // per-contact arrays indexed together
 
-mod contacts_support;
 
-use contacts_support::*;
+use crate::contacts_support::*;
 use serde_json::json;
 use sim::dynamics::contact::{ContactEventKind, ContactMode};
 use sim::error::{DynamicsError, RunError};

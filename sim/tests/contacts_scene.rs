@@ -3,9 +3,8 @@
 //! stays bilateral and the paper scene's text is unchanged when re-serialised; the `table`
 //! construct makes unilateral contacts active in every run; `events` settings are read.
 
-mod contacts_support;
 
-use contacts_support::*;
+use crate::contacts_support::*;
 use serde_json::json;
 use sim::dynamics::contact::ContactModel;
 use sim::scene::Scene;

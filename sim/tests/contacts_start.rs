@@ -4,8 +4,7 @@
 //! negative lifts off at once instead of pulling, and a slip that starts slower than the stick
 //! speed (1e-6 m/s) stops at once instead of reversing under a frozen friction direction.
 
-mod contacts_support;
-use contacts_support::*;
+use crate::contacts_support::*;
 use serde_json::json;
 use sim::dynamics::contact::{ContactEventKind, ContactMode};
 

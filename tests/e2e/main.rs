@@ -9,6 +9,7 @@ mod analyze_figures;
 mod analyze_tables;
 mod bounded_memory;
 mod cli_voice;
+mod docs_book;
 mod format_ownership;
 mod foxglove_layout;
 mod live;

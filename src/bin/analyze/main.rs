@@ -57,7 +57,7 @@ enum Command {
     #[command(after_help = "Example:\n  analyze completions bash > ~/.local/share/bash-completion/completions/analyze")]
     Completions(CompletionsArgs),
     /// Write the man pages of `analyze` and its commands into a directory.
-    #[command(after_help = "Example:\n  analyze man -o man/ && man man/analyze-compare.1")]
+    #[command(after_help = "Examples:\n  analyze man -o man/ && man man/analyze-compare.1\n  analyze man --markdown -o docs/src/reference/   the book's CLI reference, analyze.md")]
     Man(ManArgs),
 }
 
@@ -75,9 +75,9 @@ fn main() -> ExitCode {
         Command::View(a) => view::run(&a, v),
         Command::Layout(a) => layout::run(&a, v),
         Command::Completions(a) => cli::extras::completions(Cli::command(), a.shell).map(|()| exit::SUCCESS),
-        Command::Man(a) => cli::extras::man_pages(Cli::command(), &a.out).map(|n| {
+        Command::Man(a) => cli::extras::man(Cli::command(), &a).map(|n| {
             if !v.quiet {
-                eprintln!("analyze: {n} man pages in {}", a.out.display());
+                eprintln!("analyze: {n} {} in {}", if a.markdown { "Markdown page" } else { "man pages" }, a.out.display());
             }
             exit::SUCCESS
         }),

@@ -72,7 +72,7 @@ enum Command {
     #[command(after_help = "Example:\n  sim completions bash > ~/.local/share/bash-completion/completions/sim")]
     Completions(CompletionsArgs),
     /// Write the man pages of `sim` and its commands into a directory.
-    #[command(after_help = "Example:\n  sim man -o man/ && man man/sim-run.1")]
+    #[command(after_help = "Examples:\n  sim man -o man/ && man man/sim-run.1\n  sim man --markdown -o docs/src/reference/   the book's CLI reference, sim.md")]
     Man(ManArgs),
 }
 
@@ -90,9 +90,9 @@ fn main() -> ExitCode {
         Some(Command::ExportScene(a)) => export_scene::run(&a, v),
         Some(Command::List(a)) => list::run(&a),
         Some(Command::Completions(a)) => cli::extras::completions(Cli::command(), a.shell).map(|()| exit::SUCCESS),
-        Some(Command::Man(a)) => cli::extras::man_pages(Cli::command(), &a.out).map(|n| {
+        Some(Command::Man(a)) => cli::extras::man(Cli::command(), &a).map(|n| {
             if !v.quiet {
-                eprintln!("sim: {n} man pages in {}", a.out.display());
+                eprintln!("sim: {n} {} in {}", if a.markdown { "Markdown page" } else { "man pages" }, a.out.display());
             }
             exit::SUCCESS
         }),
