@@ -105,7 +105,7 @@ fn sim_default_output_is_brief_and_fits_100_columns() {
     for name in ["two-elbow", "one-elbow", "no-elbow *", "two-elbow-unilateral", "one-elbow-unilateral", "whole-table"] {
         assert!(table.lines().any(|l| l.starts_with(&format!("{name} "))), "{name}:\n{table}");
     }
-    for head in ["E_j", "E_ratio", "e_rms_mm", "e_max_mm", "contacts"] {
+    for head in ["E_total_j", "E_ratio", "e_rms_mm", "e_max_mm", "contacts"] {
         assert!(table.lines().nth(1).unwrap().contains(head), "{head}:\n{table}");
     }
     assert!(table.contains("elbow4 pulls 4.964 s"), "{table}");

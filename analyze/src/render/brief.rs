@@ -1,7 +1,7 @@
 //! The brief comparison, what `sim` prints by default: the findings that matter first
 //! ([`Comparison::headline`], at most [`FINDINGS`], most important first: a reader sees the
 //! conclusions before the evidence, as `analyze report` opens with them), then one table with a
-//! row per run: the electric energy `E_j`, its ratio to the baseline `E_ratio` (the saving), the
+//! row per run: the electric energy `E_total_j`, its ratio to the baseline `E_ratio` (the saving), the
 //! hand error's RMS and max of |e| (`e_rms_mm`, `e_max_mm`), and per contact what it did (a
 //! bilateral table: how long it pulls and its minimum f_n; a unilateral or compliant contact:
 //! how long it stays closed and its lift-offs; the contacts that never touched in one line), led
@@ -45,7 +45,7 @@ pub(super) fn render(cmp: &Comparison, width: usize) -> String {
 fn table(cmp: &Comparison) -> TextTable {
     let runs: Vec<&RunMetrics> = cmp.runs.iter().map(|r| &r.metrics).collect();
     let labels = super::run_labels(&runs);
-    let mut t = TextTable::new(&["run", "E_j", "E_ratio", "e_rms_mm", "e_max_mm", "contacts"]);
+    let mut t = TextTable::new(&["run", "E_total_j", "E_ratio", "e_rms_mm", "e_max_mm", "contacts"]);
     t.notes = true;
     for (k, (r, label)) in cmp.runs.iter().zip(labels).enumerate() {
         let m = &r.metrics;

@@ -207,7 +207,7 @@ fn every_number_of_the_brief_is_in_the_full_tables() {
     assert!(brief.starts_with("Findings\n- "), "{brief}");
     assert!(brief.lines().all(|l| unicode_width::UnicodeWidthStr::width(l) <= 100), "{brief}");
     let table = &brief[brief.find("\nrun ").unwrap()..];
-    assert!(table.contains("E_j") && table.contains("E_ratio") && table.contains("e_rms_mm") && table.contains("e_max_mm"), "{table}");
+    assert!(table.contains("E_total_j") && table.contains("E_ratio") && table.contains("e_rms_mm") && table.contains("e_max_mm"), "{table}");
     assert!(table.contains("no-elbow *"), "{table}");
     assert!(table.contains("elbow4 pulls 0.310 s, min -4.000 N"), "{table}");
     assert!(table.contains(" closed "), "{table}");
