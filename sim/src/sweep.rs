@@ -10,19 +10,22 @@
 
 use std::path::{Path, PathBuf};
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use crate::error::SceneError;
 use crate::limits::{read_text, MAX_INPUT_BYTES};
+use crate::scene::schema_key::{SkipSchemaKey, SCHEMA_KEY};
 use crate::scene::{Scene, SceneSpec, PAPER_SCENE_JSON, PAPER_URDF};
 
-/// The sweep file as written by people.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A sweep file: a base scene and the axes of a grid of its variations (README, "Sweeps").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepSpec {
     /// Short name: variants are `<name>-<k>`, files `<name>-<k>-<run>.mcap`.
     pub name: String,
+    /// What the sweep is for (default: empty).
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub description: String,
     /// Scene file, relative to the sweep file (default: the built-in paper scene).
@@ -34,16 +37,18 @@ pub struct SweepSpec {
     /// Simulated time of every run, s (default: the scene's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub duration: Option<f64>,
-    /// The axes of the grid, slowest first.
+    /// The axes of the grid, slowest first (default: none, the scene as is).
     #[serde(default)]
     pub axes: Vec<AxisSpec>,
 }
 
 /// One axis: a dot path into the scene JSON and the values that replace that node.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AxisSpec {
+    /// A dot path into the scene JSON: object keys and array indices (`contacts.0.plane.offset`).
     pub field: String,
+    /// The values that replace that node, one grid coordinate each (numbers, arrays, objects).
     pub values: Vec<Value>,
 }
 
@@ -257,8 +262,12 @@ impl Sweep {
         }
         let mut base: Value = serde_json::from_str(scene_text)
             .map_err(|e| err("scene", &scene_source, format!("not valid JSON: {e}")))?;
-        let base_spec: SceneSpec = serde_json::from_value(base.clone())
+        let base_spec = SceneSpec::deserialize(SkipSchemaKey(base.clone()))
             .map_err(|e| err("scene", &scene_source, format!("not a valid scene: {e} (run `sim check` on it)")))?;
+        // the base scene's "$schema" (a string: just read) is for editors, not for the variants
+        if let Value::Object(m) = &mut base {
+            m.remove(SCHEMA_KEY);
+        }
         if let Some(d) = spec.duration {
             if !(d > 0.0 && d.is_finite()) {
                 return Err(err("duration", &d, "must be a positive number of seconds".into()).into());
@@ -389,7 +398,8 @@ impl Sweep {
 
 fn parse_spec(text: &str, file: &str) -> Result<SweepSpec, SceneError> {
     let de = &mut serde_json::Deserializer::from_str(text);
-    serde_path_to_error::deserialize(de).map_err(|e| {
+    // a top-level "$schema" (for editors) is dropped
+    serde_path_to_error::deserialize(SkipSchemaKey(de)).map_err(|e| {
         let path = e.path().to_string();
         SceneError::new(file, if path == "." { "(document)".into() } else { path }, "", e.inner().to_string())
     })

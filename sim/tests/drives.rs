@@ -171,7 +171,7 @@ fn tight_limit(dir: &Path, lower: f64, upper: f64, edit: impl FnOnce(&mut SceneS
   <link name="link4">"#),
     );
     std::fs::write(dir.join("small_arm.urdf"), urdf).unwrap();
-    let mut spec: SceneSpec = serde_json::from_str(&std::fs::read_to_string(base.join("small.json")).unwrap()).unwrap();
+    let mut spec: SceneSpec = Scene::load(&base.join("small.json")).unwrap().spec().clone();
     edit(&mut spec);
     std::fs::write(dir.join("tight.json"), serde_json::to_string_pretty(&spec).unwrap()).unwrap();
     Scene::load(&dir.join("tight.json")).unwrap()

@@ -95,6 +95,41 @@ fn identical_runs_give_identical_files() {
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
 }
 
+/// A scene file's `"$schema"` (for editors) changes no byte of a recording: the small scene
+/// and the built-in paper scene, as shipped (with the key) and with the key's line removed,
+/// give the same spec, the same stored scene JSON and the same recording, byte for byte.
+#[test]
+fn a_schema_key_changes_no_byte_of_a_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let without = |text: &str| -> String {
+        assert!(text.starts_with("{\n  \"$schema\": "), "the shipped scene names its schema first");
+        text.lines().filter(|l| !l.starts_with("  \"$schema\": ")).collect::<Vec<_>>().join("\n")
+    };
+    let small_dir = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/small"));
+    let small_text = std::fs::read_to_string(small_dir.join("small.json")).unwrap();
+    let paper_urdf = |name: &str| if name == "paper_arm.urdf" { Ok(sim::scene::PAPER_URDF.to_string()) } else { Err(format!("no {name}")) };
+    let small_urdf = |name: &str| sim::scene::read_urdf_file(small_dir, name);
+    for (label, text, run) in [("small", small_text.as_str(), "elbow"), ("paper", sim::scene::PAPER_SCENE_JSON, "two-elbow")] {
+        let load = |t: &str| {
+            let s = if label == "small" { Scene::from_json(t, "s.json", small_urdf) } else { Scene::from_json(t, "s.json", paper_urdf) };
+            // a short run: the recording's every part is there (metadata, messages, summary)
+            s.unwrap().vary(|sp| sp.duration = 0.02).unwrap()
+        };
+        let (with, plain) = (load(text), load(&without(text)));
+        assert_eq!(with.spec(), plain.spec(), "{label}");
+        let run = with.run(run).unwrap().clone();
+        let (a, b) = (dir.path().join(format!("{label}-a.mcap")), dir.path().join(format!("{label}-b.mcap")));
+        sim::run::run_to_file(&with, &run, &a, |_| {}).unwrap();
+        sim::run::run_to_file(&plain, &run, &b, |_| {}).unwrap();
+        let bytes = std::fs::read(&a).unwrap();
+        assert_eq!(bytes, std::fs::read(&b).unwrap(), "{label}: the recordings differ");
+        let stored = read_recording(&a).unwrap().scene().unwrap().json;
+        assert!(!stored.contains("$schema") && stored == serde_json::to_string_pretty(plain.spec()).unwrap(), "{label}");
+    }
+    // the built-in paper scene is the one its recordings were made from
+    assert_eq!(Scene::paper().unwrap().spec(), &sim::scene::read_spec(&without(sim::scene::PAPER_SCENE_JSON), "p").unwrap());
+}
+
 /// A run that fails numerically still closes a valid recording holding every sample up to
 /// the failure and a result record saying when and why; the error names the time.
 #[test]

@@ -60,7 +60,7 @@ fn shared_flags_mean_the_same_in_both_tools() {
     }
     // every command's help says what it outputs and gives examples
     for (name, cmds) in [
-        ("sim", &["run", "check", "replay", "sweep", "precision", "export-scene"][..]),
+        ("sim", &["run", "check", "replay", "sweep", "precision", "export-scene", "schema"][..]),
         ("analyze", &["compare", "metrics", "summary", "diff", "report", "figures", "export", "layout"][..]),
     ] {
         for cmd in cmds {

@@ -16,6 +16,7 @@ mod live;
 mod pipeline;
 mod rerun_view;
 mod sampled_energy;
+mod scene_schema;
 mod sim_bad_input;
 mod sim_list;
 mod sim_output;

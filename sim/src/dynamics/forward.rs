@@ -36,7 +36,7 @@ use super::walker_orin;
 use crate::error::DynamicsError;
 
 /// How the joint-space inertia is computed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum MassMatrixMethod {
     /// Composite-rigid-body algorithm (RBDA §6.2).
@@ -47,21 +47,26 @@ pub enum MassMatrixMethod {
 }
 
 /// Constraint stabilisation: the acceleration-level constraint of eq 15 lets C and Ċ drift.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case", tag = "method", deny_unknown_fields)]
 pub enum Stabilization {
     /// Eq 15 as in the paper: `J_c q̈ = −J̇_c q̇`.
     #[default]
     None,
     /// Baumgarte (1972): `J_c q̈ = −J̇_c q̇ − 2 α Ċ − β² C`, α and β in 1/s.
-    Baumgarte { alpha: f64, beta: f64 },
+    Baumgarte {
+        /// Velocity gain α, 1/s.
+        alpha: f64,
+        /// Position gain β, 1/s.
+        beta: f64,
+    },
     /// After every accepted step, project q onto C = 0 and q̇ onto Ċ = 0 (mass-weighted
     /// Gauss–Newton; Hairer, Lubich & Wanner, *Geometric Numerical Integration*, §IV.4).
     Projection,
 }
 
 /// How the constrained system is solved.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum ConstraintSolver {
     /// Cholesky of M_J and of the nc x nc Schur complement.

@@ -6,6 +6,8 @@ pub mod builtin;
 mod contacts;
 mod ctx;
 mod robot;
+pub mod schema;
+pub mod schema_key;
 pub mod spec;
 mod spec_contacts;
 mod target;
@@ -246,37 +248,7 @@ impl Scene {
         dir: Option<&Path>,
         read_urdf: impl Fn(&str) -> Result<String, String>,
     ) -> Result<Scene, SceneError> {
-        let de = &mut serde_json::Deserializer::from_str(text);
-        let spec: SceneSpec = serde_path_to_error::deserialize(de).map_err(|e| {
-            // a syntax error's path ends in `?` (the position serde had not reached)
-            let path = e.path().to_string();
-            let path = path.trim_end_matches('?').trim_end_matches('.');
-            let why = e.inner().to_string();
-            // a value read whole (the target) says where inside it: "at `path.inside`: why"
-            let (path, why) = match why.strip_prefix("at `").and_then(|r| r.split_once("`: ")) {
-                Some((inside, rest)) => (format!("{path}.{inside}"), rest.to_string()),
-                None => (path.to_string(), why),
-            };
-            let path = path.as_str();
-            // a tagged value (the integrator) is read whole: name the unknown key inside it
-            if let Some(key) = why.strip_prefix("unknown field `").and_then(|r| r.split('`').next()) {
-                // serde_path_to_error's path already ends in the unknown key; a tagged value's does not
-                let field = if path.is_empty() {
-                    key.to_string()
-                } else if path == key || path.ends_with(&format!(".{key}")) {
-                    path.to_string()
-                } else {
-                    format!("{path}.{key}")
-                };
-                let value = serde_json::from_str::<serde_json::Value>(text)
-                    .ok()
-                    .and_then(|doc| doc.pointer(&format!("/{}", field.replace('.', "/").replace('[', "/").replace(']', ""))).map(|v| v.to_string()))
-                    .unwrap_or_default();
-                return SceneError::new(source, field, value, why);
-            }
-            let field = if path.is_empty() { "(document)" } else { path };
-            SceneError::new(source, field, json_literal_at(text, e.inner()), why)
-        })?;
+        let spec = read_spec(text, source)?;
         let urdf_xml = read_urdf(&spec.urdf).map_err(|why| SceneError::new(source, "urdf", &spec.urdf, why))?;
         // a joint CSV is read like the URDF: next to the scene, bounded in size
         let csv = match &spec.target {
@@ -316,6 +288,44 @@ impl Scene {
     pub fn run_contacts(&self, run: &Run) -> Vec<PointOnPlane> {
         run.contacts.iter().map(|&k| self.contacts[k].clone()).collect()
     }
+}
+
+/// Parse scene JSON into its spec, without validating it (what a scene file says, as
+/// [`Scene::from_json`] reads it: unknown keys refused, a top-level `"$schema"` dropped); errors
+/// name `source`, the field and the value.
+pub fn read_spec(text: &str, source: &str) -> Result<SceneSpec, SceneError> {
+    let de = &mut serde_json::Deserializer::from_str(text);
+    // a top-level "$schema" (for editors) is dropped here, before the spec exists
+    serde_path_to_error::deserialize(schema_key::SkipSchemaKey(de)).map_err(|e| {
+        // a syntax error's path ends in `?` (the position serde had not reached)
+        let path = e.path().to_string();
+        let path = path.trim_end_matches('?').trim_end_matches('.');
+        let why = e.inner().to_string();
+        // a value read whole (the target) says where inside it: "at `path.inside`: why"
+        let (path, why) = match why.strip_prefix("at `").and_then(|r| r.split_once("`: ")) {
+            Some((inside, rest)) => (format!("{path}.{inside}"), rest.to_string()),
+            None => (path.to_string(), why),
+        };
+        let path = path.as_str();
+        // a tagged value (the integrator) is read whole: name the unknown key inside it
+        if let Some(key) = why.strip_prefix("unknown field `").and_then(|r| r.split('`').next()) {
+            // serde_path_to_error's path already ends in the unknown key; a tagged value's does not
+            let field = if path.is_empty() {
+                key.to_string()
+            } else if path == key || path.ends_with(&format!(".{key}")) {
+                path.to_string()
+            } else {
+                format!("{path}.{key}")
+            };
+            let value = serde_json::from_str::<serde_json::Value>(text)
+                .ok()
+                .and_then(|doc| doc.pointer(&format!("/{}", field.replace('.', "/").replace('[', "/").replace(']', ""))).map(|v| v.to_string()))
+                .unwrap_or_default();
+            return SceneError::new(source, field, value, why);
+        }
+        let field = if path.is_empty() { "(document)" } else { path };
+        SceneError::new(source, field, json_literal_at(text, e.inner()), why)
+    })
 }
 
 /// The text of the URDF `name` next to a scene in `dir` (a regular file of at most

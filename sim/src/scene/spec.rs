@@ -2,13 +2,16 @@
 //! the experiment is here, none is a constant in code. Validation into a runnable
 //! [`super::Scene`] happens once, in `super::build`.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 
 pub use super::spec_contacts::{EventsSpec, LawKeys, TablePointSpec, TableSpec};
+use super::spec_contacts::ContactModelName;
 
 /// A per-joint setting: one number for every joint, or an array with one per joint (dof order).
+/// Its JSON Schema is written by hand (`schema.rs`), as its `Deserialize` is.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum PerJoint {
@@ -16,6 +19,7 @@ pub enum PerJoint {
     Each(Vec<f64>),
 }
 
+// its schema: `schema.rs` (number or array of numbers), written by hand as this is
 impl<'de> Deserialize<'de> for PerJoint {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         struct V;
@@ -67,6 +71,7 @@ impl Serialize for InitialQ {
     }
 }
 
+// its schema: `schema.rs` (a per-joint value or "from-target"), written by hand as this is
 impl<'de> Deserialize<'de> for InitialQ {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         struct V;
@@ -103,70 +108,84 @@ impl<'de> Deserialize<'de> for InitialQ {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A scene file: the arm (a URDF), its drives and controller, the task, the contacts, the
+/// integrator and the runs (README, "Scenes"). Units are SI, angles in radians; a per-joint
+/// value is one number for all joints or an array in joint (dof) order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSpec {
-    /// Short name, used in output file names.
+    /// Short name, used in output file names (`<name>-<run>.mcap`): letters, digits, `-`, `_`, `.`.
     pub name: String,
+    /// What the scene is, one sentence for `sim list` (default: empty).
     #[serde(default)]
     pub description: String,
-    /// URDF file, relative to the scene file.
+    /// URDF file of the arm, relative to the scene file.
     pub urdf: String,
-    /// Gravitational acceleration in the world frame, m/s^2.
+    /// Gravitational acceleration in the world frame, m/s^2 (e.g. [0, 0, -9.81]).
     pub gravity: [f64; 3],
     /// Simulated time of each run, s.
     pub duration: f64,
     /// Rate of the recorded samples, Hz (independent of the integrator's steps).
     pub output_rate: f64,
-    /// Viscous friction D of each joint, N m s/rad.
+    /// Viscous friction D of each joint, N m s/rad (per joint).
     pub joint_damping: PerJoint,
+    /// The DC motor and gear of each joint (the paper's eqs 1–12).
     pub motor: MotorSpec,
+    /// The controller: its law (default: the paper's PD on the motor voltage, eq 27) and gains.
     pub controller: ControllerSpec,
-    /// Joints without a motor (URDF joint names): no current, voltage or rotor.
+    /// Joints without a motor (URDF joint names): no current, voltage or rotor (default: none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub passive: Vec<String>,
-    /// Monitor the URDF's joint limits (and enforce the position limits by soft stops when
-    /// asked); absent: limits are not looked at (the paper's behaviour).
+    /// What is done at the URDF's joint limits: flagged, or soft stops at the position limits
+    /// (absent: the limits are watched and flagged, as with `"position": "flag"`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint_limits: Option<JointLimitsSpec>,
-    /// The hand point whose path is tracked.
+    /// The hand point whose path is tracked: a joint's origin, or a point of a link.
     pub hand: PointSpec,
+    /// What the arm is asked to do: the paper's circle and IK, or a target tagged by `kind`.
     pub target: TargetSpec,
+    /// The state at t = 0: joint angles, speeds and motor currents.
     pub initial: InitialSpec,
-    /// Named contacts; each run picks some of them.
+    /// Named point-on-plane contacts; each run picks some of them (default: none).
     #[serde(default)]
     pub contacts: Vec<ContactSpec>,
+    /// How M(q) is computed, the constrained system solved and the constraints stabilised
+    /// (default: CRBA, Schur complement, no stabilisation).
     #[serde(default)]
     pub dynamics: DynamicsSpec,
+    /// The integrator, tagged by `method`, and its settings.
     pub integrator: IntegratorSpec,
-    /// The runs of this scene (e.g. the paper's three elbow configurations).
+    /// The runs of this scene (e.g. the paper's three elbow configurations); at least one.
     pub runs: Vec<RunSpec>,
     /// How the URDF is loaded: locked joints, inertia repair, mesh packages (absent: as is).
     #[serde(default, skip_serializing_if = "RobotSpec::is_default")]
     pub robot: RobotSpec,
-    /// A table plane under named points, each a (unilateral by default) contact of every run.
+    /// A table plane under named points, each a (unilateral by default) contact of every run
+    /// (default: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub table: Option<TableSpec>,
-    /// Settings of the event-driven integration (runs with a non-bilateral contact).
+    /// Settings of the event-driven integration of runs with a non-bilateral contact (default:
+    /// each setting's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub events: Option<EventsSpec>,
 }
 
 /// How the URDF is loaded (`"robot": {...}`); every key optional.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RobotSpec {
-    /// Joints made fixed at a value (rad, or m for a prismatic joint): their child is welded
-    /// to the parent at that value (a gripper, a joint the task does not use). A `<mimic>`
-    /// joint whose leader is locked is locked with it at `multiplier · value + offset`.
+    /// Joints made fixed at a value, rad (m for a prismatic joint), by URDF joint name: the
+    /// child is welded to the parent there (default: none). A `<mimic>` joint whose leader is
+    /// locked is locked with it at `multiplier · value + offset`.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub locked: std::collections::BTreeMap<String, f64>,
     /// Replace an implausible inertia of a moving link (not positive semi-definite, or
-    /// violating the triangle inequality) by the nearest plausible one; the repaired links
-    /// are listed in the scene's model (`Model::repaired_inertias`).
+    /// violating the triangle inequality) by the nearest plausible one, and record the repair
+    /// (default: false, an error).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub repair_inertia: bool,
-    /// ROS package name → directory (relative to the scene file) for `package://` mesh URIs.
+    /// ROS package name → directory (relative to the scene file) for `package://` mesh URIs
+    /// (default: none).
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub package_paths: std::collections::BTreeMap<String, String>,
 }
@@ -178,43 +197,46 @@ impl RobotSpec {
 }
 
 /// DC motor and gear of each joint (the paper's eqs 1–12); each entry per joint or for all.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MotorSpec {
-    /// K, N m/A (= V s/rad).
+    /// Torque constant K, N m/A (= V s/rad), per joint.
     pub torque_constant: PerJoint,
-    /// R, ohm.
+    /// Armature resistance R, ohm, per joint.
     pub resistance: PerJoint,
-    /// L, H.
+    /// Armature inductance L, H, per joint (0 on every joint: quasi-static currents).
     pub inductance: PerJoint,
-    /// I_m, kg m^2.
+    /// Rotor inertia I_m, kg m^2, per joint.
     pub rotor_inertia: PerJoint,
-    /// k, motor turns per joint turn.
+    /// Gear ratio k, motor turns per joint turn (rad/m for a prismatic joint), per joint.
     pub gear_ratio: PerJoint,
-    /// d_m, N m s/rad (motor side).
+    /// Gear damping d_m, N m s/rad (motor side), per joint.
     pub gear_damping: PerJoint,
-    /// K_e, V s/rad (motor side); absent: equal to `torque_constant`.
+    /// Back-EMF constant K_e, V s/rad (motor side), per joint (default: `torque_constant`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub back_emf_constant: Option<PerJoint>,
-    /// Supply voltage limit, V: the amplifier saturates at ±limit.
+    /// Supply voltage limit, V, per joint: the amplifier saturates at ±limit (default: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub voltage_limit: Option<PerJoint>,
-    /// The driver's current limit, A.
+    /// The driver's current limit, A, per joint (default: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub current_limit: Option<PerJoint>,
 }
 
 /// The controller's law (`sim/src/control/controller.rs` gives each equation).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum LawSpec {
+    /// The paper's PD on the motor voltage, v = k_p e + k_d ė (eq 27).
     Pd,
+    /// PD plus gravity (and, with `friction`, viscous friction) feed-forward.
     PdGravity,
+    /// Computed torque with an inner current loop (`current_gain`).
     ComputedTorque,
 }
 
 /// What the monitor does at a joint's position limit.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum PositionLimitMode {
     /// Flag the crossing (first time, time beyond, peak); nothing pushes back.
@@ -226,47 +248,52 @@ pub enum PositionLimitMode {
 
 /// `"joint_limits"`: the URDF `<limit>`s are monitored at every output sample (position,
 /// velocity, effort), and the position limits optionally enforced by soft stops.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointLimitsSpec {
+    /// What is done at a position limit: `flag` it, or a soft `stop` (default: flag).
     #[serde(default)]
     pub position: PositionLimitMode,
-    /// The stops' stiffness, N m/rad (`stop` only).
+    /// The stops' stiffness, N m/rad (`stop` only; required there).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stiffness: Option<f64>,
-    /// The stops' damping, N m s/rad (`stop` only).
+    /// The stops' damping, N m s/rad (`stop` only; default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub damping: Option<f64>,
 }
 
 /// The controller: the paper's PD on the motor voltage (eq 27) when `law` is absent or `pd`;
 /// `pd-gravity` (with `friction`) or `computed-torque` (with `current_gain`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ControllerSpec {
+    /// The control law (default: `pd`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub law: Option<LawSpec>,
-    /// k_p: V/rad (`pd`, `pd-gravity`), 1/s^2 (`computed-torque`).
+    /// Proportional gain k_p, per joint: V/rad (`pd`, `pd-gravity`), 1/s^2 (`computed-torque`).
     pub kp: PerJoint,
-    /// k_d: V s/rad (`pd`, `pd-gravity`), 1/s (`computed-torque`).
+    /// Derivative gain k_d, per joint: V s/rad (`pd`, `pd-gravity`), 1/s (`computed-torque`).
     pub kd: PerJoint,
-    /// `pd-gravity`: also feed forward the viscous friction (D + D_m) q'_d.
+    /// `pd-gravity` only: also feed forward the viscous friction (D + D_m) q'_d (default: false).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<bool>,
-    /// `computed-torque`: the inner current loop's gain k_i, V/A (default 0).
+    /// `computed-torque` only: the inner current loop's gain k_i, V/A, per joint (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub current_gain: Option<PerJoint>,
 }
 
-/// A point fixed on the robot: the origin of a joint, or a point in a link's frame.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A point fixed on the robot: the origin of a joint, or a point in a link's frame (one of
+/// `joint` and `link`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PointSpec {
+    /// A URDF joint: the point is its origin (plus `offset`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint: Option<String>,
+    /// A URDF link: the point is `offset` in its frame.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub link: Option<String>,
-    /// Offset in the link's (or the joint's child link's) frame, m.
+    /// Offset in the link's (or the joint's child link's) frame, m (default: [0, 0, 0]).
     #[serde(default)]
     pub offset: [f64; 3],
 }
@@ -289,6 +316,7 @@ impl Serialize for TargetSpec {
     }
 }
 
+// its schema: `schema.rs` (the paper's form or a `kind`-tagged one), written by hand as this is
 impl<'de> Deserialize<'de> for TargetSpec {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let v = serde_json::Value::deserialize(d)?;
@@ -357,15 +385,18 @@ impl<'de> Deserialize<'de> for PathSpec {
 }
 
 /// The paper's target: a horizontal circle and the closed-form IK.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PaperTargetSpec {
+    /// The horizontal circle the hand follows.
     pub circle: CircleSpec,
+    /// The closed-form IK's joints and branch.
     pub ik: IkSpec,
 }
 
-/// The targets selected by `kind` (read by hand, so that errors keep their path inside).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// The targets selected by `kind`.
+// (read by hand, so that errors keep their path inside)
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum KindedTarget {
     /// Joint-space waypoints joined by a named spline.
@@ -378,7 +409,7 @@ pub enum KindedTarget {
 
 /// `cubic`: the clamped C² cubic spline at rest at both ends; `quintic`: minimum-jerk
 /// segments at rest at every waypoint.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Interpolation {
     #[default]
@@ -392,64 +423,74 @@ impl Interpolation {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointSplineSpec {
+    /// The spline joining the waypoints: `cubic` or `quintic` (default: cubic).
     #[serde(default, skip_serializing_if = "Interpolation::is_cubic")]
     pub interpolation: Interpolation,
+    /// The waypoints, in time order.
     pub waypoints: Vec<JointWaypointSpec>,
 }
 
 /// Joint angles (rad, one per joint in dof order) at time `t` (s).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointWaypointSpec {
+    /// Time of the waypoint, s.
     pub t: f64,
+    /// Joint angles, rad (m for a prismatic joint), one per joint in dof order.
     pub q: Vec<f64>,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct JointCsvSpec {
-    /// CSV file, relative to the scene file.
+    /// CSV file (header `t,<joint names>`; t in s, angles in rad), relative to the scene file.
     pub file: String,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CartesianSpec {
+    /// The hand path, world frame, tagged by `shape`.
     pub path: PathSpec,
-    /// A constant orientation of the hand frame, held along the path.
+    /// A constant orientation of the hand frame, held along the path (default: position only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orientation: Option<OrientationSpec>,
+    /// The general IK's settings (default: each setting's own).
     #[serde(default)]
     pub ik: GeneralIkSpec,
 }
 
-/// A hand path, world frame, selected by `shape` (read by hand, as [`KindedTarget`]).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// A hand path, world frame, selected by `shape`.
+// (read by hand, as [`KindedTarget`])
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
 #[serde(tag = "shape", rename_all = "kebab-case")]
 pub enum PathSpec {
+    /// A circle in any plane.
     Circle(CirclePathSpec),
+    /// Straight segments, each with a minimum-jerk time profile (at rest at each point).
     Lines(PointsSpec),
+    /// A C² cubic spline through the points.
     Waypoints(PointsSpec),
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CirclePathSpec {
-    /// m.
+    /// Centre of the circle, m, world frame.
     pub center: [f64; 3],
-    /// The plane's normal (normalised when read).
+    /// The circle plane's normal (normalised when read).
     pub normal: [f64; 3],
-    /// m.
+    /// Radius, m.
     pub radius: f64,
-    /// s per turn.
+    /// Time of one turn, s.
     pub period: f64,
-    /// Angle at t = 0 from the zero axis, rad.
+    /// Angle at t = 0 from the zero axis, rad (default 0).
     #[serde(default)]
     pub phase: f64,
-    /// About the normal (right-hand rule).
+    /// Sense of rotation about the normal, right-hand rule (default: counter-clockwise).
     #[serde(default = "ccw")]
     pub direction: Direction,
     /// The direction of angle 0, projected onto the plane (default: world x, or world y when
@@ -463,21 +504,25 @@ fn ccw() -> Direction {
 }
 
 /// Points (m) reached at times (s).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PointsSpec {
+    /// The points [x, y, z], m, world frame.
     pub points: Vec<[f64; 3]>,
+    /// The time each point is reached, s, one per point, increasing.
     pub times: Vec<f64>,
 }
 
 /// URDF convention: roll about x, pitch about y, yaw about z, fixed axes (R = Rz Ry Rx), rad.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OrientationSpec {
+    /// Roll, pitch, yaw, rad (R = Rz(yaw) Ry(pitch) Rx(roll)).
     pub rpy: [f64; 3],
 }
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// The general IK's solver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum IkSolver {
     /// Damped least squares / Levenberg–Marquardt with a null-space posture task.
@@ -486,18 +531,19 @@ pub enum IkSolver {
 }
 
 /// The general IK's settings.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GeneralIkSpec {
+    /// The solver (default: `dls`).
     #[serde(default)]
     pub solver: IkSolver,
-    /// Joints the IK moves (default: all); the others hold their posture angle.
+    /// Joints the IK moves, URDF names (default: all); the others hold their posture angle.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joints: Option<Vec<String>>,
     /// Null-space posture, rad, one per joint (default: initial.q).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub posture: Option<Vec<f64>>,
-    /// Scene contacts whose point must stay on its plane along the path.
+    /// Scene contacts whose point must stay on its plane along the path (default: none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub keep_contacts: Vec<String>,
     /// Grid step of the solved trajectory, s (default 0.002).
@@ -505,7 +551,8 @@ pub struct GeneralIkSpec {
     pub grid_step: Option<f64>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// A sense of rotation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Direction {
     CounterClockwise,
@@ -513,35 +560,36 @@ pub enum Direction {
 }
 
 /// A horizontal circle run once per `period`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CircleSpec {
-    /// m, world frame.
+    /// Centre of the circle, m, world frame.
     pub center: [f64; 3],
-    /// m.
+    /// Radius, m.
     pub radius: f64,
-    /// s per turn.
+    /// Time of one turn, s.
     pub period: f64,
     /// Angle at t = 0 from +x towards +y, rad.
     pub phase: f64,
-    /// Seen from above (+z).
+    /// Sense of rotation, seen from above (+z).
     pub direction: Direction,
-    /// Optional jump of the target: `offset` (m) is added from `time` (s) on.
+    /// A jump of the target: `offset` (m) is added from `time` (s) on (default: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<StepSpec>,
 }
 
 /// A step in the target.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StepSpec {
-    /// s.
+    /// Time of the jump, s.
     pub time: f64,
-    /// m, world frame.
+    /// Added to the target from then on, m, world frame.
     pub offset: [f64; 3],
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// Which of the closed-form IK's two solutions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Branch {
     Positive,
@@ -550,24 +598,27 @@ pub enum Branch {
 
 /// Closed-form IK (eqs 28–29): a yaw joint and two planar joints; every other joint holds its
 /// initial angle.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct IkSpec {
+    /// The yaw joint (URDF name): a revolute joint about the vertical.
     pub yaw_joint: String,
+    /// The two planar joints (URDF names), parallel axes, in one plane with the hand.
     pub planar_joints: [String; 2],
     /// Sign of the second planar joint's angle relative to the first link.
     pub branch: Branch,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// The state at t = 0.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// rad, or `"from-target"`: q_d(0).
+    /// Joint angles, rad, per joint; or `"from-target"`: q_d(0), the target at t = 0.
     pub q: InitialQ,
-    /// rad/s.
+    /// Joint speeds, rad/s, per joint (default 0).
     #[serde(default = "PerJoint::zero")]
     pub qd: PerJoint,
-    /// A.
+    /// Motor currents, A, per joint (default 0).
     #[serde(default = "PerJoint::zero")]
     pub current: PerJoint,
 }
@@ -577,14 +628,18 @@ pub struct InitialSpec {
 /// `"bilateral"`, `"unilateral"` (rigid, event-driven: `restitution`, `friction`) or
 /// `"compliant"` (`stiffness`, `damping`, `friction`, `slip_velocity`). Keys that do not belong
 /// to the chosen model are rejected.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
+    /// The contact's name, used by `runs[].contacts` and in the recordings.
     pub name: String,
+    /// The point of the arm that touches the plane.
     pub point: PointSpec,
+    /// The plane, world frame.
     pub plane: PlaneSpec,
-    /// `"bilateral"` (absent), `"unilateral"` or `"compliant"`.
+    /// The contact model: `bilateral`, `unilateral` or `compliant` (default: bilateral).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(with = "Option<ContactModelName>")]
     pub model: Option<String>,
     /// Newton's coefficient of restitution e in [0, 1] (unilateral; default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -604,30 +659,34 @@ pub struct ContactSpec {
 }
 
 /// The plane `normal · x = offset`, world frame.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneSpec {
+    /// The plane's normal n, world frame (normalised when read).
     pub normal: [f64; 3],
-    /// m.
+    /// The plane's offset d along n, m: n · x = d.
     pub offset: f64,
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+/// How the dynamics are computed.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DynamicsSpec {
+    /// How M(q) is computed: `crba` or `walker-orin` (default: crba).
     #[serde(default)]
     pub mass_matrix: MassMatrixMethod,
+    /// How the constrained system is solved: `schur` or `kkt` (default: schur).
     #[serde(default)]
     pub constraint_solver: ConstraintSolver,
-    /// Constraint stabilisation (default none, as in the paper).
+    /// Constraint stabilisation, tagged by `method` (default: none, as in the paper).
     #[serde(default)]
     pub stabilization: Stabilization,
 }
 
 /// The integrator and its settings, tagged by `method`; each method accepts only its own
-/// settings (an unknown or misplaced one is rejected with its name). Defaults are filled in one
-/// place, [`crate::integrator::Integrator::from_spec`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// settings (an unknown or misplaced one is rejected with its name).
+// Defaults are filled in one place, [`crate::integrator::Integrator::from_spec`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "method", rename_all = "kebab-case")]
 pub enum IntegratorSpec {
     /// Classical Runge–Kutta with the fixed `step`, s.
@@ -649,20 +708,20 @@ pub enum IntegratorSpec {
 }
 
 /// `rk4`'s settings.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FixedStepSpec {
-    /// s.
+    /// The fixed step, s.
     pub step: f64,
 }
 
 /// The step control of an adaptive method (`dopri45`, `imex`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AdaptiveSpec {
-    /// Relative tolerance.
+    /// Relative tolerance (dimensionless).
     pub rtol: f64,
-    /// Absolute tolerance (in each state component's unit).
+    /// Absolute tolerance, in each state component's unit.
     pub atol: f64,
     /// Largest step, s (default: the output interval).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -673,10 +732,12 @@ pub struct AdaptiveSpec {
 }
 
 /// `rosenbrock`'s, `rodas5p`'s and `rodas4`'s settings: the step control of [`AdaptiveSpec`] and the Jacobian's reuse.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RosenbrockSpec {
+    /// Relative tolerance (dimensionless).
     pub rtol: f64,
+    /// Absolute tolerance, in each state component's unit.
     pub atol: f64,
     /// Largest step, s (default: the output interval).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -709,10 +770,12 @@ impl IntegratorSpec {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// One run of the scene: which contacts are active.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RunSpec {
+    /// The run's name, used in output file names: letters, digits, `-`, `_`, `.`.
     pub name: String,
-    /// Names of the contacts active in this run.
+    /// Names of the contacts active in this run (the table's points are in every run).
     pub contacts: Vec<String>,
 }

@@ -2,19 +2,24 @@
 //! `events` settings, and the model keys of a contact or of the table ([`LawKeys`]). Part of
 //! [`super::spec`] (re-exported there); validated in `scene/contacts.rs`.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::spec::{ContactSpec, PlaneSpec, PointSpec};
 
 /// `"table"`: one plane under named points; each point becomes a contact (unilateral unless
 /// `model` says otherwise) that is part of every run.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TableSpec {
+    /// The table's plane, world frame.
     pub plane: PlaneSpec,
+    /// The points of the arm over the table, each a contact of every run.
     pub points: Vec<TablePointSpec>,
-    /// `"unilateral"` (absent), `"bilateral"` or `"compliant"`.
+    /// The contact model of every point: `unilateral`, `bilateral` or `compliant` (default:
+    /// unilateral).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(with = "Option<ContactModelName>")]
     pub model: Option<String>,
     /// Newton's coefficient of restitution e in [0, 1] (unilateral; default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -34,15 +39,17 @@ pub struct TableSpec {
 }
 
 /// One point of the table construct.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TablePointSpec {
+    /// The contact's name (as a contact's `name`).
     pub name: String,
+    /// The point of the arm.
     pub point: PointSpec,
 }
 
 /// `"events"`: settings of the event-driven integration (every key optional).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct EventsSpec {
     /// Width of the bracket an event time is located to, s (default 1e-12).
@@ -55,6 +62,20 @@ pub struct EventsSpec {
     /// Most contact events in a run (default 100000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_events: Option<u64>,
+}
+
+/// A contact model (README, "A table that only pushes: contacts").
+// (for the schema only: the spec keeps the string, validated in `contacts.rs` with its message)
+#[derive(JsonSchema)]
+#[schemars(rename_all = "kebab-case")]
+#[allow(dead_code)]
+pub(super) enum ContactModelName {
+    /// The paper's: the point stays on the plane, f_n of either sign, no friction.
+    Bilateral,
+    /// Rigid, event-driven: g >= 0, f_n >= 0; Newton restitution at impacts; Coulomb friction.
+    Unilateral,
+    /// A spring-damper: f_n = max(0, k δ + c δ̇) for a penetration δ; regularised friction.
+    Compliant,
 }
 
 /// The model keys of a contact or of the table, as written.

@@ -1,16 +1,21 @@
-//! `sim export-scene`: a built-in scene (the paper's by default) and its URDF, as files to edit.
+//! `sim export-scene`: a built-in scene (the paper's by default) and its URDF, as files to edit,
+//! with the scene files' JSON Schema next to them (named by the scene's `"$schema"`).
 
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use cli::{exit, Verbosity};
 use sim::scene::builtin;
+use sim::scene::schema::{self, FileKind};
 
-/// Write a built-in scene (`sim list`; default: the paper's, paper.json and paper_arm.urdf) and
-/// its URDF into a directory, to edit; existing files are not overwritten.
+/// Write a built-in scene (`sim list`; default: the paper's, paper.json and paper_arm.urdf), its
+/// URDF and the scene files' JSON Schema into a directory, to edit; existing files are not
+/// overwritten.
 #[derive(Debug, Clone, clap::Args)]
 #[command(after_help = "\
-Output: DIR/<scene>.json and the URDF it names (paper.json and paper_arm.urdf by default).
+Output: DIR/<scene>.json and the URDF it names (paper.json and paper_arm.urdf by default), and
+DIR/scene.schema.json, which the scene names as its \"$schema\" so that an editor checks it
+(`sim schema`; one already there is kept when it is the same).
 
 Examples:
   sim export-scene -o my-scene/ && sim check my-scene/paper.json
@@ -29,7 +34,16 @@ pub fn run(a: &ExportSceneArgs, v: Verbosity) -> Result<u8> {
         bail!("no built-in scene `{}` (built-in scenes: {})", a.name, builtin::names().join(", "));
     };
     cli::create_dir(&a.out)?;
-    let files: Vec<(&str, &str)> = std::iter::once((b.file, b.json)).chain(b.files.iter().copied()).collect();
+    // the scene names the schema beside it (in the repository it is one directory up or here)
+    let schema_file = FileKind::Scene.schema_file();
+    let scene = schema::with_schema_path(b.json, schema_file);
+    let schema = schema::schema_text(FileKind::Scene);
+    let mut files: Vec<(&str, &str)> = std::iter::once((b.file, scene.as_str())).chain(b.files.iter().copied()).collect();
+    // a schema already there from another export is left as it is when it is this one
+    let schema_path = a.out.join(schema_file);
+    if std::fs::read_to_string(&schema_path).ok().as_deref() != Some(schema.as_str()) {
+        files.push((schema_file, schema.as_str()));
+    }
     for (name, _) in &files {
         let p = a.out.join(name);
         if p.exists() {

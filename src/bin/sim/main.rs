@@ -10,6 +10,7 @@ mod live;
 mod precision;
 mod replay;
 mod run;
+mod schema;
 mod sweep;
 
 use std::path::PathBuf;
@@ -30,6 +31,7 @@ Examples:
   sim list                              the built-in scenes: the paper and three real arms
   sim ur5e-like -o /tmp/ur              a built-in scene by name (as `sim run ur5e-like`)
   sim export-scene -o scenes/           the built-in scene and URDF, to edit
+  sim schema -o scene.schema.json       the scene files' JSON Schema, for editors
   sim replay out/paper-two-elbow.mcap   re-run a recording from its own metadata
   sim sweep sim/scenes/sweeps/paper-gains.json -j 2
   sim precision --duration 1            speed against error of every integrator
@@ -68,6 +70,7 @@ enum Command {
     Precision(precision::PrecisionArgs),
     ExportScene(export_scene::ExportSceneArgs),
     List(list::ListArgs),
+    Schema(schema::SchemaArgs),
     /// Print the shell completion script (bash, zsh, fish, elvish, powershell).
     #[command(after_help = "Example:\n  sim completions bash > ~/.local/share/bash-completion/completions/sim")]
     Completions(CompletionsArgs),
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Some(Command::Precision(a)) => precision::run(&a, v),
         Some(Command::ExportScene(a)) => export_scene::run(&a, v),
         Some(Command::List(a)) => list::run(&a),
+        Some(Command::Schema(a)) => schema::run(&a, v),
         Some(Command::Completions(a)) => cli::extras::completions(Cli::command(), a.shell).map(|()| exit::SUCCESS),
         Some(Command::Man(a)) => cli::extras::man(Cli::command(), &a).map(|n| {
             if !v.quiet {
@@ -176,6 +180,16 @@ mod tests {
         assert_eq!(argv(&["run", "paper"]), ["sim", "run", "paper"]);
         assert_eq!(argv(&[]), ["sim"]);
         assert!(matches!(parse(&["list", "-f", "csv"]).unwrap().command, Some(Command::List(_))));
+    }
+
+    #[test]
+    fn schema_prints_the_scene_schema_by_default() {
+        let Some(Command::Schema(a)) = parse(&["schema"]).unwrap().command else { panic!() };
+        assert_eq!((a.kind, a.format, a.out), (schema::Kind::Scene, schema::SchemaFormat::Json, None));
+        let Some(Command::Schema(a)) = parse(&["schema", "sweep", "-f", "markdown", "-o", "f.md"]).unwrap().command else { panic!() };
+        assert_eq!((a.kind, a.format, a.out), (schema::Kind::Sweep, schema::SchemaFormat::Markdown, Some(PathBuf::from("f.md"))));
+        assert_eq!(parse(&["schema", "scenes"]).unwrap_err().kind(), ErrorKind::InvalidValue);
+        assert_eq!(parse(&["schema", "-f", "csv"]).unwrap_err().kind(), ErrorKind::InvalidValue);
     }
 
     #[test]
