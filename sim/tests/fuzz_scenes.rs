@@ -15,7 +15,7 @@
 //!
 //! The counts are printed (`-- --nocapture`). About 1 min in the test profile on 2 cores.
 //! Larger runs (another seed, more cases):
-//! `FUZZ_CASES=100000 FUZZ_SEED=7 cargo test --profile test -p sim --test fuzz_scenes -- --nocapture`
+//! `FUZZ_CASES=100000 FUZZ_SEED=7 cargo test --profile test -p sim --test all fuzz_scenes -- --nocapture`
 //! (`FUZZ_CASES` scales both generators: URDF cases are a fifth of it).
 //! (The table of hand-written bad inputs is in `bad_input.rs`; the runaway cases in
 //! `runaway.rs`.)

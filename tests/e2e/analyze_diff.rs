@@ -140,7 +140,7 @@ fn fixture() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("analyze/tests/fixtures/format-v0-small.mcap")
 }
 
-/// Rewrites the committed fixture: `cargo test -p analyze --test diff -- --ignored`. Only
+/// Rewrites the committed fixture: `cargo test --all-features --test e2e regenerate_format_v0_fixture -- --ignored`. Only
 /// when its description in tests/fixtures/README.md changes: it stands for files already
 /// written, so a new writer must not silently replace it.
 #[test]
