@@ -2,8 +2,9 @@
 //! one, each as it was a binary of its own), so that a cold `cargo test` compiles and links the
 //! library's generic code once instead of once per file, and the tests of every file share the
 //! test harness's threads. Files that must stay binaries of their own (a counting global
-//! allocator) are `[[test]]` targets of their own in `Cargo.toml`; the last test here fails if a
-//! file of `tests/` is in neither place, so no test file can silently stop running.
+//! allocator) are `[[test]]` targets of their own in `Cargo.toml`; the root package's test
+//! `e2e::test_binaries` fails if a file of `tests/` is in neither place, so no test file can
+//! silently stop running.
 
 mod contacts_support;
 #[path = "arms_load.rs"]
@@ -53,23 +54,3 @@ mod targets;
 #[path = "urdf_corpus.rs"]
 mod urdf_corpus;
 
-/// Every `.rs` file of `tests/` is a module here or a `[[test]]` target of its own.
-#[test]
-fn every_test_file_runs() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
-    let here = include_str!("all.rs");
-    let manifest = include_str!("../Cargo.toml");
-    let mut lost = Vec::new();
-    for e in std::fs::read_dir(&dir).unwrap().map(Result::unwrap) {
-        let name = e.file_name().to_string_lossy().to_string();
-        if !name.ends_with(".rs") || name == "all.rs" {
-            continue;
-        }
-        let as_module = format!("#[path = \"{name}\"]");
-        let as_target = format!("path = \"tests/{name}\"");
-        if !here.contains(&as_module) && !manifest.contains(&as_target) {
-            lost.push(name);
-        }
-    }
-    assert!(lost.is_empty(), "test files that no test binary compiles (add them to tests/all.rs): {lost:?}");
-}
