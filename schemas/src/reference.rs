@@ -48,6 +48,7 @@ fn doc<M: Message>(topic: &'static str, when: &'static str, what: &'static str) 
 fn topic_docs() -> Vec<TopicDoc> {
     const EVERY: &str = "every recording, every sample";
     const CONTACTS: &str = "runs with a unilateral or compliant contact, at each event";
+    const CONTACTS_EVERY: &str = "runs with a unilateral or compliant contact, every sample";
     vec![
         doc::<RosString>(topics::ROBOT_DESCRIPTION, "every recording, once at t = 0", "the URDF (XML text) of the robot that ran"),
         doc::<fm::FrameTransforms>(topics::TF, EVERY, "world → base link and every URDF joint's transform (fixed joints included)"),
@@ -67,8 +68,6 @@ fn topic_docs() -> Vec<TopicDoc> {
         ),
     ]
 }
-
-const CONTACTS_EVERY: &str = "runs with a unilateral or compliant contact, every sample";
 
 /// One field of a schema: its name, its type as the schema says it, whether it is an array.
 struct Field {

@@ -66,7 +66,8 @@ fn includes(page: &Path, text: &str) -> Vec<(String, PathBuf)> {
 /// The page as mdBook renders it: every include directive replaced by the file it names.
 fn expanded(page: &Path) -> String {
     let mut text = read(page);
-    for (directive, file) in includes(page, &text.clone()) {
+    let directives = includes(page, &text);
+    for (directive, file) in directives {
         assert!(file.is_file(), "{}: {directive} names a missing file", page.display());
         text = text.replace(&directive, &read(&file));
     }
@@ -167,18 +168,25 @@ fn anchors(md: &str) -> BTreeSet<String> {
             ids.insert(if *n == 0 { id.clone() } else { format!("{id}-{n}") });
             *n += 1;
         }
-        for attr in ["id=\"", "name=\""] {
-            let mut rest = line;
-            while let Some(i) = rest.find(attr) {
-                let after = &rest[i + attr.len()..];
-                if let Some(end) = after.find('"') {
-                    ids.insert(after[..end].to_string());
-                }
-                rest = &after[after.len().min(1)..];
-            }
-        }
+        ids.extend(attr_values(line, &["id", "name"]));
     }
     ids
+}
+
+/// The values of the HTML attributes `names` (`name="value"`) on a line, in order.
+fn attr_values(line: &str, names: &[&str]) -> Vec<String> {
+    let mut out = Vec::new();
+    for name in names {
+        let attr = format!("{name}=\"");
+        let mut rest = line;
+        while let Some(i) = rest.find(&attr) {
+            let after = &rest[i + attr.len()..];
+            let Some(end) = after.find('"') else { break };
+            out.push(after[..end].to_string());
+            rest = &after[end + 1..];
+        }
+    }
+    out
 }
 
 /// The link targets of a page (inline `[..](target)`, images, reference definitions
@@ -216,16 +224,7 @@ fn links(md: &str) -> Vec<(usize, String)> {
                 }
             }
         }
-        for attr in ["href=\"", "src=\""] {
-            let mut rest = line.as_str();
-            while let Some(i) = rest.find(attr) {
-                let after = &rest[i + attr.len()..];
-                if let Some(end) = after.find('"') {
-                    out.push((n, after[..end].to_string()));
-                }
-                rest = &after[after.len().min(1)..];
-            }
-        }
+        out.extend(attr_values(&line, &["href", "src"]).into_iter().map(|v| (n, v)));
     }
     out
 }
