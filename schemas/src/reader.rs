@@ -326,6 +326,9 @@ struct State {
     last_time: BTreeMap<u16, u64>,
     /// Largest log time of any message, ns.
     t_end_ns: Option<u64>,
+    /// Smallest and largest log time of the messages counted since it was last reset, ns
+    /// (recovery: the time span of one record).
+    span: Option<(u64, u64)>,
     first_joint_array_len: Option<usize>,
     energy_has_gear_friction: Option<bool>,
     /// The `run` record as read so far ([`DecodedMessage::run`]).
@@ -550,6 +553,7 @@ impl State {
         }
         self.last_time.insert(channel_id, log_time);
         self.t_end_ns = Some(self.t_end_ns.map_or(log_time, |t| t.max(log_time)));
+        self.span = Some(self.span.map_or((log_time, log_time), |(a, b)| (a.min(log_time), b.max(log_time))));
         info.message_count += 1;
         self.total += 1;
         Ok(index)
@@ -574,8 +578,15 @@ impl State {
 
     /// Hands the messages held back to `visitor` (recovery, after their record read whole).
     fn commit(&mut self, visitor: &mut dyn Visitor) -> Result<(), Error> {
+        self.commit_first(usize::MAX, visitor)
+    }
+
+    /// Hands the first `n` messages held back to `visitor` (recovery: those before a flush
+    /// point), keeping the others held.
+    fn commit_first(&mut self, n: usize, visitor: &mut dyn Visitor) -> Result<(), Error> {
         let Some(pending) = self.pending.as_mut() else { return Ok(()) };
-        for p in pending.drain(..) {
+        let n = n.min(pending.len());
+        for p in pending.drain(..n) {
             let topic = &self.channels[&p.channel_id].topic;
             visitor.message(DecodedMessage { file: &self.file, topic, index: p.index, log_time_ns: p.log_time_ns, body: p.body, run: self.run.as_ref() })?;
         }

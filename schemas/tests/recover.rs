@@ -297,3 +297,70 @@ fn chunks_out_of_time_order_are_refused() {
         assert!(list.windows(2).all(|w| w[0].0 < w[1].0));
     }
 }
+
+
+/// 10 s of /motors and /hand every 10 ms and a sparse topic (/contact_events, every 0.37 s,
+/// between samples, written before the next sample as `sim` does), with the default writer.
+fn recording_default() -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let mut w = RecordingWriter::create(&dir.path().join("d.mcap")).unwrap();
+    let mut run = BTreeMap::new();
+    run.insert("run".to_string(), "two-elbow".to_string());
+    w.write_metadata_raw("run", &run).unwrap();
+    let mut next_event = 0.37;
+    for k in 0..1000u32 {
+        let t = f64::from(k) * 1e-2;
+        while next_event <= t {
+            let e = schemas::ContactEventMsg { time: next_event, contact: "elbow".into(), kind: "impact".into(), impulse: next_event, ..Default::default() };
+            w.write(topics::CONTACT_EVENTS, schemas::to_log_time(next_event), &e).unwrap();
+            next_event += 0.37;
+        }
+        let ns = schemas::to_log_time(t);
+        let m = MotorState { time: t, current: vec![t.sin(); 3], voltage: vec![f64::from(k); 3], ..Default::default() };
+        w.write(topics::MOTORS, ns, &m).unwrap();
+        let h = HandState { time: t, error: Vec3 { x: t, y: -t, z: t * t }, error_norm: t * 2.0, ..Default::default() };
+        w.write(topics::HAND, ns, &h).unwrap();
+    }
+    let mut result = BTreeMap::new();
+    result.insert("status".to_string(), "complete".to_string());
+    w.write_metadata_raw("result", &result).unwrap();
+    std::fs::read(w.finish().unwrap()).unwrap()
+}
+
+/// What a crash leaves (issue 29, item 7): the default writer writes every topic's chunk
+/// together at least every second of log time, so a file cut anywhere gives, by recovery, every
+/// topic up to the same time and nothing after: exactly the intact recording restricted to
+/// `[0, t_end]` (the sparse topic too), losing at most the flush group the cut falls into
+/// (≤ 1 s of log time here, at most one chunk per topic). On the writer that wrote a topic's
+/// chunk only when it held 1 MiB, every cut before the end recovered no message at all.
+#[test]
+fn a_cut_file_of_the_default_writer_keeps_every_topic_up_to_the_same_time() {
+    let full = recording_default();
+    let normal = read_recording_bytes(&full, "d.mcap").unwrap();
+    assert_eq!(normal.messages(topics::CONTACT_EVENTS).unwrap().len(), 27);
+    let mut last = 0;
+    let mut recovered = 0;
+    for k in 1..40 {
+        let cut = k * full.len() / 40;
+        let (rec, report) = read_recording_recover_bytes(&full[..cut], "cut.mcap").unwrap();
+        assert!(!report.complete && report.aligned, "cut at {cut}: {report}");
+        let t_end = report.t_end_ns.unwrap_or(0);
+        // the intact recording restricted to [0, t_end]: every topic, exactly
+        for (topic, list) in normal.message_map() {
+            let expected: Vec<_> = list.iter().filter(|(t, _)| report.t_end_ns.is_some_and(|end| *t <= end)).cloned().collect();
+            let got = rec.message_map().get(topic).cloned().unwrap_or_default();
+            assert_eq!(got, expected, "cut at {cut}: {topic} is not the intact one up to {t_end} ns: {report}");
+        }
+        assert!(t_end >= last, "cut at {cut}: {t_end} < {last}");
+        last = t_end;
+        assert!(report.held_back_chunks <= 3, "cut at {cut}: more than one group lost: {report}");
+        // the part lost: at most the group the cut falls into (≤ 1 s), whose chunks follow
+        // the data in proportion to the bytes (10 s in all; 0.5 s of slack for the metadata)
+        let t_cut = 10.0 * cut as f64 / full.len() as f64;
+        let t = schemas::from_log_time(t_end);
+        assert!(report.t_end_ns.is_none() && t_cut < 1.5 || t > t_cut - 1.5, "cut at {cut} (~{t_cut} s): recovered to {t} s: {report}");
+        recovered += usize::from(report.messages > 0);
+        assert!(report.to_string().contains("every topic up to it") || report.messages == 0, "{report}");
+    }
+    assert!(recovered >= 34, "{recovered} of 39 cuts recovered messages");
+}

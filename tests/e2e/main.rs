@@ -14,6 +14,7 @@ mod format_ownership;
 mod foxglove_layout;
 mod live;
 mod pipeline;
+mod recover_crash;
 mod rerun_view;
 mod sampled_energy;
 mod scene_schema;

@@ -9,8 +9,22 @@
 //! and decodes them one at a time (a chunk as a whole: its CRC is checked before any of its
 //! messages is used, and a chunk that fails anywhere contributes nothing), and stops at the first
 //! record that is cut short or does not read, or at the end of the data section. Messages and
-//! metadata records before that point are returned, with a [`RecoverReport`] saying how much
-//! was read and where and why it stopped.
+//! metadata records up to the last *flush point* before that (below) are returned, with a
+//! [`RecoverReport`] saying how much was read and where and why it stopped.
+//!
+//! **Flush points: every topic up to the same time.** Our writer writes the chunks of every
+//! topic together (a flush group, `writer/worker.rs`), each group strictly later in log time
+//! than the one before. A flush point is where a group ends: before a record whose messages all
+//! start after the end of every message read before it (the first chunk of the next group),
+//! before a metadata record (the writer writes every staged chunk before one), and at the end
+//! of the data section. Messages after the last flush point (the group a cut falls into, even
+//! when some of its chunks are whole) are left out and counted
+//! ([`RecoverReport::held_back_chunks`]): the recovered part is then every message logged up to
+//! [`RecoverReport::t_end_ns`] on every topic, i.e. the intact recording restricted to that
+//! interval, and never a topic that stops earlier than another. A file whose records show no
+//! flush point within [`HOLD_LIMIT_BYTES`] of chunk data (another writer's) is read as before,
+//! up to the last whole record, and the report says its topics may stop at different times
+//! ([`RecoverReport::aligned`] = false). Memory: the decoded messages of one group at most.
 //!
 //! Nothing that failed a CRC is used:
 //! - a chunk is used only after its own CRC matched;
@@ -25,7 +39,8 @@
 //!   backwards on a channel, which stops the reading there.
 //!
 //! Memory: one record at a time (at most [`super::MAX_RECORD_BYTES`]), the decoded messages of
-//! one chunk until it is read whole, and a fingerprint (length and CRC-32) per chunk.
+//! one flush group until it is confirmed whole (at most [`HOLD_LIMIT_BYTES`] of chunk data), and
+//! a fingerprint (length and CRC-32) per chunk.
 
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::fmt;
@@ -54,11 +69,18 @@ pub struct RecoverReport {
     pub stopped_at: u64,
     /// Why reading stopped; `None` when `complete`.
     pub reason: Option<String>,
-    /// Chunk records read.
+    /// Chunk records read and kept (up to the last flush point).
     pub chunks: usize,
-    /// Messages read (every channel, decoded or not).
+    /// Chunk records read whole but left out: after the last flush point (the flush group the
+    /// damage falls into), so that every topic stops at the same time.
+    pub held_back_chunks: usize,
+    /// Every topic was read up to the same time ([`RecoverReport::t_end_ns`]): false only for a
+    /// file whose flush points this reader cannot see (module docs), where the topics recovered
+    /// may stop at different times.
+    pub aligned: bool,
+    /// Messages read and kept (every channel, decoded or not).
     pub messages: u64,
-    /// Largest log time of the messages read, ns.
+    /// Largest log time of the messages kept, ns.
     pub t_end_ns: Option<u64>,
     /// Names of the metadata records read.
     pub metadata: Vec<String>,
@@ -97,19 +119,27 @@ impl fmt::Display for RecoverReport {
         write!(
             f,
             "{}: damaged recording: stopped at byte {} of {}: {}; recovered {} messages in {} \
-             complete chunks ({t_end}) and metadata records: {meta}{}",
+             complete chunks ({t_end}{}) and metadata records: {meta}{}",
             self.source,
             self.stopped_at,
             self.file_len,
             self.reason.as_deref().unwrap_or("unknown"),
             self.messages,
             self.chunks,
+            match (self.aligned, self.t_end_ns) {
+                (true, Some(_)) => ", every topic up to it",
+                (true, None) => "",
+                (false, _) => ", the topics may stop at different times: no flush points seen",
+            },
             if self.metadata_verified || self.metadata.is_empty() {
                 ""
             } else {
                 " (not checked by a CRC: the file ends before the data section's CRC)"
             }
         )?;
+        if self.held_back_chunks > 0 {
+            write!(f, "; {} complete chunks after the last flush point left out", self.held_back_chunks)?;
+        }
         if self.duplicate_chunks > 0 {
             write!(f, "; {} repeated chunks skipped", self.duplicate_chunks)?;
         }
@@ -195,8 +225,14 @@ fn complete_report(state: &State, len: u64) -> RecoverReport {
         metadata: state.metadata.keys().cloned().collect(),
         metadata_verified: true,
         duplicate_chunks: 0,
+        held_back_chunks: 0,
+        aligned: true,
     }
 }
+
+/// Chunk data (uncompressed) held back at most while waiting for a flush point: past it the
+/// group is kept as it is, and the report says the topics may not be aligned.
+pub const HOLD_LIMIT_BYTES: u64 = 64 << 20;
 
 /// Opcode (1 byte) and length (u64 LE) before every record.
 const RECORD_HEAD: usize = 9;
@@ -211,6 +247,8 @@ struct Snapshot {
     first_joint_array_len: Option<usize>,
     energy_has_gear_friction: Option<bool>,
     total: u64,
+    /// Messages held back (the pending list's length).
+    pending: usize,
 }
 
 impl Snapshot {
@@ -224,24 +262,25 @@ impl Snapshot {
             first_joint_array_len: s.first_joint_array_len,
             energy_has_gear_friction: s.energy_has_gear_friction,
             total: s.total,
+            pending: s.pending.as_ref().map_or(0, Vec::len),
         }
     }
 
-    fn restore(self, s: &mut State) {
+    fn restore(&self, s: &mut State) {
         s.schemas.retain(|id, _| self.schemas.contains(id));
         s.channels.retain(|id, _| self.channels.contains_key(id));
         s.decoders.retain(|id, _| self.channels.contains_key(id));
         for (id, c) in &mut s.channels {
             c.message_count = self.channels[id];
         }
-        s.last_time = self.last_time;
+        s.last_time.clone_from(&self.last_time);
         s.t_end_ns = self.t_end_ns;
-        s.metadata = self.metadata;
+        s.metadata.clone_from(&self.metadata);
         s.first_joint_array_len = self.first_joint_array_len;
         s.energy_has_gear_friction = self.energy_has_gear_friction;
         s.total = self.total;
         if let Some(p) = s.pending.as_mut() {
-            p.clear();
+            p.truncate(self.pending);
         }
     }
 }
@@ -281,6 +320,15 @@ fn scan(
     let mut seen_chunks: HashSet<(u64, u32)> = HashSet::new();
     let mut metadata_verified = false;
     let mut buf: Vec<u8> = Vec::new();
+    // the state at the last flush point, the chunks read before it, and the largest log time
+    // of the messages read so far (module docs: flush points)
+    let mut confirmed = Snapshot::take(&state);
+    let mut confirmed_chunks = 0;
+    let mut max_end: Option<u64> = None;
+    let mut held_bytes = 0u64;
+    let mut aligned = true;
+    let mut mixed = false;
+    let mut data_end = false;
     let reason = loop {
         let left = len - at;
         if left == 0 {
@@ -310,6 +358,8 @@ fn scan(
             break format!("record (opcode {opcode:#04x}) of {rec_len} bytes is cut short: {got} bytes remain");
         }
         if opcode == op::DATA_END || opcode == op::FOOTER {
+            // the end of the data section: the last flush point
+            data_end = true;
             if opcode == op::DATA_END {
                 let saved = buf.get(RECORD_HEAD..RECORD_HEAD + 4).map_or(0, |b| u32::from_le_bytes(b.try_into().unwrap_or([0; 4])));
                 let calculated = crc.clone().finalize();
@@ -334,16 +384,66 @@ fn scan(
         }
         crc.update(&buf);
         let snapshot = Snapshot::take(&state);
+        state.span = None;
         let mut record = buf.as_slice();
-        let fed = feed(&mut record, options.clone(), &mut state, visitor);
-        if let Err(e) = fed.and_then(|()| state.commit(visitor)) {
+        if let Err(e) = feed(&mut record, options.clone(), &mut state, visitor) {
             snapshot.restore(&mut state);
             break format!("record (opcode {opcode:#04x}) at byte {at} is unreadable: {}", strip(&e));
         }
+        // a flush point before this record (its messages start after every message before it)
+        // or after it (a metadata record): hand over the messages before it
+        // a record with messages of several channels: not our writer's chunks of one topic each
+        mixed |= state.channels.iter().filter(|(id, c)| snapshot.channels.get(id).map_or(c.message_count > 0, |&n| c.message_count > n)).count() > 1;
+        let starts_group = state.span.zip(max_end).is_some_and(|((first, _), end)| first > end);
+        let flush = if starts_group {
+            Some((snapshot, chunks))
+        } else if opcode == op::METADATA {
+            Some((Snapshot::take(&state), chunks))
+        } else if held_bytes > HOLD_LIMIT_BYTES {
+            aligned = false;
+            Some((Snapshot::take(&state), chunks + usize::from(opcode == op::CHUNK)))
+        } else {
+            None
+        };
+        if let Some((mut point, chunks_before)) = flush {
+            if let Err(e) = state.commit_first(point.pending, visitor) {
+                // the visitor refused a message: nothing after the last flush point is kept
+                confirmed.restore(&mut state);
+                break format!("record (opcode {opcode:#04x}) at byte {at} is unreadable: {}", strip(&e));
+            }
+            point.pending = 0;
+            confirmed = point;
+            confirmed_chunks = chunks_before;
+            held_bytes = 0;
+        }
+        if let Some((_, end)) = state.span {
+            max_end = Some(max_end.map_or(end, |m| m.max(end)));
+        }
         if opcode == op::CHUNK {
             chunks += 1;
+            // the chunk's uncompressed size (MCAP "Chunk": after its start and end times)
+            held_bytes += buf.get(RECORD_HEAD + 16..RECORD_HEAD + 24).map_or(0, |b| u64::from_le_bytes(b.try_into().unwrap_or([0; 8])));
         }
         at += buf.len() as u64;
+    };
+    let mut reason = reason;
+    // at the end of the data section everything read is whole; otherwise the messages after
+    // the last flush point are left out
+    // (chunks that mix topics, another writer's: kept up to the last whole record, as their
+    // flush points cannot be seen, and the report says so)
+    let keep_all = data_end || (mixed && chunks > confirmed_chunks);
+    aligned &= data_end || !keep_all;
+    let committed = if keep_all { state.commit(visitor) } else { Ok(()) };
+    if let Err(e) = &committed {
+        reason = format!("a message after the last flush point is unreadable: {}", strip(e));
+    }
+    let held_back_chunks = if keep_all && committed.is_ok() {
+        0
+    } else {
+        confirmed.restore(&mut state);
+        let held = chunks - confirmed_chunks;
+        chunks = confirmed_chunks;
+        held
     };
     let report = RecoverReport {
         source: source.to_string(),
@@ -357,6 +457,8 @@ fn scan(
         metadata: state.metadata.keys().cloned().collect(),
         metadata_verified,
         duplicate_chunks,
+        held_back_chunks,
+        aligned,
     };
     Ok((state, report))
 }

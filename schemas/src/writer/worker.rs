@@ -4,13 +4,34 @@
 //! thread's timing).
 //!
 //! **Chunks per topic** ([`super::WriterOptions::chunk_per_topic`]): each channel's messages are
-//! staged in a buffer of their own and written as one chunk when the buffer reaches the chunk
-//! size (and at a metadata record and at the end), so every chunk holds one channel, and its
-//! channel record sits in the first chunk of that channel. A reader that wants some topics
-//! finds in the summary's chunk indexes (their message-index offsets name the channels of each
-//! chunk, MCAP spec "Chunk Index") which chunks to decompress and skips the rest. Messages stay
-//! in log-time order within each channel (MCAP asks no order across channels; the chunk
-//! indexes give each chunk's time range). Memory: at most one chunk per channel staged.
+//! staged in a buffer of their own and written as one chunk, so every chunk holds one channel,
+//! and its channel record sits in the first chunk of that channel. A reader that wants some
+//! topics finds in the summary's chunk indexes (their message-index offsets name the channels
+//! of each chunk, MCAP spec "Chunk Index") which chunks to decompress and skips the rest.
+//! Messages stay in log-time order within each channel (MCAP asks no order across channels;
+//! the chunk indexes give each chunk's time range). Memory: at most one chunk per channel staged.
+//!
+//! **Flush groups: what a cut file keeps.** The staged chunks are written *all together* (a
+//! *flush group*), never one channel alone, so that a file cut anywhere (a killed run's
+//! `.partial`, a copy that stopped) holds every topic up to the same time:
+//! - at the first message of a new log time (strictly later than every message before it) once
+//!   [`super::WriterOptions::flush_interval_ns`] of log time has passed (the group boundaries
+//!   are the multiples of the interval: 1 s of simulated time by default), or once any
+//!   channel's staged chunk has reached [`super::WriterOptions::chunk_size`];
+//! - before a metadata record and at the end;
+//! - and, only for a caller that writes more than twice the chunk size on one channel at one
+//!   log time, at once (a group that then splits one instant, which the reader below treats as
+//!   one with the next).
+//!
+//! Within a group the chunks are written in order of their last log time, latest first (then
+//! by channel id). With a caller that writes in log-time order (`sim` does: the contact events
+//! since the previous sample, at their own times, before it), every message of a group is
+//! strictly earlier than every message of the next, so the first chunk of a group is the first
+//! chunk in the file that starts after the end of every chunk before it, and no other chunk
+//! is: a reader that walks a cut file ([`crate::reader`]'s `recover.rs`) finds each flush point
+//! from the chunks' own messages, without a marker record, and keeps exactly the groups that a
+//! later flush point confirms whole. The price (measured, `writer.rs` [`super::WriterOptions`]
+//! default): more, smaller chunks.
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -76,6 +97,15 @@ pub(super) struct Worker {
     tap: Option<Tap>,
     /// Another consumer of the records (a live view), after the tap.
     mirror: Option<Box<dyn Mirror>>,
+    /// Largest log time written so far, ns (a message later than it starts a new instant).
+    last_ns: Option<u64>,
+    /// The log time at or after which the next new instant closes the group, ns.
+    next_flush_ns: Option<u64>,
+    /// Some channel's staged chunk has reached the chunk size: the next new instant closes
+    /// the group.
+    full: bool,
+    /// Scratch for the order of a group's chunks: (last log time, channel id).
+    order: Vec<(u64, u16)>,
 }
 
 /// Bytes of a message record in a chunk besides its data: opcode, length, channel id,
@@ -84,7 +114,19 @@ const MESSAGE_RECORD_OVERHEAD: u64 = 1 + 8 + 2 + 4 + 8 + 8;
 
 impl Worker {
     pub(super) fn new(mcap: mcap::Writer<BufWriter<File>>, file: String, options: WriterOptions, tap: Option<Tap>, mirror: Option<Box<dyn Mirror>>) -> Self {
-        Worker { mcap: Some(mcap), file, options, schemas: BTreeMap::new(), channels: BTreeMap::new(), tap, mirror }
+        Worker {
+            mcap: Some(mcap),
+            file,
+            options,
+            schemas: BTreeMap::new(),
+            channels: BTreeMap::new(),
+            tap,
+            mirror,
+            last_ns: None,
+            next_flush_ns: None,
+            full: false,
+            order: Vec::new(),
+        }
     }
 
     /// The tap and the mirror, those there are (none: nothing to do, nothing allocated).
@@ -150,6 +192,19 @@ impl Worker {
             let r = self.w().write_to_known_channel(header, data);
             return r.map_err(|e| self.err(e));
         }
+        // a new instant closes the group when it is due (module docs: flush groups)
+        let t = header.log_time;
+        let new_instant = self.last_ns.is_none_or(|last| t > last);
+        if new_instant {
+            if self.full || self.next_flush_ns.is_some_and(|due| t >= due) {
+                self.flush_all()?;
+            }
+            if self.next_flush_ns.is_none_or(|due| t >= due) {
+                let every = self.options.flush_interval_ns;
+                self.next_flush_ns = (every > 0).then(|| (t / every).saturating_add(1).saturating_mul(every));
+            }
+            self.last_ns = Some(t);
+        }
         let Some(chan) = self.channels.get_mut(&header.channel_id) else {
             unreachable!("the writer sends a channel before its messages");
         };
@@ -157,7 +212,11 @@ impl Worker {
         chan.staged.push((*header, chan.bytes.len()));
         chan.chunk_bytes += MESSAGE_RECORD_OVERHEAD + data.len() as u64;
         if chan.chunk_bytes >= self.options.chunk_size {
-            self.flush_channel(header.channel_id)?;
+            self.full = true;
+        }
+        if chan.chunk_bytes >= self.options.chunk_size.saturating_mul(2) {
+            // one instant larger than two chunks: bound the memory, split the instant
+            self.flush_all()?;
         }
         Ok(())
     }
@@ -201,17 +260,20 @@ impl Worker {
         w.flush().map_err(|e| write_error(&self.file, e))
     }
 
-    /// Writes every staged chunk, in channel id order; registers every channel (one without
-    /// messages too).
+    /// Writes every staged chunk (a flush group): latest last log time first, then by channel
+    /// id (module docs).
     fn flush_all(&mut self) -> Result<(), Error> {
         if !self.options.chunk_per_topic {
             return Ok(());
         }
-        let ids: Vec<u16> = self.channels.keys().copied().collect();
-        for id in ids {
-            self.flush_channel(id)?;
-        }
-        Ok(())
+        let mut order = std::mem::take(&mut self.order);
+        order.clear();
+        order.extend(self.channels.iter().filter_map(|(&id, c)| c.staged.last().map(|(h, _)| (h.log_time, id))));
+        order.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+        let flushed = order.iter().try_for_each(|&(_, id)| self.flush_channel(id));
+        self.order = order;
+        self.full = false;
+        flushed
     }
 
     /// Summary and footer; the file, flushed, and what the tap saw.
