@@ -91,6 +91,16 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>> {
     Ok(e.files)
 }
 
+/// The line that says a recording is of a failed run, with its status and reason
+/// (`FILE: the run failed at t = 0 s: REASON`), or `None` for a complete run or one without a
+/// `result` record. The commands that read recordings print it on standard error and exit 1.
+pub fn failed_run_note(file: &Path, result: Option<&schemas::RunResult>) -> Option<String> {
+    let r = result.filter(|r| r.status == schemas::RunStatus::Failed)?;
+    let at = r.error_time_s.map(|t| format!(" at t = {t} s")).unwrap_or_default();
+    let why = r.error.as_deref().unwrap_or("no reason recorded");
+    Some(format!("{}: the run {}{at}: {why}", file.display(), r.status_text()))
+}
+
 /// Runs `each` on every file in order; a file that fails is reported on standard error
 /// (`program: error: …`, naming it) and the others go on. Returns the results of the files that
 /// worked and the number that failed, or the first error when none worked (a bad input, exit

@@ -89,7 +89,7 @@ impl Default for ExportOptions<'_> {
 }
 
 /// What [`export_file`] wrote.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Exported {
     /// Topic tables written (besides `metadata.json`).
     pub tables: usize,
@@ -97,6 +97,8 @@ pub struct Exported {
     pub rows: usize,
     /// Topics not exported (their reasons are in `metadata.json`).
     pub skipped: usize,
+    /// The run's status and reason (record `result`), when the recording has one.
+    pub result: Option<schemas::RunResult>,
 }
 
 /// Writes the topics of the recording at `path` into `dir`. A topic asked for (`topics`) that
@@ -122,7 +124,15 @@ pub fn export_file(path: &Path, dir: &Path, options: &ExportOptions<'_>) -> Resu
             let w = write_tables(&mut f, dir, options.format, options.layout)?;
             Ok((w.rows, w.tables.len()))
         })?;
-        Ok(Exported { tables, rows, skipped: f.skipped.len() })
+        let result = match f.metadata.get(<schemas::RunResult as schemas::MetadataRecord>::NAME) {
+            Some(fields) => Some(
+                serde_json::to_value(fields)
+                    .and_then(serde_json::from_value::<schemas::RunResult>)
+                    .map_err(|e| Error::Table { file: file(), detail: format!("metadata record `result`: {e}") })?,
+            ),
+            None => None,
+        };
+        Ok(Exported { tables, rows, skipped: f.skipped.len(), result })
     }
     #[cfg(not(feature = "tables"))]
     {

@@ -249,6 +249,9 @@ pub struct RunSeries {
     pub voltage: Series,
     /// Normal force on each elbow, N, one column per contact.
     pub normal_force: Series,
+    /// The run's status and reason (record `result`), when the recording has one: a failed
+    /// run is drawn with what it recorded (nothing, when it failed at t = 0).
+    pub result: Option<schemas::RunResult>,
 }
 
 /// The series of one recording in memory; `fallback_name` names it if it has no `run` record.
@@ -287,7 +290,9 @@ impl SeriesCollect {
             series.finish();
         }
         let run = rec.run_opt()?;
+        let result = rec.result()?;
         Ok(RunSeries {
+            result,
             name: run.as_ref().map_or_else(|| stem.to_string(), |r| r.run.clone()),
             contacts: run.as_ref().map(|r| r.contacts.clone()).unwrap_or_default(),
             joints: run.map(|r| r.joint_names).unwrap_or_default(),

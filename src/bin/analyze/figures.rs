@@ -32,6 +32,13 @@ pub fn run(a: &FiguresArgs, v: Verbosity) -> Result<u8> {
     let (read, failed) =
         cli::inputs::each_file(&expanded.files, |p| analyze::figures::read_run(p).with_context(|| format!("reading {}", p.display())))?;
     let (paths, runs): (Vec<_>, Vec<_>) = read.into_iter().unzip();
+    let mut failed = failed;
+    for (p, r) in paths.iter().zip(&runs) {
+        if let Some(note) = cli::inputs::failed_run_note(p, r.result.as_ref()) {
+            eprintln!("analyze: {note} (drawn with what it recorded)");
+            failed += 1;
+        }
+    }
     let figures = analyze::figures::write_all(&runs, &paths, &a.out)?;
     if !v.quiet {
         eprintln!(

@@ -38,7 +38,8 @@ pub struct LayoutArgs {
 /// The layout input of the recording at `p`, read streamed: the camera from the box around the
 /// desired hand positions of `/hand` (the same as [`LayoutInput::from_recording`] gives from all
 /// of them, which [`layout::camera_for`] reduces to that box).
-fn read_one(p: &std::path::Path) -> Result<LayoutInput> {
+/// With it, the line that says the run failed (if it did).
+fn read_one(p: &std::path::Path) -> Result<(LayoutInput, Option<String>)> {
     // lowest and highest finite desired position, per axis
     let mut bounds: Option<([f64; 3], [f64; 3])> = None;
     let mut visit = |m: schemas::DecodedMessage<'_>| -> Result<(), schemas::Error> {
@@ -61,7 +62,7 @@ fn read_one(p: &std::path::Path) -> Result<LayoutInput> {
     let mut one = LayoutInput::from_recording(&rec)?;
     let corners: Vec<[f64; 3]> = bounds.map(|(lo, hi)| vec![lo, hi]).unwrap_or_default();
     (one.focus, one.camera_distance_m) = layout::camera_for(&corners);
-    Ok(one)
+    Ok((one, cli::inputs::failed_run_note(p, rec.result()?.as_ref())))
 }
 
 pub fn run(a: &LayoutArgs, v: Verbosity) -> Result<u8> {
@@ -71,7 +72,12 @@ pub fn run(a: &LayoutArgs, v: Verbosity) -> Result<u8> {
     let (read, failed) = cli::inputs::each_file(&expanded.files, |p| read_one(p).with_context(|| format!("reading {}", p.display())))?;
     // one layout input per scene, in the order the scenes first appear
     let mut scenes: Vec<LayoutInput> = Vec::new();
-    for (p, one) in read {
+    let mut failed = failed;
+    for (p, (one, note)) in read {
+        if let Some(note) = note {
+            eprintln!("analyze: {note} (in the layout with the others)");
+            failed += 1;
+        }
         match scenes.iter_mut().find(|m| m.title == one.title) {
             None => scenes.push(one),
             Some(m) => {

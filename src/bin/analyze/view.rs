@@ -94,11 +94,19 @@ fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<(Vec<PathBu
     let total: usize = jobs.iter().map(|(_, i)| i.len()).sum();
     let bar = cli::progress::count(total, "reading", "recordings", v.quiet || total < 2);
     let outs: Vec<PathBuf> = jobs.iter().map(|(out, _)| out.clone()).collect();
+    let failed_runs = std::cell::Cell::new(0usize);
     let result = cli::inputs::each_file(&outs, |out| {
         let inputs = &jobs.iter().find(|(o, _)| o == out).expect("a job per output").1;
         let started = std::time::Instant::now();
         let names = inputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-        let size = analyze::view::convert(inputs, out, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
+        let converted = analyze::view::convert(inputs, out, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
+        let size = converted.bytes;
+        for (p, result) in &converted.results {
+            if let Some(note) = cli::inputs::failed_run_note(p, result.as_ref()) {
+                bar.suspend(|| eprintln!("analyze: {note} (drawn with what it recorded)"));
+                failed_runs.set(failed_runs.get() + 1);
+            }
+        }
         if !v.quiet {
             let mcap: u64 = inputs.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
             bar.suspend(|| {
@@ -117,5 +125,6 @@ fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<(Vec<PathBu
     });
     bar.finish_and_clear();
     let (written, failed) = result?;
+    let failed = failed + failed_runs.get();
     Ok((written.into_iter().map(|(out, ())| out).collect(), failed))
 }
