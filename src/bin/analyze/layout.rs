@@ -43,17 +43,15 @@ fn read_one(p: &std::path::Path) -> Result<(LayoutInput, Option<String>)> {
     // lowest and highest finite desired position, per axis
     let mut bounds: Option<([f64; 3], [f64; 3])> = None;
     let mut visit = |m: schemas::DecodedMessage<'_>| -> Result<(), schemas::Error> {
-        let value = m.value();
-        let Some(d) = value.get("desired") else { return Ok(()) };
-        let f = |k: &str| d.get(k).and_then(schemas::Value::as_f64);
-        if let (Some(x), Some(y), Some(z)) = (f("x"), f("y"), f("z")) {
-            let q = [x, y, z];
-            if q.iter().all(|v| v.is_finite()) {
-                let (lo, hi) = bounds.get_or_insert((q, q));
-                for k in 0..3 {
-                    lo[k] = lo[k].min(q[k]);
-                    hi[k] = hi[k].max(q[k]);
-                }
+        // a message without a target (another producer's /hand) places no camera, as in
+        // `LayoutInput::from_recording`
+        let Ok(h) = m.decode::<schemas::HandState>(None) else { return Ok(()) };
+        let q = [h.desired.x, h.desired.y, h.desired.z];
+        if q.iter().all(|v| v.is_finite()) {
+            let (lo, hi) = bounds.get_or_insert((q, q));
+            for k in 0..3 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
             }
         }
         Ok(())
