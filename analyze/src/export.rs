@@ -3,7 +3,10 @@
 //! type and a build without the feature says what is missing. Every file goes through
 //! `schemas::atomic` (a lock on the final name, a temporary name of its own, a rename), so
 //! neither a killed export nor a second one at the same time ever leaves a half-written table
-//! under its final name.
+//! under its final name. The directory of one recording's tables is marked while it is written:
+//! a file [`INCOMPLETE`] comes first and goes last, so a killed or disk-full export leaves a
+//! directory that says it is incomplete, never tables that look finished without their
+//! `metadata.json` (issue 29).
 //!
 //! Units (`schemas::units`, the one table) travel with the tables:
 //! - Parquet: each column's Arrow field metadata `unit` (`current.joint4` → `A`), which is how
@@ -86,7 +89,7 @@ impl Default for ExportOptions<'_> {
 }
 
 /// What [`export_file`] wrote.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Exported {
     /// Topic tables written (besides `metadata.json`).
     pub tables: usize,
@@ -94,6 +97,8 @@ pub struct Exported {
     pub rows: usize,
     /// Topics not exported (their reasons are in `metadata.json`).
     pub skipped: usize,
+    /// The run's status and reason (record `result`), when the recording has one.
+    pub result: Option<schemas::RunResult>,
 }
 
 /// Writes the topics of the recording at `path` into `dir`. A topic asked for (`topics`) that
@@ -115,14 +120,54 @@ pub fn export_file(path: &Path, dir: &Path, options: &ExportOptions<'_>) -> Resu
                 return Err(Error::Table { file: file(), detail: format!("topic {t}: {why}") });
             }
         }
-        let written = write_tables(&mut f, dir, options.format, options.layout)?;
-        Ok(Exported { tables: written.tables.len(), rows: written.rows, skipped: f.skipped.len() })
+        let (rows, tables) = write_marked(dir, path, |dir| {
+            let w = write_tables(&mut f, dir, options.format, options.layout)?;
+            Ok((w.rows, w.tables.len()))
+        })?;
+        let result = match f.metadata.get(<schemas::RunResult as schemas::MetadataRecord>::NAME) {
+            Some(fields) => Some(
+                serde_json::to_value(fields)
+                    .and_then(serde_json::from_value::<schemas::RunResult>)
+                    .map_err(|e| Error::Table { file: file(), detail: format!("metadata record `result`: {e}") })?,
+            ),
+            None => None,
+        };
+        Ok(Exported { tables, rows, skipped: f.skipped.len(), result })
     }
     #[cfg(not(feature = "tables"))]
     {
         let _ = (path, dir, options);
         Err(Error::TablesUnavailable)
     }
+}
+
+/// The marker file of an export directory that is being written: `INCOMPLETE`.
+pub const INCOMPLETE: &str = "INCOMPLETE";
+
+/// Writes into `dir` with `write`, marked incomplete meanwhile: [`INCOMPLETE`] is written (and
+/// synced) before anything else and removed only after `write` has succeeded, so a killed or
+/// disk-full export leaves the marker beside whatever it wrote (an earlier export's tables of
+/// the other format stay, as before). A directory without the marker is a finished export.
+#[cfg(feature = "tables")]
+fn write_marked<T>(dir: &Path, source: &Path, write: impl FnOnce(&Path) -> Result<T, Error>) -> Result<T, Error> {
+    let io = |p: &Path, op: &'static str| {
+        let file = p.display().to_string();
+        move |source| Error::Io { file, op, source }
+    };
+    std::fs::create_dir_all(dir).map_err(io(dir, "creating"))?;
+    let marker = dir.join(INCOMPLETE);
+    let text = format!(
+        "analyze export of {} did not finish (killed, or an error it reported): the tables here may be partial or stale; run it again\n",
+        source.display()
+    );
+    {
+        use std::io::Write;
+        let mut f = std::fs::File::create(&marker).map_err(io(&marker, "creating"))?;
+        f.write_all(text.as_bytes()).and_then(|()| f.sync_all()).map_err(io(&marker, "writing"))?;
+    }
+    let out = write(dir)?;
+    std::fs::remove_file(&marker).map_err(io(&marker, "removing"))?;
+    Ok(out)
 }
 
 #[cfg(feature = "tables")]

@@ -70,11 +70,74 @@ pub enum FigureError {
     Draw(String),
 }
 
+/// Rows a [`Series`] keeps at most (16 384): a figure is at most a few thousand pixels wide, so
+/// this is several rows per pixel column. A run of up to this many samples (the paper's 5 s at
+/// 1 kHz: 5 001) is kept sample for sample; a longer one is decimated as it is read.
+pub const MAX_ROWS: usize = 1 << 14;
+
 /// Sample times (s) and one column per array entry (joint or contact).
+///
+/// Memory is bounded by [`MAX_ROWS`], not by the recording: past it the series is min-max
+/// decimated as it is read, as plotting libraries do for long signals (M4 / min-max
+/// decimation, Jugel et al., "M4: a visualization-oriented time series data aggregation",
+/// VLDB 2014): consecutive samples are grouped into buckets of `stride` samples (a power of two,
+/// doubled whenever the rows would pass [`MAX_ROWS`]), and each bucket keeps two rows, at its
+/// first and last sample time, holding per column its smallest and largest value in the order
+/// they occurred. Every peak and trough stays visible; a line moves by less than a bucket
+/// (under one pixel column) in time. [`Series::finish`] adds the last, partial bucket.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Series {
     pub t: Vec<f64>,
     pub cols: Vec<Vec<f64>>,
+    /// Samples per bucket: 1 while the series is kept sample for sample.
+    stride: usize,
+    /// The bucket being filled (decimated series only).
+    pending: Option<Bucket>,
+}
+
+/// Samples of one bucket, reduced: times of its first and last sample and, per column, the
+/// extremes with their sample index.
+#[derive(Debug, Clone, PartialEq)]
+struct Bucket {
+    count: usize,
+    t_first: f64,
+    t_last: f64,
+    /// Per column: `(min, index of min, max, index of max)`, NaN when every value was NaN.
+    extremes: Vec<(f64, usize, f64, usize)>,
+}
+
+impl Bucket {
+    fn new(t: f64) -> Self {
+        Bucket { count: 0, t_first: t, t_last: t, extremes: Vec::new() }
+    }
+
+    fn add(&mut self, t: f64, row: impl Iterator<Item = f64>, width: usize) {
+        while self.extremes.len() < width {
+            self.extremes.push((f64::NAN, 0, f64::NAN, 0));
+        }
+        for (e, v) in self.extremes.iter_mut().zip(row.chain(std::iter::repeat(f64::NAN))) {
+            if !v.is_nan() {
+                if e.0.is_nan() || v < e.0 {
+                    (e.0, e.1) = (v, self.count);
+                }
+                if e.2.is_nan() || v > e.2 {
+                    (e.2, e.3) = (v, self.count);
+                }
+            }
+        }
+        self.t_last = t;
+        self.count += 1;
+    }
+
+    /// The bucket's rows: `(t, values)`, one row for a single sample, else two.
+    fn rows(&self) -> Vec<(f64, Vec<f64>)> {
+        let first: Vec<f64> = self.extremes.iter().map(|e| if e.1 <= e.3 { e.0 } else { e.2 }).collect();
+        if self.count == 1 {
+            return vec![(self.t_first, first)];
+        }
+        let last: Vec<f64> = self.extremes.iter().map(|e| if e.1 <= e.3 { e.2 } else { e.0 }).collect();
+        vec![(self.t_first, first), (self.t_last, last)]
+    }
 }
 
 impl Series {
@@ -83,16 +146,80 @@ impl Series {
     }
 
     /// Appends one row: a longer row than the ones before adds columns (NaN before it, not
-    /// drawn); a shorter one leaves NaN in the columns it lacks.
+    /// drawn); a shorter one leaves NaN in the columns it lacks. Past [`MAX_ROWS`] rows, the
+    /// row goes into the current bucket (see [`Series`]).
     fn push(&mut self, t: f64, row: &[f64]) {
         let n = self.t.len();
         while self.cols.len() < row.len() {
             self.cols.push(vec![f64::NAN; n]);
         }
-        for (j, col) in self.cols.iter_mut().enumerate() {
-            col.push(row.get(j).copied().unwrap_or(f64::NAN));
+        if self.stride <= 1 {
+            self.push_row(t, row.iter().copied());
+            if self.t.len() >= MAX_ROWS {
+                // every two rows are a bucket of two samples: merge pairs of them
+                self.stride = 2;
+                self.compact();
+            }
+            return;
+        }
+        let width = self.cols.len();
+        let b = self.pending.get_or_insert_with(|| Bucket::new(t));
+        b.add(t, row.iter().copied(), width);
+        if b.count == self.stride {
+            let b = self.pending.take().expect("a bucket");
+            for (t, r) in b.rows() {
+                self.push_row(t, r.into_iter());
+            }
+            if self.t.len() >= MAX_ROWS {
+                self.compact();
+            }
+        }
+    }
+
+    fn push_row(&mut self, t: f64, row: impl Iterator<Item = f64>) {
+        for (col, v) in self.cols.iter_mut().zip(row.chain(std::iter::repeat(f64::NAN))) {
+            col.push(v);
         }
         self.t.push(t);
+    }
+
+    /// Merges each two consecutive buckets (four rows) into one (two rows: per column the
+    /// extremes of the four in time order) and doubles the stride.
+    fn compact(&mut self) {
+        let rows = self.t.len() / 4 * 4;
+        let width = self.cols.len();
+        let mut t = Vec::with_capacity(MAX_ROWS);
+        let mut cols: Vec<Vec<f64>> = (0..width).map(|_| Vec::with_capacity(MAX_ROWS)).collect();
+        for start in (0..rows).step_by(4) {
+            let mut b = Bucket::new(self.t[start]);
+            for k in start..start + 4 {
+                b.add(self.t[k], self.cols.iter().map(|c| c[k]), width);
+            }
+            for (tk, r) in b.rows() {
+                t.push(tk);
+                for (c, v) in cols.iter_mut().zip(r) {
+                    c.push(v);
+                }
+            }
+        }
+        // rows that do not make a whole pair of buckets stay as they are
+        for k in rows..self.t.len() {
+            t.push(self.t[k]);
+            for (c, src) in cols.iter_mut().zip(&self.cols) {
+                c.push(src[k]);
+            }
+        }
+        (self.t, self.cols) = (t, cols);
+        self.stride *= 2;
+    }
+
+    /// Adds the partial bucket, if any (called once the series is read).
+    pub fn finish(&mut self) {
+        if let Some(b) = self.pending.take() {
+            for (t, r) in b.rows() {
+                self.push_row(t, r.into_iter());
+            }
+        }
     }
 }
 
@@ -122,6 +249,9 @@ pub struct RunSeries {
     pub voltage: Series,
     /// Normal force on each elbow, N, one column per contact.
     pub normal_force: Series,
+    /// The run's status and reason (record `result`), when the recording has one: a failed
+    /// run is drawn with what it recorded (nothing, when it failed at t = 0).
+    pub result: Option<schemas::RunResult>,
 }
 
 /// The series of one recording in memory; `fallback_name` names it if it has no `run` record.
@@ -143,9 +273,26 @@ pub struct SeriesCollect(RunSeries);
 
 impl SeriesCollect {
     /// The series, named by the `run` record of `rec` (or `stem` without one).
-    pub fn into_series(self, rec: &Recording, stem: &str) -> Result<RunSeries, Error> {
+    pub fn into_series(mut self, rec: &Recording, stem: &str) -> Result<RunSeries, Error> {
+        let s = &mut self.0;
+        for series in [
+            &mut s.actual,
+            &mut s.desired,
+            &mut s.error_norm,
+            &mut s.work,
+            &mut s.work_total,
+            &mut s.electric,
+            &mut s.electric_total,
+            &mut s.current,
+            &mut s.voltage,
+            &mut s.normal_force,
+        ] {
+            series.finish();
+        }
         let run = rec.run_opt()?;
+        let result = rec.result()?;
         Ok(RunSeries {
+            result,
             name: run.as_ref().map_or_else(|| stem.to_string(), |r| r.run.clone()),
             contacts: run.as_ref().map(|r| r.contacts.clone()).unwrap_or_default(),
             joints: run.map(|r| r.joint_names).unwrap_or_default(),
@@ -236,4 +383,55 @@ pub fn write_all(
     let figures = write_figures(runs, dir)?;
     write_index(&figures, runs, sources, dir)?;
     Ok(figures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A series of up to [`MAX_ROWS`] samples is kept sample for sample; a million samples are
+    /// kept in at most [`MAX_ROWS`] rows, in time order from the first sample to the last, with
+    /// the one spike and the one trough exactly, and every bucket's rows within the range of the
+    /// samples it stands for (sin 2πt sampled at 1 kHz: the decimated line's extremes over a
+    /// second are exactly those of the samples).
+    #[test]
+    fn long_series_are_min_max_decimated_keeping_peaks() {
+        let f = |k: usize| match k {
+            123_456 => -100.0,
+            777_777 => 100.0,
+            _ => (2.0 * std::f64::consts::PI * k as f64 * 1e-3).sin(),
+        };
+        let mut short = Series::default();
+        for k in 0..MAX_ROWS - 1 {
+            short.push(k as f64 * 1e-3, &[f(k), 2.0]);
+        }
+        short.finish();
+        assert_eq!(short.t.len(), MAX_ROWS - 1);
+        assert!(short.t.iter().enumerate().all(|(k, &t)| t == k as f64 * 1e-3 && short.cols[0][k] == f(k)));
+
+        let n = 1_000_000;
+        let mut s = Series::default();
+        for k in 0..n {
+            s.push(k as f64 * 1e-3, &[f(k), 2.0]);
+        }
+        s.finish();
+        assert!(s.t.len() <= MAX_ROWS + 2 && s.t.len() > MAX_ROWS / 4, "{} rows", s.t.len());
+        assert_eq!((s.t[0], *s.t.last().unwrap()), (0.0, (n - 1) as f64 * 1e-3));
+        assert!(s.t.windows(2).all(|w| w[0] <= w[1]), "times out of order");
+        let max = s.cols[0].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let min = s.cols[0].iter().copied().fold(f64::INFINITY, f64::min);
+        assert_eq!((min, max), (-100.0, 100.0));
+        assert!(s.cols[1].iter().all(|&v| v == 2.0));
+        // each whole second (away from the spikes): the decimated extremes are the samples'
+        for sec in [1usize, 10, 500, 900] {
+            let (lo, hi) = (sec as f64, sec as f64 + 1.0);
+            let rows: Vec<f64> = (0..s.t.len()).filter(|&k| s.t[k] >= lo && s.t[k] < hi).map(|k| s.cols[0][k]).collect();
+            let raw: Vec<f64> = (sec * 1000..(sec + 1) * 1000).map(f).collect();
+            let ext = |v: &[f64]| (v.iter().copied().fold(f64::INFINITY, f64::min), v.iter().copied().fold(f64::NEG_INFINITY, f64::max));
+            let (dmin, dmax) = ext(&rows);
+            let (rmin, rmax) = ext(&raw);
+            // the extremes sit mid-second (t = .25, .75), inside their buckets
+            assert_eq!((dmin, dmax), (rmin, rmax), "second {sec}");
+        }
+    }
 }

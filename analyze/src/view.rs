@@ -45,11 +45,21 @@ use std::path::{Path, PathBuf};
 
 use crate::Error;
 
+/// What [`convert`] wrote.
+#[derive(Debug, Clone, Default)]
+pub struct Converted {
+    /// Bytes of the `.rrd`.
+    pub bytes: u64,
+    /// The `result` record of each input (in order), when it has one: a failed run is drawn
+    /// with what it recorded, and the caller says it failed.
+    pub results: Vec<(PathBuf, Option<schemas::RunResult>)>,
+}
+
 /// Converts the recordings `inputs` into one `.rrd` at `out` (written atomically, its directory
 /// created if needed), application
 /// id = `out`'s file stem; `progress` is called after each input is read. Returns the bytes
-/// written. Without the feature `rerun`, an error that says how to get it.
-pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<u64, Error> {
+/// written and the runs' results. Without the feature `rerun`, an error that says how to get it.
+pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<Converted, Error> {
     #[cfg(feature = "rerun")]
     {
         let mut read = Vec::with_capacity(inputs.len());
@@ -63,7 +73,8 @@ pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<u6
             std::fs::create_dir_all(dir).map_err(|source| Error::Io { file: dir.display().to_string(), op: "creating the directory", source })?;
         }
         schemas::atomic::write_file(out, &bytes)?;
-        Ok(bytes.len() as u64)
+        let results = inputs.iter().zip(&read).map(|(p, i)| (p.clone(), i.run.result.clone())).collect();
+        Ok(Converted { bytes: bytes.len() as u64, results })
     }
     #[cfg(not(feature = "rerun"))]
     {

@@ -21,6 +21,9 @@ fn config() -> (usize, u64) {
     (var("FUZZ_CASES").map_or(10_000, |n| n as usize), var("FUZZ_SEED").unwrap_or(0xF022_0000_2EAD_0001))
 }
 
+/// The tests below silence the process-wide panic hook meanwhile: they take turns.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 struct Rng(u64);
 
 impl Rng {
@@ -110,6 +113,7 @@ fn mutate(r: &mut Rng, base: &[u8], recs: &[(usize, usize)]) -> Vec<u8> {
 
 #[test]
 fn reading_path_never_panics() {
+    let _turn = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
     let mut s = Synth::new("one-elbow", &["elbow4"], 2);
     (s.dt, s.n, s.chunk_size) = (1e-3, 39, Some(1024));
@@ -228,4 +232,100 @@ fn reading_path_never_panics() {
         recovered_metrics_ok > metrics_ok && recovered_metrics_ok > cases / 10,
         "{recovered_metrics_ok}"
     );
+}
+
+/// What one command's reading path gave for a damaged file: `Ok(true)` it read, with exactly
+/// the intact file's result; `Ok(false)` a refusal naming the file; `Err` a failure.
+type Outcome = Result<bool, String>;
+
+/// The reading paths behind the other commands (issue 29): `diff` (`analyze::read_input`),
+/// `figures` (`figures::read_run`), `export` (`frames::read_frames`), `layout` (the streamed
+/// reader + `LayoutInput`), `view` (`view::read_input`); `metrics`, `compare`, `summary` and
+/// `report` read through `read_run_metrics` and `--recover` through `read_run_metrics_recover`
+/// (both in [`reading_path_never_panics`]). The same generator and rule: no panic, an error
+/// naming the file, or the intact file's result exactly. Default 2,000 cases (`FUZZ_CASES`
+/// sets it, as for the test above); the counts per command are printed.
+#[test]
+fn every_commands_reading_path_never_panics() {
+    let _turn = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Synth::new("one-elbow", &["elbow4"], 2);
+    (s.dt, s.n, s.chunk_size) = (1e-3, 39, Some(1024));
+    let path = s.write(&dir.path().join("small.mcap"));
+    let base = std::fs::read(&path).unwrap();
+    let recs = records(&base);
+    let (cases, seed) = config();
+    let cases = std::env::var("FUZZ_CASES").ok().map_or(2_000, |_| cases);
+
+    // the intact file's results, each command's own way
+    let diff_of = |p: &std::path::Path| analyze::read_input(p).map(|i| i.runs.into_iter().map(|r| format!("{:?}", r.values)).collect::<Vec<_>>());
+    let figures_of = |p: &std::path::Path| analyze::figures::read_run(p).map(|r| analyze::figures::RunSeries { name: String::new(), ..r });
+    let frames_of = |p: &std::path::Path| {
+        analyze::frames::read_frames(p, analyze::frames::Selection::default())
+            .map(|f| f.topics.into_iter().map(|t| (t.topic, t.frame)).collect::<Vec<_>>())
+    };
+    let layout_of = |p: &std::path::Path| -> Result<serde_json::Value, schemas::Error> {
+        let rec = schemas::read_recording_topics(p, Some(&[schemas::topics::HAND]))?;
+        Ok(schemas::layout::foxglove(&schemas::layout::LayoutInput::from_recording(&rec)?))
+    };
+    // `view` needs the feature `rerun` (`cargo test -p analyze --all-features --test fuzz_read`)
+    #[cfg(feature = "rerun")]
+    let view_of = |p: &std::path::Path| {
+        analyze::view::read_input(p).map(|i| i.run.hand.iter().map(|(t, h)| format!("{t} {h:?}")).collect::<Vec<_>>()).map_err(|e| e.to_string())
+    };
+    #[cfg(not(feature = "rerun"))]
+    let view_of = |_: &std::path::Path| -> Result<Vec<String>, String> { Ok(Vec::new()) };
+    let intact = (diff_of(&path).unwrap(), figures_of(&path).unwrap(), frames_of(&path).unwrap(), layout_of(&path).unwrap(), view_of(&path).unwrap());
+
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut r = Rng(seed ^ 0x29);
+    let names = ["diff", "figures", "export", "layout", "view"];
+    let mut read = [0usize; 5];
+    let mut refused = [0usize; 5];
+    let mut escaped = Vec::new();
+    for case in 0..cases {
+        let input = mutate(&mut r, &base, &recs);
+        let file = dir.path().join(format!("case{case}.mcap"));
+        std::fs::write(&file, &input).unwrap();
+        let label = file.display().to_string();
+        let judge = |result: Result<bool, String>| -> Outcome {
+            match result {
+                Ok(same) if same => Ok(true),
+                Ok(_) => Err("read without error, with another result than the intact file's".into()),
+                Err(e) if e.contains(&label) => Ok(false),
+                Err(e) => Err(format!("error without the file name: {e}")),
+            }
+        };
+        let paths: [Box<dyn Fn() -> Outcome>; 5] = [
+            Box::new(|| judge(diff_of(&file).map(|v| v == intact.0).map_err(|e| e.to_string()))),
+            Box::new(|| judge(figures_of(&file).map(|v| v == intact.1).map_err(|e| e.to_string()))),
+            Box::new(|| {
+                judge(
+                    frames_of(&file)
+                        .map(|v| v.len() == intact.2.len() && v.iter().zip(&intact.2).all(|(a, b)| a.0 == b.0 && a.1.equals_missing(&b.1)))
+                        .map_err(|e| e.to_string()),
+                )
+            }),
+            Box::new(|| judge(layout_of(&file).map(|v| v == intact.3).map_err(|e| e.to_string()))),
+            Box::new(|| judge(view_of(&file).map(|v| v == intact.4))),
+        ];
+        for (k, run) in paths.iter().enumerate() {
+            match catch_unwind(AssertUnwindSafe(run)) {
+                Ok(Ok(true)) => read[k] += 1,
+                Ok(Ok(false)) => refused[k] += 1,
+                Ok(Err(why)) => escaped.push(format!("case {case} ({} bytes), {}: {why}", input.len(), names[k])),
+                Err(_) => escaped.push(format!("case {case} ({} bytes), {}: panicked", input.len(), names[k])),
+            }
+        }
+        std::fs::remove_file(&file).unwrap();
+    }
+    std::panic::set_hook(hook);
+    let counts: Vec<String> = (0..5).map(|k| format!("{} read {} refused {}", names[k], read[k], refused[k])).collect();
+    eprintln!("every_commands_reading_path_never_panics: {cases} inputs (seed {seed:#x}); {}", counts.join("; "));
+    assert!(escaped.is_empty(), "{} failures:\n{}", escaped.len(), escaped[..escaped.len().min(20)].join("\n"));
+    assert!((0..5).all(|k| read[k] + refused[k] == cases));
+    if cfg!(not(feature = "rerun")) {
+        eprintln!("every_commands_reading_path_never_panics: `view` not covered: build with --all-features (feature rerun)");
+    }
 }

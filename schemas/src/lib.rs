@@ -52,7 +52,7 @@ pub use meta::{
     RunDescription, RunInfo, RunNames, RunResult, RunStatus, SceneRecord, Setup, UrdfRecord,
 };
 pub use reader::{
-    read_recording, read_recording_bytes, read_recording_bytes_topics, read_recording_recover,
+    open_regular, starts_with_mcap_magic, read_recording, read_recording_bytes, read_recording_bytes_topics, read_recording_recover,
     read_recording_recover_bytes, read_recording_topics, stream_recording, stream_recording_recover,
     ArraySizes, Body, ChannelInfo, DecodedMessage, Known, Recording, RecoverReport, Tap, Tapped, Visitor, MAX_RECORD_BYTES,
     NOT_SELECTED,

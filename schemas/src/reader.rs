@@ -49,6 +49,7 @@ mod regroup;
 mod typed;
 mod visit;
 use crate::Error;
+pub use input::{open_regular, starts_with_mcap_magic};
 pub use recover::{read_recording_recover, read_recording_recover_bytes, stream_recording_recover, RecoverReport};
 pub use tap::{Tap, Tapped};
 pub use typed::ArraySizes;

@@ -207,3 +207,40 @@ fn recovered_metrics_are_the_metrics_of_the_prefix() {
     }
     assert!(ok > 25, "{ok} cuts gave metrics");
 }
+
+/// A run that failed at t = 0 (nine rigid contacts closed, over the limit of 8): the recording
+/// has its `run` and `result` records and no samples. `view`, `export`, `figures` and `layout`
+/// read it (issue 29: before, every command refused it with "no topic /hand"), name the file,
+/// the status and the reason on stderr, write what there is, and exit 1 (a failed run is a
+/// result to see); a directory with it and a good run does both, exit 1.
+#[test]
+fn a_run_that_failed_at_t0_reads_with_its_status_and_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let runs = dir.path().join("runs");
+    std::fs::create_dir(&runs).unwrap();
+    let reason = "9 rigid contacts closed at once, more than the limit of 8";
+    let mut synth = small();
+    (synth.hand, synth.motors, synth.constraints, synth.energy) = (None, None, None, None);
+    synth.result = Some(schemas::RunResult::failed(reason.into(), Some(0.0)));
+    let failed = synth.write(&runs.join("failed.mcap"));
+    small().write(&runs.join("good.mcap"));
+    let out = dir.path().join("out");
+    let (f, o) = (s(&failed), out.to_str().unwrap());
+    for (args, made) in [
+        (vec!["export", f, "-o", o, "-f", "csv"], out.join("failed").join("metadata.json")),
+        (vec!["figures", f, "-o", o], out.join("index.html")),
+        (vec!["layout", f, "-o", o], out.clone()),
+        (vec!["view", f], runs.join("failed.rrd")),
+    ] {
+        let res = run_analyze(&args);
+        let stderr = String::from_utf8_lossy(&res.stderr);
+        assert_eq!(res.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(f) && stderr.contains("failed") && stderr.contains(reason), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked") && !stderr.contains("error:"), "{args:?}: {stderr}");
+        assert!(made.exists(), "{args:?}: {} not written", made.display());
+    }
+    let res = run_analyze(&["figures", runs.to_str().unwrap(), "-o", out.join("both").to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&res.stderr);
+    assert_eq!(res.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains(reason) && out.join("both").join("index.html").is_file(), "{stderr}");
+}

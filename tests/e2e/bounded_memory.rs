@@ -43,3 +43,33 @@ fn long_recordings_are_read_in_bounded_memory() {
     let peak = v[0]["peak_current"]["current_a"].as_f64().unwrap();
     assert!((peak - 3.0).abs() < 1e-9, "{peak}");
 }
+
+/// The long recording of [`long_recordings_are_read_in_bounded_memory`], in `dir`.
+fn long_recording(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut s = Synth::new("long", &["elbow"], 3);
+    (s.dt, s.n) = (1e-3, 300_000);
+    s.with_setup().write_in(dir)
+}
+
+/// `figures` and `layout` on the 300 s recording within 200 MB (issue 29): `layout` keeps only
+/// the box of the hand's target positions, `figures` at most `analyze::figures::MAX_ROWS` rows
+/// per series (min-max decimated as read). The layout's camera is the one of the whole series
+/// (the target circles the synthetic arm's base: focus on it), and every figure is written.
+#[test]
+fn long_recordings_are_drawn_and_laid_out_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = long_recording(dir.path());
+    let p = path.to_str().unwrap();
+    let figs = dir.path().join("figures");
+    let out = analyze_limited(200_000, &["figures", p, "-o", figs.to_str().unwrap(), "-q"]);
+    assert_eq!(out.status.code(), Some(0), "figures within 200 MB: {}", String::from_utf8_lossy(&out.stderr));
+    let index = std::fs::read_to_string(figs.join("index.md")).unwrap();
+    assert!(index.contains("fig05_electric_total"), "{index:.300}");
+    let out = analyze_limited(200_000, &["layout", p]);
+    assert_eq!(out.status.code(), Some(0), "layout within 200 MB: {}", String::from_utf8_lossy(&out.stderr));
+    let streamed: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // the same layout as from the recording read whole
+    let rec = schemas::read_recording_topics(&path, Some(&[schemas::topics::HAND])).unwrap();
+    let whole = schemas::layout::foxglove(&schemas::layout::LayoutInput::from_recording(&rec).unwrap());
+    assert_eq!(streamed, whole);
+}

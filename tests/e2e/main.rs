@@ -10,6 +10,7 @@ mod analyze_tables;
 mod bounded_memory;
 mod cli_voice;
 mod docs_book;
+mod every_reader;
 mod format_ownership;
 mod foxglove_layout;
 mod live;

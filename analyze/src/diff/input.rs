@@ -83,8 +83,14 @@ impl From<Error> for DiffError {
     }
 }
 
+/// The largest JSON or CSV table `analyze diff` reads (8 MiB: several thousand runs; a table is
+/// parsed whole, and its parsed form takes several times its size).
+pub const MAX_TABLE_BYTES: u64 = 8 << 20;
+
 /// Reads one input: a recording, a directory of recordings, or a JSON or CSV table (told
-/// apart by content: MCAP magic, then a leading `[` or `{`, else CSV).
+/// apart by content: a `.mcap` name or the MCAP magic, then a leading `[` or `{`, else CSV).
+/// Before any byte is read the path must be a regular file (FIFOs, devices and links to them
+/// are refused), and a table at most [`MAX_TABLE_BYTES`]; a recording is read streamed.
 pub fn read_input(path: &Path) -> Result<Input, DiffError> {
     let source = path.display().to_string();
     let io = |e| DiffError::Io {
@@ -112,10 +118,29 @@ pub fn read_input(path: &Path) -> Result<Input, DiffError> {
             .collect::<Result<Vec<_>, DiffError>>()?;
         return checked(source, InputKind::Recording, runs);
     }
-    let bytes = std::fs::read(path).map_err(io)?;
-    if bytes.starts_with(b"\x89MCAP") {
+    // the guard of every reader: a regular file (no FIFO, device or directory), then MCAP by
+    // its magic or name, else a table no larger than MAX_TABLE_BYTES, read only then
+    let (file, len) = schemas::open_regular(path).map_err(Error::from)?;
+    let is_mcap_name = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
+    if is_mcap_name || schemas::starts_with_mcap_magic(path).map_err(Error::from)? {
         let runs = vec![from_metrics(&read_run_metrics(path)?)];
         return checked(source, InputKind::Recording, runs);
+    }
+    if len > MAX_TABLE_BYTES {
+        return Err(DiffError::BadTable {
+            file: source.clone(),
+            detail: format!(
+                "{len} bytes: not a recording (no MCAP magic), and over the {MAX_TABLE_BYTES}-byte limit of a JSON or CSV table"
+            ),
+        });
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, MAX_TABLE_BYTES + 1), &mut bytes).map_err(io)?;
+    if bytes.len() as u64 > MAX_TABLE_BYTES {
+        return Err(DiffError::BadTable {
+            file: source.clone(),
+            detail: format!("grew past the {MAX_TABLE_BYTES}-byte limit of a JSON or CSV table while it was read"),
+        });
     }
     let text = String::from_utf8(bytes).map_err(|_| DiffError::BadTable {
         file: source.clone(),

@@ -30,14 +30,33 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3))
 }
 
-/// Reads the recording at `path` for [`encode`].
+/// Reads the recording at `path` for [`encode`], through the reader's guard (a regular file
+/// with the MCAP magic, bounded records, read streamed: a FIFO, a device or a 20 GB file of
+/// anything else is refused before it is read).
 pub fn read_input(path: &Path) -> Result<Input, Error> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| Error::Io { file: file.clone(), op: "reading", source })?;
-    let rec = schemas::read_recording_bytes(&bytes, &file)?;
+    let rec = schemas::read_recording(path)?;
     let stem = path.file_stem().map_or_else(|| "recording".to_string(), |s| s.to_string_lossy().into_owned());
     let run = Run::read(&rec, &stem)?;
-    Ok(Input { run, stem, hash: fnv1a(&bytes) })
+    Ok(Input { run, stem, hash: fnv1a_file(path)? })
+}
+
+/// [`fnv1a`] of the file at `path`, read in blocks (the file has passed the reader's guard).
+fn fnv1a_file(path: &Path) -> Result<u64, Error> {
+    use std::io::Read;
+    let file = path.display().to_string();
+    let io = |source| Error::Io { file: file.clone(), op: "reading", source };
+    let (mut f, _) = schemas::open_regular(path)?;
+    let mut buf = vec![0u8; 1 << 16];
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    loop {
+        let n = match f.read(&mut buf) {
+            Ok(0) => return Ok(h),
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(io(e)),
+        };
+        h = buf[..n].iter().fold(h, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3));
+    }
 }
 
 struct Ids {

@@ -11,7 +11,7 @@
 use std::collections::BTreeMap;
 
 use schemas::{
-    ArraySizes, ConstraintState, ContactEventMsg, ContactState, ContactsRecord, EnergyState, HandState, MotorState, Recording,
+    RunResult, RunStatus, ArraySizes, ConstraintState, ContactEventMsg, ContactState, ContactsRecord, EnergyState, HandState, MotorState, Recording,
     Transforms,
 };
 
@@ -72,6 +72,8 @@ pub struct Run {
     /// `/contacts` (runs with a unilateral or compliant contact).
     pub contact_states: Option<Vec<(f64, ContactState)>>,
     pub events: Vec<(f64, ContactEventMsg)>,
+    /// The run's status and reason (record `result`), when the recording has one.
+    pub result: Option<RunResult>,
 }
 
 fn bad(file: &str, detail: String) -> Error {
@@ -209,6 +211,10 @@ impl Run {
             Some(_) => rec.read::<ContactEventMsg>()?,
             None => Vec::new(),
         };
+        // a run that failed early may have no samples (t = 0: no topic at all): drawn empty
+        let result = rec.result()?;
+        let failed = result.as_ref().is_some_and(|r| r.status == RunStatus::Failed);
+        let absent = |topic: &str| failed && rec.channel(topic).is_none();
         Ok(Run {
             name,
             joints,
@@ -218,12 +224,13 @@ impl Run {
             frames,
             tf_times_ns,
             visuals,
-            hand: rec.read()?,
-            motors: rec.read_sized(sizes)?,
-            energy: rec.read_sized(sizes)?,
-            constraints: rec.read_sized(sizes)?,
+            hand: if absent(schemas::topics::HAND) { Vec::new() } else { rec.read()? },
+            motors: if absent(schemas::topics::MOTORS) { Vec::new() } else { rec.read_sized(sizes)? },
+            energy: if absent(schemas::topics::ENERGY) { Vec::new() } else { rec.read_sized(sizes)? },
+            constraints: if absent(schemas::topics::CONSTRAINTS) { Vec::new() } else { rec.read_sized(sizes)? },
             contact_states,
             events,
+            result,
         })
     }
 

@@ -19,12 +19,7 @@ pub(crate) const BUFFER_BYTES: usize = 256 << 10;
 pub(crate) fn open(path: &Path) -> Result<(BufReader<File>, u64, String), Error> {
     let label = path.display().to_string();
     let io = |op, source| Error::Io { file: label.clone(), op, source };
-    let meta = std::fs::metadata(path).map_err(|e| io("opening", e))?;
-    if !meta.is_file() {
-        return Err(Error::NotAFile { file: label, kind: file_kind(&meta) });
-    }
-    let file = File::open(path).map_err(|e| io("opening", e))?;
-    let len = file.metadata().map_err(|e| io("opening", e))?.len();
+    let (file, len) = open_regular(path)?;
     let mut magic = [0u8; 8];
     let mut reader = BufReader::with_capacity(BUFFER_BYTES, file);
     let head = read_up_to(&mut reader, &mut magic).map_err(|e| io("reading", e))?;
@@ -34,6 +29,36 @@ pub(crate) fn open(path: &Path) -> Result<(BufReader<File>, u64, String), Error>
     let mut file = reader.into_inner();
     std::io::Seek::rewind(&mut file).map_err(|e| io("reading", e))?;
     Ok((BufReader::with_capacity(BUFFER_BYTES, file), len, label))
+}
+
+/// Opens `path` for reading if it names a regular file (links followed), with its length; a
+/// directory, FIFO, socket or device (a link to `/dev/zero` included) is refused with
+/// [`Error::NotAFile`] before it is opened, so a FIFO without a writer cannot block. The guard
+/// every reader of a user's file goes through, recordings and tables alike (`analyze diff`
+/// reads JSON and CSV tables through it).
+pub fn open_regular(path: &Path) -> Result<(File, u64), Error> {
+    let label = || path.display().to_string();
+    let io = |op, source| Error::Io { file: label(), op, source };
+    let meta = std::fs::metadata(path).map_err(|e| io("opening", e))?;
+    if !meta.is_file() {
+        return Err(Error::NotAFile { file: label(), kind: file_kind(&meta) });
+    }
+    let file = File::open(path).map_err(|e| io("opening", e))?;
+    // what was opened is what was checked (the path may have been replaced in between)
+    let meta = file.metadata().map_err(|e| io("opening", e))?;
+    if !meta.is_file() {
+        return Err(Error::NotAFile { file: label(), kind: file_kind(&meta) });
+    }
+    Ok((file, meta.len()))
+}
+
+/// Whether the file at `path` starts with the MCAP magic: reads at most its first 8 bytes
+/// after the checks of [`open_regular`].
+pub fn starts_with_mcap_magic(path: &Path) -> Result<bool, Error> {
+    let (mut file, _) = open_regular(path)?;
+    let mut magic = [0u8; 8];
+    let head = read_up_to(&mut file, &mut magic).map_err(|source| Error::Io { file: path.display().to_string(), op: "reading", source })?;
+    Ok(head == magic.len() && magic[..] == mcap::MAGIC[..])
 }
 
 /// Reads until `buf` is full or the input ends; the number of bytes read.

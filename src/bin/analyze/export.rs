@@ -69,7 +69,9 @@ pub enum TableFile {
 
 /// `analyze export`.
 pub fn run(a: &ExportArgs, v: Verbosity) -> Result<u8> {
-    let paths = cli::inputs::expand(&a.inputs)?;
+    let expanded = cli::inputs::expand_all(&a.inputs)?;
+    expanded.warn_skipped();
+    let paths = expanded.files.clone();
     let format = match a.format {
         TableFile::Parquet => ExportFormat::Parquet,
         TableFile::Csv => ExportFormat::Csv,
@@ -94,13 +96,22 @@ pub fn run(a: &ExportArgs, v: Verbosity) -> Result<u8> {
             );
         }
     }
-    for path in &paths {
-        let dir = a.out.join(stem(path));
+    // each recording on its own: one that fails is reported and the others go on (exit 1)
+    let (done, failed) = cli::inputs::each_file(&paths, |path| {
+        let dir = a.out.join(stem(&path.to_path_buf()));
         let e = export_file(path, &dir, &options).with_context(|| format!("exporting {}", path.display()))?;
         if !v.quiet {
             let skipped = if e.skipped == 0 { String::new() } else { format!(", {} topics not exported: see metadata.json", e.skipped) };
             eprintln!("analyze: {} -> {} ({} tables, {} rows{skipped})", path.display(), dir.display(), e.tables, e.rows);
         }
+        Ok(cli::inputs::failed_run_note(path, e.result.as_ref()))
+    })?;
+    let (done, failed) = (done, failed);
+    let mut failed_runs = 0;
+    for note in done.iter().filter_map(|(_, note)| note.as_ref()) {
+        eprintln!("analyze: {note} (its tables hold what it recorded)");
+        failed_runs += 1;
     }
-    Ok(exit::SUCCESS)
+    let failed = failed + failed_runs;
+    Ok(if failed > 0 || !expanded.skipped.is_empty() { exit::FAILED } else { exit::SUCCESS })
 }

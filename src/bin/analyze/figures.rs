@@ -26,11 +26,19 @@ pub struct FiguresArgs {
 }
 
 pub fn run(a: &FiguresArgs, v: Verbosity) -> Result<u8> {
-    let paths = cli::inputs::expand(&a.inputs)?;
-    let runs = paths
-        .iter()
-        .map(|p| analyze::figures::read_run(p).with_context(|| format!("reading {}", p.display())))
-        .collect::<Result<Vec<_>>>()?;
+    let expanded = cli::inputs::expand_all(&a.inputs)?;
+    expanded.warn_skipped();
+    // each recording on its own: one that cannot be read is reported and left out (exit 1)
+    let (read, failed) =
+        cli::inputs::each_file(&expanded.files, |p| analyze::figures::read_run(p).with_context(|| format!("reading {}", p.display())))?;
+    let (paths, runs): (Vec<_>, Vec<_>) = read.into_iter().unzip();
+    let mut failed = failed;
+    for (p, r) in paths.iter().zip(&runs) {
+        if let Some(note) = cli::inputs::failed_run_note(p, r.result.as_ref()) {
+            eprintln!("analyze: {note} (drawn with what it recorded)");
+            failed += 1;
+        }
+    }
     let figures = analyze::figures::write_all(&runs, &paths, &a.out)?;
     if !v.quiet {
         eprintln!(
@@ -41,5 +49,5 @@ pub fn run(a: &FiguresArgs, v: Verbosity) -> Result<u8> {
             a.out.join("index.html").display()
         );
     }
-    Ok(exit::SUCCESS)
+    Ok(if failed > 0 || !expanded.skipped.is_empty() { exit::FAILED } else { exit::SUCCESS })
 }

@@ -1,5 +1,7 @@
 //! `analyze layout`: the Foxglove layout of recordings (`schemas::layout`, the one owner of the
-//! format; `sim` writes the same beside its recordings).
+//! format; `sim` writes the same beside its recordings). Each recording is read streamed and
+//! only the box around its desired hand positions is kept: memory does not grow with the
+//! recording.
 
 use std::path::PathBuf;
 
@@ -33,13 +35,47 @@ pub struct LayoutArgs {
     pub out: Option<PathBuf>,
 }
 
+/// The layout input of the recording at `p`, read streamed: the camera from the box around the
+/// desired hand positions of `/hand` (the same as [`LayoutInput::from_recording`] gives from all
+/// of them, which [`layout::camera_for`] reduces to that box).
+/// With it, the line that says the run failed (if it did).
+fn read_one(p: &std::path::Path) -> Result<(LayoutInput, Option<String>)> {
+    // lowest and highest finite desired position, per axis
+    let mut bounds: Option<([f64; 3], [f64; 3])> = None;
+    let mut visit = |m: schemas::DecodedMessage<'_>| -> Result<(), schemas::Error> {
+        // a message without a target (another producer's /hand) places no camera, as in
+        // `LayoutInput::from_recording`
+        let Ok(h) = m.decode::<schemas::HandState>(None) else { return Ok(()) };
+        let q = [h.desired.x, h.desired.y, h.desired.z];
+        if q.iter().all(|v| v.is_finite()) {
+            let (lo, hi) = bounds.get_or_insert((q, q));
+            for k in 0..3 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        Ok(())
+    };
+    let rec = schemas::stream_recording(p, Some(&[schemas::topics::HAND]), &mut visit)?;
+    let mut one = LayoutInput::from_recording(&rec)?;
+    let corners: Vec<[f64; 3]> = bounds.map(|(lo, hi)| vec![lo, hi]).unwrap_or_default();
+    (one.focus, one.camera_distance_m) = layout::camera_for(&corners);
+    Ok((one, cli::inputs::failed_run_note(p, rec.result()?.as_ref())))
+}
+
 pub fn run(a: &LayoutArgs, v: Verbosity) -> Result<u8> {
-    let paths = cli::inputs::expand(&a.inputs)?;
+    let expanded = cli::inputs::expand_all(&a.inputs)?;
+    expanded.warn_skipped();
+    // each recording on its own: one that cannot be read is reported and left out (exit 1)
+    let (read, failed) = cli::inputs::each_file(&expanded.files, |p| read_one(p).with_context(|| format!("reading {}", p.display())))?;
     // one layout input per scene, in the order the scenes first appear
     let mut scenes: Vec<LayoutInput> = Vec::new();
-    for p in &paths {
-        let rec = schemas::read_recording_topics(p, Some(&[schemas::topics::HAND])).with_context(|| format!("reading {}", p.display()))?;
-        let one = LayoutInput::from_recording(&rec).with_context(|| format!("reading {}", p.display()))?;
+    let mut failed = failed;
+    for (p, (one, note)) in read {
+        if let Some(note) = note {
+            eprintln!("analyze: {note} (in the layout with the others)");
+            failed += 1;
+        }
         match scenes.iter_mut().find(|m| m.title == one.title) {
             None => scenes.push(one),
             Some(m) => {
@@ -82,5 +118,5 @@ pub fn run(a: &LayoutArgs, v: Verbosity) -> Result<u8> {
             }
         }
     }
-    Ok(exit::SUCCESS)
+    Ok(if failed > 0 || !expanded.skipped.is_empty() { exit::FAILED } else { exit::SUCCESS })
 }

@@ -41,7 +41,9 @@ fn stem(p: &Path) -> String {
 
 /// `analyze view`.
 pub fn run(a: &ViewArgs, v: Verbosity) -> Result<u8> {
-    let paths = cli::inputs::expand(&a.inputs)?;
+    let expanded = cli::inputs::expand_all(&a.inputs)?;
+    expanded.warn_skipped();
+    let paths = expanded.files.clone();
     // (output, its inputs)
     let jobs: Vec<(PathBuf, Vec<PathBuf>)> = match &a.out {
         Some(out) => {
@@ -62,7 +64,7 @@ pub fn run(a: &ViewArgs, v: Verbosity) -> Result<u8> {
     if a.spawn {
         which_rerun()?;
     }
-    let written = convert(&jobs, v)?;
+    let (written, failed) = convert(&jobs, v)?;
     if a.spawn {
         let status = std::process::Command::new("rerun").args(&written).status();
         match status {
@@ -71,7 +73,7 @@ pub fn run(a: &ViewArgs, v: Verbosity) -> Result<u8> {
             Err(e) => bail!("starting the Rerun viewer (`rerun`): {e}"),
         }
     }
-    Ok(exit::SUCCESS)
+    Ok(if failed > 0 || !expanded.skipped.is_empty() { exit::FAILED } else { exit::SUCCESS })
 }
 
 /// `rerun` on PATH, or an error that says how to get it.
@@ -85,15 +87,26 @@ fn which_rerun() -> Result<()> {
     Ok(())
 }
 
-fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<Vec<PathBuf>> {
+/// Converts each job (an output and its inputs); a job that fails is reported and the others go
+/// on. The outputs written and the number of jobs that failed.
+fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<(Vec<PathBuf>, usize)> {
     use anyhow::Context;
     let total: usize = jobs.iter().map(|(_, i)| i.len()).sum();
     let bar = cli::progress::count(total, "reading", "recordings", v.quiet || total < 2);
-    let mut written = Vec::new();
-    for (out, inputs) in jobs {
+    let outs: Vec<PathBuf> = jobs.iter().map(|(out, _)| out.clone()).collect();
+    let failed_runs = std::cell::Cell::new(0usize);
+    let result = cli::inputs::each_file(&outs, |out| {
+        let inputs = &jobs.iter().find(|(o, _)| o == out).expect("a job per output").1;
         let started = std::time::Instant::now();
         let names = inputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-        let size = analyze::view::convert(inputs, out, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
+        let converted = analyze::view::convert(inputs, out, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
+        let size = converted.bytes;
+        for (p, result) in &converted.results {
+            if let Some(note) = cli::inputs::failed_run_note(p, result.as_ref()) {
+                bar.suspend(|| eprintln!("analyze: {note} (drawn with what it recorded)"));
+                failed_runs.set(failed_runs.get() + 1);
+            }
+        }
         if !v.quiet {
             let mcap: u64 = inputs.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
             bar.suspend(|| {
@@ -108,8 +121,10 @@ fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<Vec<PathBuf
                 )
             });
         }
-        written.push(out.clone());
-    }
+        Ok(())
+    });
     bar.finish_and_clear();
-    Ok(written)
+    let (written, failed) = result?;
+    let failed = failed + failed_runs.get();
+    Ok((written.into_iter().map(|(out, ())| out).collect(), failed))
 }
