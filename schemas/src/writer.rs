@@ -234,6 +234,8 @@ impl RecordingWriter {
             .chunk_size((!options.chunk_per_topic).then_some(options.chunk_size));
         // (an error drops `output`, which deletes the temporary file)
         let mcap = mcap_options.create(BufWriter::new(out)).map_err(|source| write_error(&file, source))?;
+        // a mirror's panic must not take the recording with it (writer/mirror.rs)
+        let mirror = mirror.map(|m| Box::new(mirror::Guarded::new(m)) as Box<dyn Mirror>);
         let worker = Worker::new(mcap, file.clone(), options, tap, mirror);
         let backend = if options.background {
             let queue = options.queue.max(1);

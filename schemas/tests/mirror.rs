@@ -1,6 +1,7 @@
 //! A [`Mirror`] is handed exactly the records the writer writes (the schemas, channels with their
 //! metadata, metadata records and message bytes of the finished file, read back with the `mcap`
-//! crate), and the file does not depend on it (byte-identical to one written without).
+//! crate), and the file does not depend on it (byte-identical to one written without), even
+//! when it panics (issue 29: a failure in the live view never loses the recording).
 
 
 use std::collections::BTreeMap;
@@ -95,5 +96,49 @@ fn a_mirror_is_handed_the_records_of_the_file_and_changes_no_byte() {
         from_mirror.sort();
         records.sort();
         assert_eq!(from_mirror, records);
+    }
+}
+
+/// Panics on the `n`-th message (or, `n` = 0, on the first channel); counts finish calls.
+struct Panics {
+    n: usize,
+    seen: usize,
+    finished: Arc<Mutex<usize>>,
+}
+
+impl Mirror for Panics {
+    fn channel(&mut self, _id: u16, _schema_id: u16, topic: &str, _enc: &str, _metadata: &BTreeMap<String, String>) {
+        assert!(self.n != 0, "a deliberate panic on channel {topic}");
+    }
+    fn message(&mut self, _channel_id: u16, _sequence: u32, _log_time_ns: u64, _data: &[u8]) {
+        self.seen += 1;
+        assert!(self.seen != self.n, "a deliberate panic on message {}", self.n);
+    }
+    fn finish(&mut self) {
+        *self.finished.lock().unwrap() += 1;
+    }
+}
+
+/// A mirror that panics (on a channel, on the first message, mid-run) does not lose the
+/// recording: the file is written, finished and byte-identical to one written without a
+/// mirror, with the writer on its background thread and inline; the mirror gets nothing after
+/// its panic (no finish). Before issue 29 the panic unwound the writer's thread and the file
+/// was never finished.
+#[test]
+fn a_mirror_that_panics_loses_no_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = content(300);
+    for options in [WriterOptions::default(), WriterOptions::INLINE_MIXED_ZSTD3] {
+        let without = dir.path().join("without.mcap");
+        write_all_with(&without, &c, RecordingWriter::create_with(&without, options).unwrap());
+        for n in [0, 1, 150] {
+            let with = dir.path().join(format!("with{n}.mcap"));
+            let finished = Arc::new(Mutex::new(0));
+            let mirror = Panics { n, seen: 0, finished: finished.clone() };
+            let w = RecordingWriter::create_mirrored(&with, options, None, Some(Box::new(mirror))).unwrap();
+            write_all_with(&with, &c, w);
+            assert_eq!(std::fs::read(&with).unwrap(), std::fs::read(&without).unwrap(), "panic at {n} ({options:?})");
+            assert_eq!(*finished.lock().unwrap(), 0, "a mirror that panicked is not called again");
+        }
     }
 }

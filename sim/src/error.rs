@@ -73,6 +73,10 @@ pub enum DynamicsError {
     /// geometry); `contact` names the contact(s).
     #[error("t = {t:.9} s: contact {contact}: {why}")]
     InconsistentContact { t: f64, contact: String, why: String },
+    /// The run's wall-time budget ran out inside an evaluation (`during`: the contact mode
+    /// enumeration); the run turns it into [`RunError::OutOfTime`] with its limit and method.
+    #[error("t = {t:.9} s: the wall-time budget ran out {during}")]
+    OutOfTime { t: f64, during: crate::integrate::Phase },
 }
 
 /// A failure of a whole run.
@@ -85,8 +89,11 @@ pub enum RunError {
     StepSizeTooSmall { t: f64, h: f64 },
     #[error("the integrator stopped at t = {t:.9} s: the problem is stiff for an explicit method (h lambda = {h_lambda:.2} at the stability limit, h = {h:.3e} s, more than 10^6 steps to go): use rosenbrock or imex")]
     Stiff { t: f64, h: f64, h_lambda: f64 },
-    #[error("the run stopped at t = {t:.9} s: it used its wall-time limit of {limit_s} s with {method}; {hint}, or the run is long: to allow more, give --max-wall-time SECONDS", hint = slow_run_hint(method))]
-    OutOfTime { t: f64, limit_s: f64, method: &'static str },
+    /// `during`: where in a step the budget ran out (between steps, or inside one of a step's
+    /// long loops: the Jacobian by differences, the factorisation, an event location, the
+    /// contact mode enumeration).
+    #[error("the run stopped at t = {t:.9} s: it used its wall-time limit of {limit_s} s with {method}, {during}; {hint}, or the run is long: to allow more, give --max-wall-time SECONDS", hint = out_of_time_hint(method, during))]
+    OutOfTime { t: f64, limit_s: f64, method: &'static str, during: crate::integrate::Phase },
     #[error("the run stopped at t = {t:.9} s: at its pace so far it would need about {projected_s:.0} s of wall time with {method}, more than twice its limit of {limit_s} s; {hint}, or the run is long: to allow more, give --max-wall-time SECONDS", hint = slow_run_hint(method))]
     TooSlow { t: f64, projected_s: f64, limit_s: f64, method: &'static str },
     #[error("the implicit integrator stopped: its iteration matrix I - h gamma J is singular at t = {t:.9} s (h = {h:e} s)")]
@@ -97,12 +104,24 @@ pub enum RunError {
     TooManySteps { t: f64, max_steps: usize, method: &'static str },
     #[error("the run stopped at t = {t:.9} s: more than {max_events} contact events; a contact chatters, or the run is long (events.max_events)")]
     TooManyEvents { t: f64, max_events: u64 },
-    #[error("the run stopped at t = {t:.9} s: {count} contact events in a row at the same instant (within {window:e} s): the contact modes chatter; {events}")]
-    Chattering { t: f64, count: u32, window: f64, events: String },
+    /// More than `limit` (the scene's `events.max_events_at_one_time`) events in a row within
+    /// `window` s of each other.
+    #[error("the run stopped at t = {t:.9} s: {count} contact events in a row at the same instant (within {window:e} s), more than events.max_events_at_one_time = {limit}: the contact modes chatter; {events}. Remedies: raise events.max_events_at_one_time in the scene if the events do settle (a cascade through many contacts); make the contacts compliant (model \"compliant\", no instantaneous mode switches); lower the contacts' friction (a high coefficient can make the rigid contact problem inconsistent, Painleve's paradox); or check the initial state and the target near that time")]
+    Chattering { t: f64, count: u32, window: f64, limit: u32, events: String },
     /// The recording could not be written (I/O error, full disk, another writer of the same
     /// path): `source` names the path and the OS reason.
     #[error("writing the recording: {source}")]
     Recording { path: PathBuf, source: schemas::Error },
+}
+
+/// What makes a run with `method` slow where its budget ran out (`during`), and what to do.
+fn out_of_time_hint(method: &str, during: &crate::integrate::Phase) -> &'static str {
+    use crate::integrate::Phase;
+    match during {
+        Phase::Jacobian { .. } | Phase::Factoring { .. } => "the Jacobian by differences costs one right-hand side per state of the q, q̇, i block (3 per joint) and its factorisation grows as their cube: for a long chain use rosenbrock (a structured Jacobian) or imex",
+        Phase::ChoosingModes { .. } => "the rigid contact mode problem tries up to 3^n combinations of the n closed contacts, each a constrained solve: use compliant contacts, or fewer simultaneous contacts",
+        Phase::LocatingEvent { .. } | Phase::Stepping => slow_run_hint(method),
+    }
 }
 
 /// What makes a run with `method` (a scene's `integrator.method`) take tiny steps, and what
@@ -123,7 +142,8 @@ impl DynamicsError {
             | DynamicsError::SingularConstraints { t, .. }
             | DynamicsError::Unreachable { t, .. }
             | DynamicsError::NonFinite { t, .. }
-            | DynamicsError::InconsistentContact { t, .. } => t,
+            | DynamicsError::InconsistentContact { t, .. }
+            | DynamicsError::OutOfTime { t, .. } => t,
         }
     }
 }

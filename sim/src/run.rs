@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::error::RunError;
+use crate::error::{DynamicsError, RunError};
 use crate::limits::DEFAULT_MAX_WALL_TIME;
 use crate::integrate::{IntegrateError, Stats};
 use crate::scene::{Run, Scene};
@@ -47,10 +47,14 @@ impl Default for Budget {
     }
 }
 
-fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget: Budget, method: &'static str) -> RunError {
+fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget: Budget, method: &'static str, max_events_at_one_time: u32) -> RunError {
     match e {
         IntegrateError::Stiff { t, h, h_lambda } => RunError::Stiff { t, h, h_lambda },
-        IntegrateError::OutOfTime { t } => RunError::OutOfTime { t, limit_s: budget.wall_time.as_secs_f64(), method },
+        IntegrateError::OutOfTime { t, during } => RunError::OutOfTime { t, limit_s: budget.wall_time.as_secs_f64(), method, during },
+        // the budget ran out inside the system's own loop (the contact mode enumeration)
+        IntegrateError::Rhs(RunError::Dynamics(DynamicsError::OutOfTime { t, during })) => {
+            RunError::OutOfTime { t, limit_s: budget.wall_time.as_secs_f64(), method, during }
+        }
         IntegrateError::TooSlow { t, projected_s } => RunError::TooSlow { t, projected_s, limit_s: budget.wall_time.as_secs_f64(), method },
         IntegrateError::Rhs(e) | IntegrateError::Sample { source: e, .. } => e,
         IntegrateError::StepSizeTooSmall { t, h } => RunError::StepSizeTooSmall { t, h },
@@ -60,7 +64,7 @@ fn map_err(e: IntegrateError<RunError>, names: &dyn Fn(usize) -> String, budget:
             RunError::TooManySteps { t, max_steps: usize::try_from(max_steps).unwrap_or(usize::MAX), method }
         }
         IntegrateError::TooManyEvents { t, max_events } => RunError::TooManyEvents { t, max_events },
-        IntegrateError::Chattering { t, count, window, events } => RunError::Chattering { t, count, window, events },
+        IntegrateError::Chattering { t, count, window, events } => RunError::Chattering { t, count, window, limit: max_events_at_one_time, events },
         IntegrateError::InvalidOutputGrid { t0, t_end, dt_out } => RunError::Dynamics(crate::error::DynamicsError::NonFinite {
             t: t0,
             what: format!("the output grid (t_end = {t_end}, dt = {dt_out})"),
@@ -106,6 +110,8 @@ pub fn simulate_outputs(
         .checked_add(budget.wall_time)
         .map(|at| crate::integrate::Deadline { at, judge_pace_after: budget.judge_pace_after });
     let mut sys = ArmSystem::new(scene, run);
+    // the system's own long loop (the contact mode enumeration) looks at the deadline too
+    sys.set_watch(crate::integrate::Watch::new(deadline));
     let y0 = sys.initial_state();
     let dt_out = 1.0 / scene.output_rate;
     let joints = scene.model.joint_names();
@@ -139,17 +145,22 @@ pub fn simulate_outputs(
     let result = if sys.is_hybrid() {
         // unilateral or compliant contacts: event-driven, with the scene's `events` settings
         let cs = &scene.contact_settings;
-        let settings = crate::integrate::EventSettings { time_tol: cs.time_tol, max_events: cs.max_events, ..Default::default() };
+        let settings = crate::integrate::EventSettings {
+            time_tol: cs.time_tol,
+            max_events: cs.max_events,
+            max_events_at_one_time: cs.max_events_at_one_time,
+        };
         scene.integrator.integrate_hybrid(&mut sys, &y0, scene.duration, dt_out, deadline, settings, |t, y, sys| on_sample(t, y, Some(sys)))
     } else {
         // every contact bilateral (the paper's runs): the smooth path, as before
         scene.integrator.integrate(&mut sys, &y0, scene.duration, dt_out, deadline, |t, y| on_sample(t, y, None))
     };
-    let stats = result.map_err(|e| match map_err(e, &names, budget, scene.integrator.method()) {
+    let chatter_limit = scene.contact_settings.max_events_at_one_time;
+    let stats = result.map_err(|e| match map_err(e, &names, budget, scene.integrator.method(), chatter_limit) {
         // the driver names event-function indices; the system knows the contacts and their
         // current modes (review F5)
-        RunError::Chattering { t, count, window, events } => {
-            RunError::Chattering { t, count, window, events: sys.describe_event_functions(&events) }
+        RunError::Chattering { t, count, window, limit, events } => {
+            RunError::Chattering { t, count, window, limit, events: sys.describe_event_functions(&events) }
         }
         other => other,
     })?;

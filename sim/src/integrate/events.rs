@@ -64,7 +64,7 @@ mod toys;
 
 use self::locate::{crosses, locate_root, Bracket, Side};
 use super::sampled::{OutputGrid, Pace};
-use super::{Deadline, IntegrateError, OdeSystem, Stats, Stepper};
+use super::{Deadline, IntegrateError, OdeSystem, Stats, Stepper, Watch};
 
 /// A system whose right-hand side depends on a discrete mode that changes at events.
 ///
@@ -170,6 +170,10 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
     let n_out = grid.n_out;
     let n_ev = sys.n_events();
     let rhs = IntegrateError::Rhs;
+    // the long loops inside a step (the stepper's Jacobian, the event location) look at the
+    // deadline too
+    let watch = Watch::new(deadline);
+    stepper.set_watch(watch);
 
     // the modes at t0, then the first sample
     let mut y_star = y0.to_vec();
@@ -246,7 +250,7 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
 
         // an event in [t_before, t_after]: its time, then the samples before it
         let tol = time_tolerance(settings.time_tol, t_after);
-        let t_star = if at_start { t_before } else { locate_root(stepper, sys, &mut br, t_before, t_after, tol, &mut buf)? };
+        let t_star = if at_start { t_before } else { locate_root(stepper, sys, &mut br, t_before, t_after, tol, watch, &mut buf)? };
         while k <= n_out && grid.time(k) < t_star {
             let t_k = grid.time(k);
             stepper.interpolate(t_k, &mut buf);

@@ -8,7 +8,7 @@
 //! components that sit near 0 are the least accurate. A Rosenbrock-W method
 //! ([`super::Rosenbrock`]) keeps its order with such an approximation.
 
-use super::{OdeJacobian, OdeSystem};
+use super::{OdeJacobian, OdeSystem, Watch};
 
 /// Forward-difference Jacobian `jac[i * n + j] ≈ ∂f_i/∂y_j` of `sys` at `(t, y)`, column by
 /// column (`n = y.len()` evaluations of `rhs`), given `fy = f(t, y)`. `scratch_y`, `scratch_f`
@@ -34,7 +34,8 @@ pub fn fd_jacobian<S: OdeSystem>(
 /// [`fd_jacobian`] for the first `cols` columns only (`cols` evaluations of `rhs`), with the
 /// increment `sqrt(eps) max(|y_j|, floor)` (`fd_jacobian`: `floor = 1e-5`); the other columns
 /// of `jac` are left untouched. For systems whose trailing components do not feed back
-/// ([`OdeJacobian::coupled_dim`]): their columns are zero. The floor is the size below which a
+/// ([`OdeJacobian::coupled_dim`]): their columns are zero. [`fd_jacobian_columns_within`]
+/// also watches a deadline. The floor is the size below which a
 /// component counts as zero: at `y_j = 0` the increment is `sqrt(eps) floor`, and the
 /// rounding error of the column is `eps |f| / (sqrt(eps) floor)`, so a floor far below the
 /// component's natural scale (an angle at 0 rad with a floor of 1e-5 rad) buys a rounding
@@ -57,6 +58,32 @@ pub fn fd_jacobian_columns<S: OdeSystem>(
     scratch_y: &mut [f64],
     scratch_f: &mut [f64],
 ) -> Result<(), S::Error> {
+    fd_jacobian_columns_within(sys, t, y, fy, jac, cols, floor, scratch_y, scratch_f, Watch::default()).map(|_| ())
+}
+
+/// [`fd_jacobian_columns`] that reads `watch`'s clock before every column after the first
+/// (each costs one evaluation of `rhs`, far more than the clock): `Ok(None)` when every column
+/// is done, `Ok(Some(j))` when the deadline passed before column `j` (0-based; the columns
+/// from `j` on are not computed). Allocates nothing.
+///
+/// # Errors
+/// The first error of `sys.rhs` (the remaining columns are not computed).
+///
+/// # Panics
+/// As [`fd_jacobian_columns`].
+#[allow(clippy::too_many_arguments)]
+pub fn fd_jacobian_columns_within<S: OdeSystem>(
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    fy: &[f64],
+    jac: &mut [f64],
+    cols: usize,
+    floor: f64,
+    scratch_y: &mut [f64],
+    scratch_f: &mut [f64],
+    watch: Watch,
+) -> Result<Option<usize>, S::Error> {
     let n = y.len();
     assert!(
         fy.len() == n && scratch_y.len() == n && scratch_f.len() == n && jac.len() == n * n && cols <= n,
@@ -65,6 +92,9 @@ pub fn fd_jacobian_columns<S: OdeSystem>(
     let sqrt_eps = f64::EPSILON.sqrt();
     scratch_y.copy_from_slice(y);
     for j in 0..cols {
+        if j > 0 && watch.out_of_time() {
+            return Ok(Some(j));
+        }
         let yj = y[j];
         let delta = sqrt_eps * yj.abs().max(floor);
         scratch_y[j] = if yj < 0.0 { yj - delta } else { yj + delta };
@@ -76,7 +106,7 @@ pub fn fd_jacobian_columns<S: OdeSystem>(
             jac[i * n + j] = (scratch_f[i] - fy[i]) / d;
         }
     }
-    Ok(())
+    Ok(None)
 }
 
 /// Wraps an [`OdeSystem`] to make it an [`OdeJacobian`] by forward differences

@@ -124,11 +124,11 @@ pub use self::control::{SettingsError, StepControl};
 pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
 pub use self::events::{integrate_hybrid, EventSettings, HybridSystem};
 pub use self::imex::ArkImex;
-pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, FdJacobian};
+pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, fd_jacobian_columns_within, FdJacobian};
 pub use self::rk4::Rk4;
 pub use self::rodas::{Rodas, RodasMethod};
 pub use self::rosenbrock::Rosenbrock;
-pub use self::sampled::{integrate_sampled, integrate_sampled_within, Deadline, PACE_AFTER};
+pub use self::sampled::{integrate_sampled, integrate_sampled_within, Deadline, Phase, Watch, PACE_AFTER};
 
 /// What gets integrated: y' = f(t, y). Must be a pure function of (t, y) apart from scratch.
 ///
@@ -263,8 +263,9 @@ pub enum IntegrateError<E> {
     /// step, `h_lambda` the last estimate of `h λ`.
     Stiff { t: f64, h: f64, h_lambda: f64 },
     /// [`integrate_sampled_within`]'s wall-clock deadline passed; `t` is where the stepper
-    /// stands (the state there is valid).
-    OutOfTime { t: f64 },
+    /// stands (the state there is valid), `during` what it was doing (between steps, or inside
+    /// one of a step's long loops: a difference Jacobian, a factorisation, an event location).
+    OutOfTime { t: f64, during: Phase },
     /// At the pace of its first [`Deadline::judge_pace_after`] of wall time, the run would need
     /// `projected_s` of wall time, more than twice its budget: stopped at `t` rather than at the
     /// deadline.
@@ -313,8 +314,8 @@ impl<E: fmt::Display> fmt::Display for IntegrateError<E> {
                 "the problem is stiff at t = {t}: h lambda = {h_lambda:.2} is at the explicit \
                  method's stability limit (h = {h:e}); use an implicit method"
             ),
-            IntegrateError::OutOfTime { t } => {
-                write!(f, "the wall-clock deadline passed at t = {t}")
+            IntegrateError::OutOfTime { t, during } => {
+                write!(f, "the wall-clock deadline passed at t = {t} {during}")
             }
             IntegrateError::TooSlow { t, projected_s } => {
                 write!(f, "at t = {t} the pace so far projects {projected_s:.0} s of wall time, more than twice the budget")
@@ -394,6 +395,13 @@ pub trait Stepper<S: OdeSystem> {
     /// and re-evaluate what the method keeps about it (one `rhs` call); the step size, the
     /// controller and the statistics carry on. Dense output of the last step is not updated.
     fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>>;
+    /// The deadline the stepper's own long loops look at (a difference Jacobian's columns, a
+    /// factorisation's), ending the step with [`IntegrateError::OutOfTime`] and where it was;
+    /// set by the drivers from their [`Deadline`]. The default ignores it (a method whose
+    /// step is a few right-hand sides: the driver's clock between steps is enough).
+    fn set_watch(&mut self, watch: Watch) {
+        let _ = watch;
+    }
 }
 
 /// Index of the first NaN/inf in `v`, if any.

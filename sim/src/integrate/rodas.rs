@@ -42,12 +42,12 @@
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
 use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
-use super::jacobian::fd_jacobian_columns;
-use super::lu::{lu_factor, lu_solve};
+use super::jacobian::fd_jacobian_columns_within;
+use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::rosenbrock::{stage_argument, stage_rhs, time_derivative};
 use super::{
-    dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeJacobian, SettingsError,
-    Stats, StepControl, Stepper,
+    dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeJacobian, Phase, SettingsError,
+    Stats, StepControl, Stepper, Watch,
 };
 
 pub(crate) mod tableau;
@@ -121,6 +121,8 @@ pub struct Rodas {
     f_stage: Vec<f64>,
     y_new: Vec<f64>,
     f_new: Vec<f64>,
+    /// The deadline the difference Jacobian and the factorisation look at.
+    watch: Watch,
 }
 
 impl Rodas {
@@ -168,6 +170,7 @@ impl Rodas {
             f_stage: z(),
             y_new: z(),
             f_new: z(),
+            watch: Watch::default(),
         })
     }
 
@@ -249,8 +252,7 @@ impl Rodas {
             .map_err(IntegrateError::Rhs)?;
         if !exact {
             self.jac.fill(0.0);
-            self.core.stats.rhs_evals += nc as u64;
-            fd_jacobian_columns(
+            let stopped = fd_jacobian_columns_within(
                 sys,
                 t,
                 &self.y,
@@ -260,8 +262,15 @@ impl Rodas {
                 fd_floor(&self.core.control),
                 &mut self.y_stage,
                 &mut self.f_stage,
+                self.watch,
             )
             .map_err(IntegrateError::Rhs)?;
+            if let Some(j) = stopped {
+                self.core.stats.rhs_evals += j as u64;
+                self.jac_valid = false;
+                return Err(IntegrateError::OutOfTime { t, during: Phase::Jacobian { column: j + 1, columns: nc } });
+            }
+            self.core.stats.rhs_evals += nc as u64;
         }
         if let Some(k) = first_non_finite(&self.jac) {
             return Err(IntegrateError::NonFiniteState {
@@ -287,8 +296,9 @@ impl Rodas {
         Ok(())
     }
 
-    /// LU of `I/(h gamma) - J_cc`; `false` if singular.
-    fn factor(&mut self, h: f64) -> bool {
+    /// LU of `I/(h gamma) - J_cc`; `Ok(false)` if singular, [`IntegrateError::OutOfTime`]
+    /// past the deadline.
+    fn factor<E>(&mut self, h: f64) -> Result<bool, IntegrateError<E>> {
         let (n, nc) = (self.dim, self.nc);
         let d = 1.0 / (h * self.tab.gamma);
         for i in 0..nc {
@@ -298,9 +308,16 @@ impl Rodas {
             self.lu[i * nc + i] += d;
         }
         self.core.stats.lu_decompositions += 1;
-        let ok = lu_factor(&mut self.lu[..nc * nc], nc, &mut self.piv[..nc], d + self.jac_max).is_ok();
-        self.lu_h = if ok { h } else { f64::NAN };
-        ok
+        let result = lu_factor_within(&mut self.lu[..nc * nc], nc, &mut self.piv[..nc], d + self.jac_max, || self.watch.out_of_time());
+        self.lu_h = if result.is_ok() { h } else { f64::NAN };
+        match result {
+            Ok(()) => Ok(true),
+            Err(LuStop::Singular(_)) => Ok(false),
+            Err(LuStop::OutOfTime(k)) => Err(IntegrateError::OutOfTime {
+                t: self.core.t,
+                during: Phase::Factoring { column: k + 1, columns: nc },
+            }),
+        }
     }
 
     /// Solves `(I/(h gamma) - J) x = r` in place: the coupled block by the LU, the rest by
@@ -357,7 +374,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
         if !self.dfdt_fresh {
             self.evaluate_dfdt(sys)?;
         }
-        if self.lu_h != h && !self.factor(h) {
+        if self.lu_h != h && !self.factor(h)? {
             return self.core.reject_singular(h);
         }
         self.core.singular_run = 0;
@@ -464,6 +481,10 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
     }
 
     forward_stepper_accessors!(Rodas);
+
+    fn set_watch(&mut self, watch: Watch) {
+        self.watch = watch;
+    }
 
     fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.y.copy_from_slice(y);

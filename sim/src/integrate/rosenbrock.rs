@@ -55,10 +55,10 @@
 use self::tableau::{Tableau, GAMMA};
 use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
-use super::lu::{lu_factor, lu_solve};
+use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::{
     dense_output, eval, eval_finite, first_non_finite, hermite, IntegrateError, OdeJacobian,
-    SettingsError, Stats, StepControl, Stepper,
+    Phase, SettingsError, Stats, StepControl, Stepper, Watch,
 };
 
 mod tableau;
@@ -106,6 +106,8 @@ pub struct Rosenbrock {
     f_stage: Vec<f64>,
     y_new: Vec<f64>,
     f_new: Vec<f64>,
+    /// The deadline the factorisation looks at.
+    watch: Watch,
 }
 
 impl Rosenbrock {
@@ -153,6 +155,7 @@ impl Rosenbrock {
             f_stage: z(),
             y_new: z(),
             f_new: z(),
+            watch: Watch::default(),
         })
     }
 
@@ -252,8 +255,9 @@ impl Rosenbrock {
         Ok(())
     }
 
-    /// LU of `I/(h gamma) - J`; `false` if singular.
-    fn factor(&mut self, h: f64) -> bool {
+    /// LU of `I/(h gamma) - J`; `Ok(false)` if singular, [`IntegrateError::OutOfTime`] past
+    /// the deadline.
+    fn factor<E>(&mut self, h: f64) -> Result<bool, IntegrateError<E>> {
         let n = self.dim;
         let d = 1.0 / (h * GAMMA);
         for (w, j) in self.lu.iter_mut().zip(&self.jac) {
@@ -263,9 +267,15 @@ impl Rosenbrock {
             self.lu[i * n + i] += d;
         }
         self.core.stats.lu_decompositions += 1;
-        let ok = lu_factor(&mut self.lu, n, &mut self.piv, d + self.jac_max).is_ok();
-        self.lu_h = if ok { h } else { f64::NAN };
-        ok
+        let result = lu_factor_within(&mut self.lu, n, &mut self.piv, d + self.jac_max, || self.watch.out_of_time());
+        self.lu_h = if result.is_ok() { h } else { f64::NAN };
+        match result {
+            Ok(()) => Ok(true),
+            Err(LuStop::Singular(_)) => Ok(false),
+            Err(LuStop::OutOfTime(k)) => {
+                Err(IntegrateError::OutOfTime { t: self.core.t, during: Phase::Factoring { column: k + 1, columns: n } })
+            }
+        }
     }
 
 }
@@ -308,7 +318,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
         if !self.dfdt_fresh {
             self.evaluate_dfdt(sys)?;
         }
-        if self.lu_h != h && !self.factor(h) {
+        if self.lu_h != h && !self.factor(h)? {
             return self.core.reject_singular(h);
         }
         self.core.singular_run = 0;
@@ -405,6 +415,10 @@ impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
     }
 
     forward_stepper_accessors!(Rosenbrock);
+
+    fn set_watch(&mut self, watch: Watch) {
+        self.watch = watch;
+    }
 
     fn set_state(&mut self, sys: &mut S, y: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.y.copy_from_slice(y);

@@ -71,6 +71,68 @@ impl Deadline {
     }
 }
 
+/// A wall-clock deadline as the long loops inside one step see it (a difference Jacobian's
+/// columns, an LU factorisation's, the trial points of an event location, a system's mode
+/// enumeration): [`Watch::out_of_time`] reads the clock (no allocation, some tens of ns), so a
+/// loop whose every pass costs a right-hand side looks at every pass, and a cheaper one every
+/// few. The default watches nothing.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Watch {
+    at: Option<Instant>,
+}
+
+impl Watch {
+    /// Watches `deadline` (`None`: nothing).
+    pub fn new(deadline: Option<Deadline>) -> Self {
+        Watch { at: deadline.map(|d| d.at) }
+    }
+
+    /// Watches the instant `at`.
+    pub fn until(at: Instant) -> Self {
+        Watch { at: Some(at) }
+    }
+
+    /// Whether the deadline has passed.
+    #[inline]
+    pub fn out_of_time(&self) -> bool {
+        self.at.is_some_and(|at| Instant::now() >= at)
+    }
+}
+
+/// Where in a step a run was when its wall-time budget ran out ([`IntegrateError::OutOfTime`]),
+/// for the message: between steps, or inside one of the long loops a step may run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Phase {
+    /// Between steps or events (the driver's clock).
+    #[default]
+    Stepping,
+    /// Building the Jacobian by differences: `column` (1-based) of `columns`, each one
+    /// evaluation of the right-hand side.
+    Jacobian { column: usize, columns: usize },
+    /// Factoring the iteration matrix: `column` (1-based) of `columns`.
+    Factoring { column: usize, columns: usize },
+    /// Locating an event on a step's dense output: after `trials` trial points.
+    LocatingEvent { trials: usize },
+    /// Choosing the contact modes: after `tried` of the `of` combinations.
+    ChoosingModes { tried: usize, of: usize },
+}
+
+impl std::fmt::Display for Phase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Phase::Stepping => write!(f, "between steps"),
+            Phase::Jacobian { column, columns } => write!(f, "while building the Jacobian (column {column} of {columns})"),
+            Phase::Factoring { column, columns } => {
+                write!(f, "while factoring the iteration matrix (column {column} of {columns})")
+            }
+            Phase::LocatingEvent { trials } => write!(f, "while locating an event (after {trials} trial points)"),
+            Phase::ChoosingModes { tried, of } => {
+                write!(f, "while choosing the contact modes ({tried} of {of} combinations tried)")
+            }
+        }
+    }
+}
+
 /// [`integrate_sampled`] with a wall-clock `deadline`: after it passes, the run stops with
 /// [`IntegrateError::OutOfTime`] at the stepper's time (the clock is read every
 /// [`CLOCK_EVERY`] accepted steps; a step ends before it is read, so a run may overrun by
@@ -90,6 +152,8 @@ pub fn integrate_sampled_within<S: OdeSystem, St: Stepper<S> + ?Sized>(
 ) -> Result<Stats, IntegrateError<S::Error>> {
     let grid = OutputGrid::new(t0, t_end, dt_out)?;
     let n_out = grid.n_out;
+    // the stepper's own long loops (a difference Jacobian) look at the deadline too
+    stepper.set_watch(Watch::new(deadline));
 
     // first sample: the initial state exactly
     stepper.init(sys, t0, y0)?;
@@ -210,7 +274,7 @@ impl Pace {
             if self.steps.is_multiple_of(CLOCK_EVERY) {
                 let now = Instant::now();
                 if now >= deadline.at {
-                    return Err(IntegrateError::OutOfTime { t: t_after });
+                    return Err(IntegrateError::OutOfTime { t: t_after, during: Phase::Stepping });
                 }
                 let spent = now.duration_since(self.started);
                 let done = (t_after - self.t0) / (self.t_end - self.t0);
@@ -229,7 +293,7 @@ impl Pace {
     /// every event, since handling one (a system's mode problem) may cost far more than a step.
     pub(super) fn after_event<E>(&self, t: f64) -> Result<(), IntegrateError<E>> {
         match self.deadline {
-            Some(deadline) if Instant::now() >= deadline.at => Err(IntegrateError::OutOfTime { t }),
+            Some(deadline) if Instant::now() >= deadline.at => Err(IntegrateError::OutOfTime { t, during: Phase::Stepping }),
             _ => Ok(()),
         }
     }
@@ -402,7 +466,7 @@ mod tests {
             Ok(())
         });
         match res {
-            Err(IntegrateError::OutOfTime { t }) => assert_eq!(t, st.t()),
+            Err(IntegrateError::OutOfTime { t, during }) => assert_eq!((t, during), (st.t(), Phase::Stepping)),
             other => panic!("expected OutOfTime, got {other:?}"),
         }
         assert_eq!(st.stats().steps, CLOCK_EVERY);

@@ -24,13 +24,13 @@
 
 use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState};
 use crate::dynamics::contact::impact::solve_impact;
-use crate::dynamics::contact::modes::choose_modes;
+use crate::dynamics::contact::modes::choose_modes_within;
 use crate::dynamics::contact::{Contact, ContactEvent, ContactEventKind, ContactMode, ContactModel, ContactOutput, ContactSettings};
 use crate::dynamics::forward::Plant;
 use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
 use crate::dynamics::motor::Electrical;
 use crate::error::{DynamicsError, RunError};
-use crate::integrate::HybridSystem;
+use crate::integrate::{HybridSystem, Watch};
 use crate::scene::{Run, Scene};
 
 use super::arm::ArmSystem;
@@ -54,6 +54,8 @@ pub(crate) struct Hybrid {
     pub(crate) zeros: Vec<f64>,
     pub(crate) proj_rows: Vec<crate::dynamics::contact::solve::ActiveRow>,
     pub(crate) proj_dx: Vec<f64>,
+    /// The run's deadline, read by the mode enumeration ([`ArmSystem::set_watch`]).
+    pub(crate) watch: Watch,
 }
 
 impl Hybrid {
@@ -74,6 +76,7 @@ impl Hybrid {
             zeros: vec![0.0; nv],
             proj_rows: Vec::with_capacity(3 * nc),
             proj_dx: vec![0.0; nv],
+            watch: Watch::default(),
             contacts,
         }
     }
@@ -97,6 +100,15 @@ fn in_touch(m: ContactMode) -> bool {
 }
 
 impl ArmSystem<'_> {
+    /// The run's deadline for the system's own long loop (the contact mode enumeration, up to
+    /// 3^8 constrained solves at one event): past it, [`crate::error::DynamicsError::OutOfTime`]. A run
+    /// without events has no such loop.
+    pub fn set_watch(&mut self, watch: Watch) {
+        if let Some(h) = self.hybrid.as_mut() {
+            h.watch = watch;
+        }
+    }
+
     /// Whether this run is event-driven: it has a non-bilateral contact (then the run uses
     /// `integrate_hybrid`, records `/contacts` and fills `Outputs::contacts`).
     pub fn is_hybrid(&self) -> bool {
@@ -308,7 +320,7 @@ impl ArmSystem<'_> {
                 h.state.mode[k] = ContactMode::Separated;
             }
         }
-        choose_modes(&h.contacts, &mut h.state, closed, preferred, h.settings.vel_tol, stab, &mut self.ws.fd, &mut h.cd, t)?;
+        choose_modes_within(&h.contacts, &mut h.state, closed, preferred, h.settings.vel_tol, stab, &mut self.ws.fd, &mut h.cd, t, h.watch)?;
         let mut events = Vec::new();
         for k in 0..h.contacts.len() {
             let (a, b) = (before[k], h.state.mode[k]);

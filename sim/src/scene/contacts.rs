@@ -124,6 +124,13 @@ pub(super) fn build_contacts(
             }
             settings.max_events = x;
         }
+        if let Some(x) = ev.max_events_at_one_time {
+            let (lo, hi) = (2, crate::dynamics::contact::MAX_EVENTS_AT_ONE_TIME_LIMIT);
+            if !(lo..=hi).contains(&x) {
+                return Err(c.err("events.max_events_at_one_time", x, format!("must be in [{lo}, {hi}]")));
+            }
+            settings.max_events_at_one_time = x;
+        }
     }
     let mut planes: Vec<PointOnPlane> = Vec::new();
     let mut contacts: Vec<Contact> = Vec::new();

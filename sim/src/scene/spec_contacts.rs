@@ -62,6 +62,11 @@ pub struct EventsSpec {
     /// Most contact events in a run (default 100000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_events: Option<u64>,
+    /// Most contact events in a row at one instant (each within 10 time_tolerance of the
+    /// previous) before the run stops as chattering, in [2, 10000] (default 32). Raise it for a
+    /// cascade of events through many contacts that does settle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_events_at_one_time: Option<u32>,
 }
 
 /// A contact model (README, "A table that only pushes: contacts").

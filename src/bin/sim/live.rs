@@ -18,9 +18,10 @@
 //!   that connects mid-run still draws the arm (ROS calls such topics latched; the protocol has
 //!   no such notion, the server does it per subscription).
 //! - **`--wait`**: no run starts before a client is connected; every message of a channel is then
-//!   kept until the channel's first subscription and sent to it then (at most [`KEPT_BYTES`] per
-//!   channel, oldest dropped beyond), so a client that subscribes as channels appear receives
-//!   every message of the run. After the runs the server stays up until the clients disconnect
+//!   kept until the channel's first subscription and sent to it then (at most `KEPT_BYTES`,
+//!   64 MiB, per channel: beyond, the oldest are dropped, counted per topic, reported on stderr
+//!   when the command ends, and the exit status is 1), so a client that subscribes as channels
+//!   appear receives every message of the run. After the runs the server stays up until the clients disconnect
 //!   (the queued messages reach them), or Ctrl-C.
 //! - **Several runs** (`sim` alone runs six) are streamed one at a time, in order, on the same
 //!   topics as their files (prefixing topics would not separate them in the 3D panel: the frames
@@ -116,7 +117,7 @@ mod server {
             match *self {}
         }
 
-        pub fn close(self) {
+        pub fn close(self) -> bool {
             match self {}
         }
     }

@@ -119,10 +119,9 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     let layout = write_layout(&scene, &done, &a.out, v);
     let code = finish(&done, a.format, a.baseline.as_deref(), v).map(|c| if layout.is_err() { c.max(exit::BAD_INPUT) } else { c });
     report_layouts(&[layout], v);
-    if let Some(live) = live {
-        live.close();
-    }
-    code
+    // messages the live view dropped (said on stderr) make the command's status 1
+    let dropped = live.is_some_and(live::Session::close);
+    code.map(|c| if dropped { c.max(exit::FAILED) } else { c })
 }
 
 /// `sim` with no scene: the paper's scene and the same arm over a real table
@@ -165,10 +164,8 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
     let failed = layouts.iter().any(Result::is_err);
     let code = finish(&done, a.format, a.baseline.as_deref(), v).map(|c| if failed { c.max(exit::BAD_INPUT) } else { c });
     report_layouts(&layouts, v);
-    if let Some(live) = live {
-        live.close();
-    }
-    code
+    let dropped = live.is_some_and(live::Session::close);
+    code.map(|c| if dropped { c.max(exit::FAILED) } else { c })
 }
 
 /// Write the Foxglove layout of `scene`'s recordings, `<out>/<scene>.foxglove-layout.json`

@@ -194,11 +194,28 @@ pub struct ContactSettings {
     pub rest_velocity: f64,
     /// Most contact events in a run (default 100 000).
     pub max_events: u64,
+    /// Most events in a row at one instant (within `10 time_tol` of each other) before the
+    /// run stops as chattering (default [`DEFAULT_MAX_EVENTS_AT_ONE_TIME`]).
+    pub max_events_at_one_time: u32,
 }
+
+/// The default of the scene's `events.max_events_at_one_time`.
+pub const DEFAULT_MAX_EVENTS_AT_ONE_TIME: u32 = 32;
+
+/// The bound on the scene's `events.max_events_at_one_time`: past a few thousand events at
+/// one instant nothing settles, and each event may cost a mode enumeration.
+pub const MAX_EVENTS_AT_ONE_TIME_LIMIT: u32 = 10_000;
 
 impl Default for ContactSettings {
     fn default() -> Self {
-        ContactSettings { time_tol: 1e-12, gap_tol: 1e-9, vel_tol: 1e-9, rest_velocity: 1e-4, max_events: 100_000 }
+        ContactSettings {
+            time_tol: 1e-12,
+            gap_tol: 1e-9,
+            vel_tol: 1e-9,
+            rest_velocity: 1e-4,
+            max_events: 100_000,
+            max_events_at_one_time: DEFAULT_MAX_EVENTS_AT_ONE_TIME,
+        }
     }
 }
 

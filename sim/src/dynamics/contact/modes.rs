@@ -22,6 +22,7 @@ use super::forward::{solve_modes, ContactData, ContactState};
 use super::{Contact, ContactMode, ContactModel, MAX_CLOSED_CONTACTS};
 use crate::dynamics::forward::{ForwardData, Stabilization};
 use crate::error::DynamicsError;
+use crate::integrate::{Phase, Watch};
 
 fn mu_of(c: &Contact) -> f64 {
     match c.model {
@@ -60,6 +61,25 @@ pub fn choose_modes(
     cd: &mut ContactData,
     t: f64,
 ) -> Result<(), DynamicsError> {
+    choose_modes_within(contacts, state, closed, preferred, vel_tol, stabilization, fd, cd, t, Watch::default())
+}
+
+/// [`choose_modes`] that reads `watch`'s clock before every combination after the first (each
+/// costs one or more constrained solves, up to 3^8 of them): past the deadline,
+/// [`DynamicsError::OutOfTime`] with how many were tried, `state` unchanged.
+#[allow(clippy::too_many_arguments)]
+pub fn choose_modes_within(
+    contacts: &[Contact],
+    state: &mut ContactState,
+    closed: &[usize],
+    preferred: &[ContactMode],
+    vel_tol: f64,
+    stabilization: Stabilization,
+    fd: &mut ForwardData,
+    cd: &mut ContactData,
+    t: f64,
+    watch: Watch,
+) -> Result<(), DynamicsError> {
     let names = || closed.iter().map(|&k| contacts[k].name()).collect::<Vec<_>>().join(", ");
     if closed.len() > MAX_CLOSED_CONTACTS {
         return Err(DynamicsError::InconsistentContact {
@@ -84,7 +104,13 @@ pub fn choose_modes(
     let mut idx = vec![0usize; closed.len()];
     let mut feasible: Vec<Feasible> = Vec::new();
     let mut trial = state.clone();
+    let combinations: usize = cands.iter().map(Vec::len).product();
+    let mut tried = 0usize;
     loop {
+        if tried > 0 && watch.out_of_time() {
+            return Err(DynamicsError::OutOfTime { t, during: Phase::ChoosingModes { tried, of: combinations } });
+        }
+        tried += 1;
         // the combination idx
         let mut from_rest = false;
         for (i, &k) in closed.iter().enumerate() {

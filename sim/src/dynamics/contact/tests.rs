@@ -394,3 +394,25 @@ fn compliant_forces_on_a_point_mass() {
         }
     }
 }
+
+/// The mode enumeration reads the run's budget before every combination after the first
+/// (issue 29): with the deadline already past, the block of the test above stops after one of
+/// its three combinations (stick, slide, separate) with how far it got, its modes unchanged.
+#[test]
+fn the_mode_enumeration_stops_at_the_deadline() {
+    use crate::dynamics::contact::modes::choose_modes_within;
+    use crate::integrate::{Phase, Watch};
+    let model = point_mass(2.0);
+    let drives = force_drives(3);
+    let contacts = [table(&model, "ball", Vector3::zeros(), "block", ContactModel::Unilateral { restitution: 0.0, friction: 0.5 })];
+    let mut data = Data::new(&model);
+    let (mut fd, mut cd) = (ForwardData::new(3, 1), ContactData::new(3, 1));
+    prepare(&plant(&model, &drives), &contacts, &mut data, &mut fd, &mut cd, 0.25, &[0.0; 3], &[0.0; 3], &[1.0, 0.0, 0.0]).expect("prepare");
+    let mut state = ContactState::new(&contacts);
+    let before = state.mode.clone();
+    let past = Watch::until(std::time::Instant::now());
+    let err = choose_modes_within(&contacts, &mut state, &[0], &[ContactMode::Sticking], 1e-9, Default::default(), &mut fd, &mut cd, 0.25, past).unwrap_err();
+    assert_eq!(err, DynamicsError::OutOfTime { t: 0.25, during: Phase::ChoosingModes { tried: 1, of: 3 } });
+    assert_eq!(state.mode, before);
+    assert!(err.to_string().contains("while choosing the contact modes (1 of 3 combinations tried)"), "{err}");
+}

@@ -3,7 +3,7 @@
 //! TOMS 31 (2005) 363–396, §2.4), on the stepper's dense output (HNW I §II.6).
 
 use super::HybridSystem;
-use crate::integrate::{IntegrateError, Stepper};
+use crate::integrate::{IntegrateError, Phase, Stepper, Watch};
 
 /// Most trial points of one root search: far more than the ~log2(h / time_tol) ≈ 40 a
 /// bisection would need, so the bound only stops a search that cannot shrink its bracket
@@ -141,6 +141,10 @@ pub(super) fn crosses(dir: i8, lo: f64, g: f64) -> bool {
 /// `br.g_hi` hold the functions at its ends and have a sign change): narrows the bracket to
 /// `≤ tol` and returns its upper end `t*`, with `br.fired` the functions that changed sign
 /// over the final bracket and `br.g_hi` their values at `t*`. `y` is scratch (length dim).
+/// Each trial point evaluates every event function (for the arm, a right-hand side), so the
+/// clock is read before each: past `watch`'s deadline the location stops with
+/// [`IntegrateError::OutOfTime`] at `t_lo` (where the stepper's state is still the step's).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
     stepper: &St,
     sys: &mut S,
@@ -148,6 +152,7 @@ pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
     mut t_lo: f64,
     mut t_hi: f64,
     tol: f64,
+    watch: Watch,
     y: &mut [f64],
 ) -> Result<f64, IntegrateError<S::Error>> {
     let n = br.g_lo.len();
@@ -173,6 +178,9 @@ pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
     let (mut side, mut side_prev) = (0u8, 0u8);
     let mut trials = 0;
     while t_hi - t_lo > tol && trials < MAX_TRIALS {
+        if watch.out_of_time() {
+            return Err(IntegrateError::OutOfTime { t: t_lo, during: Phase::LocatingEvent { trials: trials as usize } });
+        }
         trials += 1;
         // Illinois weight: the same side twice in a row -> weight the retained end's value
         alpha = if trials > 2 && side == side_prev { if side == 2 { alpha * 2.0 } else { alpha * 0.5 } } else { 1.0 };

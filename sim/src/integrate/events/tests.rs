@@ -237,6 +237,14 @@ fn chattering_and_max_events_are_typed_errors() {
             }
             other => panic!("{name}: expected Chattering, got {:?}", other.map(|r| r.1)),
         }
+        // the limit is a setting (the scene's events.max_events_at_one_time): 64 stops at 65
+        let mut toy = Toy::new(Thresholds { c: vec![0.5], dirs: vec![1], shift: Some(1e-13) });
+        let mut st = methods::<Thresholds>(0.1, 1e-8, 1e-10, 0.25).into_iter().find(|m| m.0 == name).unwrap().1;
+        let settings = EventSettings { max_events_at_one_time: 64, ..EventSettings::default() };
+        match run(st.as_mut(), &mut toy, [0.0, 1.0], 1.0, 0.1, settings) {
+            Err(IntegrateError::Chattering { count: 65, .. }) => assert_eq!(toy.log.len(), 64, "{name}"),
+            other => panic!("{name}: expected Chattering after 65, got {:?}", other.map(|r| r.1)),
+        }
     }
     for (name, mut st) in methods::<Thresholds>(0.1, 1e-8, 1e-10, 0.25) {
         let mut toy = Toy::new(Thresholds { c: vec![0.5], dirs: vec![1], shift: Some(0.01) });
@@ -405,4 +413,26 @@ fn init_modes_runs_before_the_first_sample() {
     let mut toy = Toy::new(Thresholds { c: vec![5.0], dirs: vec![1], shift: None });
     let (samples, _) = run(&mut Rk4::new(2, 0.1), &mut toy, y0, 1.0, 0.1, EventSettings::default()).unwrap();
     assert_eq!(samples[0].1.map(f64::to_bits), y0.map(f64::to_bits));
+}
+
+/// The budget is read inside the event location too (issue 29): with the deadline already
+/// past, a step that crosses the ball's impact stops at the location's first trial point, as
+/// [`IntegrateError::OutOfTime`] at the step's start with where it was, instead of locating the
+/// root (some 40 evaluations of every event function, each a right-hand side for the arm)
+/// and handling the event first. One rk4 step of 1 s crosses the impact at 0.45 s; the
+/// driver's own clock, read every 16 steps, has not looked yet.
+#[test]
+fn the_deadline_stops_an_event_location() {
+    let mut toy = Toy::new(Ball::new(G, 0.5, 1e-3));
+    let mut st = Rk4::new(2, 1.0);
+    let deadline = Some(Deadline::new(std::time::Instant::now()));
+    let r = integrate_hybrid(&mut st, &mut toy, 0.0, &[1.0, 0.0], 1.0, 0.5, deadline, EventSettings::default(), |_, _, _| Ok(()));
+    match r {
+        Err(IntegrateError::OutOfTime { t, during }) => {
+            assert_eq!((t, during), (0.0, crate::integrate::Phase::LocatingEvent { trials: 0 }));
+        }
+        other => panic!("expected OutOfTime while locating, got {other:?}"),
+    }
+    // the functions at the start and at the step's end, no trial point, no event handled
+    assert_eq!((toy.event_calls, toy.log.len()), (2, 0));
 }

@@ -19,7 +19,8 @@ use foxglove::{ChannelBuilder, ChannelId, Context, PartialMetadata, RawChannel, 
 use super::{LiveArgs, Pace};
 
 /// Bytes of messages kept per channel until its first subscription (`--wait`); beyond, the
-/// oldest are dropped. A paper run's largest channel (`/tf`, 5 s at 1 kHz) is about 6 MB.
+/// oldest are dropped, counted, and reported when the command ends (exit status 1). A paper
+/// run's largest channel (`/tf`, 5 s at 1 kHz) is about 6 MB.
 pub const KEPT_BYTES: usize = 64 << 20;
 
 /// Messages queued per client by the server before it drops the oldest (the crate's default
@@ -29,6 +30,7 @@ const BACKLOG_FAST: usize = 1 << 17;
 /// One MCAP channel of the current run, as advertised.
 struct LiveChannel {
     raw: Arc<RawChannel>,
+    topic: String,
     /// Every message of a latched topic, for later subscribers.
     latched: Option<Vec<(u64, Vec<u8>)>>,
     /// With `--wait`, the messages written before the first subscription.
@@ -54,6 +56,47 @@ struct Hub {
     by_sdk_id: HashMap<ChannelId, u16>,
     /// `--wait`: keep every message until its channel's first subscription.
     keep_until_subscribed: bool,
+    /// At most this many bytes kept per channel ([`KEPT_BYTES`]).
+    kept_bytes: usize,
+    /// Messages and bytes dropped from the kept ones, by topic, over all runs: reported at
+    /// the end, and the command's exit status says so (never a silent drop).
+    dropped: BTreeMap<String, (u64, usize)>,
+}
+
+impl Hub {
+    fn new(keep_until_subscribed: bool) -> Self {
+        Hub { keep_until_subscribed, kept_bytes: KEPT_BYTES, ..Hub::default() }
+    }
+
+    /// Keeps a message of channel `id` until its first subscription, dropping the oldest kept
+    /// beyond [`Hub::kept_bytes`] (counted in [`Hub::dropped`]).
+    fn keep(&mut self, id: u16, log_time_ns: u64, data: &[u8]) {
+        let limit = self.kept_bytes;
+        let Some(ch) = self.channels.get_mut(&id) else { return };
+        ch.pending.push_back((log_time_ns, data.to_vec()));
+        ch.pending_bytes += data.len();
+        while ch.pending_bytes > limit {
+            let Some((_, old)) = ch.pending.pop_front() else { break };
+            ch.pending_bytes -= old.len();
+            let d = self.dropped.entry(ch.topic.clone()).or_default();
+            d.0 += 1;
+            d.1 += old.len();
+        }
+    }
+
+    /// One line per topic with dropped messages (empty: none dropped).
+    fn drop_report(&self) -> Vec<String> {
+        self.dropped
+            .iter()
+            .map(|(topic, (n, bytes))| {
+                format!(
+                    "sim: live: warning: {n} messages ({:.1} MiB) of {topic} were not streamed: they were written before the viewer subscribed to it, beyond the {} MiB kept per channel (the recording has them all)",
+                    *bytes as f64 / f64::from(1 << 20),
+                    self.kept_bytes >> 20
+                )
+            })
+            .collect()
+    }
 }
 
 fn lock(hub: &Mutex<Hub>) -> MutexGuard<'_, Hub> {
@@ -117,7 +160,7 @@ impl Session {
             return Ok(None);
         }
         let context = Context::new();
-        let hub = Arc::new(Mutex::new(Hub { keep_until_subscribed: a.wait, ..Hub::default() }));
+        let hub = Arc::new(Mutex::new(Hub::new(a.wait)));
         let info: HashMap<String, String> = about.iter().map(|(k, v)| (k.to_string(), v.clone())).collect();
         let mut server = WebSocketServer::new()
             .name("elbow-sim")
@@ -191,8 +234,10 @@ impl Session {
         })
     }
 
-    /// After the runs: with `--wait`, serves until the clients disconnect; then stops.
-    pub fn close(mut self) {
+    /// After the runs: with `--wait`, serves until the clients disconnect; then stops. Returns
+    /// whether messages were dropped (each topic's count printed on stderr): the command then
+    /// exits with status 1.
+    pub fn close(mut self) -> bool {
         if self.wait && self.clients() > 0 {
             if !self.quiet {
                 eprintln!("sim: live: the runs are done; serving until the viewer disconnects (Ctrl-C to stop)");
@@ -205,6 +250,11 @@ impl Session {
         if let Some(s) = self.server.take() {
             drop(s.stop());
         }
+        let report = lock(&self.hub).drop_report();
+        for line in &report {
+            eprintln!("{line}");
+        }
+        !report.is_empty()
     }
 }
 
@@ -239,7 +289,10 @@ impl schemas::Mirror for LiveMirror {
             Ok(raw) => {
                 hub.by_sdk_id.insert(raw.id(), id);
                 let latched = schemas::topics::LATCHED.contains(&topic).then(Vec::new);
-                hub.channels.insert(id, LiveChannel { raw, latched, pending: VecDeque::new(), pending_bytes: 0, subscribed_once: false, sinks: Vec::new() });
+                hub.channels.insert(
+                    id,
+                    LiveChannel { raw, topic: topic.into(), latched, pending: VecDeque::new(), pending_bytes: 0, subscribed_once: false, sinks: Vec::new() },
+                );
             }
             // (the recording is unaffected; the viewer misses this topic)
             Err(e) => eprintln!("sim: live: warning: {topic} is not streamed: {e}"),
@@ -261,16 +314,41 @@ impl schemas::Mirror for LiveMirror {
             kept.push((log_time_ns, data.to_vec()));
         }
         if keep && !ch.subscribed_once {
-            ch.pending.push_back((log_time_ns, data.to_vec()));
-            ch.pending_bytes += data.len();
-            while ch.pending_bytes > KEPT_BYTES {
-                let Some((_, old)) = ch.pending.pop_front() else { break };
-                ch.pending_bytes -= old.len();
-            }
+            hub.keep(channel_id, log_time_ns, data);
             return;
         }
         for sink in &ch.sinks {
             ch.send(log_time_ns, data, *sink);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Messages kept past the per-channel limit before the first subscription are counted per
+    /// topic and reported (issue 29: they were dropped silently); nothing is reported when all
+    /// fit. The channel is advertised on a context of its own, no server.
+    #[test]
+    fn messages_dropped_before_the_first_subscription_are_counted_and_reported() {
+        let context = Context::new();
+        let mut hub = Hub::new(true);
+        hub.kept_bytes = 1000;
+        let raw = ChannelBuilder::new("/tf").context(&context).message_encoding("cdr").build_raw().unwrap();
+        hub.channels.insert(3, LiveChannel { raw, topic: "/tf".into(), latched: None, pending: VecDeque::new(), pending_bytes: 0, subscribed_once: false, sinks: Vec::new() });
+        for t in 0..10 {
+            hub.keep(3, t, &[0u8; 100]);
+        }
+        assert!(hub.drop_report().is_empty(), "1000 bytes fit");
+        for t in 10..25 {
+            hub.keep(3, t, &[0u8; 100]);
+        }
+        assert_eq!(hub.dropped["/tf"], (15, 1500));
+        let ch = &hub.channels[&3];
+        assert_eq!((ch.pending.len(), ch.pending_bytes, ch.pending[0].0), (10, 1000, 15), "the newest kept");
+        let report = hub.drop_report();
+        assert_eq!(report.len(), 1);
+        assert!(report[0].contains("15 messages") && report[0].contains("of /tf were not streamed") && report[0].contains("the recording has them all"), "{}", report[0]);
     }
 }
