@@ -12,6 +12,8 @@
 //!   M(q), the Coriolis terms and G(q) of the two-link arm), not the plant's RNEA, so an error
 //!   the plant and the controller would share (a sign in `rnea`) cannot hide.
 
+#![allow(clippy::needless_range_loop)] // per-joint arrays indexed together
+
 use std::collections::BTreeMap;
 
 use nalgebra::{DVector, Vector3};
