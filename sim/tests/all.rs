@@ -11,6 +11,8 @@ mod contacts_support;
 mod arms_load;
 #[path = "bad_input.rs"]
 mod bad_input;
+#[path = "by_hand.rs"]
+mod by_hand;
 #[path = "contacts_paper.rs"]
 mod contacts_paper;
 #[path = "contacts_pendulum.rs"]

@@ -7,8 +7,8 @@
 //! The balance (`Outputs::balance_residual`): `Σ E_j − (ΔT + ΔV + ΔE_L + E_R + E_D + E_Dm +
 //! Σ_k (E_imp,k + E_fric,k + E_damp,k))`, every term a quadrature of the state or a function
 //! of it, the impact losses added at the impacts. At rtol 1e-10 each term carries ~1e-10 of its
-//! size (≤ a few 1e3 J), so the residual is bounded by 1e-8 of the electric energy drawn
-//! `Σ_j |E_j(t_end)|` (the issue's bound), at every sample.
+//! size, so the residual is bounded by 1e-10 (the rtol) of the electric energy drawn
+//! `Σ_j |E_j(t_end)|`, at every sample (measured 4.5e-13 … 6.8e-12; issue 11 asked for 1e-8).
 
 #![allow(clippy::needless_range_loop)] // per-contact arrays indexed together
 
@@ -22,6 +22,24 @@ use sim::scene::Scene;
 
 fn scene(file: &str) -> Scene {
     Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/contacts").join(file)).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+/// Every impact (and rest) logged obeys Newton's law with restitution `e` (Pfeiffer & Glocker
+/// 1996, §6.2; impacts are frictionless, `dynamics/contact/impact.rs`): a contact that took an
+/// impulse Λ > 0 leaves with ġ⁺ = −e ġ⁻ (1e-9 (1 + |ġ⁻|): the solve's complementarity
+/// tolerance), and its logged loss is the work of that impulse, ½ Λ (1 − e)(−ġ⁻) (1e-9 of it).
+/// This checks the logged losses against the law; the losses added to the state are checked by
+/// the energy balance, which closes only with them.
+fn impacts_obey_newtons_law(run: &str, events: &[sim::dynamics::contact::ContactEvent], e: f64) {
+    for ev in events.iter().filter(|x| matches!(x.kind, ContactEventKind::Impact | ContactEventKind::Rest)) {
+        let (before, after) = (ev.gap_rate_before, ev.gap_rate_after);
+        assert!(ev.impulse > 0.0 && before < 0.0, "{run}: {ev:?}");
+        // the rest rule makes the impact plastic (e = 0)
+        let e = if ev.kind == ContactEventKind::Rest { 0.0 } else { e };
+        assert!((after + e * before).abs() <= 1e-9 * (1.0 + before.abs()), "{run}: ġ⁺ = {after}, −e ġ⁻ = {}: {ev:?}", -e * before);
+        let work = 0.5 * ev.impulse * (1.0 - e) * -before;
+        assert!((ev.energy_lost - work).abs() <= 1e-9 * work, "{run}: logged loss {} J, ½ Λ (1 − e)|ġ⁻| = {work} J", ev.energy_lost);
+    }
 }
 
 /// The scene with every contact's (and the table's) friction set to `mu`.
@@ -60,7 +78,7 @@ fn the_balance_closes_with_friction_and_lift_off_on_the_paper_arm_with_unilatera
         let fric: f64 = last.contacts.iter().map(|k| k.friction_work).sum();
         let imp: f64 = last.contacts.iter().map(|k| k.impact_loss).sum();
         eprintln!("{run}: Σ|E_j| = {e:.6} J, max |residual| / Σ|E_j| = {rel:.2e}, friction work {fric:.3e} J, impact loss {imp:.3e} J, {} events", c.events.len());
-        assert!(rel <= 1e-8, "{run}: residual {rel:e} of {e} J");
+        assert!(rel <= 1e-10, "{run}: residual {rel:e} of {e} J");
         assert_eq!(last.contacts.len(), s.run(run).unwrap().contacts.len());
         assert!(last.contacts.iter().all(|k| k.friction_work >= -1e-12 && k.impact_loss >= 0.0), "{run}: losses are losses");
     }
@@ -68,7 +86,8 @@ fn the_balance_closes_with_friction_and_lift_off_on_the_paper_arm_with_unilatera
 
 /// The same with frictionless unilateral elbows (μ = 0): lift-offs and plastic impacts (the
 /// two-elbow run's elbows both lift off in the first 2 ms and come down with speed), whose
-/// losses close the balance; the state's cumulative impact losses equal the events' (1e-9).
+/// losses close the balance; every impact obeys Newton's law with its logged loss the work of
+/// its impulse ([`impacts_obey_newtons_law`]).
 #[test]
 fn the_balance_closes_with_impacts_on_the_paper_arm_with_frictionless_unilateral_elbows() {
     let s = tight(&with_friction(&scene("paper_unilateral.json"), 0.0));
@@ -76,17 +95,17 @@ fn the_balance_closes_with_impacts_on_the_paper_arm_with_frictionless_unilateral
         let c = collect(&s, run);
         let (rel, e) = balance(&c);
         let lost: f64 = c.samples.last().unwrap().contacts.iter().map(|k| k.impact_loss).sum();
-        let logged: f64 = c.events.iter().map(|e| e.energy_lost).sum();
         let impacts = c.events_of(ContactEventKind::Impact).len();
         eprintln!("{run} μ = 0: Σ|E_j| = {e:.6} J, residual {rel:.2e}, {impacts} impacts losing {lost:.4e} J, {} events", c.events.len());
         assert!(impacts > 0 && lost > 0.0, "{run}: events {:?}", c.events);
-        assert!((lost - logged).abs() <= 1e-9 * lost, "{run}: impact loss {lost} J in the state, {logged} J in the events");
-        assert!(rel <= 1e-8, "{run}: residual {rel:e} of {e} J");
+        impacts_obey_newtons_law(run, &c.events, 0.0);
+        assert!(rel <= 1e-10, "{run}: residual {rel:e} of {e} J");
     }
 }
 
 /// The whole-arm table: elbows that sag touch down with speed: impacts, whose losses close the
-/// balance (and at least one impact happens, or the case tests nothing).
+/// balance (and at least one impact happens, or the case tests nothing); every impact obeys
+/// Newton's law with its logged loss the work of its impulse.
 #[test]
 fn the_balance_closes_with_impacts_under_a_table_under_the_whole_arm() {
     let s = tight(&scene("paper_table.json"));
@@ -94,11 +113,10 @@ fn the_balance_closes_with_impacts_under_a_table_under_the_whole_arm() {
     let (rel, e) = balance(&c);
     let impacts = c.events_of(ContactEventKind::Impact).len() + c.events_of(ContactEventKind::Rest).len();
     let lost: f64 = c.samples.last().unwrap().contacts.iter().map(|k| k.impact_loss).sum();
-    let logged: f64 = c.events.iter().map(|e| e.energy_lost).sum();
     eprintln!("table: Σ|E_j| = {e:.6} J, residual {rel:.2e}, {impacts} impacts losing {lost:.3e} J, {} events", c.events.len());
-    assert!(impacts > 0, "no impact: events {:?}", c.events);
-    assert!(lost > 0.0 && (lost - logged).abs() <= 1e-9 * lost.max(1e-12), "impact loss {lost} J in the state, {logged} J in the events");
-    assert!(rel <= 1e-8, "residual {rel:e} of {e} J");
+    assert!(impacts > 0 && lost > 0.0, "no impact: events {:?}", c.events);
+    impacts_obey_newtons_law("table", &c.events, 0.0);
+    assert!(rel <= 1e-10, "residual {rel:e} of {e} J");
 }
 
 /// The paper's question, answered (run by hand: `cargo test -p sim --release --test

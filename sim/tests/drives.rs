@@ -2,8 +2,8 @@
 //! bound or a closed form, on the small arm (`scenes/small`) varied per test:
 //!
 //! - voltage saturation: the recorded |v| ≤ limit exactly, and the run says it saturated;
-//! - current limit: |i| ≤ I exactly for quasi-static motors, within 1e-6 relative for inductive
-//!   ones (the barrier `di/dt ≤ 0` at i = ±I holds up to the integration error);
+//! - current limit: |i| ≤ I exactly for quasi-static motors, within 1e-12 relative for inductive
+//!   ones (the barrier `di/dt ≤ 0` at i = ±I holds; the dense output's rounding at the limit);
 //! - a joint crossing a tight URDF limit is flagged (report, `result` and `limits` records,
 //!   status text); a soft stop holds it near the limit;
 //! - the energy balance closes to ≤ 1e-6 of the electric energy with each new part (saturation,
@@ -144,7 +144,7 @@ fn current_limit_bounds_the_current() {
     let lim = r.limits.unwrap();
     assert!(lim.events.iter().any(|e| e.kind == "current-limit"), "{lim:?}");
     assert!(!lim.events.iter().any(|e| e.kind == "current"), "the current exceeded its limit: {lim:?}");
-    // inductive motors: the barrier, up to the integration error (rtol 1e-9)
+    // inductive motors: the barrier holds to rounding (TESTING.md: ≤ I (1 + 1e-12))
     let ind = vary(|s| {
         with_step(s);
         s.motor.current_limit = Some(PerJoint::All(i_max));
@@ -152,7 +152,7 @@ fn current_limit_bounds_the_current() {
     let r = record(&ind, "free");
     let peak = (0..4).map(|j| max_abs(&r, |m| &m.current, j)).fold(0.0, f64::max);
     eprintln!("inductive current peak {peak:.15} (limit {i_max})");
-    assert!(peak <= i_max * (1.0 + 1e-6), "inductive: |i| = {peak} > {i_max} (1 + 1e-6)");
+    assert!(peak <= i_max * (1.0 + 1e-12), "inductive: |i| = {peak} > {i_max} (1 + 1e-12)");
     assert!(peak > 0.99 * i_max, "inductive: the limit was not approached ({peak}): the test does not test");
     assert!(balance(&r) <= 1e-6, "inductive: balance {:.2e}", balance(&r));
     assert_eq!(r.result.limits_exceeded, Some(0));
@@ -219,7 +219,8 @@ fn a_run_crossing_a_joint_limit_is_flagged_and_a_stop_holds_it() {
     let ev2 = r.report.limits.as_ref().unwrap().events.iter().find(|e| e.joint == "joint4" && e.kind.name() == "position").cloned().expect("still flagged");
     let tau_max = max_abs(&r, |m| &m.torque, 3);
     eprintln!("flag: {ev:?}; stop: {ev2:?}; |tau4| max {tau_max}");
-    assert!(ev2.peak - hi <= tau_max / k * 1.5 + 1e-3, "overshoot {} with |τ| ≤ {tau_max}", ev2.peak - hi);
+    // (measured: 0.047 rad against 1.5 · 94.3 / 2000 = 0.071 rad; no absolute slack)
+    assert!(ev2.peak - hi <= tau_max / k * 1.5, "overshoot {} with |τ| ≤ {tau_max}", ev2.peak - hi);
     assert!(ev2.peak - hi < (ev.peak - hi) / 2.0, "the stop did not hold: {} vs {}", ev2.peak - hi, ev.peak - hi);
     let terms = r.terms.clone().expect("energy_terms record");
     assert!(terms.stop_loss.unwrap() > 0.0 && terms.emf_conversion.is_none());

@@ -1,7 +1,8 @@
 //! Properties that hold for every input, checked on generated inputs (proptest):
 //!
 //! - on random chains and branching trees (1–16 joints, random axes, placements and physically
-//!   valid inertias; `dynamics::samples`) at random states: M is symmetric positive definite,
+//!   valid inertias; `dynamics::samples`), all revolute or mixed (about a third of the joints
+//!   prismatic), at random states: M is symmetric positive definite,
 //!   Walker–Orin's M equals CRBA's, `M q'' + bias = RNEA(q, q', q'')`, and a point's Jacobian is
 //!   the derivative of its position (central differences) — 256 cases each;
 //! - on random variations of the small scene (motor constants, gains, damping, gear, gravity,
@@ -18,17 +19,19 @@ use proptest::prelude::*;
 use sim::dynamics::crba::crba;
 use sim::dynamics::kinematics::{forward_kinematics, BodyPoint};
 use sim::dynamics::rnea::{bias_forces, rnea};
-use sim::dynamics::samples::{random_branching_tree, random_chain, SplitMix64};
+use sim::dynamics::samples::{random_branching_tree, random_chain, random_mixed_chain, random_mixed_tree, SplitMix64};
 use sim::dynamics::walker_orin;
 use sim::dynamics::{Data, Model};
 use sim::scene::spec::PerJoint;
 use sim::scene::Scene;
 
-fn model(n: usize, seed: u64, tree: bool) -> Model {
-    if tree {
-        random_branching_tree(n, seed)
-    } else {
-        random_chain(n, seed)
+/// A random chain or tree of `n` joints, revolute only or `mixed` (about a third prismatic).
+fn model(n: usize, seed: u64, tree: bool, mixed: bool) -> Model {
+    match (tree, mixed) {
+        (false, false) => random_chain(n, seed),
+        (true, false) => random_branching_tree(n, seed),
+        (false, true) => random_mixed_chain(n, seed),
+        (true, true) => random_mixed_tree(n, seed),
     }
 }
 
@@ -44,8 +47,8 @@ proptest! {
     /// its smallest pivot is positive), from CRBA and from Walker–Orin alike, and the two agree
     /// to 1e-12 of the largest entry (both are exact algorithms; rounding only).
     #[test]
-    fn mass_matrix_is_spd_and_both_algorithms_agree(n in 1usize..=16, seed in any::<u64>(), tree in any::<bool>()) {
-        let m = model(n, seed, tree);
+    fn mass_matrix_is_spd_and_both_algorithms_agree(n in 1usize..=16, seed in any::<u64>(), tree in any::<bool>(), mixed in any::<bool>()) {
+        let m = model(n, seed, tree, mixed);
         let mut data = Data::new(&m);
         let (q, _, _) = state(m.nv, seed);
         let a = crba(&m, &mut data, &q).clone();
@@ -62,8 +65,8 @@ proptest! {
     /// Inverse dynamics by RNEA equals `M q'' + h(q, q')` from CRBA and RNEA at q'' = 0, to 1e-10
     /// of the largest term (a sum of up to 16 chained products of rounded values).
     #[test]
-    fn crba_plus_bias_is_rnea(n in 1usize..=16, seed in any::<u64>(), tree in any::<bool>()) {
-        let m = model(n, seed, tree);
+    fn crba_plus_bias_is_rnea(n in 1usize..=16, seed in any::<u64>(), tree in any::<bool>(), mixed in any::<bool>()) {
+        let m = model(n, seed, tree, mixed);
         let mut data = Data::new(&m);
         let (q, qd, qdd) = state(m.nv, seed);
         let mass = crba(&m, &mut data, &q).clone();
@@ -75,11 +78,11 @@ proptest! {
     }
 
     /// A point's Jacobian (3 x nv) is the derivative of its world position: central differences
-    /// with h = 1e-6 rad agree to 1e-8 m/rad (their error h² |p'''| ≈ 1e-12 m plus rounding
+    /// with h = 1e-6 rad (m for a prismatic joint) agree to 1e-8 m/rad (their error h² |p'''| ≈ 1e-12 m plus rounding
     /// ε |p| / h ≈ 1e-10 m).
     #[test]
-    fn point_jacobian_is_the_derivative_of_the_position(n in 1usize..=16, seed in any::<u64>(), tree in any::<bool>()) {
-        let m = model(n, seed, tree);
+    fn point_jacobian_is_the_derivative_of_the_position(n in 1usize..=16, seed in any::<u64>(), tree in any::<bool>(), mixed in any::<bool>()) {
+        let m = model(n, seed, tree, mixed);
         let mut data = Data::new(&m);
         let (q, _, _) = state(m.nv, seed);
         let mut rng = SplitMix64(seed.rotate_left(17));

@@ -22,8 +22,10 @@ fn final_q(scene: &Scene, run: &str) -> (Vec<f64>, f64, f64) {
 
 /// L = 0 (the "mechanical" variant, no electrical states): the state has 4n + 2 components,
 /// the energy balance closes without a magnetic term (1e-6 of E), and the solution is the
-/// limit of the electrical model as L -> 0: the difference in the final angles shrinks about
-/// linearly with L (a singular perturbation of order L/R); checked at L/10 and L/100.
+/// limit of the electrical model as L -> 0: the difference in the final angles shrinks
+/// linearly with L (a singular perturbation of order L/R): from L/10 to L/100 by a factor
+/// 10^(1 ± 0.15), i.e. 7.1–14.1 (the observed order 1 ± 0.15, as the convergence tests state
+/// orders).
 #[test]
 fn quasi_static_motors_are_the_small_inductance_limit() {
     let qs = paper_with(|v| v["motor"]["inductance"] = 0.0.into());
@@ -39,7 +41,9 @@ fn quasi_static_motors_are_the_small_inductance_limit() {
         q.iter().zip(&q0).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
     };
     let (d10, d100) = (diff(0.0017 / 10.0), diff(0.0017 / 100.0));
-    assert!(d100 < d10 / 5.0 && d100 < 1e-3, "L/10: {d10:e}, L/100: {d100:e}");
+    let order = (d10 / d100).log10();
+    eprintln!("L -> 0: L/10 {d10:e}, L/100 {d100:e}, observed order {order:.3}");
+    assert!((order - 1.0).abs() <= 0.15 && d100 < 1e-3, "L/10: {d10:e}, L/100: {d100:e}: order {order}");
 }
 
 /// Without friction and gravity the reduced terms are skipped and the energy still balances.

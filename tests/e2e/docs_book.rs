@@ -509,8 +509,7 @@ fn no_file_names_a_path_of_the_machine_it_was_written_on() {
     let files: Vec<PathBuf> = match o {
         Ok(o) if o.status.success() => o.stdout.split(|b| *b == 0).filter(|s| !s.is_empty()).map(|s| root().join(String::from_utf8_lossy(s).as_ref())).collect(),
         _ => {
-            eprintln!("no_file_names_a_path_of_the_machine: not a git checkout, nothing to list");
-            assert!(std::env::var_os("CI").is_none(), "CI runs on a clone: git ls-files must work");
+            crate::skip::skip("docs_book::no_file_names_a_path_of_the_machine_it_was_written_on", "not a git checkout (`git ls-files` failed), nothing to list");
             return;
         }
     };

@@ -24,6 +24,7 @@ mod sim_list;
 mod sim_output;
 mod sim_sweep;
 mod sim_table;
+mod skip;
 mod test_binaries;
 
 /// Runs `analyze` with `args`.

@@ -5,7 +5,8 @@
 //! and contacts of the recording, with one row per recorded sample, on a duration timeline.
 //!
 //! The Python is `ELBOW_RERUN_PYTHON` (default `~/.cache/elbow-sim/venv-check/bin/python`, the
-//! venv of `.ci/run`); without it the test fails under CI (`CI` set) and is skipped otherwise.
+//! venv of `.ci/run`); without it the test fails under CI and is skipped otherwise with a
+//! visible `SKIPPED` line (`skip.rs`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -55,20 +56,17 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The Python with rerun-sdk 0.41, or `None` (skipped) when it is missing and `CI` is not set.
-fn rerun_python() -> Option<PathBuf> {
+/// The Python with rerun-sdk 0.41, or `None` when it is missing (the policy of `skip.rs`).
+fn rerun_python(test: &str) -> Option<PathBuf> {
     let p = std::env::var_os("ELBOW_RERUN_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(std::env::var_os("HOME").unwrap_or_default()).join(".cache/elbow-sim/venv-check/bin/python"));
     let works = Command::new(&p).args(["-c", "import rerun.chunk"]).output().is_ok_and(|o| o.status.success());
-    match (works, std::env::var_os("CI").is_some()) {
-        (true, _) => Some(p),
-        (false, true) => panic!("{}: no Python with rerun-sdk 0.41 (set ELBOW_RERUN_PYTHON); CI needs it for this test", p.display()),
-        (false, false) => {
-            eprintln!("rerun_view: skipped: {} has no rerun-sdk 0.41 (set ELBOW_RERUN_PYTHON, or make the venv of .ci/run)", p.display());
-            None
-        }
+    if works {
+        return Some(p);
     }
+    crate::skip::skip(test, &format!("{} has no rerun-sdk 0.41 (set ELBOW_RERUN_PYTHON, or make the venv as .ci/run does)", p.display()));
+    None
 }
 
 fn facts(python: &Path, rrd: &Path) -> Facts {
@@ -142,7 +140,7 @@ fn check(python: &Path, mcap: &Path, rrd: &Path) -> Facts {
 
 #[test]
 fn rerun_reads_the_blueprint_and_named_scalars_of_a_paper_and_a_unilateral_recording() {
-    let Some(python) = rerun_python() else { return };
+    let Some(python) = rerun_python("rerun_view::rerun_reads_the_blueprint_and_named_scalars_of_a_paper_and_a_unilateral_recording") else { return };
     let dir = tempfile::tempdir().unwrap();
 
     // the paper's two-elbow run (bilateral: /constraints)

@@ -154,13 +154,14 @@ fn an_unwritable_recording_exits_2_naming_the_path_and_the_reason() {
 /// A full disk: `sim` writes into a 64 KiB tmpfs (mounted in a private user and mount
 /// namespace with `unshare -rm`, so no root is needed) and must exit 2 with "No space left on
 /// device" and the path, leaving nothing in the directory. Where user namespaces are not
-/// available the test says so and checks nothing (the rename failure above and the ENOSPC test
-/// of `schemas::writer` still run).
+/// available the test checks nothing and says so with a visible `SKIPPED` line, and fails
+/// under CI (`skip.rs`; the rename failure above and the ENOSPC test of `schemas::writer` still
+/// run).
 #[test]
 fn a_full_disk_exits_2_with_enospc_and_leaves_nothing() {
     let probe = Command::new("unshare").args(["-rm", "sh", "-c", "mount -t tmpfs -o size=64k tmpfs /tmp && echo ok"]).output();
     if !probe.is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "ok") {
-        eprintln!("skipped: `unshare -rm` with a tmpfs mount is not available here");
+        crate::skip::skip("sim_output::a_full_disk_exits_2_with_enospc_and_leaves_nothing", "`unshare -rm` with a tmpfs mount is not available here (user namespaces)");
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -230,11 +231,12 @@ fn other_outputs_report_io_errors_with_path_and_reason() {
 }
 
 /// Standard output on a full disk (`/dev/full`, where every write fails with ENOSPC) is an I/O
-/// error too: exit 2 and the OS reason, in both tools.
+/// error too: exit 2 and the OS reason, in both tools. Without `/dev/full`, skipped by the
+/// policy of `skip.rs`.
 #[test]
 fn a_full_standard_output_exits_2_with_enospc() {
     let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
-        eprintln!("skipped: no /dev/full here");
+        crate::skip::skip("sim_output::a_full_standard_output_exits_2_with_enospc", "no /dev/full here");
         return;
     };
     let o = sim().arg("check").arg(small_scene()).stdout(full).output().unwrap();
