@@ -72,7 +72,7 @@ part_recordings() {
 
 # Damaged copies of a real recording and hostile files, then every command on each.
 part_commands() {
-  local n=$((2000 / scale)) d="$work/commands"
+  local n=$((500 / scale)) d="$work/commands"
   mkdir -p "$d/in" "$d/out"
   "$SIM" run "$small" --run free --duration 0.5 --quiet -o "$d/good" > /dev/null
   local good
