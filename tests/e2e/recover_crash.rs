@@ -125,5 +125,5 @@ fn a_killed_sim_leaves_a_partial_file_that_recovers() {
     let name = file.file_name().unwrap().to_str().unwrap().to_string();
     assert!(name.starts_with(".paper-two-elbow.mcap.") && name.ends_with(".partial"), "{name}");
     let t_end = check_recovered(&file, &intact);
-    assert!(t_end >= 0.5 && t_end < 10.0, "recovered to {t_end} s");
+    assert!((0.5..10.0).contains(&t_end), "recovered to {t_end} s");
 }
