@@ -20,7 +20,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::metrics::{RunMetrics, Status};
+use crate::metrics::{AxisError, HandError, RunMetrics, Status};
 use crate::Error;
 
 /// Ratios of one run to the baseline (`run / baseline`).
@@ -43,6 +43,12 @@ pub struct Ratios {
 pub struct RunComparison {
     pub metrics: RunMetrics,
     pub to_baseline: Ratios,
+    /// Why this run is not compared with the baseline (its ratios are `None`, and it is in no
+    /// ranking, claim or gap): it failed before its first sample, or it covers another
+    /// interval than the baseline (e.g. stopped at 1.33 s of 5 s: totals over different
+    /// durations are not comparable). `None` for a run that is compared.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub not_compared: Option<String>,
 }
 
 /// One link of one run in the per-link table.
@@ -85,33 +91,53 @@ pub struct Comparison {
 
 impl Comparison {
     /// Compares `runs` (kept in order) against `baseline`: a run name, a file path or a file
-    /// stem; `None` picks the first run without contacts, else the first run.
+    /// stem; `None` picks the first run without contacts that has numbers, else the first run
+    /// with numbers. Only runs over the baseline's interval (the same `t_end_s`, to
+    /// [`SAME_END`]) are compared: the others keep their row, with no ratios and a reason
+    /// ([`RunComparison::not_compared`]), and stay out of the rankings and claims.
     pub fn new(runs: &[RunMetrics], baseline: Option<&str>) -> Result<Self, Error> {
         if runs.is_empty() {
             return Err(Error::NoRuns);
         }
         let base = match baseline {
-            Some(name) => find_run(runs, name).ok_or_else(|| Error::UnknownBaseline {
-                name: name.into(),
-                available: runs.iter().map(|r| r.run.clone()).collect(),
-            })?,
-            None => runs.iter().position(|r| r.contacts.is_empty()).unwrap_or(0),
+            Some(name) => {
+                let k = find_run(runs, name).ok_or_else(|| Error::UnknownBaseline {
+                    name: name.into(),
+                    available: runs.iter().map(|r| r.run.clone()).collect(),
+                })?;
+                if !runs[k].measured() {
+                    return Err(Error::UnmeasuredBaseline { name: name.into(), file: runs[k].file.clone(), why: failure(&runs[k]) });
+                }
+                k
+            }
+            None => runs
+                .iter()
+                .position(|r| r.contacts.is_empty() && r.measured())
+                .or_else(|| runs.iter().position(RunMetrics::measured))
+                .unwrap_or(0),
         };
         let b = &runs[base];
+        let why_not: Vec<Option<String>> = runs.iter().map(|r| not_compared(r, b)).collect();
         let with_ratios = runs
             .iter()
-            .map(|r| RunComparison {
+            .zip(&why_not)
+            .map(|(r, why)| RunComparison {
                 metrics: r.clone(),
-                to_baseline: Ratios {
-                    electric_energy: ratio(r.electric_energy_total_j, b.electric_energy_total_j),
-                    link_work: ratio(r.link_work_total_j, b.link_work_total_j),
-                    error_z_rms: ratio(r.hand_error.z.rms_m, b.hand_error.z.rms_m),
-                    error_norm_rms: ratio(r.hand_error.norm.rms_m, b.hand_error.norm.rms_m),
+                to_baseline: match why {
+                    Some(_) => Ratios { electric_energy: None, link_work: None, error_z_rms: None, error_norm_rms: None },
+                    None => Ratios {
+                        electric_energy: ratio(r.e_total(), b.e_total()),
+                        link_work: ratio(r.w_total(), b.w_total()),
+                        error_z_rms: ratio(r.hand().z.rms_m, b.hand().z.rms_m),
+                        error_norm_rms: ratio(r.hand().norm.rms_m, b.hand().norm.rms_m),
+                    },
                 },
+                not_compared: why.clone(),
             })
             .collect();
-        let links = link_table(runs, base);
-        let findings = findings(runs, base, &links);
+        let compared: Vec<bool> = why_not.iter().map(Option::is_none).collect();
+        let links = link_table(runs, base, &compared);
+        let findings = findings(runs, base, &links, &why_not);
         Ok(Self {
             baseline: b.run.clone(),
             baseline_index: base,
@@ -120,11 +146,97 @@ impl Comparison {
             findings,
         })
     }
+
+    /// The runs compared with the baseline (measured, over its interval), in order, and the
+    /// baseline's index among them.
+    pub(crate) fn compared(&self) -> (Vec<RunMetrics>, usize) {
+        let mut base = 0;
+        let mut out = Vec::new();
+        for (k, r) in self.runs.iter().enumerate() {
+            if k == self.baseline_index {
+                base = out.len();
+            }
+            if r.not_compared.is_none() {
+                out.push(r.metrics.clone());
+            }
+        }
+        (out, base)
+    }
+}
+
+/// Two runs cover the same interval when their last samples are this close, relative to
+/// `max(1, t_end)` s (the tolerance of [`claims`]' pairs).
+pub const SAME_END: f64 = 1e-9;
+
+/// "failed at t = 0.000 s (reason)", from the run's `result` record.
+pub(crate) fn failure(r: &RunMetrics) -> String {
+    let at = r.error_time_s.map_or(String::new(), |t| format!(" at t = {t:.3} s"));
+    format!("{}{at} ({})", crate::render::status(r.status), r.error.as_deref().unwrap_or("no reason recorded"))
+}
+
+/// Why `r` is not compared with the baseline `b` ([`RunComparison::not_compared`]).
+fn not_compared(r: &RunMetrics, b: &RunMetrics) -> Option<String> {
+    match (r.t_end_s, b.t_end_s) {
+        (None, _) => Some(format!("{}: no sample, so no numbers to compare", failure(r))),
+        (Some(_), None) => Some(format!("the baseline {} has no numbers ({})", b.run, failure(b))),
+        (Some(t), Some(tb)) if (t - tb).abs() > SAME_END * tb.abs().max(1.0) => {
+            let why = if r.status == Status::Complete { String::new() } else { format!(", {}", failure(r)) };
+            Some(format!(
+                "it ran to t = {} s{why}, the baseline {} to {} s: totals and RMS over different durations are not compared",
+                crate::render::short_num(t),
+                b.run,
+                crate::render::short_num(tb)
+            ))
+        }
+        _ => None,
+    }
+}
+
+/// The numbers of a run that the comparison ranks and divides, for runs that have them: only
+/// runs with samples are compared ([`Comparison::new`]), so the NaN of a run without them
+/// never reaches a ratio, a ranking or an output.
+pub(crate) trait Measured {
+    fn hand(&self) -> &HandError;
+    fn e_total(&self) -> f64;
+    fn w_total(&self) -> f64;
+    fn audit_rel(&self) -> Option<f64>;
+    fn t_end(&self) -> f64;
+}
+
+const NO_AXIS: AxisError = AxisError { rms_m: f64::NAN, max_abs_m: f64::NAN, t_max_s: f64::NAN };
+const NO_HAND: HandError = HandError { x: NO_AXIS, y: NO_AXIS, z: NO_AXIS, norm: NO_AXIS };
+
+impl Measured for RunMetrics {
+    fn hand(&self) -> &HandError {
+        self.hand_error.as_ref().unwrap_or(&NO_HAND)
+    }
+    fn e_total(&self) -> f64 {
+        self.electric_energy_total_j.unwrap_or(f64::NAN)
+    }
+    fn w_total(&self) -> f64 {
+        self.link_work_total_j.unwrap_or(f64::NAN)
+    }
+    fn audit_rel(&self) -> Option<f64> {
+        self.energy.as_ref().and_then(|e| e.max_abs_residual_rel)
+    }
+    fn t_end(&self) -> f64 {
+        self.t_end_s.unwrap_or(f64::NAN)
+    }
+}
+
+/// `x` with `d` decimals, in scientific notation from 1e6 on (a fixed-point 4e302 would be a
+/// 300-digit number in a sentence).
+pub(crate) fn fixed(x: f64, d: usize) -> String {
+    if x.is_finite() && x.abs() >= 1e6 {
+        format!("{x:.d$e}")
+    } else {
+        format!("{x:.d$}")
+    }
 }
 
 /// `x / base`, if both are finite and `base != 0`.
 fn ratio(x: f64, base: f64) -> Option<f64> {
-    (x.is_finite() && base.is_finite() && base != 0.0).then(|| x / base)
+    Some(x / base).filter(|q| x.is_finite() && base.is_finite() && base != 0.0 && q.is_finite())
 }
 
 /// The run called `name`, else the one read from file `name`, else whose file stem is `name`.
@@ -143,7 +255,7 @@ fn find_run(runs: &[RunMetrics], name: &str) -> Option<usize> {
         })
 }
 
-fn link_table(runs: &[RunMetrics], base: usize) -> Vec<LinkComparison> {
+fn link_table(runs: &[RunMetrics], base: usize, compared: &[bool]) -> Vec<LinkComparison> {
     let mut joints: Vec<&str> = Vec::new();
     for l in runs.iter().flat_map(|r| &r.links) {
         if !joints.contains(&l.joint.as_str()) {
@@ -153,7 +265,7 @@ fn link_table(runs: &[RunMetrics], base: usize) -> Vec<LinkComparison> {
     let find = |r: &RunMetrics, j: &str| r.links.iter().find(|l| l.joint == j).cloned();
     // a link whose baseline energy is a rounding residue of the run's (a joint that never
     // moved) has no meaningful ratio
-    let floor = 1e-9 * runs[base].electric_energy_total_j.abs();
+    let floor = 1e-9 * runs[base].e_total().abs();
     joints
         .into_iter()
         .map(|joint| {
@@ -162,12 +274,13 @@ fn link_table(runs: &[RunMetrics], base: usize) -> Vec<LinkComparison> {
                 .filter(|b| b.abs() > floor);
             let cells = runs
                 .iter()
-                .map(|r| {
+                .zip(compared)
+                .map(|(r, &compared)| {
                     find(r, joint).map(|l| LinkCell {
                         run: r.run.clone(),
                         work_j: l.work_j,
                         electric_energy_j: l.electric_energy_j,
-                        electric_energy_ratio: base_e.and_then(|b| ratio(l.electric_energy_j, b)),
+                        electric_energy_ratio: base_e.filter(|_| compared).and_then(|b| ratio(l.electric_energy_j, b)),
                     })
                 })
                 .collect();
@@ -179,9 +292,9 @@ fn link_table(runs: &[RunMetrics], base: usize) -> Vec<LinkComparison> {
         .collect()
 }
 
-fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<String> {
+fn findings(all: &[RunMetrics], base: usize, links: &[LinkComparison], why_not: &[Option<String>]) -> Vec<String> {
     let mut out = Vec::new();
-    let b = &runs[base];
+    let b = &all[base];
     let reason = if b.contacts.is_empty() {
         "no contacts"
     } else {
@@ -191,16 +304,24 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
         "Baseline: {} ({reason}); ratios are run / baseline.",
         b.run
     ));
-    for r in runs.iter().filter(|r| r.status == Status::Failed) {
-        let at = r
-            .error_time_s
-            .map_or(String::new(), |t| format!(" at t = {t:.3} s"));
-        let why = r.error.as_deref().unwrap_or("no reason recorded");
-        out.push(format!(
-            "{} did not complete: failed{at} ({why}); its totals stop at t = {:.3} s.",
-            r.run, r.t_end_s
-        ));
+    for r in all.iter().filter(|r| r.status == Status::Failed) {
+        match r.t_end_s {
+            Some(t) => out.push(format!("{} did not complete: {}; its totals stop at t = {t:.3} s.", r.run, failure(r))),
+            None => out.push(format!("{} did not complete: {}; it has no sample, so no numbers.", r.run, failure(r))),
+        }
     }
+    // (a run without samples is named above: it has no numbers to leave out)
+    for (r, why) in all.iter().zip(why_not).filter(|(r, _)| r.measured()) {
+        if let Some(why) = why {
+            out.push(format!("{} is not compared with the baseline (no ratios, not ranked): {why}.", r.run));
+        }
+    }
+    // the rankings, claims and gaps below are over the runs compared (measured, over the
+    // baseline's interval); the per-run facts over every run with numbers
+    let measured: Vec<RunMetrics> = all.iter().filter(|r| r.measured()).cloned().collect();
+    let runs = &measured[..];
+    let compared_index: Vec<usize> = (0..all.len()).filter(|&k| why_not[k].is_none()).collect();
+    let compared: Vec<RunMetrics> = compared_index.iter().map(|&k| all[k].clone()).collect();
     for r in runs.iter() {
         let Some(l) = r.limits.as_ref().filter(|l| !l.events.is_empty()) else { continue };
         let list: Vec<String> = l
@@ -241,27 +362,31 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
     for r in runs.iter().filter(|r| r.status == Status::Incomplete) {
         out.push(format!(
             "{} is incomplete (recovered from a damaged recording): its totals stop at t = {:.3} s.",
-            r.run, r.t_end_s
+            r.run, r.t_end()
         ));
     }
 
-    // least energy, smallest z error
+    // least energy, smallest z error (over the runs compared; none when no run has numbers)
+    let Some(cbase) = compared_index.iter().position(|&k| k == base) else {
+        return out;
+    };
     let argmin = |v: &dyn Fn(&RunMetrics) -> f64| {
-        (0..runs.len())
-            .min_by(|&i, &j| v(&runs[i]).total_cmp(&v(&runs[j])))
+        (0..compared.len())
+            .min_by(|&i, &j| v(&compared[i]).total_cmp(&v(&compared[j])))
             .unwrap_or(0)
     };
-    let e = argmin(&|r| r.electric_energy_total_j);
-    let r = &runs[e];
-    let rel = ratio(r.electric_energy_total_j, b.electric_energy_total_j)
+    let e = argmin(&|r| r.e_total());
+    let r = &compared[e];
+    let rel = ratio(r.e_total(), b.e_total())
         .map_or(String::new(), |x| format!(", {x:.3} × baseline"));
     out.push(format!(
-        "Least total electric energy: {} ({:.3} J{rel}).",
-        r.run, r.electric_energy_total_j
+        "Least total electric energy: {} ({} J{rel}).",
+        r.run,
+        fixed(r.e_total(), 3)
     ));
-    let z = argmin(&|r| r.hand_error.z.rms_m);
-    let r = &runs[z];
-    let (rms, max) = (r.hand_error.z.rms_m * 1e3, r.hand_error.z.max_abs_m * 1e3);
+    let z = argmin(&|r| r.hand().z.rms_m);
+    let r = &compared[z];
+    let (rms, max) = (r.hand().z.rms_m * 1e3, r.hand().z.max_abs_m * 1e3);
     out.push(format!(
         "Smallest z error: {} (RMS {rms:.3} mm, max {max:.3} mm).",
         r.run
@@ -269,11 +394,11 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
 
     // the paper's claim, per scene, over runs ordered by the number of contacts that carried the
     // arm; then how it changes when the table can only push
-    let verdicts = claims::claim_findings(runs, &mut out);
-    out.extend(claims::table_pairs(runs, base, &verdicts));
+    let verdicts = claims::claim_findings(&compared, &mut out);
+    out.extend(claims::table_pairs(&compared, cbase, &verdicts));
 
     // largest per-link electric-energy gaps to the baseline
-    for (k, r) in runs.iter().enumerate().filter(|&(k, _)| k != base) {
+    for (k, r) in all.iter().enumerate().filter(|&(k, _)| k != base && why_not[k].is_none()) {
         let mut gaps: Vec<(&str, f64, Option<f64>)> = links
             .iter()
             .filter_map(|l| match (&l.runs[k], &l.runs[base]) {
@@ -291,7 +416,9 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
             .take(3)
             .map(|(j, d, q)| {
                 format!(
-                    "{j} {d:+.3} J{}",
+                    "{j} {}{} J{}",
+                    if *d >= 0.0 { "+" } else { "" },
+                    fixed(*d, 3),
                     q.map_or(String::new(), |q| format!(" ({:+.1} %)", (q - 1.0) * 100.0))
                 )
             })
@@ -354,7 +481,7 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
                 r.run,
                 c.contact,
                 c.time_in_contact_s,
-                r.t_end_s,
+                r.t_end(),
                 ev.lift_offs,
                 ev.touch_downs,
                 ev.impacts,
@@ -372,7 +499,7 @@ fn findings(runs: &[RunMetrics], base: usize, links: &[LinkComparison]) -> Vec<S
 
     // energy balance
     let worst = (0..runs.len())
-        .filter_map(|k| runs[k].energy.max_abs_residual_rel.map(|x| (k, x)))
+        .filter_map(|k| runs[k].audit_rel().map(|x| (k, x)))
         .max_by(|a, b| a.1.total_cmp(&b.1));
     if let Some((k, x)) = worst {
         out.push(format!(

@@ -153,7 +153,9 @@ pub struct EnergyAudit {
     pub max_abs_residual_j: f64,
     /// Time of that maximum, s.
     pub t_max_abs_residual_s: f64,
-    /// `max_abs_residual_j / |electric_j|`; `None` when no electric energy was drawn.
+    /// `max_abs_residual_j / |electric_j|`; `None` when no electric energy was drawn or the
+    /// quotient is not a finite number (a denominator of ~0: the absolute residual above is
+    /// the number to read; never `inf` or NaN).
     pub max_abs_residual_rel: Option<f64>,
 }
 
@@ -173,25 +175,28 @@ pub struct RunMetrics {
     pub joint_names: Vec<String>,
     /// Number of `/hand` messages.
     pub samples: usize,
-    /// Time of the last `/hand` message, s.
-    pub t_end_s: f64,
+    /// Time of the last `/hand` message, s; `None` when the run failed before its first sample
+    /// (e.g. at t = 0: no message at all).
+    pub t_end_s: Option<f64>,
     pub status: Status,
     /// Metadata `result.error`, if the run failed.
     pub error: Option<String>,
     /// Metadata `result.error_time`, s, if the run failed and the time is known.
     pub error_time_s: Option<f64>,
-    pub hand_error: HandError,
-    /// One per joint, in `joint_names` order.
+    /// `None` when the run failed before its first sample (so for every number below: absent,
+    /// never made up; `null` in JSON).
+    pub hand_error: Option<HandError>,
+    /// One per joint, in `joint_names` order; empty when the run failed before its first sample.
     pub links: Vec<LinkMetrics>,
     /// `Σ_j W_j` at the end (recorded total), J.
-    pub link_work_total_j: f64,
+    pub link_work_total_j: Option<f64>,
     /// `Σ_j E_j` at the end (recorded total), J.
-    pub electric_energy_total_j: f64,
+    pub electric_energy_total_j: Option<f64>,
     /// `None` only for a run without motors.
     pub peak_current: Option<PeakCurrent>,
-    /// One per contact, in `contacts` order.
+    /// One per contact, in `contacts` order; empty when the run failed before its first sample.
     pub contact_forces: Vec<ContactMetrics>,
-    pub energy: EnergyAudit,
+    pub energy: Option<EnergyAudit>,
     /// What the limits monitor found (metadata `limits`), for runs whose scene monitors
     /// joint or drive limits; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -221,6 +226,38 @@ pub struct LimitsMetrics {
 }
 
 impl RunMetrics {
+    /// A run that failed before its first sample: its names, status, error and time from the
+    /// metadata, and no numbers (`samples` = 0, every measured value `None` or empty).
+    pub fn without_samples(file: String, run: schemas::RunDescription, status: Status, error: Option<String>, error_time_s: Option<f64>) -> Self {
+        RunMetrics {
+            file,
+            scene: run.scene,
+            run: run.run,
+            contacts: run.contacts,
+            joint_names: run.joint_names,
+            samples: 0,
+            t_end_s: None,
+            status,
+            error,
+            error_time_s,
+            hand_error: None,
+            links: Vec::new(),
+            link_work_total_j: None,
+            electric_energy_total_j: None,
+            peak_current: None,
+            contact_forces: Vec::new(),
+            energy: None,
+            limits: None,
+            energy_terms: None,
+            contact_states: Vec::new(),
+        }
+    }
+
+    /// Whether the run has numbers (it did not fail before its first sample).
+    pub fn measured(&self) -> bool {
+        self.samples > 0
+    }
+
     /// The status with what the limits monitor found: "complete", "complete, 3 limits
     /// exceeded", "complete, 1 saturation" (never silent about a limit).
     pub fn status_text(&self) -> String {

@@ -2,7 +2,10 @@
 //!
 //! - [`Format::Table`]: aligned text in sections (runs, hand error in mm, energy totals,
 //!   per-link energy `W_j`/`E_j` at the end, contacts, energy balance, findings), units in the
-//!   headers, `-` where a value does not exist (e.g. a ratio to a zero baseline).
+//!   headers, `-` where a value does not exist (e.g. a ratio to a zero baseline), `—` for the
+//!   numbers of a run that has none (it failed before its first sample); never `inf` or `NaN`,
+//!   and scientific notation from 10^6 on (no 300-digit cell). A run not compared with the
+//!   baseline (another interval: [`crate::compare::RunComparison::not_compared`]) is marked `†`.
 //! - [`Format::Json`]: the serde form of the structs, pretty-printed; keys are the field names
 //!   and stable. Non-finite numbers come out as `null` (serde_json's rule), so only finite
 //!   values round-trip.
@@ -16,7 +19,8 @@
 //!   `stick_to_slip.…`, `slip_to_stick.…` (counts), `impact_loss.elbow4_j`, `friction_work.…_j`,
 //!   `damping_loss.…_j`, `mu_stick.elbow4_ratio`, `mu_contact.…_ratio`, `fn_contact_min.…_n`,
 //!   `fn_contact_max.…_n`. Empty cells where a run lacks the joint or contact or the value does
-//!   not exist. Numbers use Rust's shortest round-trip form.
+//!   not exist (or is not finite). Numbers use Rust's shortest round-trip form, in scientific
+//!   notation below 1e-5 and from 1e16 on. A comparison ends with the column `not_compared`.
 //!
 //! Text fits a width when asked ([`render_comparison_fitted`], [`render_metrics_fitted`]: a
 //! terminal's): a wide table is split into column groups that each fit, titles and findings

@@ -55,7 +55,8 @@ pub fn read_run(path: &Path, check_from: f64, series: bool) -> Result<(RunMetric
         sampled: [0.0, check_from].map(|from| tee.samples.integrals(&rec, from).map_err(|e| e.to_string())),
     };
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let series = tee.series.map(|s| s.into_series(&rec, &stem)).transpose()?;
+    // a run that failed before its first sample has nothing to draw
+    let series = tee.series.filter(|_| metrics.measured()).map(|s| s.into_series(&rec, &stem)).transpose()?;
     Ok((metrics, info, series))
 }
 
@@ -240,14 +241,14 @@ pub fn render_report(
         let dash = |s: &Option<String>| s.clone().unwrap_or_else(|| "-".into());
         let _ = writeln!(
             out,
-            "| {} | `{}` | {} | {} | {} | {} | {:.3} |",
+            "| {} | `{}` | {} | {} | {} | {} | {} |",
             name,
             r.file,
             dash(&i.tool),
             i.format_version.map_or("-".into(), |v| v.to_string()),
             dash(&i.integrator),
             r.samples,
-            r.t_end_s
+            r.t_end_s.map_or("—".into(), |t| format!("{t:.3}"))
         );
     }
     out.push('\n');
@@ -308,7 +309,7 @@ fn contacts(out: &mut String, runs: &[&RunMetrics], labels: &[String]) {
                     s.friction_work_j,
                     s.stick_friction_needed.map_or("-".into(), |x| format!("{x:.3}")),
                 ),
-                None => format!("bilateral | {:.4} | {:.4} | {:.3} | - | - | - | - | -", r.t_end_s, c.pull_time_s, c.min_normal_force_n),
+                None => format!("bilateral | {:.4} | {:.4} | {:.3} | - | - | - | - | -", r.t_end_s.unwrap_or_default(), c.pull_time_s, c.min_normal_force_n),
             };
             let _ = writeln!(out, "| {name} | {} | {row} |", c.contact);
         }
@@ -329,7 +330,11 @@ fn audit(out: &mut String, runs: &[&RunMetrics], labels: &[String], info: &[RunI
     out.push_str("| run | E in | ΔT | ΔV | Δ(½Li²) | R loss | D loss | D_m loss | residual | max \\|residual\\| / E |\n");
     out.push_str("|:--|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n");
     for (r, name) in runs.iter().zip(labels) {
-        let a = &r.energy;
+        // a run that failed before its first sample has no balance: its row says so
+        let Some(a) = &r.energy else {
+            let _ = writeln!(out, "| {name} | — | — | — | — | — | — | — | — | — |");
+            continue;
+        };
         let split = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.4}"));
         let (d, dm) = match a.gear_friction_loss_j {
             Some(g) => (split(Some(a.friction_loss_j - g)), split(Some(g))),
@@ -377,7 +382,7 @@ fn audit(out: &mut String, runs: &[&RunMetrics], labels: &[String], info: &[RunI
                         out,
                         "| {name} | {}–{:.3} | {} | {de} | {ee} | {dw} | {ew} | {} |",
                         s.from_s,
-                        r.t_end_s,
+                        r.t_end_s.unwrap_or_default(),
                         s.dt_s,
                         if s.agrees() { "yes" } else { "**no**" }
                     );

@@ -81,6 +81,37 @@ fn row_of(metrics: RunMetrics, rec: &Recording, bytes: u64, params: &[String]) -
     })
 }
 
+/// A note when the rows cover different intervals (their `t_end_s` differ, or a run has none):
+/// totals and RMS are each over the run's own interval, so ranking them by a column compares
+/// unlike things. `None` when every run ends at the same time.
+pub fn duration_note(rows: &[SummaryRow]) -> Option<String> {
+    let ends: Vec<f64> = rows.iter().filter_map(|r| r.metrics.t_end_s).collect();
+    let (lo, hi) = ends.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+    let without = rows.iter().filter(|r| r.metrics.t_end_s.is_none()).count();
+    let differ = !ends.is_empty() && hi - lo > crate::compare::SAME_END * hi.abs().max(1.0);
+    if !differ && without == 0 {
+        return None;
+    }
+    let mut parts = Vec::new();
+    if differ {
+        let short: Vec<String> = rows
+            .iter()
+            .filter(|r| r.metrics.t_end_s.is_some_and(|t| hi - t > crate::compare::SAME_END * hi.abs().max(1.0)))
+            .map(|r| format!("{} ({}, t_end {} s)", r.metrics.run, r.metrics.status_text(), crate::render::short_num(r.metrics.t_end_s.unwrap_or_default())))
+            .collect();
+        parts.push(format!(
+            "the runs end at different times ({} to {} s; shorter: {}): each total and RMS is over its run's own interval, so rows with different t_end_s are not comparable and a sort by them does not rank like with like",
+            crate::render::short_num(lo),
+            crate::render::short_num(hi),
+            short.join(", ")
+        ));
+    }
+    if without > 0 {
+        parts.push(format!("{without} run(s) failed before their first sample and have no numbers (empty cells)"));
+    }
+    Some(format!("Note: {}.", parts.join("; ")))
+}
+
 /// A dot path (`controller.kp`, `contacts.0.plane.offset`) or a JSON pointer (`/controller/kp`,
 /// RFC 6901) as a JSON pointer.
 pub fn json_pointer(path: &str) -> String {

@@ -93,8 +93,8 @@ fn friction_loss_splits_into_joint_and_gear_parts() {
     let path = dir.path().join("no-elbow.mcap");
     sim::run::run_to_file(&scene, &run, &path, |_| {}).unwrap();
     let m = analyze::read_run_metrics(&path).unwrap();
-    let gear = m.energy.gear_friction_loss_j.expect("format 2 records the gear part");
-    let total = m.energy.friction_loss_j;
+    let gear = m.energy.as_ref().unwrap().gear_friction_loss_j.expect("format 2 records the gear part");
+    let total = m.energy.as_ref().unwrap().friction_loss_j;
     assert!(total > 0.0);
     assert!((gear / total - dm / (d + dm)).abs() < 1e-9, "{gear} of {total}, D = {d}, D_m = {dm}");
 }

@@ -155,3 +155,76 @@ fn in_a_terminal_every_table_fits_its_width() {
     let piped = run(Command::new(sim).args(["--quiet", "--duration", "0.3", "-f", "json", "-o"]).arg(dir.path()));
     assert_eq!(json(&in_terminal(60, "-f json")), json(&piped));
 }
+
+/// `sim run`'s own table has every run (issue 29, item 3): a run that failed at t = 0 (nine
+/// closed rigid contacts, over the limit of 8; on main it was left out of the table without a
+/// line) is a row with its status and no numbers, in the brief table, the full one and JSON;
+/// the exit status is 1.
+#[test]
+fn sim_table_has_the_failed_run_with_its_status() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = crate::analyze_cli::nine_contacts_scene(dir.path(), 0.1);
+    let out = dir.path().join("out");
+    let sim = |extra: &[&str]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_sim")).arg("run").arg(&scene).arg("-o").arg(&out).args(extra).output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let brief = sim(&[]);
+    let row = brief.lines().find(|l| l.starts_with("nine")).unwrap_or_else(|| panic!("no row for the failed run:\n{brief}"));
+    assert!(row.contains("failed at 0.000 s") && row.contains('—'), "{row}");
+    assert!(brief.lines().any(|l| l.starts_with("free *")), "{brief}");
+    let full = sim(&["-v"]);
+    assert!(full.contains("more than 8 simultaneous rigid contacts"), "{full}");
+    let json: serde_json::Value = serde_json::from_str(&sim(&["-f", "json", "-q"])).unwrap();
+    let runs = json["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2, "{json}");
+    let nine = runs.iter().find(|r| r["metrics"]["run"] == "nine").unwrap();
+    assert_eq!(nine["metrics"]["status"], "failed");
+    assert!(nine["metrics"]["electric_energy_total_j"].is_null());
+}
+
+/// Motor and drive values outside their physical range are refused by validation, naming the
+/// file, the field and the value (issue 29, item 3: on main a current limit of 5e-324 A, a
+/// voltage limit of 1e-300 V or an inductance of 1e300 H ran "complete" with exit 0 and printed
+/// `inf` or a residual of 4e302).
+#[test]
+fn motor_values_outside_their_physical_range_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(root.join("sim/scenes/small/small.json")).unwrap()).unwrap();
+    for (field, value) in [
+        ("current_limit", serde_json::json!(5e-324)),
+        ("current_limit", serde_json::json!(1e-7)),
+        ("voltage_limit", serde_json::json!(1e-300)),
+        ("voltage_limit", serde_json::json!(1e300)),
+        ("inductance", serde_json::json!(1e300)),
+        ("inductance", serde_json::json!(1e-15)),
+        ("resistance", serde_json::json!(1e-300)),
+        ("resistance", serde_json::json!(1e9)),
+    ] {
+        let mut s = base.clone();
+        s.as_object_mut().unwrap().remove("$schema");
+        s["urdf"] = root.join("sim/scenes/small/small_arm.urdf").display().to_string().into();
+        s["motor"][field] = value.clone();
+        let path = dir.path().join(format!("{field}.json"));
+        std::fs::write(&path, serde_json::to_string(&s).unwrap()).unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_sim")).arg("check").arg(&path).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{field} = {value}: {err}");
+        let shown = format!("{}", value.as_f64().unwrap());
+        assert!(err.contains(&format!("motor.{field}")) && err.contains(&path.display().to_string()) && err.contains("physical range"), "{field} = {value}: {err}");
+        assert!(err.contains(&shown) || err.contains(&format!("{:e}", value.as_f64().unwrap())), "{field} = {value} ({shown}): {err}");
+    }
+    // the bounds themselves are accepted
+    let mut s = base.clone();
+    s.as_object_mut().unwrap().remove("$schema");
+    s["urdf"] = root.join("sim/scenes/small/small_arm.urdf").display().to_string().into();
+    s["motor"]["current_limit"] = 1e-6.into();
+    s["motor"]["voltage_limit"] = 1e-3.into();
+    s["motor"]["inductance"] = 1.0.into();
+    let path = dir.path().join("bounds.json");
+    std::fs::write(&path, serde_json::to_string(&s).unwrap()).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_sim")).arg("check").arg(&path).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

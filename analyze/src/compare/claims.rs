@@ -15,6 +15,7 @@
 //!   saving against a run without contacts of the same duration, hand error, B's time in contact
 //!   and A's time with a pulling table.
 
+use super::Measured;
 use crate::metrics::RunMetrics;
 
 /// The claim in the "So ..." sentences.
@@ -111,8 +112,8 @@ fn verdict(e_ok: Option<bool>, z_ok: Option<bool>) -> &'static str {
 /// The trend sentences, per scene when the runs come from several: `out` gets them, the result
 /// is each checked scene's verdict on [`CLAIM`].
 pub(super) fn claim_findings(runs: &[RunMetrics], out: &mut Vec<String>) -> Vec<(String, &'static str)> {
-    let energy = |g: &[&RunMetrics]| trend(g, "less electric energy", |r| r.electric_energy_total_j, |x| format!("{x:.3} J"));
-    let z = |g: &[&RunMetrics]| trend(g, "smaller z error", |r| r.hand_error.z.rms_m, |x| format!("{:.3} mm", x * 1e3));
+    let energy = |g: &[&RunMetrics]| trend(g, "less electric energy", |r| r.e_total(), |x| format!("{} J", super::fixed(x, 3)));
+    let z = |g: &[&RunMetrics]| trend(g, "smaller z error", |r| r.hand().z.rms_m, |x| format!("{:.3} mm", x * 1e3));
     let mut scenes: Vec<&str> = Vec::new();
     for r in runs {
         if !scenes.contains(&r.scene.as_str()) {
@@ -151,7 +152,7 @@ pub(super) fn claim_findings(runs: &[RunMetrics], out: &mut Vec<String>) -> Vec<
 
 /// Whether two runs have the same duration (module docs).
 fn same_duration(a: &RunMetrics, b: &RunMetrics) -> bool {
-    (a.t_end_s - b.t_end_s).abs() <= 1e-9 * a.t_end_s.abs().max(b.t_end_s.abs()).max(1.0)
+    (a.t_end() - b.t_end()).abs() <= 1e-9 * a.t_end().abs().max(b.t_end().abs()).max(1.0)
 }
 
 fn sorted(mut v: Vec<&str>) -> Vec<&str> {
@@ -201,20 +202,20 @@ pub(super) fn table_pairs(runs: &[RunMetrics], base: usize, verdicts: &[(String,
         } else {
             format!("{}: {}, only {names} touched; paired by those", b.run, plural(b.contacts.len(), "candidate contact"))
         };
-        let (ea, eb) = (a.electric_energy_total_j, b.electric_energy_total_j);
+        let (ea, eb) = (a.e_total(), b.e_total());
         let times = if ea != 0.0 && ea.is_finite() && eb.is_finite() {
             format!(" (× {:.3})", eb / ea)
         } else {
             String::new()
         };
         // the run without contacts to measure savings against: the baseline, else one of A's scene
-        let bare = |k: usize| runs[k].contacts.is_empty() && same_duration(&runs[k], a) && runs[k].electric_energy_total_j != 0.0;
+        let bare = |k: usize| runs[k].contacts.is_empty() && same_duration(&runs[k], a) && runs[k].e_total() != 0.0;
         let zero = std::iter::once(base)
             .chain((0..runs.len()).filter(|&k| runs[k].scene == a.scene))
             .chain(0..runs.len())
             .find(|&k| bare(k));
         let saving = zero.map_or(String::new(), |k| {
-            let e0 = runs[k].electric_energy_total_j;
+            let e0 = runs[k].e_total();
             let s = |e: f64| (1.0 - e / e0) * 100.0;
             format!(", saving against {} {:.1} % → {:.1} %", runs[k].run, s(ea), s(eb))
         });
@@ -236,17 +237,19 @@ pub(super) fn table_pairs(runs: &[RunMetrics], base: usize, verdicts: &[(String,
             format!("{}'s table pulled (f_n < 0) on {}", a.run, pulls.join(", "))
         };
         out.push(format!(
-            "{} → {} ({basis}): electric energy {ea:.3} J → {eb:.3} J{times}{saving}, z error RMS {} → {}, |e| RMS {} → {}; \
+            "{} → {} ({basis}): electric energy {} J → {} J{times}{saving}, z error RMS {} → {}, |e| RMS {} → {}; \
              time in contact ({}): {} of {:.3} s; {pulled}.",
             a.run,
             b.run,
-            mm(a.hand_error.z.rms_m),
-            mm(b.hand_error.z.rms_m),
-            mm(a.hand_error.norm.rms_m),
-            mm(b.hand_error.norm.rms_m),
+            super::fixed(ea, 3),
+            super::fixed(eb, 3),
+            mm(a.hand().z.rms_m),
+            mm(b.hand().z.rms_m),
+            mm(a.hand().norm.rms_m),
+            mm(b.hand().norm.rms_m),
             b.run,
             in_contact.join(", "),
-            b.t_end_s,
+            b.t_end(),
         ));
     }
     // the claim in each bilateral scene against each unilateral one of the pairs

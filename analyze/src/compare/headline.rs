@@ -5,6 +5,9 @@
 //! carried the arm, the per-scene verdict on the paper's claim, the bilateral → unilateral
 //! pairs) and the runs' metrics, in this order:
 //!
+//! 0. **Runs not compared** ([`super::RunComparison::not_compared`]): a run that failed
+//!    before its first sample, or covers another interval than the baseline; the sentences
+//!    below are over the runs compared.
 //! 1. **A table that pulls** (SCENE.md "Physics checks": f_n < 0 is a force a real table
 //!    cannot apply): per bilateral run whose table pulls for at least [`LONG_PULL`] of the run,
 //!    which contacts, for what share of the run and how hard; the brief pulls of the other runs
@@ -19,7 +22,7 @@
 //! Numbers: values of 100 and more whole, smaller ones to three significant digits, shares of
 //! a run in whole per cent.
 
-use super::{claims, Comparison};
+use super::{claims, Comparison, Measured};
 use crate::metrics::RunMetrics;
 
 /// A bilateral table that pulls for at least this share of the run gets its own sentence.
@@ -61,8 +64,13 @@ fn join(items: &[String]) -> String {
 impl Comparison {
     /// The findings that matter physically, one sentence each (module docs).
     pub fn headline(&self) -> Vec<String> {
-        let runs: Vec<RunMetrics> = self.runs.iter().map(|r| r.metrics.clone()).collect();
-        let mut out = Vec::new();
+        // first, the runs left out of the comparison and why (their numbers are not ranked)
+        let mut out: Vec<String> = self
+            .runs
+            .iter()
+            .filter_map(|r| r.not_compared.as_ref().map(|why| format!("{} is not compared with the baseline: {why}.", r.metrics.run)))
+            .collect();
+        let (runs, _) = self.compared();
         pulling(&runs, &mut out);
         real_table(&runs, &mut out);
         let mut scratch = Vec::new();
@@ -73,7 +81,7 @@ impl Comparison {
         }
         let worst = runs
             .iter()
-            .filter_map(|r| r.energy.max_abs_residual_rel.map(|x| (r, x)))
+            .filter_map(|r| r.audit_rel().map(|x| (r, x)))
             .max_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((r, x)) = worst {
             out.push(if x < 1e-6 {
@@ -91,14 +99,14 @@ fn pulling(runs: &[RunMetrics], out: &mut Vec<String>) {
     let mut brief = Vec::new();
     for r in runs.iter().filter(|r| claims::is_bilateral(r)) {
         let pulls: Vec<_> = r.contact_forces.iter().filter(|c| c.pull_time_s > 0.0).collect();
-        let (long, short): (Vec<&&crate::metrics::ContactMetrics>, Vec<_>) = pulls.iter().partition(|c| c.pull_time_s >= LONG_PULL * r.t_end_s);
+        let (long, short): (Vec<&&crate::metrics::ContactMetrics>, Vec<_>) = pulls.iter().partition(|c| c.pull_time_s >= LONG_PULL * r.t_end());
         brief.extend(short.iter().map(|c| format!("{} {} for {} s", r.run, c.contact, num(c.pull_time_s))));
         if long.is_empty() {
             continue;
         }
         let parts: Vec<String> = long
             .iter()
-            .map(|c| format!("{} down for {} of the run ({} of {} s, up to {} N)", c.contact, percent(c.pull_time_s, r.t_end_s), num(c.pull_time_s), num(r.t_end_s), num(-c.min_normal_force_n)))
+            .map(|c| format!("{} down for {} of the run ({} of {} s, up to {} N)", c.contact, percent(c.pull_time_s, r.t_end()), num(c.pull_time_s), num(r.t_end()), num(-c.min_normal_force_n)))
             .collect();
         out.push(format!(
             "In {}, the bilateral table pulls {}: a real table cannot pull, so this run relies on a force no table provides.",
@@ -119,7 +127,7 @@ fn real_table(runs: &[RunMetrics], out: &mut Vec<String>) {
     let key = |(a, b): (usize, usize)| {
         let b = &runs[b];
         let contact: Vec<String> = b.contact_states.iter().filter(|c| c.time_in_contact_s > 0.0).map(|c| format!("{} {}", c.contact, num(c.time_in_contact_s))).collect();
-        (a, num(b.electric_energy_total_j), num(b.hand_error.norm.rms_m * 1e3), contact)
+        (a, num(b.e_total()), num(b.hand().norm.rms_m * 1e3), contact)
     };
     let mut groups: Vec<(usize, usize, Vec<&str>)> = Vec::new();
     let mut seen = Vec::new();
@@ -146,12 +154,12 @@ fn real_table(runs: &[RunMetrics], out: &mut Vec<String>) {
             "On a table that only pushes ({who}), the arm of {} keeps {} of {} s on the table and draws {} J instead of {} J (× {}), with a hand error RMS of {} mm instead of {} mm.",
             a.run,
             join(&closed),
-            num(b.t_end_s),
-            num(b.electric_energy_total_j),
-            num(a.electric_energy_total_j),
-            num(b.electric_energy_total_j / a.electric_energy_total_j),
-            num(b.hand_error.norm.rms_m * 1e3),
-            num(a.hand_error.norm.rms_m * 1e3),
+            num(b.t_end()),
+            num(b.e_total()),
+            num(a.e_total()),
+            num(b.e_total() / a.e_total()),
+            num(b.hand().norm.rms_m * 1e3),
+            num(a.hand().norm.rms_m * 1e3),
         ));
     }
 }
@@ -162,8 +170,8 @@ fn claim(scene: &str, verdict: &str, group: &[&RunMetrics], name_scene: bool) ->
     order.sort_by_key(|r| claims::carried(r).len());
     let chain = |f: &dyn Fn(&RunMetrics) -> String| order.iter().map(|r| f(r)).collect::<Vec<_>>().join(" → ");
     let counts = chain(&|r| claims::carried(r).len().to_string());
-    let energy = chain(&|r| num(r.electric_energy_total_j));
-    let z = chain(&|r| num(r.hand_error.z.rms_m * 1e3));
+    let energy = chain(&|r| num(r.e_total()));
+    let z = chain(&|r| num(r.hand().z.rms_m * 1e3));
     let wher = if name_scene { format!(" in scene {scene}") } else { String::new() };
     format!(
         "The paper's claim {} {verdict}{wher}: with {counts} contacts the electric energy is {energy} J and the z error RMS {z} mm.",
@@ -190,7 +198,7 @@ mod tests {
     #[test]
     fn a_pulling_table_comes_first() {
         let mut runs = super::super::tests::paper_runs();
-        let t_end = runs[0].t_end_s;
+        let t_end = runs[0].t_end();
         runs[0].contact_forces[0].pull_time_s = 0.99 * t_end;
         runs[0].contact_forces[0].min_normal_force_n = -6.9;
         runs[1].contact_forces[0].pull_time_s = 0.019;

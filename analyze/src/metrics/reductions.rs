@@ -210,6 +210,12 @@ impl Reductions {
                 (status, r.error, r.error_time_s)
             }
         };
+        // a run that failed before its first sample (t = 0: a start the solver refuses, NaN in
+        // the initial state) has its metadata and no messages: its row says so, without numbers
+        let no_samples = [&self.hand_samples, &self.motor_samples, &self.contact_samples, &self.energy_samples].iter().all(|s| s.count == 0);
+        if status == Status::Failed && no_samples {
+            return Ok(RunMetrics::without_samples(rec.source.clone(), run, status, error, error_time_s));
+        }
         for topic in REQUIRED_METRIC_TOPICS {
             rec.check_topic(topic)?;
         }
@@ -305,7 +311,7 @@ impl Reductions {
             residual_j: last.balance_residual,
             max_abs_residual_j: self.residual.abs,
             t_max_abs_residual_s: self.residual.t,
-            max_abs_residual_rel: (electric_j != 0.0).then(|| self.residual.abs / electric_j.abs()),
+            max_abs_residual_rel: Some(self.residual.abs / electric_j.abs()).filter(|x| electric_j != 0.0 && x.is_finite()),
         };
         Ok(RunMetrics {
             file: file(),
@@ -314,17 +320,17 @@ impl Reductions {
             contacts,
             joint_names,
             samples: n,
-            t_end_s: self.hand_samples.last_t,
+            t_end_s: Some(self.hand_samples.last_t),
             status,
             error,
             error_time_s,
-            hand_error,
+            hand_error: Some(hand_error),
             links,
-            link_work_total_j: last.link_work_total,
-            electric_energy_total_j: electric_j,
+            link_work_total_j: Some(last.link_work_total),
+            electric_energy_total_j: Some(electric_j),
             peak_current,
             contact_forces,
-            energy: energy_audit,
+            energy: Some(energy_audit),
             limits: match rec.record_opt::<schemas::LimitsRecord>()? {
                 Some(l) => Some(super::LimitsMetrics { exceeded: l.exceeded, saturations: l.saturations, resolution_s: l.resolution, events: l.events }),
                 None => None,

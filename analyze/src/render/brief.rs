@@ -10,7 +10,7 @@
 //! Every number is printed by the full tables' own formats (`table.rs`), so each one is found
 //! there as it is here (the test `every_number_of_the_brief_is_in_the_full_tables`).
 
-use super::table::{f, mm, q};
+use super::table::{f, fo, mm, q, ABSENT};
 use super::text::{wrap, TextTable};
 use crate::compare::Comparison;
 use crate::metrics::{RunMetrics, Status};
@@ -38,6 +38,12 @@ pub(super) fn render(cmp: &Comparison, width: usize) -> String {
         "",
     ));
     out.push_str(&table(cmp).fitted(width));
+    // the runs not compared, and why (their rows have no ratio)
+    for r in cmp.runs.iter() {
+        if let Some(why) = &r.not_compared {
+            out.push_str(&wrap(&format!("† {}: not compared with the baseline: {why}.", r.metrics.run), width, "", "  "));
+        }
+    }
     out
 }
 
@@ -49,13 +55,20 @@ fn table(cmp: &Comparison) -> TextTable {
     t.notes = true;
     for (k, (r, label)) in cmp.runs.iter().zip(labels).enumerate() {
         let m = &r.metrics;
-        let name = if k == cmp.baseline_index { format!("{label} *") } else { label };
+        let name = if k == cmp.baseline_index {
+            format!("{label} *")
+        } else if r.not_compared.is_some() {
+            format!("{label} †")
+        } else {
+            label
+        };
+        let hand = |f: fn(&crate::metrics::HandError) -> f64| m.hand_error.as_ref().map_or(ABSENT.into(), |h| mm(f(h)));
         t.rows.push(vec![
             name,
-            f(m.electric_energy_total_j, 4),
+            fo(m.electric_energy_total_j, 4),
             q(r.to_baseline.electric_energy),
-            mm(m.hand_error.norm.rms_m),
-            mm(m.hand_error.norm.max_abs_m),
+            hand(|h| h.norm.rms_m),
+            hand(|h| h.norm.max_abs_m),
             contacts(m),
         ]);
     }

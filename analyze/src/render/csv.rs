@@ -11,11 +11,23 @@ impl Row {
     fn text(&mut self, s: &str) {
         self.0.push(Some(s.to_string()));
     }
+    /// A number; an empty cell when it is not finite (a CSV never holds `inf` or `NaN`).
     fn num(&mut self, x: f64) {
-        self.0.push(Some(x.to_string()));
+        self.opt(Some(x));
     }
+    /// A number, or an empty cell when the run does not have it.
     fn opt(&mut self, x: Option<f64>) {
-        self.0.push(x.map(|x| x.to_string()));
+        self.0.push(x.filter(|x| x.is_finite()).map(number));
+    }
+}
+
+/// `x` in Rust's shortest round-trip form: positional from 1e-5 to 1e16 (as `Display`
+/// writes it), scientific outside (`Display` would write 5e-324 as a 326-character decimal).
+fn number(x: f64) -> String {
+    if x == 0.0 || (1e-5..1e16).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
     }
 }
 
@@ -98,6 +110,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
     }
     // contacts with a contact model in some run (`/contacts`): their states
     let states = super::union(runs.iter().flat_map(|r| r.contact_states.iter().map(|c| c.contact.as_str())));
+    let last = cmp.map(|_| "not_compared".to_string());
     for c in &states {
         head.extend([
             format!("in_contact.{c}_s"),
@@ -117,6 +130,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
         ]);
     }
 
+    head.extend(last);
     let mut lines = Vec::with_capacity(runs.len());
     for (k, r) in runs.iter().enumerate() {
         let mut row = Row(Vec::with_capacity(64));
@@ -131,15 +145,15 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
         }
         row.num(r.contacts.len() as f64);
         row.num(r.samples as f64);
-        row.num(r.t_end_s);
+        row.opt(r.t_end_s);
         row.opt(r.error_time_s);
-        let e = &r.hand_error;
-        for a in [&e.x, &e.y, &e.z, &e.norm] {
-            row.num(a.rms_m);
-            row.num(a.max_abs_m);
+        let e = r.hand_error.as_ref();
+        for a in [e.map(|e| &e.x), e.map(|e| &e.y), e.map(|e| &e.z), e.map(|e| &e.norm)] {
+            row.opt(a.map(|a| a.rms_m));
+            row.opt(a.map(|a| a.max_abs_m));
         }
-        row.num(r.electric_energy_total_j);
-        row.num(r.link_work_total_j);
+        row.opt(r.electric_energy_total_j);
+        row.opt(r.link_work_total_j);
         if let Some((_, ratios)) = cmp {
             let q = ratios[k];
             for x in [
@@ -153,21 +167,21 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
         }
         row.opt(r.peak_current.as_ref().map(|p| p.current_a));
         row.0.push(r.peak_current.as_ref().map(|p| p.joint.clone()));
-        let a = &r.energy;
+        let a = r.energy.as_ref();
         for x in [
-            a.kinetic_change_j,
-            a.potential_change_j,
-            a.magnetic_change_j,
-            a.resistive_loss_j,
-            a.friction_loss_j,
+            a.map(|a| a.kinetic_change_j),
+            a.map(|a| a.potential_change_j),
+            a.map(|a| a.magnetic_change_j),
+            a.map(|a| a.resistive_loss_j),
+            a.map(|a| a.friction_loss_j),
         ] {
-            row.num(x);
+            row.opt(x);
         }
-        row.opt(a.gear_friction_loss_j);
-        for x in [a.residual_j, a.max_abs_residual_j] {
-            row.num(x);
+        row.opt(a.and_then(|a| a.gear_friction_loss_j));
+        for x in [a.map(|a| a.residual_j), a.map(|a| a.max_abs_residual_j)] {
+            row.opt(x);
         }
-        row.opt(a.max_abs_residual_rel);
+        row.opt(a.and_then(|a| a.max_abs_residual_rel));
         for j in &joints {
             let link = r.links.iter().find(|l| l.joint == *j);
             row.opt(link.map(|l| l.work_j));
@@ -208,6 +222,10 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
             row.opt(c.and_then(|c| c.contact_friction_needed));
             row.opt(c.and_then(|c| c.min_normal_force_in_contact_n));
             row.opt(c.and_then(|c| c.max_normal_force_in_contact_n));
+        }
+        if let Some((c, _)) = cmp {
+            // why the run has no ratios (empty when it is compared)
+            row.0.push(c.runs[k].not_compared.clone());
         }
         lines.push(row.0.into_iter().map(Option::unwrap_or_default).collect());
     }

@@ -30,9 +30,25 @@ impl Table {
     }
 }
 
-/// `x` with `d` decimals.
+/// `x` with `d` decimals; in scientific notation with `d` significant decimals from 1e6 on
+/// (a fixed-point 4e302 would be a 307-character cell), and `—` when it is not a finite number
+/// (no table prints `inf` or `NaN`).
 pub(super) fn f(x: f64, d: usize) -> String {
-    format!("{x:.d$}")
+    if !x.is_finite() {
+        ABSENT.into()
+    } else if x.abs() >= 1e6 {
+        format!("{x:.d$e}")
+    } else {
+        format!("{x:.d$}")
+    }
+}
+
+/// The cell of a number a run does not have (it failed before its first sample).
+pub(super) const ABSENT: &str = "—";
+
+/// [`f`] of a number a run may not have: `—` when it has none.
+pub(super) fn fo(x: Option<f64>, d: usize) -> String {
+    x.map_or(ABSENT.into(), |x| f(x, d))
 }
 
 /// In mm with 3 decimals, from m.
@@ -40,14 +56,18 @@ pub(super) fn mm(x_m: f64) -> String {
     f(x_m * 1e3, 3)
 }
 
-/// Scientific with 2 decimals.
+/// Scientific with 2 decimals (`—` when not finite).
 fn e(x: f64) -> String {
-    format!("{x:.2e}")
+    if x.is_finite() {
+        format!("{x:.2e}")
+    } else {
+        ABSENT.into()
+    }
 }
 
 /// A ratio with 3 decimals, `-` when it does not exist.
 pub(super) fn q(x: Option<f64>) -> String {
-    x.map_or("-".into(), |x| f(x, 3))
+    x.filter(|x| x.is_finite()).map_or("-".into(), |x| f(x, 3))
 }
 
 /// The sections as aligned text (fitted to `width` columns when given), or (`markdown`) as
@@ -56,10 +76,13 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
     let ratios: Option<Vec<&Ratios>> = cmp.map(|c| c.runs.iter().map(|r| &r.to_baseline).collect());
     let base = cmp.map(|c| c.baseline_index);
     let labels = super::run_labels(runs);
+    let left_out = |k: usize| cmp.is_some_and(|c| c.runs[k].not_compared.is_some());
     let name = |k: usize| {
         let r = &labels[k];
         if Some(k) == base {
             format!("{r} *")
+        } else if left_out(k) {
+            format!("{r} †")
         } else {
             r.clone()
         }
@@ -67,8 +90,14 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
     let mut out = String::new();
 
     // runs
-    let title = if cmp.is_some() {
+    let any_left_out = (0..runs.len()).any(left_out);
+    let title = if any_left_out {
+        "Runs (* = baseline; ratios are run / baseline; † = not compared: no ratios, not ranked, the findings say why; \
+         — = a number the run does not have)"
+    } else if cmp.is_some() {
         "Runs (* = baseline; ratios are run / baseline)"
+    } else if runs.iter().any(|r| !r.measured()) {
+        "Runs (— = a number the run does not have: it failed before its first sample)"
     } else {
         "Runs"
     };
@@ -107,7 +136,7 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
             r.scene.clone(),
             contacts,
             st,
-            f(r.t_end_s, 3),
+            fo(r.t_end_s, 3),
             r.samples.to_string(),
             peak,
             joint,
@@ -132,10 +161,14 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
     }
     let mut t = Table::new("Hand error r - r_d", &head);
     for (k, r) in runs.iter().enumerate() {
-        let h = &r.hand_error;
         let mut row = vec![name(k)];
-        row.extend([&h.x, &h.y, &h.z, &h.norm].map(|a| mm(a.rms_m)));
-        row.extend([&h.x, &h.y, &h.z, &h.norm].map(|a| mm(a.max_abs_m)));
+        match &r.hand_error {
+            Some(h) => {
+                row.extend([&h.x, &h.y, &h.z, &h.norm].map(|a| mm(a.rms_m)));
+                row.extend([&h.x, &h.y, &h.z, &h.norm].map(|a| mm(a.max_abs_m)));
+            }
+            None => row.extend([ABSENT; 8].map(String::from)),
+        }
         if let Some(q_) = &ratios {
             row.extend([q(q_[k].error_z_rms), q(q_[k].error_norm_rms)]);
         }
@@ -152,8 +185,8 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
     for (k, r) in runs.iter().enumerate() {
         let mut row = vec![
             name(k),
-            f(r.electric_energy_total_j, 4),
-            f(r.link_work_total_j, 4),
+            fo(r.electric_energy_total_j, 4),
+            fo(r.link_work_total_j, 4),
         ];
         if let Some(q_) = &ratios {
             row.extend([q(q_[k].electric_energy), q(q_[k].link_work)]);
@@ -328,7 +361,10 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         head.extend(["residual", "max |residual|", "max |res| / E"]);
         let mut t = Table::new(title, &head);
         for (k, r) in runs.iter().enumerate() {
-            let a = &r.energy;
+            let Some(a) = &r.energy else {
+                t.table.rows.push(std::iter::once(name(k)).chain((1..head.len()).map(|_| ABSENT.to_string())).collect());
+                continue;
+            };
             let rel = a.max_abs_residual_rel.map_or("-".into(), e);
             let mut row = vec![
                 name(k),

@@ -55,13 +55,13 @@ fn cells(line: &str) -> usize {
 }
 
 /// 19 run columns + 4 ratios + 11 peak/energy columns + 3 per joint (3 joints) + 3 per contact
-/// (2 contacts) = 49; metrics only: 19 + 11 + 2 * 3 + 3 * 2 = 42.
+/// (2 contacts) + `not_compared` = 50; metrics only: 19 + 11 + 2 * 3 + 3 * 2 = 42.
 #[test]
 fn csv_has_a_header_and_one_row_per_run_of_equal_width() {
     let text = render_comparison(&comparison(), Format::Csv).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 1 + 3);
-    assert!(lines.iter().all(|l| cells(l) == 49), "{text}");
+    assert!(lines.iter().all(|l| cells(l) == 50), "{text}");
     let head: Vec<&str> = lines[0].split(',').collect();
     for col in ["run", "E_total_j", "E_total_ratio", "W.joint1_j", "E.joint1_j", "E.joint3_ratio", "pull.elbow7_s"] {
         assert!(head.contains(&col), "{col} not in {head:?}");

@@ -15,7 +15,9 @@ use crate::metrics::RunMetrics;
 /// text).
 pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<DataFrame> {
     let n = rows.len();
-    let m = |f: &dyn Fn(&RunMetrics) -> f64| -> Vec<f64> { rows.iter().map(|r| f(&r.metrics)).collect() };
+    // a number a run does not have (it failed before its first sample) or that is not finite
+    // is null, never a made-up value
+    let m = |f: &dyn Fn(&RunMetrics) -> Option<f64>| -> Vec<Option<f64>> { rows.iter().map(|r| f(&r.metrics).filter(|x| x.is_finite())).collect() };
     let s = |f: &dyn Fn(&SummaryRow) -> Option<String>| -> Vec<Option<String>> { rows.iter().map(f).collect() };
     let min_force = |r: &RunMetrics| -> Option<f64> {
         r.contact_forces.iter().map(|c| c.min_normal_force_n).reduce(f64::min)
@@ -30,10 +32,10 @@ pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<Dat
         Column::new("integrator".into(), s(&|r| r.integrator.clone())),
         Column::new("t_end_s".into(), m(&|r| r.t_end_s)),
         Column::new("samples".into(), rows.iter().map(|r| r.metrics.samples as u64).collect::<Vec<_>>()),
-        Column::new("err_norm_rms_m".into(), m(&|r| r.hand_error.norm.rms_m)),
-        Column::new("err_norm_max_m".into(), m(&|r| r.hand_error.norm.max_abs_m)),
-        Column::new("err_z_rms_m".into(), m(&|r| r.hand_error.z.rms_m)),
-        Column::new("err_z_max_m".into(), m(&|r| r.hand_error.z.max_abs_m)),
+        Column::new("err_norm_rms_m".into(), m(&|r| r.hand_error.as_ref().map(|h| h.norm.rms_m))),
+        Column::new("err_norm_max_m".into(), m(&|r| r.hand_error.as_ref().map(|h| h.norm.max_abs_m))),
+        Column::new("err_z_rms_m".into(), m(&|r| r.hand_error.as_ref().map(|h| h.z.rms_m))),
+        Column::new("err_z_max_m".into(), m(&|r| r.hand_error.as_ref().map(|h| h.z.max_abs_m))),
         Column::new("E_total_j".into(), m(&|r| r.electric_energy_total_j)),
         Column::new("W_total_j".into(), m(&|r| r.link_work_total_j)),
         Column::new(
@@ -50,7 +52,7 @@ pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<Dat
         ),
         Column::new(
             "residual_max_rel".into(),
-            rows.iter().map(|r| r.metrics.energy.max_abs_residual_rel).collect::<Vec<_>>(),
+            m(&|r| r.energy.as_ref().and_then(|e| e.max_abs_residual_rel)),
         ),
         Column::new("error".into(), s(&|r| r.metrics.error.clone())),
         Column::new("bytes".into(), rows.iter().map(|r| r.bytes).collect::<Vec<_>>()),

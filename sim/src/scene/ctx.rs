@@ -89,3 +89,7 @@ pub(super) fn positive(x: f64) -> bool {
 pub(super) fn non_negative(x: f64) -> bool {
     x >= 0.0
 }
+/// `lo <= x <= hi` (a physical range, e.g. [`super::spec::motor_bounds`]).
+pub(super) fn within(lo: f64, hi: f64) -> impl Fn(f64) -> bool {
+    move |x| (lo..=hi).contains(&x)
+}

@@ -27,7 +27,8 @@ use crate::dynamics::urdf::MeshInfo;
 use crate::dynamics::{Data, Model};
 use crate::error::{short, SceneError};
 use crate::limits::{read_text, MAX_INPUT_BYTES, MAX_SAMPLES};
-use ctx::{names, non_negative, positive, Ctx};
+use ctx::{names, non_negative, positive, within, Ctx};
+use spec::motor_bounds::*;
 use robot::load_robot;
 pub use spec::SceneSpec;
 use spec::{KindedTarget, LawSpec, PositionLimitMode, TargetSpec};
@@ -381,8 +382,14 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     // motors and joints
     let m = &spec.motor;
     let k = c.per_joint("motor.torque_constant", &m.torque_constant, nv, positive, "must be > 0 N m/A")?;
-    let r = c.per_joint("motor.resistance", &m.resistance, nv, positive, "must be > 0 ohm")?;
-    let l = c.per_joint("motor.inductance", &m.inductance, nv, non_negative, "must be >= 0 H (0: quasi-static current)")?;
+    let r = c.per_joint("motor.resistance", &m.resistance, nv, within(RESISTANCE_MIN, RESISTANCE_MAX), "must be > 0 ohm and within the physical range 1e-6 ..= 1e3 ohm")?;
+    let l = c.per_joint(
+        "motor.inductance",
+        &m.inductance,
+        nv,
+        |x| x == 0.0 || within(INDUCTANCE_MIN, INDUCTANCE_MAX)(x),
+        "must be >= 0 H: 0 (quasi-static current) or within the physical range 1e-12 ..= 1 H",
+    )?;
     if l.iter().any(|&x| x == 0.0) && l.iter().any(|&x| x > 0.0) {
         return Err(c.err("motor.inductance", format!("{l:?}"), "must be 0 on every joint (quasi-static motors) or > 0 on every joint"));
     }
@@ -405,13 +412,13 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
         }
     }
     if let Some(p) = &m.voltage_limit {
-        let v = c.per_joint("motor.voltage_limit", p, nv, positive, "must be > 0 V")?;
+        let v = c.per_joint("motor.voltage_limit", p, nv, within(VOLTAGE_LIMIT_MIN, VOLTAGE_LIMIT_MAX), "must be > 0 V and within the physical range 1e-3 ..= 1e6 V (below 1 mV the motors deliver nothing; leave the limit out for none)")?;
         for (s, x) in specs.iter_mut().zip(v) {
             s.voltage_limit = Some(x);
         }
     }
     if let Some(p) = &m.current_limit {
-        let v = c.per_joint("motor.current_limit", p, nv, positive, "must be > 0 A")?;
+        let v = c.per_joint("motor.current_limit", p, nv, within(CURRENT_LIMIT_MIN, CURRENT_LIMIT_MAX), "must be > 0 A and within the physical range 1e-6 ..= 1e6 A (below 1 uA the motors deliver nothing; leave the limit out for none)")?;
         for (s, x) in specs.iter_mut().zip(v) {
             s.current_limit = Some(x);
         }

@@ -196,15 +196,47 @@ impl RobotSpec {
     }
 }
 
+/// The physical bounds of the motor and drive values (validation refuses values outside them,
+/// naming the file, the field and the value). Below a floor or above a ceiling a value is no
+/// motor any more, and the run's numbers stop meaning anything: a current limit of 5e-324 A
+/// lets the motors deliver nothing, so the energy balance's relative residual divides by ~0
+/// (inf); a voltage limit of 1e-300 V or an inductance of 1e300 H gave a relative residual of
+/// 4e302 with status "complete" (issue 29). The bounds are wide around real motors: armature
+/// resistances of small DC motors are 0.1-100 ohm, inductances 1e-5-1e-2 H (maxon and Faulhaber
+/// catalogues; the paper's motor: 1.1 ohm, 1.7 mH, eq 1-12 and Table 1).
+pub mod motor_bounds {
+    /// Armature resistance: `RESISTANCE_MIN <= R <= RESISTANCE_MAX`, ohm. R = 0 is a
+    /// superconductor (no quasi-static current `i = (v - K q')/R`); above 1 kohm a motor passes
+    /// no useful current at any supply voltage.
+    pub const RESISTANCE_MIN: f64 = 1e-6;
+    pub const RESISTANCE_MAX: f64 = 1e3;
+    /// Armature inductance: 0 (quasi-static currents) or `INDUCTANCE_MIN <= L <= INDUCTANCE_MAX`,
+    /// H. Below 1e-12 H the electrical time constant L/R is under 1 ps, far below any step
+    /// (use 0); above 1 H the time constant of a 1-ohm winding is over 1 s, a solenoid, not a
+    /// motor.
+    pub const INDUCTANCE_MIN: f64 = 1e-12;
+    pub const INDUCTANCE_MAX: f64 = 1.0;
+    /// Supply voltage limit: `VOLTAGE_LIMIT_MIN <= limit <= VOLTAGE_LIMIT_MAX`, V. Below 1 mV
+    /// no drive delivers any torque (the motors do nothing and every energy ratio is 0/0).
+    pub const VOLTAGE_LIMIT_MIN: f64 = 1e-3;
+    pub const VOLTAGE_LIMIT_MAX: f64 = 1e6;
+    /// The driver's current limit: `CURRENT_LIMIT_MIN <= limit <= CURRENT_LIMIT_MAX`, A. Below
+    /// 1 uA a motor delivers no torque (leave the limit out for an unlimited driver).
+    pub const CURRENT_LIMIT_MIN: f64 = 1e-6;
+    pub const CURRENT_LIMIT_MAX: f64 = 1e6;
+}
+
 /// DC motor and gear of each joint (the paper's eqs 1–12); each entry per joint or for all.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MotorSpec {
     /// Torque constant K, N m/A (= V s/rad), per joint.
     pub torque_constant: PerJoint,
-    /// Armature resistance R, ohm, per joint.
+    /// Armature resistance R, ohm, per joint: 1e-6 <= R <= 1e3 ohm (a physical range; outside
+    /// it the quasi-static current and the losses lose meaning).
     pub resistance: PerJoint,
-    /// Armature inductance L, H, per joint (0 on every joint: quasi-static currents).
+    /// Armature inductance L, H, per joint (0 on every joint: quasi-static currents); otherwise
+    /// 1e-12 <= L <= 1 H (below: use 0; above: no motor's time constant).
     pub inductance: PerJoint,
     /// Rotor inertia I_m, kg m^2, per joint.
     pub rotor_inertia: PerJoint,
@@ -215,10 +247,13 @@ pub struct MotorSpec {
     /// Back-EMF constant K_e, V s/rad (motor side), per joint (default: `torque_constant`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub back_emf_constant: Option<PerJoint>,
-    /// Supply voltage limit, V, per joint: the amplifier saturates at ±limit (default: none).
+    /// Supply voltage limit, V, per joint: the amplifier saturates at ±limit (default: none);
+    /// 1e-3 <= limit <= 1e6 V (below 1 mV the motors deliver nothing and the energy ratios are
+    /// 0/0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub voltage_limit: Option<PerJoint>,
-    /// The driver's current limit, A, per joint (default: none).
+    /// The driver's current limit, A, per joint (default: none); 1e-6 <= limit <= 1e6 A (below
+    /// 1 uA the motors deliver no torque and the energy ratios are 0/0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub current_limit: Option<PerJoint>,
 }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use analyze::{render_comparison_fitted, render_metrics_fitted, Comparison};
+use analyze::{render_comparison_fitted, render_metrics_fitted, Comparison, RunMetrics, Status};
 use anyhow::Result;
 use cli::{exit, print_out, TableFormat, Verbosity};
 
@@ -72,11 +72,28 @@ pub fn compare(a: &CompareArgs, v: Verbosity) -> Result<u8> {
     let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
     let cmp = Comparison::new(&runs, a.baseline.as_deref())?;
     print_out(&render_comparison_fitted(&cmp, a.format.format, cli::terminal_width())?)?;
-    Ok(if damaged { exit::FAILED } else { exit::SUCCESS })
+    Ok(status(&runs, damaged, v))
 }
 
 pub fn metrics(a: &MetricsArgs, v: Verbosity) -> Result<u8> {
     let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
     print_out(&render_metrics_fitted(&runs, a.format.format, cli::terminal_width())?)?;
-    Ok(if damaged { exit::FAILED } else { exit::SUCCESS })
+    Ok(status(&runs, damaged, v))
+}
+
+/// The exit status of a table of `runs`: 1 when a file was damaged or a run did not complete
+/// (each such run is named on stderr: its row has its status and reason), else 0.
+pub fn status(runs: &[RunMetrics], damaged: bool, v: Verbosity) -> u8 {
+    let failed: Vec<&RunMetrics> = runs.iter().filter(|r| r.status != Status::Complete).collect();
+    if !v.quiet {
+        for r in &failed {
+            let at = r.error_time_s.map_or(String::new(), |t| format!(" at t = {t:.3} s"));
+            eprintln!("analyze: {}: run {} {}{at}: {}", r.file, r.run, r.status_text(), r.error.as_deref().unwrap_or("no reason recorded"));
+        }
+    }
+    if damaged || !failed.is_empty() {
+        exit::FAILED
+    } else {
+        exit::SUCCESS
+    }
 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use analyze::report::{render_report, FigureLink};
 use analyze::Comparison;
 use anyhow::{Context, Result};
-use cli::{exit, Verbosity};
+use cli::Verbosity;
 
 /// The comparison report as one Markdown document: what stands out, the tables (hand error,
 /// energy totals and per link with ratios to the baseline, contacts), a contacts section (pull
@@ -79,5 +79,5 @@ pub fn run(a: &ReportArgs, v: Verbosity) -> Result<u8> {
     if !v.quiet {
         eprintln!("analyze: report of {} runs in {}", metrics.len(), path.display());
     }
-    Ok(exit::SUCCESS)
+    Ok(crate::compare::status(&metrics, false, v))
 }

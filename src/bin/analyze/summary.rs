@@ -107,11 +107,22 @@ pub fn run(a: &SummaryArgs, v: Verbosity) -> Result<u8> {
         a.columns.clone()
     };
     let query = Query { filters: a.filters.clone(), sort: a.sort.clone(), descending: a.desc, columns, limit: a.limit };
-    print_out(&summary::render(&rows, &a.params, &query, a.format.format)?)?;
+    let mut text = summary::render(&rows, &a.params, &query, a.format.format)?;
+    // runs over different intervals: their totals are not comparable, and sorting ranks them
+    // anyway; say so (in the table's text, else on stderr: JSON and CSV stay data)
+    if let Some(note) = summary::duration_note(&rows) {
+        match a.format.format {
+            Format::Table => text = format!("{text}\n{}", analyze::render::wrap(&note, cli::TEXT_WIDTH, "", "")),
+            _ => eprintln!("analyze: {note}"),
+        }
+    }
+    print_out(&text)?;
+    let metrics: Vec<analyze::RunMetrics> = rows.into_iter().map(|r| r.metrics).collect();
+    let code = crate::compare::status(&metrics, false, v);
     if bad > 0 {
         eprintln!("analyze: {bad} of {} recordings could not be read (named above) and are left out", paths.len());
         return Ok(exit::FAILED);
     }
-    Ok(exit::SUCCESS)
+    Ok(code)
 }
 

@@ -354,13 +354,17 @@ pub fn run_all_live(
     done
 }
 
-/// Prints the comparison of the complete runs (brief, or with `-v` in full) and the failures;
+/// Prints the comparison of the runs (brief, or with `-v` in full; a failed run with its
+/// status and reason, a run without a recording named under the table) and the failures;
 /// the exit status: 2 if a recording could not be written (an I/O error: its run's result is
 /// lost), else 1 if a run failed numerically (its recording says when and why), else 0.
 pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>, v: Verbosity) -> Result<u8> {
-    let complete: Vec<&Done> = done.iter().filter(|d| d.error.is_none() && d.path.is_some()).collect();
-    if !complete.is_empty() {
-        print_comparison(&complete, format.format, baseline, v.verbose > 0)?;
+    // every run with a recording is in the table, a failed one with its status and reason
+    // (read back from its recording); a run without a recording is named under the table
+    let recorded: Vec<&Done> = done.iter().filter(|d| d.path.is_some() && !d.io_error).collect();
+    let unrecorded: Vec<&str> = done.iter().filter(|d| d.path.is_none() || d.io_error).filter_map(|d| d.error.as_deref()).collect();
+    if !recorded.is_empty() {
+        print_comparison(&recorded, format.format, baseline, v.verbose > 0, &unrecorded)?;
     }
     let failures: Vec<&str> = done.iter().filter_map(|d| d.error.as_deref()).collect();
     for f in &failures {
@@ -378,7 +382,7 @@ pub fn finish(done: &[Done], format: TableFormat, baseline: Option<&str>, v: Ver
 /// Prints the comparison of the runs, from the metrics computed as they were written (a run
 /// without them, which no caller makes, is read back): as text the brief one, or (`full`) every
 /// section; JSON and CSV always whole.
-fn print_comparison(done: &[&Done], format: analyze::Format, baseline: Option<&str>, full: bool) -> Result<()> {
+fn print_comparison(done: &[&Done], format: analyze::Format, baseline: Option<&str>, full: bool, unrecorded: &[&str]) -> Result<()> {
     let metrics = done
         .iter()
         .filter_map(|d| d.path.as_deref().map(|p| (p, d.metrics.as_ref())))
@@ -390,12 +394,21 @@ fn print_comparison(done: &[&Done], format: analyze::Format, baseline: Option<&s
         .collect::<Result<Vec<_>>>()?;
     let cmp = analyze::Comparison::new(&metrics, baseline)?;
     let width = cli::terminal_width();
+    // the runs that left no recording: a line each under the table (JSON and CSV: on stderr
+    // only, with the errors)
+    let left_out = |width: usize| -> String {
+        unrecorded.iter().map(|e| analyze::render::wrap(&format!("Not in the table (no recording): {e}"), width, "", "  ")).collect()
+    };
     if format == analyze::Format::Table && !full {
         let width = width.map_or(cli::TEXT_WIDTH, |w| w.min(cli::TEXT_WIDTH));
         let more = analyze::render::wrap(BRIEF_MORE, width, "", "");
-        return print_out(&(analyze::render_comparison_brief(&cmp, width) + "\n" + &more));
+        return print_out(&(analyze::render_comparison_brief(&cmp, width) + &left_out(width) + "\n" + &more));
     }
-    print_out(&analyze::render_comparison_fitted(&cmp, format, width)?)
+    let mut text = analyze::render_comparison_fitted(&cmp, format, width)?;
+    if format == analyze::Format::Table {
+        text += &left_out(width.unwrap_or(cli::TEXT_WIDTH));
+    }
+    print_out(&text)
 }
 
 /// The last line of the brief comparison: where the rest is.

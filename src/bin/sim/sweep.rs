@@ -317,11 +317,11 @@ fn row(v: &Variant, run: &str, file: &str, status: &str, d: &Done) -> Row {
     };
     match &d.metrics {
         Some(Ok(m)) => {
-            r.electric_energy_total_j = Some(m.electric_energy_total_j);
-            r.link_work_total_j = Some(m.link_work_total_j);
-            r.hand_error_rms_m = Some(m.hand_error.norm.rms_m);
-            r.hand_error_max_m = Some(m.hand_error.norm.max_abs_m);
-            r.hand_error_z_rms_m = Some(m.hand_error.z.rms_m);
+            r.electric_energy_total_j = m.electric_energy_total_j;
+            r.link_work_total_j = m.link_work_total_j;
+            r.hand_error_rms_m = m.hand_error.as_ref().map(|h| h.norm.rms_m);
+            r.hand_error_max_m = m.hand_error.as_ref().map(|h| h.norm.max_abs_m);
+            r.hand_error_z_rms_m = m.hand_error.as_ref().map(|h| h.z.rms_m);
             r.min_normal_force_n = m.contact_forces.iter().map(|c| c.min_normal_force_n).reduce(f64::min);
         }
         Some(Err(e)) => {
