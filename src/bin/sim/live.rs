@@ -23,6 +23,9 @@
 //!   when the command ends, and the exit status is 1), so a client that subscribes as channels
 //!   appear receives every message of the run. After the runs the server stays up until the clients disconnect
 //!   (the queued messages reach them), or Ctrl-C.
+//! - **A client that falls behind** loses the oldest messages queued for it inside the crate
+//!   (`message_backlog_size`); the crate only logs it, so `server::OutboxWatch` (the process's
+//!   `log` logger) watches for that line and the command says so and exits 1.
 //! - **Several runs** (`sim` alone runs six) are streamed one at a time, in order, on the same
 //!   topics as their files (prefixing topics would not separate them in the 3D panel: the frames
 //!   of `/tf` are the same in every run); each run starts a new session (`serverInfo` with a new

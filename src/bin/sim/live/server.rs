@@ -9,7 +9,7 @@
 //! are closed outside the hub's lock, since closing calls `on_unsubscribe`).
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
@@ -26,6 +26,60 @@ pub const KEPT_BYTES: usize = 64 << 20;
 /// Messages queued per client by the server before it drops the oldest (the crate's default
 /// is 1024): a fast run writes thousands of messages in a burst.
 const BACKLOG_FAST: usize = 1 << 17;
+
+/// Times the `foxglove` crate said a client's queue was full (it then drops that client's
+/// oldest queued messages): see [`OutboxWatch`].
+static OUTBOX_FULL: AtomicU64 = AtomicU64::new(0);
+
+/// The `foxglove` crate (0.30, `websocket/connected_client/send_lossy.rs`) drops the oldest
+/// messages queued for a client that falls behind (its queue holds `message_backlog_size`
+/// messages) and has no count or callback for it in its API: it only logs "outbox for client
+/// ADDR full" through `tracing`, which (its `log` feature, no `tracing` subscriber in `sim`)
+/// becomes a `log` record, throttled by the crate to one per 30 s. This logger takes the
+/// crate's records and counts that one, so a drop is never silent: [`Session::close`] says a
+/// client missed messages and the command exits 1. It counts the crate's lines, not the
+/// messages (the crate does not say how many); the first drop is always logged (the
+/// throttle starts open), so "none counted" means none dropped.
+struct OutboxWatch;
+
+/// The `log` target prefix of the crate's records.
+const FOXGLOVE_TARGET: &str = "foxglove";
+
+impl log::Log for OutboxWatch {
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+        metadata.target().starts_with(FOXGLOVE_TARGET) && metadata.level() <= log::Level::Info
+    }
+    fn log(&self, record: &log::Record) {
+        if self.enabled(record.metadata()) && is_outbox_full(&record.args().to_string()) {
+            OUTBOX_FULL.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+    fn flush(&self) {}
+}
+
+/// The crate's line for a full client queue: "outbox for client 127.0.0.1:50212 full".
+fn is_outbox_full(line: &str) -> bool {
+    line.starts_with("outbox for client ") && line.ends_with(" full")
+}
+
+/// Installs [`OutboxWatch`] as the process's logger (once; `sim` has no other).
+fn watch_outboxes() {
+    static WATCH: OutboxWatch = OutboxWatch;
+    if log::set_logger(&WATCH).is_ok() {
+        log::set_max_level(log::LevelFilter::Info);
+    }
+}
+
+/// The line `sim` prints when a client's queue was full `times` times (none when 0).
+fn outbox_report(times: u64) -> Option<String> {
+    (times > 0).then(|| {
+        format!(
+            "sim: live: warning: a viewer fell behind and the live server dropped messages queued for it \
+             (its queue was full {times} time(s); the server does not count the messages); the recording has them all. \
+             Use --pace realtime (the default) or a lower --speed"
+        )
+    })
+}
 
 /// One MCAP channel of the current run, as advertised.
 struct LiveChannel {
@@ -159,6 +213,7 @@ impl Session {
         if !a.live {
             return Ok(None);
         }
+        watch_outboxes();
         let context = Context::new();
         let hub = Arc::new(Mutex::new(Hub::new(a.wait)));
         let info: HashMap<String, String> = about.iter().map(|(k, v)| (k.to_string(), v.clone())).collect();
@@ -250,7 +305,8 @@ impl Session {
         if let Some(s) = self.server.take() {
             drop(s.stop());
         }
-        let report = lock(&self.hub).drop_report();
+        let mut report = lock(&self.hub).drop_report();
+        report.extend(outbox_report(OUTBOX_FULL.swap(0, Ordering::Relaxed)));
         for line in &report {
             eprintln!("{line}");
         }
@@ -326,6 +382,24 @@ impl schemas::Mirror for LiveMirror {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A full client queue, as the `foxglove` crate logs it, is counted and reported (issue 29:
+    /// those drops were silent), and nothing else the crate logs is. The record is the crate's
+    /// own line, with its module as the target.
+    #[test]
+    fn a_full_client_queue_logged_by_the_server_is_counted_and_reported() {
+        watch_outboxes();
+        let before = OUTBOX_FULL.load(Ordering::Relaxed);
+        let target = "foxglove::websocket::connected_client::send_lossy";
+        log::info!(target: target, "Registered client 127.0.0.1:50212");
+        log::info!(target: "other_crate", "outbox for client 127.0.0.1:50212 full");
+        assert_eq!(OUTBOX_FULL.load(Ordering::Relaxed), before, "only the crate's full-queue line counts");
+        log::info!(target: target, "outbox for client {} full", "127.0.0.1:50212");
+        assert_eq!(OUTBOX_FULL.load(Ordering::Relaxed), before + 1);
+        assert_eq!(outbox_report(0), None);
+        let line = outbox_report(2).unwrap();
+        assert!(line.contains("dropped messages") && line.contains("2 time(s)") && line.contains("the recording has them all"), "{line}");
+    }
 
     /// Messages kept past the per-channel limit before the first subscription are counted per
     /// topic and reported (issue 29: they were dropped silently); nothing is reported when all
