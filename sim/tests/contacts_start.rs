@@ -59,3 +59,46 @@ fn a_slip_slower_than_the_stick_speed_stops_at_once() {
     let expected = 0.5 * v0 * v0;
     assert!((w_prev - expected).abs() <= 1e-9 * expected, "friction work {w_prev}, ½ m v0² = {expected}");
 }
+
+/// Two point masses (1 kg and 3 kg, on joints of their own: M is block-diagonal) resting on the
+/// table, each sliding slower than the stick speed in its own direction (5e-7 m/s along x,
+/// 3e-7 m/s along −y): both slips stop at t0 in one projection, and each contact's friction work
+/// must be ITS ball's ½ m v², to 1e-9 relative. The total alone is the projection's
+/// kinetic-energy loss by construction (`sim/src/ode/stop_slip.rs` books it so); the split
+/// between the contacts is what this checks: booking the loss on one contact, or splitting it
+/// by any rule other than each contact's own impulse work −Λ_kᵀ(v⁻_k + v⁺_k)/2, fails.
+#[test]
+fn two_slips_stopping_at_once_each_book_their_own_kinetic_energy() {
+    let (m1, m2, v1, v2) = (1.0, 3.0, 5e-7, -3e-7);
+    let lim = r#"<limit lower="-1000" upper="1000" effort="1e6" velocity="1e3"/>"#;
+    let ball = |k: usize, m: f64| {
+        format!(
+            r#"<joint name="x{k}" type="prismatic"><parent link="base"/><child link="cx{k}"/><origin xyz="0 0 0"/><axis xyz="1 0 0"/>{lim}</joint>
+  <link name="cx{k}"/>
+  <joint name="y{k}" type="prismatic"><parent link="cx{k}"/><child link="cy{k}"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/>{lim}</joint>
+  <link name="cy{k}"/>
+  <joint name="z{k}" type="prismatic"><parent link="cy{k}"/><child link="ball{k}"/><origin xyz="0 0 0"/><axis xyz="0 0 1"/>{lim}</joint>
+  <link name="ball{k}"><inertial><origin xyz="0 0 0"/><mass value="{m}"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial></link>"#
+        )
+    };
+    let urdf = format!("<?xml version=\"1.0\"?>\n<robot name=\"two-points\">\n  <link name=\"base\"/>\n  {}\n  {}\n</robot>", ball(1, m1), ball(2, m2));
+    let joints = ["x1", "y1", "z1", "x2", "y2", "z2"];
+    let q0 = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+    let qd0 = [v1, 0.0, 0.0, 0.0, v2, 0.0];
+    let mut s = passive_scene("ball1", &joints, &q0, &qd0, [0.0, 0.0, -G], 0.01, 1e-12);
+    add_table_contact(&mut s, "floor1", json!({"link": "ball1"}), json!({"model": "unilateral", "friction": 0.5}));
+    add_table_contact(&mut s, "floor2", json!({"link": "ball2"}), json!({"model": "unilateral", "friction": 0.5}));
+    let c = collect(&load(&s, &urdf), "r");
+    let stops: Vec<f64> = c.events.iter().filter(|e| e.kind == ContactEventKind::SlipToStick).map(|e| e.t).collect();
+    assert_eq!(stops, vec![0.0, 0.0], "both slips stop at t0: {:?}", c.events);
+    let last = c.samples.last().expect("samples");
+    for (k, (m, v)) in [(m1, v1), (m2, v2)].into_iter().enumerate() {
+        assert_eq!(last.contacts[k].mode, ContactMode::Sticking, "contact {k}");
+        let w = last.contacts[k].friction_work;
+        let expected = 0.5 * m * v * v;
+        assert!((w - expected).abs() <= 1e-9 * expected, "contact {k}: friction work {w} J, its ball's ½ m v² = {expected} J");
+    }
+    for o in &c.samples[1..] {
+        assert!(o.qd.iter().all(|v| v.abs() <= 1e-12), "t = {}: q̇ = {:?}", o.t, o.qd);
+    }
+}
