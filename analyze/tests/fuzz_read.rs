@@ -239,7 +239,7 @@ fn reading_path_never_panics() {
 type Outcome = Result<bool, String>;
 
 /// The reading paths behind the other commands (issue 29): `diff` (`analyze::read_input`),
-/// `figures` (`figures::read_run`), `export` (`frames::read_frames`), `layout` (the streamed
+/// `figures` (`figures::read_run`), `export` (`frames::streamed`: the plan and each topic's batches), `layout` (the streamed
 /// reader + `LayoutInput`), `view` (`view::read_input`); `metrics`, `compare`, `summary` and
 /// `report` read through `read_run_metrics` and `--recover` through `read_run_metrics_recover`
 /// (both in [`reading_path_never_panics`]). The same generator and rule: no panic, an error
@@ -264,10 +264,23 @@ fn every_commands_reading_path_never_panics() {
     };
     let figures_of =
         |p: &std::path::Path| analyze::figures::read_run(p).map(|r| analyze::figures::RunSeries { name: String::new(), ..r }).map_err(|e| e.to_string());
-    let frames_of = |p: &std::path::Path| {
-        analyze::frames::read_frames(p, analyze::frames::Selection::default())
-            .map(|f| f.topics.into_iter().map(|t| (t.topic, t.frame)).collect::<Vec<_>>())
-            .map_err(|e| e.to_string())
+    // export's path: the plan, then each topic's batches, stacked
+    let frames_of = |p: &std::path::Path| -> Result<Vec<(String, polars::prelude::DataFrame)>, String> {
+        let s = analyze::frames::streamed::plan(p, analyze::frames::Selection::default()).map_err(|e| e.to_string())?;
+        let mut out = Vec::new();
+        for (k, t) in s.topics.iter().enumerate() {
+            let mut df: Option<polars::prelude::DataFrame> = None;
+            s.batches(k, analyze::frames::streamed::MAX_CELLS, |b| {
+                match df.as_mut() {
+                    Some(d) => drop(d.vstack_mut(&b.frame)),
+                    None => df = Some(b.frame),
+                }
+                Ok(())
+            })
+            .map_err(|e| e.to_string())?;
+            out.extend(df.map(|d| (t.topic.clone(), d)));
+        }
+        Ok(out)
     };
     let layout_of = |p: &std::path::Path| -> Result<serde_json::Value, String> {
         let rec = schemas::read_recording_topics(p, Some(&[schemas::topics::HAND])).map_err(|e| e.to_string())?;
