@@ -113,3 +113,22 @@ fn long_recordings_are_exported_in_bounded_memory() {
         }
     }
 }
+
+/// A recording whose messages carry 5 002-entry arrays while its `run` record declares 3
+/// joints (issue 29: `export` took 530–610 MB on such a 343 KB file): refused as damage under
+/// 200 MB, naming the file, the topic, the field and the time, exit 2, no table left.
+#[test]
+fn arrays_longer_than_the_run_declares_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Synth::new("wide", &["elbow"], 5_002);
+    (s.dt, s.n) = (1e-3, 50);
+    s.names.as_mut().unwrap().joint_names = Some(vec!["joint1".into(), "joint2".into(), "joint3".into()]);
+    let path = s.with_setup().write_in(dir.path());
+    let out_dir = dir.path().join("tables");
+    let out = analyze_limited(200_000, &["export", path.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "-q"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let file = path.display().to_string();
+    assert!(err.contains(&file) && err.contains("topic /") && err.contains("field ") && err.contains("5002 entries, expected 3"), "{err}");
+    assert!(!out_dir.join("wide").join("metadata.json").exists());
+}

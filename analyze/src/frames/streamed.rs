@@ -5,7 +5,9 @@
 //! Three reads of the file, each one record at a time:
 //! 1. its channels and metadata records (every chunk skipped when the file has a summary): the
 //!    joint and contact names that label the arrays, and the topics of the default set;
-//! 2. the selected topics, row by row into [`Columns`] emptied every batch: the plan of each
+//! 2. the selected topics, each message's per-joint and per-contact arrays checked against the
+//!    run's joint and contact counts (`DecodedMessage::check_sizes`: a message with more
+//!    entries is refused, naming file, topic, field and time), row by row into [`Columns`] emptied every batch: the plan of each
 //!    topic, i.e. its columns (names, fields, kinds after widening) in first-appearance order,
 //!    and which columns duplicate the log time at *every* row of the whole topic (only then are
 //!    they left out, as [`super::recording_frames`] decides on the topic read whole);
@@ -136,6 +138,9 @@ pub fn plan(path: &Path, select: Selection<'_>) -> Result<Streamed, Error> {
     // 2: the columns of each topic, in batches
     let mut building: HashMap<String, Building> = HashMap::new();
     let mut visit = |m: schemas::DecodedMessage<'_>| -> Result<(), schemas::Error> {
+        // arrays bounded by the run's joints and contacts: a longer one is damage, refused
+        // before it makes thousands of columns (issue 29: 5 002-entry arrays took 600 MB)
+        m.check_sizes()?;
         let b = building.entry(m.topic.to_string()).or_insert_with(|| Building {
             cols: Columns::default(),
             ns: Vec::new(),
