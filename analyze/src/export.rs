@@ -274,6 +274,10 @@ pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportForm
     write_metadata(dir, &frames.source, &frames.metadata, &frames.skipped, format, layout, listed, tables, rows)
 }
 
+/// What the first batch says of a table: its columns, their units, the text columns left out.
+#[cfg(feature = "tables")]
+type TableHead = (Vec<String>, Vec<(String, &'static str)>, Vec<String>);
+
 /// [`write_tables`] for a recording read in batches ([`frames::streamed`]): each topic's table
 /// is written batch by batch as the file is read again (Parquet: one row group per batch; CSV:
 /// the header, then the rows of each batch), so memory is bounded by a batch, not the file. The
@@ -294,7 +298,7 @@ pub fn write_streamed(frames: &mut Streamed, dir: &Path, format: ExportFormat, l
         let table_err = |e: PolarsError| Error::Table { file: path.display().to_string(), detail: format!("building the table: {e}") };
         let write_err = |e: PolarsError| Error::Table { file: path.display().to_string(), detail: format!("writing the table: {e}") };
         // what the first batch says of the table: columns, units, text columns left out
-        let mut first: Option<(Vec<String>, Vec<(String, &'static str)>, Vec<String>)> = None;
+        let mut first: Option<TableHead> = None;
         let mut height = 0;
         schemas::atomic::write_with(&path, |f: &mut std::fs::File| -> Result<(), Error> {
             let mut parquet: Option<BatchedWriter<&mut std::fs::File>> = None;

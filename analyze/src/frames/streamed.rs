@@ -107,6 +107,8 @@ fn labeller<'a>(topic: &'a str, joints: Option<&'a [String]>, contacts: Option<&
 
 /// Reads the recording at `path` twice (module docs, reads 1 and 2): the plan of the topics of
 /// `select`. Errors are the reader's (the file is checked whole before any table is written).
+// the visitor's error is the reader's (`schemas::Error`, large), as in `super::read_frames`
+#[allow(clippy::result_large_err)]
 pub fn plan(path: &Path, select: Selection<'_>) -> Result<Streamed, Error> {
     // 1: channels and metadata
     let none: &[&str] = &[];
@@ -194,6 +196,7 @@ impl Streamed {
     /// Reads the topic `k` of [`Streamed::topics`] once more and hands its rows to `sink` as
     /// frames of at most [`MAX_ROWS`] rows and `cells` values (at most [`MAX_CELLS`]; less for
     /// a caller that makes more of each value: the long layout's row per value), in order.
+    #[allow(clippy::result_large_err)]
     pub fn batches(&self, k: usize, cells: usize, mut sink: impl FnMut(TopicFrame) -> Result<(), Error>) -> Result<(), Error> {
         let plan = &self.topics[k];
         let topic = plan.topic.as_str();
