@@ -28,10 +28,12 @@ use std::path::Path;
 use std::path::PathBuf;
 
 #[cfg(feature = "tables")]
+use polars::io::parquet::write::BatchedWriter;
+#[cfg(feature = "tables")]
 use polars::prelude::*;
 
 #[cfg(feature = "tables")]
-use crate::frames::{self, RecordingFrames, TopicFrame};
+use crate::frames::{self, streamed::Streamed, RecordingFrames, TopicFrame};
 use crate::Error;
 
 /// File format of the tables.
@@ -109,9 +111,9 @@ pub fn export_file(path: &Path, dir: &Path, options: &ExportOptions<'_>) -> Resu
         let file = || path.display().to_string();
         let topics = options.topics;
         let select = frames::Selection { only: (!topics.is_empty()).then_some(topics), include: options.include };
-        let mut f = frames::read_frames(path, select)?;
+        let mut f = frames::streamed::plan(path, select)?;
         for t in topics {
-            if f.get(t).is_none() {
+            if !f.topics.iter().any(|p| p.topic == *t) {
                 let why = f.skipped.iter().find(|(s, _)| s == t).map(|(_, w)| w.clone());
                 let why = why.filter(|w| w != schemas::NOT_SELECTED).unwrap_or_else(|| {
                     let have: Vec<&str> = f.skipped.iter().map(|(s, _)| s.as_str()).collect();
@@ -121,7 +123,7 @@ pub fn export_file(path: &Path, dir: &Path, options: &ExportOptions<'_>) -> Resu
             }
         }
         let (rows, tables) = write_marked(dir, path, |dir| {
-            let w = write_tables(&mut f, dir, options.format, options.layout)?;
+            let w = write_streamed(&mut f, dir, options.format, options.layout)?;
             Ok((w.rows, w.tables.len()))
         })?;
         let result = match f.metadata.get(<schemas::RunResult as schemas::MetadataRecord>::NAME) {
@@ -185,13 +187,11 @@ pub fn topic_file_name(topic: &str, format: ExportFormat) -> String {
 #[cfg(feature = "tables")]
 /// The file of each topic: [`topic_file_name`], with `_2`, `_3` ... before the extension when
 /// two topics map to one name (`/a/b` and `/a_b`).
-fn file_names(frames: &RecordingFrames, format: ExportFormat) -> Vec<String> {
+fn file_names<'a>(topics: impl Iterator<Item = &'a str>, format: ExportFormat) -> Vec<String> {
     let mut used = std::collections::BTreeSet::new();
-    frames
-        .topics
-        .iter()
+    topics
         .map(|t| {
-            let base = topic_file_name(&t.topic, format);
+            let base = topic_file_name(t, format);
             let mut name = base.clone();
             let mut k = 2;
             while !used.insert(name.clone()) {
@@ -231,7 +231,7 @@ pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportForm
         op: "creating",
         source,
     })?;
-    let files = file_names(frames, format);
+    let files = file_names(frames.topics.iter().map(|t| t.topic.as_str()), format);
     let mut tables = Vec::new();
     let mut rows = 0;
     let mut listed = Vec::new();
@@ -271,15 +271,128 @@ pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportForm
         listed.push(entry);
         tables.push(path);
     }
+    write_metadata(dir, &frames.source, &frames.metadata, &frames.skipped, format, layout, listed, tables, rows)
+}
+
+/// What the first batch says of a table: its columns, their units, the text columns left out.
+#[cfg(feature = "tables")]
+type TableHead = (Vec<String>, Vec<(String, &'static str)>, Vec<String>);
+
+/// [`write_tables`] for a recording read in batches ([`frames::streamed`]): each topic's table
+/// is written batch by batch as the file is read again (Parquet: one row group per batch; CSV:
+/// the header, then the rows of each batch), so memory is bounded by a batch, not the file. The
+/// tables have the columns and values of [`write_tables`]' (module docs of `frames::streamed`).
+#[cfg(feature = "tables")]
+pub fn write_streamed(frames: &mut Streamed, dir: &Path, format: ExportFormat, layout: Layout) -> Result<Written, Error> {
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        file: dir.display().to_string(),
+        op: "creating",
+        source,
+    })?;
+    let files = file_names(frames.topics.iter().map(|t| t.topic.as_str()), format);
+    let mut tables = Vec::new();
+    let mut rows = 0;
+    let mut listed = Vec::new();
+    for (k, name) in files.iter().enumerate() {
+        let path = dir.join(name);
+        let table_err = |e: PolarsError| Error::Table { file: path.display().to_string(), detail: format!("building the table: {e}") };
+        let write_err = |e: PolarsError| Error::Table { file: path.display().to_string(), detail: format!("writing the table: {e}") };
+        // what the first batch says of the table: columns, units, text columns left out
+        let mut first: Option<TableHead> = None;
+        let mut height = 0;
+        schemas::atomic::write_with(&path, |f: &mut std::fs::File| -> Result<(), Error> {
+            let mut parquet: Option<BatchedWriter<&mut std::fs::File>> = None;
+            // the file, until the Parquet writer takes it at the first batch
+            let mut file = Some(f);
+            // the long layout makes a row of six columns of each value: smaller batches
+            let cells = match layout {
+                Layout::Wide => frames::streamed::MAX_CELLS,
+                Layout::Long => frames::streamed::MAX_CELLS / 8,
+            };
+            frames.batches(k, cells, |t| {
+                let (mut df, units, text) = match layout {
+                    Layout::Wide => (t.frame.clone(), wide_units(&t), Vec::new()),
+                    Layout::Long => {
+                        let (df, text) = frames::long::long_frame(&t).map_err(table_err)?;
+                        (df, vec![(frames::TIME_COLUMN.to_string(), frames::TIME_UNIT)], text)
+                    }
+                };
+                let head = first.is_none();
+                if head {
+                    let columns = df.get_column_names().iter().map(|c| c.to_string()).collect();
+                    first = Some((columns, wide_units(&t), text));
+                }
+                height += df.height();
+                match format {
+                    ExportFormat::Parquet => {
+                        if let Some(file) = file.take() {
+                            let kv = parquet_metadata(&df, &units);
+                            parquet = Some(ParquetWriter::new(file).with_key_value_metadata(Some(kv)).batched(df.schema()).map_err(write_err)?);
+                        }
+                        if let Some(w) = parquet.as_mut() {
+                            w.write_batch(&df).map_err(write_err)?;
+                        }
+                    }
+                    ExportFormat::Csv => {
+                        if head {
+                            df.set_column_names(csv_header(&df, &units).as_slice()).map_err(write_err)?;
+                        }
+                        if let Some(file) = file.as_deref_mut() {
+                            CsvWriter::new(file).include_header(head).finish(&mut df).map_err(write_err)?;
+                        }
+                    }
+                }
+                Ok(())
+            })?;
+            if let Some(w) = parquet {
+                w.finish().map_err(write_err)?;
+            }
+            Ok(())
+        })?;
+        rows += height;
+        let t = &frames.topics[k];
+        let (columns, units, text) = first.unwrap_or_default();
+        let mut entry = serde_json::json!({
+            "topic": t.topic,
+            "schema": t.schema_name,
+            "file": name,
+            "rows": height,
+            "columns": columns,
+            "units": units.into_iter().map(|(c, u)| (c, serde_json::Value::from(u))).collect::<serde_json::Map<_, _>>(),
+        });
+        if !text.is_empty() {
+            entry["text_columns_left_out"] = serde_json::json!(text);
+        }
+        listed.push(entry);
+        tables.push(path);
+    }
+    write_metadata(dir, &frames.source, &frames.metadata, &frames.skipped, format, layout, listed, tables, rows)
+}
+
+/// Writes `metadata.json` into `dir`: the recording's metadata records typed, the tables
+/// `listed`, the topics skipped with the reason.
+#[cfg(feature = "tables")]
+#[allow(clippy::too_many_arguments)]
+fn write_metadata(
+    dir: &Path,
+    source: &str,
+    metadata: &std::collections::BTreeMap<String, std::collections::BTreeMap<String, String>>,
+    skipped: &[(String, String)],
+    format: ExportFormat,
+    layout: Layout,
+    listed: Vec<serde_json::Value>,
+    tables: Vec<PathBuf>,
+    rows: usize,
+) -> Result<Written, Error> {
     let meta = serde_json::json!({
-        "source": frames.source,
+        "source": source,
         "format": format.extension(),
         "layout": layout.as_str(),
         "time": {"column": frames::TIME_COLUMN, "unit": frames::TIME_UNIT, "doc": TIME_DOC},
         "units": "Parquet: each column's field metadata `unit` (and the file's key `units`); CSV: `name [unit]` in the header; long layout: the `unit` column; here: `topics[].units`",
-        "metadata": schemas::meta::typed_records(&frames.metadata),
+        "metadata": schemas::meta::typed_records(metadata),
         "topics": listed,
-        "skipped": frames.skipped.iter().map(|(t, why)| serde_json::json!({"topic": t, "reason": why})).collect::<Vec<_>>(),
+        "skipped": skipped.iter().map(|(t, why)| serde_json::json!({"topic": t, "reason": why})).collect::<Vec<_>>(),
     });
     let path = dir.join("metadata.json");
     let text = serde_json::to_string_pretty(&meta).unwrap_or_default() + "\n";

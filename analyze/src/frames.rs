@@ -35,6 +35,7 @@ use crate::Error;
 
 mod flatten;
 pub mod long;
+pub mod streamed;
 pub use flatten::{ColumnData, ColumnField};
 use flatten::Columns;
 
@@ -231,7 +232,13 @@ const STAMPS: [(&str, &str); 2] = [(".sec", ".nanosec"), (".seconds", ".nanos")]
 
 fn frame(topic: &str, ns: &[u64], cols: Columns) -> PolarsResult<(DataFrame, Vec<ColumnInfo>)> {
     let cols: Vec<(String, ColumnField, ColumnData)> = cols.into_columns().collect();
-    // the duplicates of the time column
+    let drop = time_duplicates(&cols, ns);
+    frame_of(topic, ns, cols, &drop)
+}
+
+/// Which of `cols` duplicate the log time `ns` at every row (a `time` field, a `sec` +
+/// `nanosec` stamp): those are left out of the frame.
+fn time_duplicates(cols: &[(String, ColumnField, ColumnData)], ns: &[u64]) -> Vec<bool> {
     let mut drop = vec![false; cols.len()];
     for (k, (name, field, data)) in cols.iter().enumerate() {
         if name == TIME_COLUMN && field.label.is_none() && is_log_time_s(data, ns) {
@@ -247,6 +254,11 @@ fn frame(topic: &str, ns: &[u64], cols: Columns) -> PolarsResult<(DataFrame, Vec
             }
         }
     }
+    drop
+}
+
+/// The frame of `cols` at the times `ns`, without the columns `drop` marks.
+fn frame_of(topic: &str, ns: &[u64], cols: Vec<(String, ColumnField, ColumnData)>, drop: &[bool]) -> PolarsResult<(DataFrame, Vec<ColumnInfo>)> {
     let t: Vec<f64> = ns.iter().map(|&n| schemas::from_log_time(n)).collect();
     let mut columns = vec![Column::new(TIME_COLUMN.into(), t)];
     let mut info = vec![ColumnInfo {
@@ -255,7 +267,7 @@ fn frame(topic: &str, ns: &[u64], cols: Columns) -> PolarsResult<(DataFrame, Vec
         label: None,
         unit: Some(TIME_UNIT),
     }];
-    for ((name, field, data), drop) in cols.into_iter().zip(drop) {
+    for ((name, field, data), &drop) in cols.into_iter().zip(drop) {
         if drop {
             continue;
         }

@@ -239,7 +239,7 @@ fn reading_path_never_panics() {
 type Outcome = Result<bool, String>;
 
 /// The reading paths behind the other commands (issue 29): `diff` (`analyze::read_input`),
-/// `figures` (`figures::read_run`), `export` (`frames::read_frames`), `layout` (the streamed
+/// `figures` (`figures::read_run`), `export` (`frames::streamed`: the plan and each topic's batches), `layout` (the streamed
 /// reader + `LayoutInput`), `view` (`view::read_input`); `metrics`, `compare`, `summary` and
 /// `report` read through `read_run_metrics` and `--recover` through `read_run_metrics_recover`
 /// (both in [`reading_path_never_panics`]). The same generator and rule: no panic, an error
@@ -258,15 +258,33 @@ fn every_commands_reading_path_never_panics() {
     let cases = std::env::var("FUZZ_CASES").ok().map_or(2_000, |_| cases);
 
     // the intact file's results, each command's own way
-    let diff_of = |p: &std::path::Path| analyze::read_input(p).map(|i| i.runs.into_iter().map(|r| format!("{:?}", r.values)).collect::<Vec<_>>());
-    let figures_of = |p: &std::path::Path| analyze::figures::read_run(p).map(|r| analyze::figures::RunSeries { name: String::new(), ..r });
-    let frames_of = |p: &std::path::Path| {
-        analyze::frames::read_frames(p, analyze::frames::Selection::default())
-            .map(|f| f.topics.into_iter().map(|t| (t.topic, t.frame)).collect::<Vec<_>>())
+    // (errors as their text: what is checked is that they name the file)
+    let diff_of = |p: &std::path::Path| {
+        analyze::read_input(p).map(|i| i.runs.into_iter().map(|r| format!("{:?}", r.values)).collect::<Vec<_>>()).map_err(|e| e.to_string())
     };
-    let layout_of = |p: &std::path::Path| -> Result<serde_json::Value, schemas::Error> {
-        let rec = schemas::read_recording_topics(p, Some(&[schemas::topics::HAND]))?;
-        Ok(schemas::layout::foxglove(&schemas::layout::LayoutInput::from_recording(&rec)?))
+    let figures_of =
+        |p: &std::path::Path| analyze::figures::read_run(p).map(|r| analyze::figures::RunSeries { name: String::new(), ..r }).map_err(|e| e.to_string());
+    // export's path: the plan, then each topic's batches, stacked
+    let frames_of = |p: &std::path::Path| -> Result<Vec<(String, polars::prelude::DataFrame)>, String> {
+        let s = analyze::frames::streamed::plan(p, analyze::frames::Selection::default()).map_err(|e| e.to_string())?;
+        let mut out = Vec::new();
+        for (k, t) in s.topics.iter().enumerate() {
+            let mut df: Option<polars::prelude::DataFrame> = None;
+            s.batches(k, analyze::frames::streamed::MAX_CELLS, |b| {
+                match df.as_mut() {
+                    Some(d) => drop(d.vstack_mut(&b.frame)),
+                    None => df = Some(b.frame),
+                }
+                Ok(())
+            })
+            .map_err(|e| e.to_string())?;
+            out.extend(df.map(|d| (t.topic.clone(), d)));
+        }
+        Ok(out)
+    };
+    let layout_of = |p: &std::path::Path| -> Result<serde_json::Value, String> {
+        let rec = schemas::read_recording_topics(p, Some(&[schemas::topics::HAND])).map_err(|e| e.to_string())?;
+        Ok(schemas::layout::foxglove(&schemas::layout::LayoutInput::from_recording(&rec).map_err(|e| e.to_string())?))
     };
     // `view` needs the feature `rerun` (`cargo test -p analyze --all-features --test fuzz_read`)
     #[cfg(feature = "rerun")]
@@ -298,16 +316,15 @@ fn every_commands_reading_path_never_panics() {
             }
         };
         let paths: [Box<dyn Fn() -> Outcome>; 5] = [
-            Box::new(|| judge(diff_of(&file).map(|v| v == intact.0).map_err(|e| e.to_string()))),
-            Box::new(|| judge(figures_of(&file).map(|v| v == intact.1).map_err(|e| e.to_string()))),
+            Box::new(|| judge(diff_of(&file).map(|v| v == intact.0))),
+            Box::new(|| judge(figures_of(&file).map(|v| v == intact.1))),
             Box::new(|| {
                 judge(
                     frames_of(&file)
-                        .map(|v| v.len() == intact.2.len() && v.iter().zip(&intact.2).all(|(a, b)| a.0 == b.0 && a.1.equals_missing(&b.1)))
-                        .map_err(|e| e.to_string()),
+                        .map(|v| v.len() == intact.2.len() && v.iter().zip(&intact.2).all(|(a, b)| a.0 == b.0 && a.1.equals_missing(&b.1))),
                 )
             }),
-            Box::new(|| judge(layout_of(&file).map(|v| v == intact.3).map_err(|e| e.to_string()))),
+            Box::new(|| judge(layout_of(&file).map(|v| v == intact.3))),
             Box::new(|| judge(view_of(&file).map(|v| v == intact.4))),
         ];
         for (k, run) in paths.iter().enumerate() {

@@ -418,3 +418,27 @@ fn a_table_with_missing_sections_is_a_difference() {
         assert_eq!(code, 0, "{section}: {out}{err}");
     }
 }
+
+/// A directory's `*.mcap` entries that are not files (a dangling link, a looping link, a
+/// directory) are named on stderr and left out, and the exit status is 1 even though the runs
+/// read have no differences (issue 29: main dropped them silently, exit 0).
+#[test]
+fn a_directory_names_the_entries_it_leaves_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let runs = dir.path().join("runs");
+    std::fs::create_dir(&runs).unwrap();
+    let a = write_run(&runs.join("a.mcap"), &Run::default());
+    std::os::unix::fs::symlink(runs.join("gone.mcap.target"), runs.join("dangling.mcap")).unwrap();
+    std::os::unix::fs::symlink(runs.join("loop.mcap"), runs.join("loop.mcap")).unwrap();
+    std::fs::create_dir(runs.join("dir.mcap")).unwrap();
+    let (code, out, err) = run(&["diff", s(&runs), s(&a)]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.trim_end().ends_with("no differences beyond rtol 1e-9, atol 1e-12"), "{out}");
+    for name in ["dangling.mcap", "loop.mcap", "dir.mcap"] {
+        assert!(err.lines().any(|l| l.contains(name) && l.contains("skipped")), "{name} not named: {err}");
+    }
+    // the other side too
+    let (code, _, err) = run(&["diff", s(&a), s(&runs)]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("dangling.mcap"), "{err}");
+}

@@ -73,3 +73,62 @@ fn long_recordings_are_drawn_and_laid_out_in_bounded_memory() {
     let whole = schemas::layout::foxglove(&schemas::layout::LayoutInput::from_recording(&rec).unwrap());
     assert_eq!(streamed, whole);
 }
+
+/// `export` on the 300 s recording within 200 MB, as Parquet and CSV, wide and long (issue 29:
+/// 1.79 GB peak on main): each topic's table is written batch by batch as the file is read
+/// (`analyze::frames::streamed`). The tables hold every sample: 300 001 rows of `/motors`, its
+/// peak current 3 A on joint 3 and its last time 300 s, read back from the CSV.
+#[test]
+fn long_recordings_are_exported_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = long_recording(dir.path());
+    let p = path.to_str().unwrap();
+    for (format, layout) in [("parquet", "wide"), ("csv", "wide"), ("csv", "long")] {
+        let out_dir = dir.path().join(format!("{format}-{layout}"));
+        let o = out_dir.to_str().unwrap();
+        let out = analyze_limited(200_000, &["export", p, "-f", format, "--layout", layout, "-o", o, "-q"]);
+        assert_eq!(out.status.code(), Some(0), "export {format} {layout} within 200 MB: {}", String::from_utf8_lossy(&out.stderr));
+        let tables = out_dir.join("long");
+        assert!(!tables.join(analyze::export::INCOMPLETE).exists());
+        let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(tables.join("metadata.json")).unwrap()).unwrap();
+        let motors = meta["topics"].as_array().unwrap().iter().find(|t| t["topic"] == "/motors").unwrap().clone();
+        if layout == "wide" {
+            assert_eq!(motors["rows"], 300_001, "{motors}");
+        }
+        if format == "csv" && layout == "wide" {
+            let text = std::fs::read_to_string(tables.join("motors.csv")).unwrap();
+            let mut lines = text.lines();
+            let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+            let col = header.iter().position(|h| h.starts_with("current.") && h.contains('3')).expect("a current column of joint 3");
+            let (mut n, mut peak, mut last) = (0, 0.0f64, 0.0f64);
+            for line in lines {
+                let cells: Vec<&str> = line.split(',').collect();
+                peak = peak.max(cells[col].parse::<f64>().unwrap().abs());
+                last = cells[0].parse().unwrap();
+                n += 1;
+            }
+            assert_eq!(n, 300_001);
+            assert!((peak - 3.0).abs() < 1e-9, "{peak}");
+            assert!((last - 300.0).abs() < 1e-9, "{last}");
+        }
+    }
+}
+
+/// A recording whose messages carry 5 002-entry arrays while its `run` record declares 3
+/// joints (issue 29: `export` took 530–610 MB on such a 343 KB file): refused as damage under
+/// 200 MB, naming the file, the topic, the field and the time, exit 2, no table left.
+#[test]
+fn arrays_longer_than_the_run_declares_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = Synth::new("wide", &["elbow"], 5_002);
+    (s.dt, s.n) = (1e-3, 50);
+    s.names.as_mut().unwrap().joint_names = Some(vec!["joint1".into(), "joint2".into(), "joint3".into()]);
+    let path = s.with_setup().write_in(dir.path());
+    let out_dir = dir.path().join("tables");
+    let out = analyze_limited(200_000, &["export", path.to_str().unwrap(), "-o", out_dir.to_str().unwrap(), "-q"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let file = path.display().to_string();
+    assert!(err.contains(&file) && err.contains("topic /") && err.contains("field ") && err.contains("5002 entries, expected 3"), "{err}");
+    assert!(!out_dir.join("wide").join("metadata.json").exists());
+}

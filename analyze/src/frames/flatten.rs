@@ -54,6 +54,17 @@ impl ColumnData {
         }
     }
 
+    /// An empty column of `d`'s kind.
+    fn empty_like_data(d: &ColumnData) -> ColumnData {
+        match d {
+            ColumnData::F64(_) => ColumnData::F64(Vec::new()),
+            ColumnData::I64(_) => ColumnData::I64(Vec::new()),
+            ColumnData::U64(_) => ColumnData::U64(Vec::new()),
+            ColumnData::Bool(_) => ColumnData::Bool(Vec::new()),
+            ColumnData::Str(_) => ColumnData::Str(Vec::new()),
+        }
+    }
+
     fn empty_like(x: &Value, rows: usize) -> Option<ColumnData> {
         Some(match x {
             Value::F64(_) => ColumnData::F64(vec![None; rows]),
@@ -181,6 +192,41 @@ impl Columns {
     /// Number of rows pushed.
     pub fn rows(&self) -> usize {
         self.rows
+    }
+
+    /// Number of columns so far.
+    pub fn width(&self) -> usize {
+        self.names.len()
+    }
+
+    /// The rows pushed so far as `(name, what it holds, values)`, in first-appearance order;
+    /// the columns (names, kinds) stay, empty, for the next rows (a batch of a streamed table).
+    pub fn take_rows(&mut self) -> Vec<(String, ColumnField, ColumnData)> {
+        self.rows = 0;
+        let empty = |d: &ColumnData| ColumnData::empty_like_data(d);
+        self.names
+            .iter()
+            .zip(&self.fields)
+            .zip(self.data.iter_mut())
+            .map(|((n, f), d)| {
+                let next = empty(d);
+                (n.clone(), f.clone(), std::mem::replace(d, next))
+            })
+            .collect()
+    }
+
+    /// Columns of `plan`'s names, fields and kinds (those of a first pass over the whole
+    /// topic), in its order, without rows: the batches of a second pass then all have every
+    /// column, in the order and of the kind the whole topic read at once gives.
+    pub fn planned(plan: impl IntoIterator<Item = (String, ColumnField, ColumnData)>) -> Columns {
+        let mut c = Columns::default();
+        for (name, field, data) in plan {
+            c.index.insert(name.clone(), c.data.len());
+            c.names.push(name);
+            c.fields.push(field);
+            c.data.push(ColumnData::empty_like_data(&data));
+        }
+        c
     }
 
     /// `(name, what it holds, values)` in first-appearance order.

@@ -105,6 +105,17 @@ impl DecodedMessage<'_> {
         self.run.map(|r| ArraySizes { joints: r.joint_names.len(), contacts: r.contacts.len() })
     }
 
+    /// Every per-joint and per-contact array has the length [`DecodedMessage::sizes`] gives
+    /// (an optional array may be empty); `Ok` when no `run` record has been read. Errors name
+    /// the file, the topic, the field, the message and its time.
+    pub fn check_sizes(&self) -> Result<(), Error> {
+        let Some(sizes) = self.sizes() else { return Ok(()) };
+        for (field, kind, len) in self.arrays() {
+            check_length(self.file, self.topic, self.index, self.log_time_ns, field, kind, len, sizes)?;
+        }
+        Ok(())
+    }
+
     /// Log time, s.
     pub fn t_s(&self) -> f64 {
         from_log_time(self.log_time_ns)

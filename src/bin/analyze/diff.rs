@@ -8,7 +8,8 @@ use cli::{exit, print_out, TableFormat};
 /// Compare two recordings, directories of recordings or exported tables run by run (matched by
 /// run name): hand error, E and W totals, per-link W_j and E_j, currents, contact forces,
 /// energy residual, with absolute and relative differences. Exit status 0: nothing moved beyond
-/// the tolerances; 1: something moved, is missing on one side, or is carried by one input only;
+/// the tolerances; 1: something moved, is missing on one side, or is carried by one input only,
+/// or a directory had `*.mcap` entries that are not files (named on stderr);
 /// 2: bad input.
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
@@ -49,9 +50,17 @@ pub struct DiffArgs {
 }
 
 pub fn run(a: &DiffArgs) -> Result<u8> {
+    // a directory's `*.mcap` entries that are not files (dangling or looping links,
+    // directories, FIFOs) are named, left out and make the exit status 1 (issue 29)
+    let mut skipped = 0;
+    for input in [&a.a, &a.b].into_iter().filter(|p| p.is_dir()) {
+        let e = cli::inputs::expand_all(std::slice::from_ref(input))?;
+        e.warn_skipped();
+        skipped += e.skipped.len();
+    }
     let (left, right) = (analyze::read_input(&a.a)?, analyze::read_input(&a.b)?);
     let tol = analyze::Tolerance { rtol: a.rtol, atol: a.atol };
     let d = analyze::diff::diff(&left, &right, tol)?.common_only(a.common_only);
     print_out(&analyze::render_diff(&d, a.format.format, a.all)?)?;
-    Ok(if d.differs() { exit::FAILED } else { exit::SUCCESS })
+    Ok(if d.differs() || skipped > 0 { exit::FAILED } else { exit::SUCCESS })
 }

@@ -35,30 +35,35 @@ pub struct LayoutArgs {
     pub out: Option<PathBuf>,
 }
 
-/// The layout input of the recording at `p`, read streamed: the camera from the box around the
-/// desired hand positions of `/hand` (the same as [`LayoutInput::from_recording`] gives from all
-/// of them, which [`layout::camera_for`] reduces to that box).
-/// With it, the line that says the run failed (if it did).
-fn read_one(p: &std::path::Path) -> Result<(LayoutInput, Option<String>)> {
-    // lowest and highest finite desired position, per axis
-    let mut bounds: Option<([f64; 3], [f64; 3])> = None;
-    let mut visit = |m: schemas::DecodedMessage<'_>| -> Result<(), schemas::Error> {
+/// The lowest and highest finite desired hand position, per axis, of the `/hand` messages seen.
+struct TargetBox(Option<([f64; 3], [f64; 3])>);
+
+impl schemas::Visitor for TargetBox {
+    fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
         // a message without a target (another producer's /hand) places no camera, as in
         // `LayoutInput::from_recording`
         let Ok(h) = m.decode::<schemas::HandState>(None) else { return Ok(()) };
         let q = [h.desired.x, h.desired.y, h.desired.z];
         if q.iter().all(|v| v.is_finite()) {
-            let (lo, hi) = bounds.get_or_insert((q, q));
+            let (lo, hi) = self.0.get_or_insert((q, q));
             for k in 0..3 {
                 lo[k] = lo[k].min(q[k]);
                 hi[k] = hi[k].max(q[k]);
             }
         }
         Ok(())
-    };
+    }
+}
+
+/// The layout input of the recording at `p`, read streamed: the camera from the box around the
+/// desired hand positions of `/hand` (the same as [`LayoutInput::from_recording`] gives from all
+/// of them, which [`layout::camera_for`] reduces to that box).
+/// With it, the line that says the run failed (if it did).
+fn read_one(p: &std::path::Path) -> Result<(LayoutInput, Option<String>)> {
+    let mut visit = TargetBox(None);
     let rec = schemas::stream_recording(p, Some(&[schemas::topics::HAND]), &mut visit)?;
     let mut one = LayoutInput::from_recording(&rec)?;
-    let corners: Vec<[f64; 3]> = bounds.map(|(lo, hi)| vec![lo, hi]).unwrap_or_default();
+    let corners: Vec<[f64; 3]> = visit.0.map(|(lo, hi)| vec![lo, hi]).unwrap_or_default();
     (one.focus, one.camera_distance_m) = layout::camera_for(&corners);
     Ok((one, cli::inputs::failed_run_note(p, rec.result()?.as_ref())))
 }
