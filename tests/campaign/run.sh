@@ -183,6 +183,24 @@ part_kills() {
     rm -rf "$d" "$d".*
   done
   echo "kills: $trials killed: $recovered partial files gave metrics with --recover, $refused refused with a reason, 0 final files, 0 leftovers after the next run"
+  # analyze export killed mid-way: what it leaves is marked INCOMPLETE until it is done
+  "$SIM" run sim/scenes/paper.json --run two-elbow --duration 30 --quiet -o "$work/kill-src" > /dev/null
+  local marked=0 finished=0
+  for t in $(seq "$trials"); do
+    local d="$work/kill-export-$t"
+    "$ANALYZE" --quiet export "$work/kill-src/paper-two-elbow.mcap" --format csv -o "$d" > /dev/null 2>&1 &
+    local pid=$!
+    sleep "$(python3 -c "import random; random.seed(1000 + $t); print(round(random.uniform(0.02, 1.0), 3))")"
+    kill -9 "$pid" 2> /dev/null || true
+    wait "$pid" 2> /dev/null || true
+    local tables="$d/paper-two-elbow"
+    if [ -d "$tables" ] && [ -n "$(ls -A "$tables")" ]; then
+      if [ -e "$tables/INCOMPLETE" ]; then marked=$((marked + 1));
+      else [ -e "$tables/metadata.json" ] || fail "export killed ($t): tables without metadata.json and without INCOMPLETE: $(ls "$tables")"; finished=$((finished + 1)); fi
+    fi
+    rm -rf "$d"
+  done
+  echo "kills: $trials analyze export killed: $marked left tables marked INCOMPLETE, $finished had finished, 0 unmarked partial exports"
 }
 
 part_disks() {
@@ -204,7 +222,11 @@ part_disks() {
       case "$code" in
         0) ;;
         2) grep -qi "no space" "$work/disk.err" || fail "$what on a ${kb} KiB disk: exit 2 without the OS reason: $(cat "$work/disk.err")"
-           ! grep -q '\.mcap$' "$work/disk.ls" || fail "$what on a ${kb} KiB disk: a recording left under its final name: $(cat "$work/disk.ls")" ;;
+           ! grep -q '\.mcap$' "$work/disk.ls" || fail "$what on a ${kb} KiB disk: a recording left under its final name: $(cat "$work/disk.ls")"
+           # an export cut short is marked INCOMPLETE (or left nothing)
+           if [ "$what" = export ] && [ -s "$work/disk.ls" ]; then
+             grep -q 'INCOMPLETE$' "$work/disk.ls" || fail "export on a ${kb} KiB disk: tables left without the INCOMPLETE mark: $(cat "$work/disk.ls")"
+           fi ;;
         *) fail "$what on a ${kb} KiB disk: exit $code: $(cat "$work/disk.err")" ;;
       esac
       n=$((n + 1))
