@@ -33,7 +33,7 @@ use polars::io::parquet::write::BatchedWriter;
 use polars::prelude::*;
 
 #[cfg(feature = "tables")]
-use crate::frames::{self, streamed::Streamed, RecordingFrames, TopicFrame};
+use crate::frames::{self, streamed::Streamed, TopicFrame};
 use crate::Error;
 
 /// File format of the tables.
@@ -204,7 +204,7 @@ fn file_names<'a>(topics: impl Iterator<Item = &'a str>, format: ExportFormat) -
         .collect()
 }
 
-/// What [`write_tables`] wrote.
+/// What [`write_streamed`] wrote.
 #[cfg(feature = "tables")]
 #[derive(Debug, Clone)]
 pub struct Written {
@@ -221,67 +221,17 @@ pub struct Written {
 const TIME_DOC: &str = "the sample's simulated time in s from the start of the run (the MCAP log time, whole ns); \
      the only time column: every topic's times are equal where their samples are";
 
-/// Writes one file per topic into `dir` (created if needed), in `layout`, plus `metadata.json`
-/// (the metadata records typed, each table's columns and units, and the topics not exported
-/// with the reason).
-#[cfg(feature = "tables")]
-pub fn write_tables(frames: &mut RecordingFrames, dir: &Path, format: ExportFormat, layout: Layout) -> Result<Written, Error> {
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-        file: dir.display().to_string(),
-        op: "creating",
-        source,
-    })?;
-    let files = file_names(frames.topics.iter().map(|t| t.topic.as_str()), format);
-    let mut tables = Vec::new();
-    let mut rows = 0;
-    let mut listed = Vec::new();
-    for (t, name) in frames.topics.iter().zip(&files) {
-        let path = dir.join(name);
-        let table_err = |e: PolarsError| Error::Table { file: path.display().to_string(), detail: format!("building the table: {e}") };
-        let (mut df, units, text) = match layout {
-            Layout::Wide => (t.frame.clone(), wide_units(t), Vec::new()),
-            Layout::Long => {
-                let (df, text) = frames::long::long_frame(t).map_err(table_err)?;
-                (df, vec![(frames::TIME_COLUMN.to_string(), frames::TIME_UNIT)], text)
-            }
-        };
-        write_atomic(&path, |f| match format {
-            ExportFormat::Parquet => {
-                let kv = parquet_metadata(&df, &units);
-                ParquetWriter::new(f).with_key_value_metadata(Some(kv)).finish(&mut df).map(drop)
-            }
-            ExportFormat::Csv => {
-                let mut headed = df.clone();
-                headed.set_column_names(csv_header(&df, &units).as_slice())?;
-                CsvWriter::new(f).include_header(true).finish(&mut headed)
-            }
-        })?;
-        rows += df.height();
-        let mut entry = serde_json::json!({
-            "topic": t.topic,
-            "schema": t.schema_name,
-            "file": name,
-            "rows": df.height(),
-            "columns": df.get_column_names().iter().map(|c| c.as_str()).collect::<Vec<_>>(),
-            "units": wide_units(t).into_iter().map(|(c, u)| (c, serde_json::Value::from(u))).collect::<serde_json::Map<_, _>>(),
-        });
-        if !text.is_empty() {
-            entry["text_columns_left_out"] = serde_json::json!(text);
-        }
-        listed.push(entry);
-        tables.push(path);
-    }
-    write_metadata(dir, &frames.source, &frames.metadata, &frames.skipped, format, layout, listed, tables, rows)
-}
-
 /// What the first batch says of a table: its columns, their units, the text columns left out.
 #[cfg(feature = "tables")]
 type TableHead = (Vec<String>, Vec<(String, &'static str)>, Vec<String>);
 
-/// [`write_tables`] for a recording read in batches ([`frames::streamed`]): each topic's table
+/// Writes one file per topic into `dir` (created if needed), in `layout`, plus `metadata.json`
+/// (the metadata records typed, each table's columns and units, and the topics not exported
+/// with the reason), for a recording read in batches ([`frames::streamed`]): each topic's table
 /// is written batch by batch as the file is read again (Parquet: one row group per batch; CSV:
 /// the header, then the rows of each batch), so memory is bounded by a batch, not the file. The
-/// tables have the columns and values of [`write_tables`]' (module docs of `frames::streamed`).
+/// tables have the columns and values of the frames read whole (module docs of
+/// `frames::streamed`).
 #[cfg(feature = "tables")]
 pub fn write_streamed(frames: &mut Streamed, dir: &Path, format: ExportFormat, layout: Layout) -> Result<Written, Error> {
     std::fs::create_dir_all(dir).map_err(|source| Error::Io {
@@ -451,14 +401,4 @@ fn parquet_metadata(df: &DataFrame, units: &[(String, &'static str)]) -> KeyValu
         kv.insert(0, (arrow.key, value));
     }
     KeyValueMetadata::from_static(kv)
-}
-
-/// Writes `path` with `write` atomically and exclusively (`schemas::atomic`); errors name the
-/// file.
-#[cfg(feature = "tables")]
-fn write_atomic(path: &Path, write: impl FnOnce(&mut std::fs::File) -> PolarsResult<()>) -> Result<(), Error> {
-    schemas::atomic::write_with(path, |f| {
-        write(f).map_err(|e| Error::Table { file: path.display().to_string(), detail: format!("writing the table: {e}") })
-    })?;
-    Ok(())
 }
