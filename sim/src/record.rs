@@ -218,6 +218,9 @@ pub struct Recorder<'a> {
     markers: ContactMarkers,
     /// Each contact's plane normal and tangents `(n, t1, t2)`, world frame, in the run's order.
     contact_frames: Vec<[nalgebra::Vector3<f64>; 3]>,
+    /// The contact audit (hybrid runs): every `/contacts` sample checked against its model's
+    /// laws; record `contact_audit` and the count in `result` at the end.
+    audit: Option<schemas::ContactAuditor>,
 }
 
 impl<'a> Recorder<'a> {
@@ -303,9 +306,13 @@ impl<'a> Recorder<'a> {
                 repaired_inertias: crate::dynamics::model::repair_summary(&scene.model.repaired_inertias),
             })
             .map_err(err)?;
-        if hybrid {
-            writer.write_record(&contacts_record(contacts, settings)).map_err(err)?;
-        }
+        let audit = if hybrid {
+            let record = contacts_record(contacts, settings);
+            writer.write_record(&record).map_err(err)?;
+            Some(schemas::ContactAuditor::new(&record))
+        } else {
+            None
+        };
 
         writer
             .write(topics::ROBOT_DESCRIPTION, 0, &RosString { data: scene.urdf_xml.clone() })
@@ -346,6 +353,7 @@ impl<'a> Recorder<'a> {
             contact_event: ContactEventMsg::default(),
             contact_terms: [0.0; 3],
             contact_frames: contacts.iter().map(|c| [c.plane.normal_world.into_inner(), c.t1, c.t2]).collect(),
+            audit,
         })
     }
 
@@ -457,6 +465,9 @@ impl<'a> Recorder<'a> {
             set_with(&mut cs.friction_work, &o.contacts, |c| c.friction_work);
             set_with(&mut cs.damping_loss, &o.contacts, |c| c.damping_loss);
             self.contact_terms = [cs.impact_loss.iter().sum(), cs.friction_work.iter().sum(), cs.damping_loss.iter().sum()];
+            if let Some(audit) = self.audit.as_mut() {
+                audit.sample(o.t, cs);
+            }
             self.writer.write(topics::CONTACTS, t_ns, &self.contact_state).map_err(&err)?;
         }
         Ok(())
@@ -549,6 +560,11 @@ impl<'a> Recorder<'a> {
                 friction_work: hybrid.then_some(fric),
                 damping_loss: hybrid.then_some(damp),
             };
+            self.writer.write_record(&rec).map_err(err)?;
+        }
+        if let Some(audit) = self.audit.take() {
+            let rec = schemas::ContactAuditRecord::from(audit.finish());
+            result.contact_law_breaches = Some(rec.breaches);
             self.writer.write_record(&rec).map_err(err)?;
         }
         self.writer.write_record(&result).map_err(err)?;
