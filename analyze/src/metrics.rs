@@ -384,11 +384,6 @@ pub fn run_metrics(rec: &Recording) -> Result<RunMetrics, Error> {
 /// `incomplete`: the recording was recovered without its `result` record; the reason.
 fn metrics(rec: &Recording, incomplete: Option<String>) -> Result<RunMetrics, Error> {
     let mut acc = Reductions::default();
-    // the records before the messages, as a streamed reading meets them (the audit needs
-    // `contacts` before the samples)
-    for (name, entries) in rec.metadata_records() {
-        schemas::Visitor::metadata(&mut acc, name, entries);
-    }
     // the contact topics only when the file has them (events first: file order)
     let present: Vec<&str> = METRIC_TOPICS.iter().copied().filter(|t| REQUIRED_METRIC_TOPICS.contains(t) || rec.channel(t).is_some()).collect();
     rec.replay(&present, &mut acc).map_err(|e| acc.take_error(e))?;
