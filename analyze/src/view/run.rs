@@ -208,7 +208,7 @@ impl RangeAfter {
     /// The range of [`range_after_transient`].
     pub fn finish(&self) -> Option<[f64; 2]> {
         let ([lo_all, hi_all], [lo, hi]) = (self.all, self.after);
-        if !self.any || !(lo.is_finite() && hi.is_finite()) || hi_all - lo_all <= 3.0 * (hi - lo) {
+        if !self.any || !lo.is_finite() || !hi.is_finite() || hi_all - lo_all <= 3.0 * (hi - lo) {
             return None;
         }
         let pad = 0.1 * (hi - lo).max(1e-9);
@@ -365,7 +365,7 @@ impl Survey<'_> {
         let k = self.tree.messages;
         self.tree.take(self.file, msg)?;
         let stride = (self.n_tf / 200).max(1);
-        if k == 0 || k % stride == 0 || k + 1 == self.n_tf {
+        if k == 0 || k.is_multiple_of(stride) || k + 1 == self.n_tf {
             let root = self.tree.root(self.file).unwrap_or_else(|_| "world".into());
             let latest = &self.tree.latest;
             let poses = world_poses(&root, &self.tree.frames, |i| latest[i]);
@@ -374,7 +374,7 @@ impl Survey<'_> {
                     self.whole.base = poses.get(base.as_str()).map_or([0.0; 3], |p| p.translation);
                 }
             }
-            if k % stride == 0 || k + 1 == self.n_tf {
+            if k.is_multiple_of(stride) || k + 1 == self.n_tf {
                 for p in poses.values() {
                     grow(&mut self.whole.arm_min, &mut self.whole.arm_max, p.translation);
                 }
@@ -392,7 +392,7 @@ impl Survey<'_> {
             grow(&mut w.arm_min, &mut w.arm_max, p);
         }
         let stride = self.n_hand.div_ceil(MAX_PATH_POINTS).max(1);
-        if self.hand_k % stride == 0 || self.hand_k + 1 == self.n_hand {
+        if self.hand_k.is_multiple_of(stride) || self.hand_k + 1 == self.n_hand {
             w.target_path.push(desired);
             w.hand_trail.push(actual);
         }
