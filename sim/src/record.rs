@@ -328,9 +328,13 @@ impl<'a> Recorder<'a> {
             target_dt_s: path_dt,
         });
         writer.write(topics::SCENE, 0, &scene_msg).map_err(err)?;
-        // world -> root, then every URDF joint (fixed ones too), in this order every sample
+        // world -> root (none when the URDF's root link is itself named `world`, as UR5's and
+        // Z1's: a frame is not its own parent), then every URDF joint (fixed ones too), in this
+        // order every sample
         let mut tf = FrameTransforms { transforms: Vec::with_capacity(scene.model.urdf_joints.len() + 1) };
-        tf.transforms.push(frame_transform(0, WORLD_FRAME, &scene.model.root_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+        if scene.model.root_link != WORLD_FRAME {
+            tf.transforms.push(frame_transform(0, WORLD_FRAME, &scene.model.root_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+        }
         for j in &scene.model.urdf_joints {
             tf.transforms.push(frame_transform(0, &j.parent_link, &j.child_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
         }
@@ -382,8 +386,9 @@ impl<'a> Recorder<'a> {
         // transforms: world -> root (identity), then every URDF joint (fixed ones too); the
         // frame names were set by `create` (no allocation per sample)
         let stamp = Some(timestamp(t_ns));
-        let (root, joints) = self.tf.transforms.split_at_mut(1);
-        root[0].timestamp = stamp;
+        let roots = self.tf.transforms.len() - model.urdf_joints.len();
+        let (root, joints) = self.tf.transforms.split_at_mut(roots);
+        root.iter_mut().for_each(|r| r.timestamp = stamp);
         for (j, tr) in model.urdf_joints.iter().zip(joints) {
             let x = match j.dof {
                 Some(d) => model.bodies[d].after(&j.origin, o.q[d]),
