@@ -238,10 +238,7 @@ impl LimitMonitor {
                 }
             }
         }
-        let mut m = match Self::new(scene.model(), scene.drives(), scene.monitors_joint_limits() || !extra.is_empty(), dt) {
-            Some(m) => m,
-            None => return None,
-        };
+        let mut m = Self::new(scene.model(), scene.drives(), scene.monitors_joint_limits() || !extra.is_empty(), dt)?;
         if !extra.is_empty() {
             m.monitored += if m.monitored.is_empty() { "" } else { "; " };
             m.monitored += "datasheet ratings (max winding temperature, gearhead max intermittent torque)";

@@ -199,8 +199,11 @@ fn fast_thermal(integrator: IntegratorSpec) -> Scene {
         .unwrap()
 }
 
-/// The samples of the two-elbow run: (hand, winding temperatures), and the work.
-fn trace(scene: &Scene) -> (Vec<(nalgebra::Vector3<f64>, Vec<f64>)>, u64) {
+/// One sample: the hand, the winding temperatures.
+type Sample = (nalgebra::Vector3<f64>, Vec<f64>);
+
+/// The samples of the two-elbow run, and the work.
+fn trace(scene: &Scene) -> (Vec<Sample>, u64) {
     let run = scene.run("two-elbow").unwrap().clone();
     let mut h = Vec::new();
     let rep = sim::run::simulate(scene, &run, |o| {
@@ -234,8 +237,8 @@ fn every_method_keeps_its_order_with_the_thermal_model_on() {
     // the temperatures do move: the hottest winding rises by more than 1 K in 0.3 s
     let rise = reference.last().unwrap().1.iter().fold(0.0f64, |a, t| a.max(t - 25.0));
     assert!(rise > 1.0, "rise {rise} K");
-    let err = |h: &[(nalgebra::Vector3<f64>, Vec<f64>)]| h.iter().zip(&reference).map(|((a, _), (b, _))| (a - b).norm()).fold(0.0, f64::max);
-    let err_t = |h: &[(nalgebra::Vector3<f64>, Vec<f64>)]| {
+    let err = |h: &[Sample]| h.iter().zip(&reference).map(|((a, _), (b, _))| (a - b).norm()).fold(0.0, f64::max);
+    let err_t = |h: &[Sample]| {
         h.iter().zip(&reference).flat_map(|((_, ta), (_, tb))| ta.iter().zip(tb).map(|(x, y)| (x - y).abs())).fold(0.0, f64::max)
     };
     let steps = [2e-4, 1e-4, 5e-5];

@@ -79,8 +79,8 @@ impl<'a> ArmSystem<'a> {
     pub(super) fn set_resistance(&mut self, y: &[f64]) {
         if let Some(th) = &self.scene.thermal {
             let t_w = &y[self.layout.winding_temperature()];
-            for j in 0..self.layout.nv {
-                self.ws.drives.r[j] = th.resistance(j, t_w[j]);
+            for (j, (r, &t)) in self.ws.drives.r.iter_mut().zip(t_w).enumerate() {
+                *r = th.resistance(j, t);
             }
         }
     }

@@ -82,7 +82,7 @@ pub(super) fn motor_params(c: &Ctx, field: &str, m: &MotorDatasheet, g: Option<&
     };
     let (ratio, gear_inertia) = match g {
         Some(g) => {
-            let k = c.number(&format!("{gfield}.reduction"), g.reduction, |x| x >= 1.0 && x <= 1e4, "must be a reduction i:1 with 1 <= i <= 1e4")?;
+            let k = c.number(&format!("{gfield}.reduction"), g.reduction, |x| (1.0..=1e4).contains(&x), "must be a reduction i:1 with 1 <= i <= 1e4")?;
             if let Some(e) = g.max_efficiency_percent {
                 c.number(&format!("{gfield}.max_efficiency_percent"), e, |x| x > 0.0 && x <= 100.0, "must be in (0, 100] %")?;
             }

@@ -118,7 +118,7 @@ fn drive_descriptions(s: &Scene) -> Vec<DriveDescription> {
     }
     let (d, names) = (s.drives(), s.model().joint_names());
     let mut out: Vec<DriveDescription> = Vec::new();
-    for j in 0..names.len() {
+    for (j, name) in names.iter().enumerate() {
         if d.passive[j] {
             continue;
         }
@@ -131,7 +131,7 @@ fn drive_descriptions(s: &Scene) -> Vec<DriveDescription> {
             (None, None) => (d.r[j], None),
         };
         let desc = DriveDescription {
-            joints: vec![names[j].clone()],
+            joints: vec![name.clone()],
             drive: ds.as_ref().map_or("motor values".into(), |x| x.what.clone()),
             km_nm_per_a: d.km[j],
             ke_v_s_per_rad: d.ke[j],
@@ -167,7 +167,7 @@ fn drive_descriptions(s: &Scene) -> Vec<DriveDescription> {
             }),
         };
         match out.iter_mut().find(|o| DriveDescription { joints: o.joints.clone(), ..desc.clone() } == **o) {
-            Some(o) => o.joints.push(names[j].clone()),
+            Some(o) => o.joints.push(name.clone()),
             None => out.push(desc),
         }
     }
