@@ -384,6 +384,14 @@ pub struct EnergyTermsRecord {
     /// The compliant contacts' damping loss, summed, J (runs with a non-bilateral contact).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
     pub damping_loss: Option<f64>,
+    /// The heat stored in the motors at the end, `Σ C_w ΔT_w + C_h ΔT_h`, J (runs with the
+    /// thermal model; with `heat_to_ambient` it books the resistive loss: E_R = the two).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub heat_stored: Option<f64>,
+    /// The heat the motors' housings gave to the ambient, `∫ Σ (T_h − T_a) / R_th2 dt`, J
+    /// (runs with the thermal model).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub heat_to_ambient: Option<f64>,
 }
 
 impl MetadataRecord for EnergyTermsRecord {

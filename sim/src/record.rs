@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use schemas::{
     frame_transform, hand_points, set_hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactInfo, ContactState,
     ContactsRecord, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
-    JointState, Mirror, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
+    JointState, Mirror, ModelInfo, MotorState, MotorThermalState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
 use schemas::markers::{self, ContactMarkers, ContactSample, MarkerMode, SceneDescription, TablePlane};
@@ -221,6 +221,10 @@ pub struct Recorder<'a> {
     /// The contact audit (hybrid runs): every `/contacts` sample checked against its model's
     /// laws; record `contact_audit` and the count in `result` at the end.
     audit: Option<schemas::ContactAuditor>,
+    /// `/motor_temperatures`, when the scene has the thermal model (names set once).
+    thermal: Option<MotorThermalState>,
+    /// The last sample's heat stored and heat to the ambient (record `energy_terms`).
+    heat: [f64; 2],
 }
 
 impl<'a> Recorder<'a> {
@@ -349,7 +353,7 @@ impl<'a> Recorder<'a> {
             constraints: ConstraintState { name: contact_names.clone(), ..Default::default() },
             energy: EnergyState { name: joint_names.clone(), ..Default::default() },
             joint_state: JointState { name: joint_names, ..Default::default() },
-            monitor: LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, 1.0 / scene.output_rate),
+            monitor: LimitMonitor::for_scene(scene, 1.0 / scene.output_rate),
             terms: [0.0; 3],
             hybrid,
             markers: ContactMarkers::new(WORLD_FRAME, &contact_names),
@@ -358,6 +362,8 @@ impl<'a> Recorder<'a> {
             contact_terms: [0.0; 3],
             contact_frames: contacts.iter().map(|c| [c.plane.normal_world.into_inner(), c.t1, c.t2]).collect(),
             audit,
+            thermal: scene.thermal.as_ref().map(|_| MotorThermalState { name: scene.model.joint_names(), ..Default::default() }),
+            heat: [0.0; 2],
         })
     }
 
@@ -410,6 +416,15 @@ impl<'a> Recorder<'a> {
         set(&mut m.electric_power, &o.electric_power);
         set(&mut m.torque, &o.tau_motor);
         self.writer.write(topics::MOTORS, t_ns, &self.motors).map_err(&err)?;
+        if let Some(th) = &mut self.thermal {
+            th.time = o.t;
+            set(&mut th.winding_temperature, &o.winding_temperature);
+            set(&mut th.housing_temperature, &o.housing_temperature);
+            set(&mut th.resistance, &o.resistance);
+            set(&mut th.copper_loss, &o.copper_loss);
+            self.heat = [o.heat_stored, o.heat_to_ambient];
+            self.writer.write(topics::MOTOR_TEMPERATURES, t_ns, th).map_err(&err)?;
+        }
 
         let c = &mut self.constraints;
         c.time = o.t;
@@ -530,7 +545,7 @@ impl<'a> Recorder<'a> {
         let err = |source| RunError::Recording { path: path.clone(), source };
         // a scene that sets no limits of its own (no `joint_limits`, no drive limits) is still
         // watched against its URDF's limits, and says so only when one was crossed
-        let configured = self.scene.spec.joint_limits.is_some() || self.scene.drives.has_limits;
+        let configured = self.scene.spec.joint_limits.is_some() || self.scene.drives.has_limits || self.scene.thermal.is_some();
         let summary = self.monitor.as_ref().map(LimitMonitor::summary).filter(|s| configured || s.exceeded() + s.saturated() > 0);
         if let Some(sum) = summary {
             let (exceeded, saturations) = (sum.exceeded() as u64, sum.saturated() as u64);
@@ -554,7 +569,8 @@ impl<'a> Recorder<'a> {
             self.writer.write_record(&rec).map_err(err)?;
         }
         let (conv, stops, hybrid) = (self.scene.drives.has_conversion, self.scene.stops.is_some(), self.hybrid);
-        if conv || stops || hybrid {
+        let thermal = self.thermal.is_some();
+        if conv || stops || hybrid || thermal {
             let [c, e, l] = self.terms;
             let [imp, fric, damp] = self.contact_terms;
             let rec = EnergyTermsRecord {
@@ -564,6 +580,8 @@ impl<'a> Recorder<'a> {
                 impact_loss: hybrid.then_some(imp),
                 friction_work: hybrid.then_some(fric),
                 damping_loss: hybrid.then_some(damp),
+                heat_stored: thermal.then_some(self.heat[0]),
+                heat_to_ambient: thermal.then_some(self.heat[1]),
             };
             self.writer.write_record(&rec).map_err(err)?;
         }
