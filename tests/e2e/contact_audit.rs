@@ -35,7 +35,8 @@ fn a_lawful_recording_passes_and_each_doctored_law_fails_naming_it() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
 
     let sliding = |t: f64| (0.71 - 1e-9..=0.80 + 1e-9).contains(&t);
-    let cases: Vec<(&str, Box<dyn Fn(f64, &mut schemas::ContactState)>, &str)> = vec![
+    type Doctor = Box<dyn Fn(f64, &mut schemas::ContactState)>;
+    let cases: Vec<(&str, Doctor, &str)> = vec![
         // friction along the slip instead of against it
         ("along", Box::new(move |t, c| if sliding(t) { c.friction_force_t1[0] = 6.0 }), "elbow4: friction not opposing the slip 3.142e0 rad (bound 1.0e-3), first at t = 0.71 s"),
         // 10 % outside the cone μ f_n = 6 N
@@ -140,4 +141,18 @@ fn sim_and_analyze_agree_on_real_runs() {
             assert!(!sim_broken, "the shipped μ = 0.5 run holds every law: {sim_err}");
         }
     }
+
+    // a sweep says the same of the same run (exit 1, the law named)
+    let sweep = d.join("bounce-sweep.json");
+    let spec = serde_json::json!({
+        "name": "bounce-sweep",
+        "scene": "bounce.json",
+        "runs": ["two-elbow-unilateral"],
+        "axes": [{ "field": "duration", "values": [0.3] }]
+    });
+    std::fs::write(&sweep, spec.to_string()).unwrap();
+    let out = run_sim(&["sweep".as_ref(), sweep.as_os_str(), "-q".as_ref(), "-o".as_ref(), d.join("sweep").as_os_str()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("the contact laws do not hold") && err.contains("elbow7: closed gap"), "{err}");
 }

@@ -101,7 +101,7 @@ impl Worst {
             self.t = t;
         }
         // a value that is not a number breaks the law (and is not kept: JSON has no NaN)
-        if !(value <= bound) {
+        if value > bound || value.is_nan() {
             self.breaches += 1;
             self.first_breach_t.get_or_insert(t);
         }
@@ -369,8 +369,11 @@ mod tests {
         }
     }
 
-    /// One sample: per contact `(mode, g, ġ, f_n, f_t, v_t)`.
-    fn state(c: [(u32, f64, f64, f64, [f64; 2], [f64; 2]); 3]) -> ContactState {
+    /// One contact in one sample: `(mode, g, ġ, f_n, f_t, v_t)`.
+    type Row = (u32, f64, f64, f64, [f64; 2], [f64; 2]);
+
+    /// One sample of the three contacts.
+    fn state(c: [Row; 3]) -> ContactState {
         ContactState {
             time: 0.0,
             name: vec!["rigid".into(), "soft".into(), "paper".into()],
@@ -436,7 +439,8 @@ mod tests {
     #[test]
     fn each_broken_law_is_found_at_its_sample_and_named() {
         let base = lawful();
-        let cases: Vec<(&str, Box<dyn Fn(&mut ContactState)>, f64)> = vec![
+        type Doctor = Box<dyn Fn(&mut ContactState)>;
+        let cases: Vec<(&str, Doctor, f64)> = vec![
             ("closed gap", Box::new(|s| s.gap[0] = 2e-6), 2e-6),
             ("closed gap rate", Box::new(|s| s.gap_rate[0] = -3e-6), 3e-6),
             // (without friction: with a pull no friction force is inside the cone)
