@@ -13,6 +13,9 @@ use sim::scene::spec::{AdaptiveSpec, IntegratorSpec};
 use sim::scene::spec_drive::MotorDatasheet;
 use sim::scene::Scene;
 
+use crate::convergence::slope;
+use crate::stiff_methods::central_jacobian;
+
 fn paper_thermal() -> Scene {
     Scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_thermal.json"))).unwrap()
 }
@@ -214,15 +217,6 @@ fn trace(scene: &Scene) -> (Vec<Sample>, u64) {
     (h, rep.stats.rhs_evals)
 }
 
-fn slope(x: &[f64], y: &[f64]) -> f64 {
-    let (lx, ly): (Vec<f64>, Vec<f64>) = (x.iter().map(|v| v.ln()).collect(), y.iter().map(|v| v.ln()).collect());
-    let n = lx.len() as f64;
-    let (mx, my) = (lx.iter().sum::<f64>() / n, ly.iter().sum::<f64>() / n);
-    let sxy: f64 = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = lx.iter().map(|a| (a - mx).powi(2)).sum();
-    sxy / sxx
-}
-
 /// The convergence harness of `convergence.rs` with the thermal model on (the same bands and
 /// the same error, the hand's largest distance from the reference at the samples: RK4 h⁴ ±
 /// 0.3; dopri45 N^-5, rosenbrock N^-3, imex N^-4, each ± 0.5; error ∝ rtol ± 0.15). R(T_w)
@@ -266,25 +260,6 @@ fn every_method_keeps_its_order_with_the_thermal_model_on() {
         let q = slope(tols, &e);
         assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");
     }
-}
-
-/// Central differences of the right-hand side (h relative to each component).
-fn central_jacobian(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {
-    let dim = y.len();
-    let mut jac = vec![0.0; dim * dim];
-    let (mut yp, mut fp, mut fm) = (y.to_vec(), vec![0.0; dim], vec![0.0; dim]);
-    for c in 0..dim {
-        let h = 1e-6 * (1.0 + y[c].abs());
-        yp[c] = y[c] + h;
-        sys.rhs(t, &yp, &mut fp).unwrap();
-        yp[c] = y[c] - h;
-        sys.rhs(t, &yp, &mut fm).unwrap();
-        yp[c] = y[c];
-        for r in 0..dim {
-            jac[r * dim + c] = (fp[r] - fm[r]) / (2.0 * h);
-        }
-    }
-    jac
 }
 
 /// The structured Jacobian of the stiff methods with the thermal model on, against central
