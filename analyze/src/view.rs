@@ -13,7 +13,8 @@
 //!   [`window`]: its samples drawn one time window at a time as the file streams by, so that
 //!   memory is bounded by the window, not by the recording (issue 29);
 //! - [`entities`]: a run's entities as chunks; [`layout`]: the blueprint; [`blueprint`]: a
-//!   blueprint tree as chunks; [`urdf`], [`pose`]: the geometry.
+//!   blueprint tree as chunks; [`urdf`], [`pose`]: the geometry; [`mesh`]: the links' meshes
+//!   (STL, COLLADA, OBJ), logged once per run, and their fallbacks.
 //!
 //! Ids are deterministic: the recording id is the application id and a hash of the input bytes,
 //! and chunk and row ids count up from a fixed time, so the same inputs give the same bytes.
@@ -28,6 +29,8 @@ pub mod entities;
 pub mod layout;
 #[cfg(feature = "rerun")]
 pub mod manifest;
+#[cfg(feature = "rerun")]
+pub mod mesh;
 #[cfg(feature = "rerun")]
 pub mod pose;
 #[cfg(feature = "rerun")]
@@ -58,6 +61,11 @@ pub struct Converted {
     /// The `result` record of each input (in order), when it has one: a failed run is drawn
     /// with what it recorded, and the caller says it failed.
     pub results: Vec<(PathBuf, Option<schemas::RunResult>)>,
+    /// The meshes drawn, over every input: entities, vertices, triangles.
+    pub meshes: (usize, usize, usize),
+    /// What could not be drawn as the URDF asks (a missing or unreadable mesh, and what was
+    /// drawn instead), one sentence per link, without repeats.
+    pub notes: Vec<String>,
 }
 
 /// Converts the recordings `inputs` into one `.rrd` at `out` (written atomically, its directory
@@ -79,13 +87,21 @@ pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<Co
         // streamed into the temporary file, renamed when whole
         let label = out.display().to_string();
         let mut bytes = 0;
+        let mut drawn = Vec::new();
         schemas::atomic::write_with(out, |f| -> Result<(), Error> {
-            let (_, n) = encode_to(&read, &app_id, std::io::BufWriter::with_capacity(1 << 20, f), &label, window::WINDOW_ROWS)?;
-            bytes = n;
+            let (_, n, d) = encode_to(&read, &app_id, std::io::BufWriter::with_capacity(1 << 20, f), &label, window::WINDOW_ROWS)?;
+            (bytes, drawn) = (n, d);
             Ok(())
         })?;
         let results = inputs.iter().zip(&read).map(|(p, i)| (p.clone(), i.run.result.clone())).collect();
-        Ok(Converted { bytes, results })
+        let meshes = drawn.iter().fold((0, 0, 0), |(m, v, t), d| (m + d.meshes, v + d.vertices, t + d.triangles));
+        let mut notes: Vec<String> = Vec::new();
+        for n in drawn.into_iter().flat_map(|d| d.notes) {
+            if !notes.contains(&n) {
+                notes.push(n);
+            }
+        }
+        Ok(Converted { bytes, results, meshes, notes })
     }
     #[cfg(not(feature = "rerun"))]
     {

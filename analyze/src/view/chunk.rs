@@ -227,6 +227,19 @@ pub fn quat_lists(rows: &[Vec<[f32; 4]>]) -> ArrayRef {
     list(fixed_f32(rows.iter().flatten().copied(), n), rows.iter().map(Vec::len), true)
 }
 
+/// `List<FixedSizeList<u32, 3>>`: N triangles (vertex indices) per row (`TriangleIndices`).
+pub fn tri_lists(rows: &[Vec<[u32; 3]>]) -> ArrayRef {
+    use arrow_array::builder::UInt32Builder;
+    let n: usize = rows.iter().map(Vec::len).sum();
+    let mut b = FixedSizeListBuilder::with_capacity(UInt32Builder::with_capacity(n * 3), 3, n)
+        .with_field(Arc::new(Field::new("item", DataType::UInt32, false)));
+    for t in rows.iter().flatten() {
+        b.values().append_slice(t);
+        b.append(true);
+    }
+    list(Arc::new(b.finish()), rows.iter().map(Vec::len), true)
+}
+
 /// `List<List<FixedSizeList<f32, 3>>>`: N line strips per row.
 pub fn strip_lists(rows: &[Vec<Vec<[f32; 3]>>]) -> ArrayRef {
     let strips: Vec<&Vec<[f32; 3]>> = rows.iter().flatten().collect();

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use super::chunk::{str_lists, Chunk, Index};
 use super::entities::{Bounds, Paths};
 use super::rrd::{RrdStream, StoreId, StoreKind};
+use super::mesh::{self, Drawn};
 use super::run::Run;
 use super::window::{self, Ids, Sink, WINDOW_ROWS};
 use super::{blueprint, layout};
@@ -84,7 +85,7 @@ fn bounds(run: &Run) -> Bounds {
 
 /// The `.rrd` bytes of `inputs` under application id `app_id` ([`encode_to`] into memory).
 pub fn encode(inputs: &[Input], app_id: &str) -> Result<Vec<u8>, Error> {
-    let (bytes, _) = encode_to(inputs, app_id, Vec::with_capacity(1 << 20), "the .rrd", WINDOW_ROWS)?;
+    let (bytes, _, _) = encode_to(inputs, app_id, Vec::with_capacity(1 << 20), "the .rrd", WINDOW_ROWS)?;
     Ok(bytes)
 }
 
@@ -92,9 +93,11 @@ pub fn encode(inputs: &[Input], app_id: &str) -> Result<Vec<u8>, Error> {
 /// errors): one run as is, several side by side (entity prefix per run, see
 /// [`super::entities`]), with the blueprint of [`layout`]. Each recording is read again and
 /// drawn in time windows of about `window_rows` samples ([`window`]), so memory does not grow
-/// with the recordings; the footer lists every chunk ([`super::manifest`]). Returns the writer
-/// and the bytes written.
-pub fn encode_to<W: Write>(inputs: &[Input], app_id: &str, out: W, label: &str, window_rows: usize) -> Result<(W, u64), Error> {
+/// with the recordings; the footer lists every chunk ([`super::manifest`]). The links' meshes
+/// of each run are static, read and written once before its samples, one file at a time
+/// ([`mesh::draw`]). Returns the writer, the bytes written and what was drawn of each run's
+/// meshes.
+pub fn encode_to<W: Write>(inputs: &[Input], app_id: &str, out: W, label: &str, window_rows: usize) -> Result<(W, u64, Vec<Drawn>), Error> {
     let hash = inputs.iter().fold(fnv1a(app_id.as_bytes()), |h, i| h.rotate_left(5) ^ i.hash);
     let recording = StoreId::new(StoreKind::Recording, app_id, &format!("{app_id}-{hash:016x}"));
     let blueprint_id = StoreId::new(StoreKind::Blueprint, app_id, &format!("{app_id}-{hash:016x}-blueprint"));
@@ -140,9 +143,15 @@ pub fn encode_to<W: Write>(inputs: &[Input], app_id: &str, out: W, label: &str, 
         str_lists(&[vec![app_id.to_string()]]),
     );
     sink.push(&recording, &properties)?;
-    // the entities of every run, window by window
+    // the entities of every run: its meshes once, then its samples window by window
+    let mut drawn = Vec::with_capacity(inputs.len());
     for (input, (paths, _)) in inputs.iter().zip(&placed) {
-        window::draw_run(&input.path, &input.run, paths, &recording, &mut sink, window_rows)?;
+        let run = &input.run;
+        let world = paths.world();
+        let link_path = |link: &str| run.frames.iter().any(|(n, _)| n == link).then(|| run.frame_path(link, &world));
+        drawn.push(mesh::draw(&run.links, &link_path, &mut |c| sink.push(&recording, &c))?);
+        window::draw_run(&input.path, run, paths, &recording, &mut sink, window_rows)?;
     }
-    sink.finish()
+    let (out, bytes) = sink.finish()?;
+    Ok((out, bytes, drawn))
 }

@@ -34,8 +34,6 @@ const POINTS: &str = "rerun.archetypes.Points3D";
 const ARROWS: &str = "rerun.archetypes.Arrows3D";
 const STRIPS: &str = "rerun.archetypes.LineStrips3D";
 const BOXES: &str = "rerun.archetypes.Boxes3D";
-const CYLINDERS: &str = "rerun.archetypes.Cylinders3D";
-const ELLIPSOIDS: &str = "rerun.archetypes.Ellipsoids3D";
 const TRANSFORM: &str = "rerun.archetypes.Transform3D";
 const SCALARS: &str = "rerun.archetypes.Scalars";
 const SERIES: &str = "rerun.archetypes.SeriesLines";
@@ -221,32 +219,7 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 let b = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
                 rgba(b(c[0]), b(c[1]), b(c[2]), b(c[3]))
             });
-            let vpath = format!("{path}/visual{k}");
-            let center = vec3_lists(&[vec![f3(v.origin.translation)]]);
-            let colors = u32_lists(&[vec![color]]);
-            let solid = u8_lists(&[vec![3]]);
-            let chunk = Chunk::new(&vpath, Index::Static);
-            let chunk = match v.shape {
-                Shape::Box { size_m } => chunk
-                    .with(BOXES, "centers", "rerun.components.Translation3D", center)
-                    .with(BOXES, "colors", "rerun.components.Color", colors)
-                    .with(BOXES, "fill_mode", "rerun.components.FillMode", solid)
-                    .with(BOXES, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![f3(size_m.map(|s| s / 2.0))]]))
-                    .with(BOXES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(v.origin.rotation)]])),
-                Shape::Cylinder { radius_m, length_m } => chunk
-                    .with(CYLINDERS, "centers", "rerun.components.Translation3D", center)
-                    .with(CYLINDERS, "colors", "rerun.components.Color", colors)
-                    .with(CYLINDERS, "fill_mode", "rerun.components.FillMode", solid)
-                    .with(CYLINDERS, "lengths", "rerun.components.Length", f32_lists(&[vec![length_m as f32]]))
-                    .with(CYLINDERS, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(v.origin.rotation)]]))
-                    .with(CYLINDERS, "radii", "rerun.components.Radius", f32_lists(&[vec![radius_m as f32]])),
-                Shape::Sphere { radius_m } => chunk
-                    .with(ELLIPSOIDS, "centers", "rerun.components.Translation3D", center)
-                    .with(ELLIPSOIDS, "colors", "rerun.components.Color", colors)
-                    .with(ELLIPSOIDS, "fill_mode", "rerun.components.FillMode", solid)
-                    .with(ELLIPSOIDS, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![[radius_m as f32; 3]]])),
-            };
-            out.push(chunk);
+            out.push(super::mesh::shape_chunk(&format!("{path}/visual{k}"), &v.origin, v.shape, color));
         }
     }
 

@@ -74,6 +74,8 @@ pub struct Run {
     /// Times of the window's `/tf` samples, ns (the samples below are the window's too).
     pub tf_times_ns: Vec<i64>,
     pub visuals: Visuals,
+    /// Every link's visuals and collisions, meshes too (drawn by [`super::mesh`]).
+    pub links: urdf::Links,
     pub hand: Vec<(f64, HandState)>,
     pub motors: Vec<(f64, MotorState)>,
     pub energy: Vec<(f64, EnergyState)>,
@@ -556,7 +558,8 @@ impl Run {
 
         // geometry (a recording of another producer may have no URDF: no visuals then)
         let xml = rec.record_opt::<schemas::UrdfRecord>()?.map(|u| u.xml).unwrap_or_default();
-        let visuals = urdf::visuals(&xml).map_err(|e| bad(&file, format!("metadata urdf: {e}")))?;
+        let links = urdf::links(&xml).map_err(|e| bad(&file, format!("metadata urdf: {e}")))?;
+        let visuals = urdf::primitive_visuals(&links);
         let children = urdf::joint_children(&xml).map_err(|e| bad(&file, format!("metadata urdf: {e}")))?;
 
         // contacts: the scene says where (point) and on what (plane); the contacts record, when
@@ -611,6 +614,7 @@ impl Run {
             frames: Vec::new(),
             tf_times_ns: Vec::new(),
             visuals,
+            links,
             hand: Vec::new(),
             motors: Vec::new(),
             energy: Vec::new(),

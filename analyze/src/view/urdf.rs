@@ -1,10 +1,12 @@
-//! The visual geometry of a URDF: per link, its `<visual>` elements (origin, primitive shape,
-//! colour), read with `quick-xml` (the parser `sim` uses).
+//! The geometry of a URDF: per link, its `<visual>` and `<collision>` elements (origin,
+//! primitive shape or mesh, colour), read with `quick-xml` (the parser `sim` uses).
 //!
 //! URDF conventions (<http://wiki.ros.org/urdf/XML/link>): a visual's `origin` is `xyz` (m) and
 //! `rpy` (rad, fixed axes X-Y-Z: `R = Rz(y) Ry(p) Rx(r)`) in the link frame; a cylinder's axis is
 //! its local z (Rerun's `Cylinders3D` too); `material` is an inline `<color rgba>` or a name
-//! defined at the top level of the robot. Meshes are left out (the viewer draws primitives).
+//! defined at the top level of the robot (before or after its use); a `<mesh>` has a
+//! `filename` and a `scale` (default `1 1 1`). [`visuals`] are the primitives `entities` draws;
+//! [`links`] every visual and collision, meshes too, which [`super::mesh`] draws.
 
 use std::collections::BTreeMap;
 
@@ -21,7 +23,7 @@ pub enum Shape {
     Sphere { radius_m: f64 },
 }
 
-/// One `<visual>` of a link.
+/// One `<visual>` primitive of a link.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Visual {
     /// Pose of the shape in the link frame.
@@ -31,8 +33,42 @@ pub struct Visual {
     pub rgba: Option<[f64; 4]>,
 }
 
-/// The visuals of every link, by link name (links without primitives are absent).
+/// The primitive visuals of every link, by link name (links without primitives are absent).
 pub type Visuals = BTreeMap<String, Vec<Visual>>;
+
+/// A `<mesh filename scale>`: the file as the recorded URDF names it (a `file://` URI when
+/// `sim` resolved the scene's `robot.package_paths`) and the scale per axis of the mesh frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshRef {
+    pub filename: String,
+    pub scale: [f64; 3],
+}
+
+/// The geometry of a `<visual>` or `<collision>`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Geometry {
+    Primitive(Shape),
+    Mesh(MeshRef),
+}
+
+/// One `<visual>` or `<collision>` of a link: its pose in the link frame, its geometry and (for
+/// a visual) its colour.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Element {
+    pub origin: Pose,
+    pub geometry: Geometry,
+    pub rgba: Option<[f64; 4]>,
+}
+
+/// Everything a link draws with: its visuals and its collisions, in document order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LinkGeometry {
+    pub visuals: Vec<Element>,
+    pub collisions: Vec<Element>,
+}
+
+/// The geometry of every link that has a visual or a collision, by link name.
+pub type Links = BTreeMap<String, LinkGeometry>;
 
 /// The child link of every joint, by joint name (`<joint name><child link/></joint>`).
 pub fn joint_children(xml: &str) -> Result<BTreeMap<String, String>, String> {
@@ -64,15 +100,52 @@ fn numbers<const N: usize>(text: &str, what: &str) -> Result<[f64; N], String> {
     v.try_into().map_err(|v: Vec<f64>| format!("{what} = {text:?}: {} numbers, expected {N}", v.len()))
 }
 
-/// The visuals of `xml` (a URDF). An error names the element and the value that does not parse.
+/// The primitive visuals of `xml` (a URDF), from [`links`].
 pub fn visuals(xml: &str) -> Result<Visuals, String> {
-    let mut reader = Reader::from_str(xml);
+    Ok(primitive_visuals(&links(xml)?))
+}
+
+/// The primitive visuals of `links`.
+pub fn primitive_visuals(links: &Links) -> Visuals {
     let mut out = Visuals::new();
+    for (name, link) in links {
+        let prims: Vec<Visual> = link
+            .visuals
+            .iter()
+            .filter_map(|e| match e.geometry {
+                Geometry::Primitive(shape) => Some(Visual { origin: e.origin, shape, rgba: e.rgba }),
+                Geometry::Mesh(_) => None,
+            })
+            .collect();
+        if !prims.is_empty() {
+            out.insert(name.clone(), prims);
+        }
+    }
+    out
+}
+
+/// Which element of a link is being read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    Visual,
+    Collision,
+}
+
+/// An element being read: kind, origin, geometry, inline colour, material name.
+type Partial = (Kind, Pose, Option<Geometry>, Option<[f64; 4]>, Option<String>);
+
+/// The visuals and collisions of every link of `xml` (a URDF). An error names the element and
+/// the value that does not parse; an element without a geometry is left out.
+pub fn links(xml: &str) -> Result<Links, String> {
+    let mut reader = Reader::from_str(xml);
+    let mut out = Links::new();
     let mut named_colors: BTreeMap<String, [f64; 4]> = BTreeMap::new();
     let mut link: Option<String> = None;
-    let mut visual: Option<(Pose, Option<Shape>, Option<[f64; 4]>, Option<String>)> = None;
+    let mut elem: Option<Partial> = None;
     let mut material: Option<String> = None; // a top-level material being defined
-    let mut depth_in_visual_geometry = false;
+    let mut in_geometry = false;
+    // the named materials of visuals, resolved at the end (a material may be defined after use)
+    let mut pending: Vec<(String, usize, String)> = Vec::new();
     loop {
         let ev = reader.read_event().map_err(|e| format!("at byte {}: {e}", reader.error_position()))?;
         let (e, empty) = match &ev {
@@ -81,14 +154,18 @@ pub fn visuals(xml: &str) -> Result<Visuals, String> {
             Event::End(e) => {
                 match e.name().as_ref() {
                     b"link" => link = None,
-                    b"visual" => {
-                        if let (Some(name), Some((origin, Some(shape), rgba, mat))) = (&link, visual.take()) {
-                            let rgba = rgba.or_else(|| mat.and_then(|m| named_colors.get(&m).copied()));
-                            out.entry(name.clone()).or_default().push(Visual { origin, shape, rgba });
+                    b"visual" | b"collision" => {
+                        if let (Some(name), Some((kind, origin, Some(geometry), rgba, mat))) = (&link, elem.take()) {
+                            let entry = out.entry(name.clone()).or_default();
+                            let list = if kind == Kind::Visual { &mut entry.visuals } else { &mut entry.collisions };
+                            if let (None, Some(m), Kind::Visual) = (rgba, mat, kind) {
+                                pending.push((name.clone(), list.len(), m));
+                            }
+                            list.push(Element { origin, geometry, rgba });
                         }
-                        visual = None;
+                        elem = None;
                     }
-                    b"geometry" => depth_in_visual_geometry = false,
+                    b"geometry" => in_geometry = false,
                     b"material" => material = None,
                     _ => {}
                 }
@@ -97,42 +174,56 @@ pub fn visuals(xml: &str) -> Result<Visuals, String> {
             Event::Eof => break,
             _ => continue,
         };
+        let set = |elem: &mut Option<Partial>, g: Geometry| {
+            if let Some(v) = elem.as_mut() {
+                v.2 = Some(g);
+            }
+        };
         match e.name().as_ref() {
             b"link" if !empty => link = attr(e, b"name"),
-            b"visual" if !empty && link.is_some() => visual = Some((Pose::IDENTITY, None, None, None)),
+            b"visual" if !empty && link.is_some() => elem = Some((Kind::Visual, Pose::IDENTITY, None, None, None)),
+            b"collision" if !empty && link.is_some() => elem = Some((Kind::Collision, Pose::IDENTITY, None, None, None)),
             b"origin" => {
-                if let Some(v) = visual.as_mut().filter(|_| !depth_in_visual_geometry) {
+                if let Some(v) = elem.as_mut().filter(|_| !in_geometry) {
                     let xyz = attr(e, b"xyz").map(|t| numbers::<3>(&t, "origin xyz")).transpose()?.unwrap_or([0.0; 3]);
                     let rpy = attr(e, b"rpy").map(|t| numbers::<3>(&t, "origin rpy")).transpose()?.unwrap_or([0.0; 3]);
-                    v.0 = Pose { translation: xyz, rotation: quat_from_rpy(rpy) };
+                    v.1 = Pose { translation: xyz, rotation: quat_from_rpy(rpy) };
                 }
             }
-            b"geometry" if visual.is_some() && !empty => depth_in_visual_geometry = true,
-            b"box" if depth_in_visual_geometry => {
+            b"geometry" if elem.is_some() && !empty => in_geometry = true,
+            b"box" if in_geometry => {
                 let size_m = numbers::<3>(&attr(e, b"size").unwrap_or_default(), "box size")?;
-                visual.as_mut().map(|v| v.1 = Some(Shape::Box { size_m }));
+                set(&mut elem, Geometry::Primitive(Shape::Box { size_m }));
             }
-            b"cylinder" if depth_in_visual_geometry => {
+            b"cylinder" if in_geometry => {
                 let [radius_m] = numbers::<1>(&attr(e, b"radius").unwrap_or_default(), "cylinder radius")?;
                 let [length_m] = numbers::<1>(&attr(e, b"length").unwrap_or_default(), "cylinder length")?;
-                visual.as_mut().map(|v| v.1 = Some(Shape::Cylinder { radius_m, length_m }));
+                set(&mut elem, Geometry::Primitive(Shape::Cylinder { radius_m, length_m }));
             }
-            b"sphere" if depth_in_visual_geometry => {
+            b"sphere" if in_geometry => {
                 let [radius_m] = numbers::<1>(&attr(e, b"radius").unwrap_or_default(), "sphere radius")?;
-                visual.as_mut().map(|v| v.1 = Some(Shape::Sphere { radius_m }));
+                set(&mut elem, Geometry::Primitive(Shape::Sphere { radius_m }));
+            }
+            b"mesh" if in_geometry => {
+                let filename = attr(e, b"filename").ok_or("mesh without a filename")?;
+                let scale = attr(e, b"scale").map(|t| numbers::<3>(&t, "mesh scale")).transpose()?.unwrap_or([1.0; 3]);
+                if scale.iter().any(|s| !s.is_finite() || *s == 0.0) {
+                    return Err(format!("mesh {filename:?}: scale = {scale:?}: each factor finite and nonzero"));
+                }
+                set(&mut elem, Geometry::Mesh(MeshRef { filename, scale }));
             }
             b"material" => {
                 let name = attr(e, b"name");
-                match visual.as_mut() {
-                    Some(v) => v.3 = name,
+                match elem.as_mut() {
+                    Some(v) => v.4 = name,
                     None if link.is_none() && !empty => material = name,
                     None => {}
                 }
             }
             b"color" => {
                 let rgba = numbers::<4>(&attr(e, b"rgba").unwrap_or_default(), "color rgba")?;
-                match (visual.as_mut(), &material) {
-                    (Some(v), _) => v.2 = Some(rgba),
+                match (elem.as_mut(), &material) {
+                    (Some(v), _) => v.3 = Some(rgba),
                     (None, Some(m)) => {
                         named_colors.insert(m.clone(), rgba);
                     }
@@ -140,6 +231,11 @@ pub fn visuals(xml: &str) -> Result<Visuals, String> {
                 }
             }
             _ => {}
+        }
+    }
+    for (name, k, m) in pending {
+        if let (Some(c), Some(l)) = (named_colors.get(&m), out.get_mut(&name)) {
+            l.visuals[k].rgba = Some(*c);
         }
     }
     Ok(out)
@@ -167,6 +263,28 @@ mod tests {
         assert_eq!(v["b"][0].rgba, Some([1.0, 0.0, 0.0, 0.5]));
         let j = joint_children(r#"<robot><joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint></robot>"#).unwrap();
         assert_eq!(j["j1"], "b");
+        // meshes (with their scale, default 1 1 1) and collisions; a material defined after use
+        let l = links(
+            r#"<robot name="r">
+          <link name="m"><visual><origin xyz="0 0 0.1"/><geometry><mesh filename="file:///a.dae" scale="0.001 0.001 0.002"/></geometry>
+            <material name="late"/></visual>
+            <collision><geometry><mesh filename="file:///a.stl"/></geometry></collision>
+            <collision><geometry><sphere radius="0.1"/></geometry></collision></link>
+          <material name="late"><color rgba="0 1 0 1"/></material>
+        </robot>"#,
+        )
+        .unwrap();
+        let m = &l["m"];
+        assert_eq!(m.visuals[0].geometry, Geometry::Mesh(MeshRef { filename: "file:///a.dae".into(), scale: [0.001, 0.001, 0.002] }));
+        assert_eq!(m.visuals[0].origin.translation, [0.0, 0.0, 0.1]);
+        assert_eq!(m.visuals[0].rgba, Some([0.0, 1.0, 0.0, 1.0]));
+        assert_eq!(m.collisions.len(), 2);
+        assert_eq!(m.collisions[0].geometry, Geometry::Mesh(MeshRef { filename: "file:///a.stl".into(), scale: [1.0; 3] }));
+        assert_eq!(m.collisions[1].geometry, Geometry::Primitive(Shape::Sphere { radius_m: 0.1 }));
+        assert!(visuals(&format!("<robot><link name='m'>{}</link></robot>", "<visual><geometry><mesh filename='x'/></geometry></visual>")).unwrap().is_empty());
+        assert!(links("<robot><link name='a'><visual><geometry><mesh filename='x' scale='1 0 1'/></geometry></visual></link></robot>")
+            .unwrap_err()
+            .contains("scale"));
         assert!(visuals("<robot><link name='a'><visual><geometry><box size='1 x 1'/></geometry></visual></link></robot>")
             .unwrap_err()
             .contains("box size"));

@@ -101,6 +101,10 @@ fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<(Vec<PathBu
         let names = inputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
         let converted = analyze::view::convert(inputs, out, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
         let size = converted.bytes;
+        // the URDF geometry that could not be drawn as written: once per output, per link
+        for note in &converted.notes {
+            bar.suspend(|| eprintln!("analyze: note: {}: {note}", out.display()));
+        }
         for (p, result) in &converted.results {
             if let Some(note) = cli::inputs::failed_run_note(p, result.as_ref()) {
                 bar.suspend(|| eprintln!("analyze: {note} (drawn with what it recorded)"));
@@ -110,8 +114,10 @@ fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<(Vec<PathBu
         if !v.quiet {
             let mcap: u64 = inputs.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum();
             bar.suspend(|| {
+                let (meshes, vertices, _) = converted.meshes;
+                let meshes = if meshes > 0 { format!(", {meshes} meshes of {vertices} vertices") } else { String::new() };
                 eprintln!(
-                    "analyze: {names} -> {} ({} run{}, {:.2} MB from {:.2} MB of MCAP, {:.2} s)",
+                    "analyze: {names} -> {} ({} run{}{meshes}, {:.2} MB from {:.2} MB of MCAP, {:.2} s)",
                     out.display(),
                     inputs.len(),
                     if inputs.len() == 1 { "" } else { "s" },
