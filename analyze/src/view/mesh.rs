@@ -123,6 +123,12 @@ pub fn urdf_color(rgba: Option<[f64; 4]>) -> Option<u32> {
 /// file's sub-meshes are merged into one. Returns the mesh and the file's size, or why it
 /// cannot be drawn (no file, not a mesh format, a parse error, no triangles).
 pub fn load(m: &MeshRef, origin: &Pose) -> Result<(TriMesh, u64), String> {
+    if m.filename.is_empty() {
+        return Err("a <mesh> without a filename".into());
+    }
+    if m.scale.iter().any(|s| !s.is_finite() || *s == 0.0) {
+        return Err(format!("scale {:?}: not three finite nonzero numbers", m.scale));
+    }
     let path = local_path(&m.filename)?;
     let bytes = read_bounded(&path)?;
     let size = bytes.len() as u64;
@@ -452,8 +458,18 @@ mod tests {
         assert_eq!(local_path("file:///a/b.stl").unwrap(), PathBuf::from("/a/b.stl"));
         let m = |f: &str| MeshRef { filename: f.into(), scale: [1.0; 3] };
         assert_eq!(load(&m("file:///nonexistent/x.stl"), &Pose::IDENTITY).unwrap_err(), "no file /nonexistent/x.stl");
-        let dir = std::env::temp_dir();
-        assert!(load(&m(&format!("file://{}", dir.display())), &Pose::IDENTITY).unwrap_err().contains("not a regular file"));
+        assert!(load(&m(""), &Pose::IDENTITY).unwrap_err().contains("without a filename"));
+        let flat = MeshRef { filename: "file:///a.stl".into(), scale: [1.0, 0.0, 1.0] };
+        assert!(load(&flat, &Pose::IDENTITY).unwrap_err().contains("scale"));
+        let dir = tempfile::tempdir().unwrap();
+        assert!(load(&m(&format!("file://{}", dir.path().display())), &Pose::IDENTITY).unwrap_err().contains("not a regular file"));
+        // a file that does not parse, and one of no known format, are named with the reason
+        for (name, text) in [("broken.dae", "<COLLADA><library_geometries><geometry"), ("part.step", "ISO-10303-21;")] {
+            let f = dir.path().join(name);
+            std::fs::write(&f, text).unwrap();
+            let why = load(&m(&format!("file://{}", f.display())), &Pose::IDENTITY).unwrap_err();
+            assert!(why.starts_with(&format!("reading {}: ", f.display())), "{why}");
+        }
     }
 
     /// [`draw`]: a present mesh becomes one `Mesh3D` entity; a missing one sends its link to

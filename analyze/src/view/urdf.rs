@@ -37,7 +37,8 @@ pub struct Visual {
 pub type Visuals = BTreeMap<String, Vec<Visual>>;
 
 /// A `<mesh filename scale>`: the file as the recorded URDF names it (a `file://` URI when
-/// `sim` resolved the scene's `robot.package_paths`) and the scale per axis of the mesh frame.
+/// `sim` resolved the scene's `robot.package_paths`; empty when it names none) and the scale
+/// per axis of the mesh frame (NaN when the attribute does not read as three numbers).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshRef {
     pub filename: String,
@@ -205,11 +206,10 @@ pub fn links(xml: &str) -> Result<Links, String> {
                 set(&mut elem, Geometry::Primitive(Shape::Sphere { radius_m }));
             }
             b"mesh" if in_geometry => {
-                let filename = attr(e, b"filename").ok_or("mesh without a filename")?;
-                let scale = attr(e, b"scale").map(|t| numbers::<3>(&t, "mesh scale")).transpose()?.unwrap_or([1.0; 3]);
-                if scale.iter().any(|s| !s.is_finite() || *s == 0.0) {
-                    return Err(format!("mesh {filename:?}: scale = {scale:?}: each factor finite and nonzero"));
-                }
+                // a mesh that cannot be drawn (no filename, a bad scale) is the viewer's note,
+                // not an error of the whole recording: `mesh::load` says why
+                let filename = attr(e, b"filename").unwrap_or_default();
+                let scale = attr(e, b"scale").map_or(Ok([1.0; 3]), |t| numbers::<3>(&t, "mesh scale")).unwrap_or([f64::NAN; 3]);
                 set(&mut elem, Geometry::Mesh(MeshRef { filename, scale }));
             }
             b"material" => {
@@ -282,9 +282,8 @@ mod tests {
         assert_eq!(m.collisions[0].geometry, Geometry::Mesh(MeshRef { filename: "file:///a.stl".into(), scale: [1.0; 3] }));
         assert_eq!(m.collisions[1].geometry, Geometry::Primitive(Shape::Sphere { radius_m: 0.1 }));
         assert!(visuals(&format!("<robot><link name='m'>{}</link></robot>", "<visual><geometry><mesh filename='x'/></geometry></visual>")).unwrap().is_empty());
-        assert!(links("<robot><link name='a'><visual><geometry><mesh filename='x' scale='1 0 1'/></geometry></visual></link></robot>")
-            .unwrap_err()
-            .contains("scale"));
+        let bad = links("<robot><link name='a'><visual><geometry><mesh filename='x' scale='1 y 1'/></geometry></visual></link></robot>").unwrap();
+        assert!(matches!(&bad["a"].visuals[0].geometry, Geometry::Mesh(m) if m.scale.iter().all(|s| s.is_nan())));
         assert!(visuals("<robot><link name='a'><visual><geometry><box size='1 x 1'/></geometry></visual></link></robot>")
             .unwrap_err()
             .contains("box size"));
