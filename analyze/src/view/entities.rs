@@ -75,16 +75,8 @@ fn hand_actual() -> u32 {
 fn hand_desired() -> u32 {
     shared(schemas::markers::colors::HAND_DESIRED)
 }
-const TABLE: u32 = rgba(176, 140, 96, 70);
+const TABLE: u32 = rgba(0x8c, 0x6d, 0x46, 70);
 const ARM: u32 = rgba(170, 180, 200, 255);
-
-/// A contact marker's colour: the mode the Foxglove markers give it ([`schemas::markers::MarkerMode`]:
-/// a `/contacts` code, else a bilateral contact pushing or pulling by the sign of f_n).
-fn mode_color(mode: Option<u32>, f_n: f64) -> u32 {
-    use schemas::markers::MarkerMode;
-    let marker = mode.map_or_else(|| MarkerMode::bilateral(f_n), |code| MarkerMode::from_code(code, f_n));
-    shared(marker.hex())
-}
 
 fn f3(p: [f64; 3]) -> [f32; 3] {
     p.map(|x| x as f32)
@@ -126,6 +118,11 @@ pub mod signal {
     pub const NORMAL_FORCE: &str = "normal_force_N";
     pub const FRICTION_FORCE: &str = "friction_force_N";
     pub const CONTACT_MODE: &str = "contact_mode";
+    /// The slip speed `|v_t|` of a unilateral or compliant contact, m/s.
+    pub const SLIP_SPEED: &str = "slip_speed_mps";
+    /// `|f_t| / (μ f_n)`: 1 on the friction cone (sliding), below it sticking (samples with
+    /// `f_n > 0` only).
+    pub const FRICTION_RATIO: &str = "friction_ratio";
     pub const ELECTRIC_ENERGY: &str = "electric_energy_J";
     pub const LINK_WORK: &str = "link_work_J";
     pub const ENERGY: &str = "energy_J";
@@ -305,11 +302,18 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.002]]))
                 .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![desired.iter().copied().map(f3).collect()]])),
         );
+        // the trail up to the current time: the actual positions so far, re-logged at most
+        // TRAIL_UPDATES times, each strip at most TRAIL_POINTS points (bounded: a long run's
+        // trail is thinned, never a strip per sample of every sample before it)
+        let (trail_t, trail) = trail_updates(&hand_times, &actual);
+        out.push(
+            Chunk::new(format!("{world}/hand_trail"), Index::SimTime(trail_t))
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&trail)),
+        );
         out.push(
             Chunk::new(format!("{world}/hand_trail"), Index::Static)
                 .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_actual()]]))
-                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.0015]]))
-                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![actual.iter().copied().map(f3).collect()]])),
+                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.0015]])),
         );
         for (name, pts, color, label, r) in
             [("actual", &actual, hand_actual(), "hand (actual)", r_point), ("desired", &desired, hand_desired(), "target (desired)", 0.75 * r_point)]
@@ -327,7 +331,8 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
-    // the table: every contact plane, a thin translucent box whose top face is the plane,
+    // the table: the boxes of `/scene` (what Foxglove draws, the same size); for a recording
+    // without them every contact plane, a thin translucent box whose top face is the plane,
     // covering the arm's reach
     let mut planes: Vec<Plane> = Vec::new();
     for p in run.contacts.iter().filter_map(|c| c.plane).chain(run.other_planes.iter().copied()) {
@@ -335,41 +340,64 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             planes.push(p);
         }
     }
-    for (k, plane) in planes.iter().enumerate() {
-        let n = plane.normal;
-        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
-        let n = n.map(|x| x / norm);
-        let d = plane.offset_m / norm;
-        let q = quat_z_to(n);
-        // the arm's bounds, projected on the plane: centre and half extent
-        let c = [0, 1, 2].map(|i| 0.5 * (bounds.arm_min[i] + bounds.arm_max[i]));
-        let half = [0, 1, 2].map(|i| 0.5 * (bounds.arm_max[i] - bounds.arm_min[i])).iter().fold(0.0f64, |a, b| a.max(*b)) + 0.15;
-        let dist = n[0] * c[0] + n[1] * c[1] + n[2] * c[2] - d;
-        let on_plane = [0, 1, 2].map(|i| c[i] - dist * n[i]);
-        let thickness = 0.01;
-        let center = [0, 1, 2].map(|i| on_plane[i] - 0.5 * thickness * n[i]);
+    let mut boxes: Vec<schemas::markers::TableBox> = run.scene.tables.clone();
+    if boxes.is_empty() {
+        for plane in &planes {
+            let n = plane.normal;
+            let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
+            let n = n.map(|x| x / norm);
+            let d = plane.offset_m / norm;
+            // the arm's bounds, projected on the plane: centre and half extent
+            let c = [0, 1, 2].map(|i| 0.5 * (bounds.arm_min[i] + bounds.arm_max[i]));
+            let half = [0, 1, 2].map(|i| 0.5 * (bounds.arm_max[i] - bounds.arm_min[i])).iter().fold(0.0f64, |a, b| a.max(*b)) + 0.15;
+            let dist = n[0] * c[0] + n[1] * c[1] + n[2] * c[2] - d;
+            let on_plane = [0, 1, 2].map(|i| c[i] - dist * n[i]);
+            let thickness = 0.01;
+            let center = [0, 1, 2].map(|i| on_plane[i] - 0.5 * thickness * n[i]);
+            boxes.push(schemas::markers::TableBox { center, rotation: quat_z_to(n), size: [2.0 * half, 2.0 * half, thickness], alpha: 70.0 / 255.0 });
+        }
+    }
+    for (k, b) in boxes.iter().enumerate() {
+        let [r, g, bl, _] = TABLE.to_be_bytes();
+        let alpha = (b.alpha.clamp(0.05, 1.0) * 255.0).round() as u8;
         out.push(
             Chunk::new(format!("{world}/table{k}"), Index::Static)
-                .with(BOXES, "centers", "rerun.components.Translation3D", vec3_lists(&[vec![f3(center)]]))
-                .with(BOXES, "colors", "rerun.components.Color", u32_lists(&[vec![TABLE]]))
+                .with(BOXES, "centers", "rerun.components.Translation3D", vec3_lists(&[vec![f3(b.center)]]))
+                .with(BOXES, "colors", "rerun.components.Color", u32_lists(&[vec![rgba(r, g, bl, alpha)]]))
                 .with(BOXES, "fill_mode", "rerun.components.FillMode", u8_lists(&[vec![4]]))
-                .with(BOXES, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![[half as f32, half as f32, (0.5 * thickness) as f32]]]))
+                .with(BOXES, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![f3(b.size.map(|x| 0.5 * x))]]))
                 .with(BOXES, "labels", "rerun.components.Text", str_lists(&[vec!["table".to_string()]]))
-                .with(BOXES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(q)]])),
+                .with(BOXES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(b.rotation)]])),
         );
     }
+    // the force arrows' scale bar, where Foxglove draws it, with its legend
+    let scale = run.scene.force_scale;
+    if !run.contacts.is_empty() {
+        let bar = run.scene.scale_bar.clone().or_else(|| {
+            // a recording without one: a bar on the first plane, at the base's projection
+            planes.first().map(|p| {
+                let f = scale.bar_force_n();
+                let n = p.normal;
+                let gap = n[0] * bounds.base[0] + n[1] * bounds.base[1] + n[2] * bounds.base[2] - p.offset_m;
+                let tail = [0, 1, 2].map(|i| bounds.base[i] - gap * n[i]);
+                schemas::markers::ScaleBar { tail, vector: n.map(|x| x * f * scale.m_per_n), text: format!("{f} N = {:.3} m", f * scale.m_per_n) }
+            })
+        });
+        if let Some(bar) = bar {
+            out.push(
+                Chunk::new(format!("{world}/force_scale"), Index::Static)
+                    .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&[vec![shared(schemas::markers::colors::SCALE_BAR)]]))
+                    .with(ARROWS, "labels", "rerun.components.Text", str_lists(&[vec![format!("{} ({})", bar.text, scale_words(&scale))]]))
+                    .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&[vec![f3(bar.tail)]]))
+                    .with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::ARROW_SHAFT_DIAMETER_M) as f32]]))
+                    .with(ARROWS, "vectors", "rerun.components.Vector3D", vec3_lists(&[vec![f3(bar.vector)]])),
+            );
+        }
+    }
 
-    // contacts: marker and force arrow per sample, coloured by mode
+    // contacts: marker, ring and force arrow per sample, coloured by mode, at the scene's one
+    // scale (`/scene`), as Foxglove draws them (`schemas::markers`)
     let (f_n, f_t, modes) = contact_forces(run);
-    // the largest force after the start-up transient (the first 5 % of the samples, where an
-    // impulse-like peak would shrink every arrow) is drawn 0.25 m long
-    let skip = |v: &Vec<f64>, per: usize| v.len() / (20 * per) * per;
-    let f_max = f_n
-        .iter()
-        .flat_map(|v| v[skip(v, 1)..].iter())
-        .chain(f_t.iter().flat_map(|v| v[skip(v, 2)..].iter()))
-        .fold(0.0f64, |a, f| a.max(f.abs()));
-    let scale = if f_max > 0.0 { 0.25 / f_max } else { 0.0 };
     let force_times: Vec<i64> = if run.contact_states.is_some() {
         run.contact_states.iter().flatten().map(|(t, _)| ns(*t)).collect()
     } else {
@@ -381,41 +409,56 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             continue; // where it acts is unknown: plots only
         }
         let base = format!("{world}/contacts/{}", escape(&c.name));
-        let norm = c.plane.map_or([0.0, 0.0, 1.0], |p| p.normal);
-        let mut colors = Vec::with_capacity(n_rows);
-        let mut origins = Vec::with_capacity(n_rows);
-        let mut vectors = Vec::with_capacity(n_rows);
-        for k in 0..n_rows {
-            let fn_k = f_n[ci][k];
-            let mode = modes.as_ref().map(|m| m[ci][k]);
-            colors.push(vec![mode_color(mode, fn_k)]);
-            let p = contact_points[ci][k];
-            origins.push(vec![f3(p)]);
-            let mut f = norm.map(|x| x * fn_k);
-            if let (Some((t1, t2)), Some(ft)) = (c.tangents, f_t.get(ci)) {
-                let (a, b) = ft.get(2 * k).copied().zip(ft.get(2 * k + 1).copied()).unwrap_or((0.0, 0.0));
-                f = [0, 1, 2].map(|i| f[i] + a * t1[i] + b * t2[i]);
-            }
-            vectors.push(vec![f3(f.map(|x| x * scale))]);
-        }
+        let d = contact_drawing(c, &contact_points[ci][..n_rows], &f_n[ci], f_t.get(ci).map(Vec::as_slice), modes.as_ref().map(|m| m[ci].as_slice()), &scale);
+        let colors: Vec<Vec<u32>> = d.modes.iter().map(|m| vec![shared(m.hex())]).collect();
+        let translucent: Vec<Vec<u32>> = d.modes.iter().map(|m| vec![shared(m.hex()) & 0xffff_ff00 | 0x90]).collect();
         let ft = Index::SimTime(force_times[..n_rows].to_vec());
         out.push(
             Chunk::new(&base, ft.clone())
-                .with(POINTS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&origins)),
+                .with(POINTS, "colors", "rerun.components.Color", u32_lists(&translucent))
+                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&d.points.iter().map(|p| vec![f3(*p)]).collect::<Vec<_>>())),
         );
         out.push(
             Chunk::new(&base, Index::Static)
                 .with(POINTS, "labels", "rerun.components.Text", str_lists(&[vec![c.name.clone()]]))
-                .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.6 * r_point) as f32]])),
+                .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![schemas::markers::CONTACT_MARKER_RADIUS_M as f32]])),
         );
+        let rings: Vec<Vec<Vec<[f32; 3]>>> = d.glyphs.iter().map(|g| vec![ring(g.tail, d.normal)]).collect();
+        out.push(
+            Chunk::new(format!("{base}/ring"), ft.clone())
+                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&colors))
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&rings)),
+        );
+        out.push(
+            Chunk::new(format!("{base}/ring"), Index::Static)
+                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::RING_LINE_WIDTH_M) as f32]])),
+        );
+        let mut label = String::with_capacity(schemas::markers::label_capacity(&c.name));
+        let labels: Vec<Vec<String>> = d
+            .glyphs
+            .iter()
+            .zip(&d.modes)
+            .map(|(g, m)| {
+                schemas::markers::write_label(&mut label, &c.name, g.magnitude_n, *m);
+                vec![label.clone()]
+            })
+            .collect();
         out.push(
             Chunk::new(format!("{base}/force"), ft)
                 .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&origins))
-                .with(ARROWS, "vectors", "rerun.components.Vector3D", vec3_lists(&vectors)),
+                .with(ARROWS, "labels", "rerun.components.Text", str_lists(&labels))
+                .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.tail)]).collect::<Vec<_>>()))
+                .with(
+                    ARROWS,
+                    "vectors",
+                    "rerun.components.Vector3D",
+                    vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.direction.map(|x| x * g.length_m))]).collect::<Vec<_>>()),
+                ),
         );
-        out.push(Chunk::new(format!("{base}/force"), Index::Static).with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.006]])));
+        out.push(
+            Chunk::new(format!("{base}/force"), Index::Static)
+                .with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::ARROW_SHAFT_DIAMETER_M) as f32]])),
+        );
     }
 
     // contact events
@@ -442,6 +485,106 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
 
     out.extend(signal_chunks(run, paths, &f_n, &f_t, modes.as_deref()));
     (out, bounds)
+}
+
+/// How many times the hand trail is re-logged, at most, and how many points each has, at most.
+pub const TRAIL_UPDATES: usize = 400;
+pub const TRAIL_POINTS: usize = 400;
+
+/// The hand trail up to the current time: `(times, rows)`, one row per update (a strip of the
+/// actual positions from the first sample to that update's, thinned to at most
+/// [`TRAIL_POINTS`], its own sample last), at most [`TRAIL_UPDATES`] updates, the last at the
+/// last sample. No row holds a position after its time.
+pub fn trail_updates(times: &[i64], actual: &[[f64; 3]]) -> (Vec<i64>, Vec<Vec<Vec<[f32; 3]>>>) {
+    let n = times.len().min(actual.len());
+    if n == 0 {
+        return (Vec::new(), Vec::new());
+    }
+    let stride = n.div_ceil(TRAIL_UPDATES).max(1);
+    let mut ks: Vec<usize> = (0..n).step_by(stride).collect();
+    if ks.last() != Some(&(n - 1)) {
+        ks.push(n - 1);
+    }
+    let rows = ks
+        .iter()
+        .map(|&k| {
+            let thin = (k + 1).div_ceil(TRAIL_POINTS).max(1);
+            let mut strip: Vec<[f32; 3]> = (0..=k).step_by(thin).map(|i| f3(actual[i])).collect();
+            if (k % thin) != 0 {
+                strip.push(f3(actual[k]));
+            }
+            vec![strip]
+        })
+        .collect();
+    (ks.iter().map(|&k| times[k]).collect(), rows)
+}
+
+/// A contact's drawing, sample by sample: where its marker is, its mode, its force glyph.
+#[derive(Debug, Clone)]
+pub struct ContactDrawing {
+    /// The contact point (the marker's centre), world frame, m.
+    pub points: Vec<[f64; 3]>,
+    pub modes: Vec<schemas::markers::MarkerMode>,
+    pub glyphs: Vec<schemas::markers::ForceGlyph>,
+    /// The plane's unit normal.
+    pub normal: [f64; 3],
+}
+
+/// The drawing of contact `c` at its `points` (per sample) with normal forces `f_n`, friction
+/// components `f_t` (`(t1, t2)` interleaved, when recorded) and mode codes (when recorded), at
+/// `scale`: the geometry of `schemas::markers` (Foxglove's), so that both viewers draw the same.
+pub fn contact_drawing(
+    c: &super::run::ContactPoint,
+    points: &[[f64; 3]],
+    f_n: &[f64],
+    f_t: Option<&[f64]>,
+    modes: Option<&[u32]>,
+    scale: &schemas::markers::ForceScale,
+) -> ContactDrawing {
+    use schemas::markers::{ForceGlyph, MarkerMode};
+    let (normal, offset) = c.plane.map_or(([0.0, 0.0, 1.0], 0.0), |p| {
+        let n = p.normal;
+        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
+        (n.map(|x| x / norm), p.offset_m / norm)
+    });
+    let mut d = ContactDrawing { points: points.to_vec(), modes: Vec::with_capacity(points.len()), glyphs: Vec::with_capacity(points.len()), normal };
+    for (k, p) in points.iter().enumerate() {
+        let fn_k = f_n.get(k).copied().unwrap_or(0.0);
+        let mode = modes.and_then(|m| m.get(k)).map_or_else(|| MarkerMode::bilateral(fn_k), |code| MarkerMode::from_code(*code, fn_k));
+        let mut f = normal.map(|x| x * fn_k);
+        if let (Some((t1, t2)), Some(ft)) = (c.tangents, f_t) {
+            let (a, b) = ft.get(2 * k).copied().zip(ft.get(2 * k + 1).copied()).unwrap_or((0.0, 0.0));
+            f = [0, 1, 2].map(|i| f[i] + a * t1[i] + b * t2[i]);
+        }
+        d.modes.push(mode);
+        d.glyphs.push(ForceGlyph::new(*p, normal, offset, f, scale));
+    }
+    d
+}
+
+/// The ring around a contact's point on the table: a closed strip of
+/// [`schemas::markers::CONTACT_RING_POINTS`] points about `center` in the plane of `normal`.
+fn ring(center: [f64; 3], normal: [f64; 3]) -> Vec<[f32; 3]> {
+    let q = quat_z_to(normal);
+    let r = schemas::markers::CONTACT_RING_RADIUS_M;
+    let n = schemas::markers::CONTACT_RING_POINTS;
+    (0..=n)
+        .map(|k| {
+            let a = std::f64::consts::TAU * (k % n) as f64 / n as f64;
+            let v = schemas::markers::rotate(q, [r * a.cos(), r * a.sin(), 0.0]);
+            f3([0, 1, 2].map(|i| center[i] + v[i]))
+        })
+        .collect()
+}
+
+/// "10 mm per N" (the scale in words).
+fn scale_words(s: &schemas::markers::ForceScale) -> String {
+    let mm = s.m_per_n * 1e3;
+    if mm >= 0.01 {
+        format!("{} mm per N", (mm * 1e4).round() / 1e4)
+    } else {
+        format!("{:e} m per N", s.m_per_n)
+    }
 }
 
 /// Per contact and sample: normal force, friction components `(t1, t2)` interleaved, and mode
@@ -510,6 +653,26 @@ fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], m
         if let Some(ft) = f_t.get(c).filter(|v| !v.is_empty()) {
             let mag = ft.chunks(2).map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt()).collect();
             out.extend(series(format!("{}/{cp}", paths.signal(FRICTION_FORCE)), &force_t, mag, &format!("{} |f_t| [N]", contact.name), color, width));
+        }
+        if let (Some(states), Some(ft)) = (&run.contact_states, f_t.get(c).filter(|v| !v.is_empty())) {
+            let slip = states
+                .iter()
+                .map(|(_, s)| {
+                    let (a, b) = (s.slip_velocity_t1.get(c).copied().unwrap_or(0.0), s.slip_velocity_t2.get(c).copied().unwrap_or(0.0));
+                    (a * a + b * b).sqrt()
+                })
+                .collect();
+            out.extend(series(format!("{}/{cp}", paths.signal(SLIP_SPEED)), &force_t, slip, &format!("{} |v_t| [m/s]", contact.name), color, width));
+            if let Some(mu) = contact.friction.filter(|m| *m > 0.0) {
+                let (t, v): (Vec<i64>, Vec<f64>) = ft
+                    .chunks(2)
+                    .zip(&f_n[c])
+                    .zip(&force_t)
+                    .filter(|((_, n), _)| **n > 0.0)
+                    .map(|((p, n), t)| (*t, (p[0] * p[0] + p[1] * p[1]).sqrt() / (mu * n)))
+                    .unzip();
+                out.extend(series(format!("{}/{cp}", paths.signal(FRICTION_RATIO)), &t, v, &format!("{} |f_t|/(μ f_n)", contact.name), color, width));
+            }
         }
         if let Some(m) = modes {
             let v = m[c].iter().map(|&x| f64::from(x)).collect();

@@ -1,14 +1,21 @@
 //! The blueprint of a converted recording: which views, where, with which cameras.
 //!
-//! One run: left, the arm in 3D from the side (the table edge-on, so that an elbow below it
-//! shows) above a close-up of the hand; right, a grid of plots: motor currents and voltages per
-//! joint, the contact forces (and friction and modes when the contact model records them), the
-//! contact events, energies per joint (E_j electric, W_j link work), the energy totals and the
-//! balance residual. Several runs: one 3D view per run side by side, and below them tabs that
-//! overlay the energy totals and the residual of every run (coloured by run), then one tab per
-//! signal with a plot per run side by side.
+//! One run (issue 27: readable at 1440×900 and 1920×1080, at most three plots to a tab, short
+//! titles, legends in the corner the data leaves empty, [`legend_corner`]): tabs
+//! - "arm": the arm in 3D from the side (the table edge-on, so that an elbow below it shows),
+//!   beside a close-up of the hand above the contact normal forces (and friction forces);
+//! - "motors": currents above voltages, per joint;
+//! - "slip / stick" (runs with unilateral or compliant contacts): slip speed `|v_t|`,
+//!   `|f_t|/(μ f_n)` (1 = on the friction cone) and the mode per contact, beside the events;
+//! - "energy": the totals above E_j (electric, per motor) and W_j (link work, per joint);
+//! - "balance": the balance residual alone, on a y range fitted to it ([`residual_range`]);
+//! - "events" (when the run has contact events): the events table, full width.
+//!
+//! Several runs: one 3D view per run side by side, and below them tabs that overlay the energy
+//! totals and the residual of every run (coloured by run), then one tab per signal with a plot
+//! per run side by side.
 
-use super::blueprint::{ContainerKind, Eye, Node, View, ViewClass};
+use super::blueprint::{ContainerKind, Corner, Eye, Node, View, ViewClass};
 use super::entities::{signal, Bounds, Paths};
 use super::run::{escape, Run};
 
@@ -76,6 +83,46 @@ pub fn range_after_transient(samples: &[(f64, Vec<f64>)]) -> Option<[f64; 2]> {
     Some([lo - pad, hi + pad])
 }
 
+/// The corner of a plot whose legend covers the fewest samples: each corner's box (a third of
+/// the time axis, the top or bottom third of the y range shown) is counted over every series;
+/// the first of left top, right top, left bottom, right bottom with the fewest wins.
+pub fn legend_corner(samples: &[(f64, Vec<f64>)], y_range: Option<[f64; 2]>) -> Corner {
+    let (Some(first), Some(last)) = (samples.first(), samples.last()) else { return Corner::LeftTop };
+    let (t0, t1) = (first.0, last.0);
+    let [lo, hi] = y_range.unwrap_or_else(|| {
+        samples.iter().flat_map(|(_, v)| v.iter().copied()).filter(|x| x.is_finite()).fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], x| [a.min(x), b.max(x)])
+    });
+    if !(hi > lo) || !(t1 > t0) {
+        return Corner::LeftTop;
+    }
+    let mut counts = [0usize; 4];
+    for (t, v) in samples {
+        let x = (t - t0) / (t1 - t0);
+        for y in v.iter().map(|y| (y - lo) / (hi - lo)) {
+            let left = x <= 1.0 / 3.0;
+            let right = x >= 2.0 / 3.0;
+            let top = y >= 2.0 / 3.0;
+            let bottom = y <= 1.0 / 3.0;
+            for (k, hit) in [left && top, right && top, left && bottom, right && bottom].into_iter().enumerate() {
+                counts[k] += usize::from(hit);
+            }
+        }
+    }
+    let best = (0..4).min_by_key(|&k| counts[k]).unwrap_or(0);
+    [Corner::LeftTop, Corner::RightTop, Corner::LeftBottom, Corner::RightBottom][best]
+}
+
+/// The y range of the balance residual: symmetric about 0, 1.2 times its largest magnitude
+/// (so the line is drawn across the plot even when it is 1e-12 J), `[-1, 1]` J when it is 0.
+pub fn residual_range(residual: &[f64]) -> [f64; 2] {
+    let m = residual.iter().filter(|x| x.is_finite()).fold(0.0f64, |a, x| a.max(x.abs()));
+    if m > 0.0 {
+        [-1.2 * m, 1.2 * m]
+    } else {
+        [-1.0, 1.0]
+    }
+}
+
 /// A plot of one run: title, entity root, fixed y range.
 struct Plot {
     /// The signal ([`signal`]): plots of several runs with the same key go side by side.
@@ -83,58 +130,101 @@ struct Plot {
     title: String,
     origin: String,
     y_range: Option<[f64; 2]>,
+    legend: Corner,
 }
 
 impl Plot {
     fn node(&self, title: &str) -> Node {
-        Node::View(View::new(ViewClass::TimeSeries, title, self.origin.clone()).y_range(self.y_range))
+        Node::View(View::new(ViewClass::TimeSeries, title, self.origin.clone()).y_range(self.y_range).legend(self.legend))
     }
 }
 
 /// The plots one run has.
 fn plots(run: &Run, paths: &Paths) -> Vec<Plot> {
-    let p = |key: &'static str, title: &str, y_range| Plot { key, title: title.to_string(), origin: paths.signal(key), y_range };
+    let p = |key: &'static str, title: &str, y_range, samples: &[(f64, Vec<f64>)]| Plot {
+        key,
+        title: title.to_string(),
+        origin: paths.signal(key),
+        y_range,
+        legend: legend_corner(samples, y_range),
+    };
     let currents: Vec<(f64, Vec<f64>)> = run.motors.iter().map(|(t, m)| (*t, m.current.clone())).collect();
     let r = range_after_transient(&currents);
-    let title = if r.is_some() { "motor currents [A] (start-up transient off scale)" } else { "motor currents [A]" };
-    let mut v = vec![p(signal::CURRENT, title, r)];
+    let title = if r.is_some() { "currents [A] (start-up off scale)" } else { "currents [A]" };
+    let mut v = vec![p(signal::CURRENT, title, r, &currents)];
     if run.motors.first().is_some_and(|(_, m)| !m.voltage.is_empty()) {
         let volts: Vec<(f64, Vec<f64>)> = run.motors.iter().map(|(t, m)| (*t, m.voltage.clone())).collect();
         let r = range_after_transient(&volts);
-        let title = if r.is_some() { "motor voltages [V] (start-up transient off scale)" } else { "motor voltages [V]" };
-        v.push(p(signal::VOLTAGE, title, r));
+        let title = if r.is_some() { "voltages [V] (start-up off scale)" } else { "voltages [V]" };
+        v.push(p(signal::VOLTAGE, title, r, &volts));
     }
     if !run.contacts.is_empty() {
-        v.push(p(signal::NORMAL_FORCE, "contact normal forces f_n [N] (< 0: the table pulls)", None));
+        let f: Vec<(f64, Vec<f64>)> = match &run.contact_states {
+            Some(s) => s.iter().map(|(t, c)| (*t, c.normal_force.clone())).collect(),
+            None => run.constraints.iter().map(|(t, c)| (*t, c.normal_force.clone())).collect(),
+        };
+        v.push(p(signal::NORMAL_FORCE, "normal force f_n [N] (< 0: pull)", None, &f));
     }
-    if run.contact_states.is_some() && !run.contacts.is_empty() {
-        v.push(p(signal::FRICTION_FORCE, "friction forces |f_t| [N]", None));
-        v.push(p(signal::CONTACT_MODE, "contact modes (0 separated, 1 sticking, 2 sliding, 3 bilateral)", Some([-0.2, 3.2])));
+    if let Some(states) = run.contact_states.as_ref().filter(|_| !run.contacts.is_empty()) {
+        let none: &[(f64, Vec<f64>)] = &[];
+        let slip: Vec<(f64, Vec<f64>)> = states
+            .iter()
+            .map(|(t, s)| (*t, s.slip_velocity_t1.iter().zip(&s.slip_velocity_t2).map(|(a, b)| (a * a + b * b).sqrt()).collect()))
+            .collect();
+        v.push(p(signal::SLIP_SPEED, "slip speed |v_t| [m/s]", None, &slip));
+        if run.contacts.iter().any(|c| c.friction.is_some_and(|m| m > 0.0)) {
+            v.push(p(signal::FRICTION_RATIO, "|f_t| / (μ f_n) (1: sliding)", Some([0.0, 1.2]), none));
+        }
+        v.push(p(signal::FRICTION_FORCE, "friction |f_t| [N]", None, none));
+        v.push(p(signal::CONTACT_MODE, "mode (0 sep., 1 stick, 2 slide)", Some([-0.2, 3.2]), none));
     }
-    v.push(p(signal::ELECTRIC_ENERGY, "electric energy per motor E_j [J]", None));
-    v.push(p(signal::LINK_WORK, "link work per joint W_j [J]", None));
+    let e: Vec<(f64, Vec<f64>)> = run.energy.iter().map(|(t, e)| (*t, e.electric_energy.clone())).collect();
+    v.push(p(signal::ELECTRIC_ENERGY, "E_j electric [J]", None, &e));
+    let w: Vec<(f64, Vec<f64>)> = run.energy.iter().map(|(t, e)| (*t, e.link_work.clone())).collect();
+    v.push(p(signal::LINK_WORK, "W_j link work [J]", None, &w));
     v
+}
+
+fn column(children: Vec<Node>) -> Node {
+    Node::container(ContainerKind::Vertical, children)
+}
+
+fn row(children: Vec<Node>) -> Node {
+    Node::container(ContainerKind::Horizontal, children)
 }
 
 /// The blueprint of one run (entities as [`super::entities::run_chunks`] made them).
 pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     let world = paths.world();
     let arm = View::new(ViewClass::Spatial3D, "arm, side view", &world).eye(side_eye(bounds));
-    let hand = View::new(ViewClass::Spatial3D, "hand close-up (purple: actual, orange: target)", &world).eye(hand_eye(bounds));
-    let mut grid: Vec<Node> = plots(run, paths).iter().map(|p| p.node(&p.title)).collect();
-    grid.push(plot("energy totals [J]", format!("/{}", signal::ENERGY)));
-    grid.push(plot("energy balance residual [J]", paths.signal(signal::RESIDUAL)));
-    if !run.events.is_empty() {
-        grid.push(Node::View(View::new(ViewClass::TextLog, "contact events", format!("{}/events", paths.prefix))));
+    let hand = View::new(ViewClass::Spatial3D, "hand (purple) and target (orange)", &world).eye(hand_eye(bounds));
+    let mut all = plots(run, paths);
+    let mut take = |key: &str| all.iter().position(|p| p.key == key).map(|k| all.remove(k)).map(|p| p.node(&p.title));
+    let mut tabs = Vec::new();
+    let mut side = vec![Node::View(hand)];
+    side.extend(take(signal::NORMAL_FORCE));
+    side.extend(take(signal::FRICTION_FORCE));
+    tabs.push(row(vec![Node::View(arm), column(side)]).shares(&[3.0, 2.0]).named("arm"));
+    let motors: Vec<Node> = [signal::CURRENT, signal::VOLTAGE].iter().filter_map(|k| take(k)).collect();
+    tabs.push(column(motors).named("motors"));
+    let events = (!run.events.is_empty()).then(|| Node::View(View::new(ViewClass::TextLog, "contact events", format!("{}/events", paths.prefix))));
+    let slip: Vec<Node> = [signal::SLIP_SPEED, signal::FRICTION_RATIO, signal::CONTACT_MODE].iter().filter_map(|k| take(k)).collect();
+    if !slip.is_empty() {
+        let mut children = vec![column(slip)];
+        children.extend(events.clone());
+        let shares: &[f32] = if children.len() == 2 { &[2.0, 1.0] } else { &[1.0] };
+        tabs.push(row(children).shares(shares).named("slip / stick"));
     }
-    Node::container(
-        ContainerKind::Horizontal,
-        vec![
-            Node::container(ContainerKind::Vertical, vec![Node::View(arm), Node::View(hand)]).shares(&[3.0, 2.0]),
-            Node::container(ContainerKind::Grid, grid),
-        ],
-    )
-    .shares(&[1.0, 1.3])
+    let totals = View::new(ViewClass::TimeSeries, "energy totals [J]", format!("/{}", signal::ENERGY)).legend(Corner::LeftTop);
+    let per_joint: Vec<Node> = [signal::ELECTRIC_ENERGY, signal::LINK_WORK].iter().filter_map(|k| take(k)).collect();
+    tabs.push(column(vec![Node::View(totals), row(per_joint)]).named("energy"));
+    let residual: Vec<f64> = run.energy.iter().map(|(_, e)| e.balance_residual).collect();
+    let balance = View::new(ViewClass::TimeSeries, "balance residual [J]", paths.signal(signal::RESIDUAL)).y_range(Some(residual_range(&residual))).legend(Corner::RightBottom);
+    tabs.push(column(vec![Node::View(balance)]).named("balance"));
+    if let Some(ev) = events {
+        tabs.push(column(vec![ev]).named("events"));
+    }
+    Node::container(ContainerKind::Tabs, tabs)
 }
 
 /// The blueprint of several runs side by side.

@@ -39,6 +39,8 @@ pub struct ContactPoint {
     pub plane: Option<Plane>,
     /// Tangent basis of the friction forces (world frame), from the `contacts` record.
     pub tangents: Option<([f64; 3], [f64; 3])>,
+    /// Friction coefficient μ, from the `contacts` record (unilateral and compliant contacts).
+    pub friction: Option<f64>,
 }
 
 /// A frame of the `/tf` tree and its poses.
@@ -74,6 +76,9 @@ pub struct Run {
     pub events: Vec<(f64, ContactEventMsg)>,
     /// The run's status and reason (record `result`), when the recording has one.
     pub result: Option<RunResult>,
+    /// What `/scene` says (the force scale, the tables, the scale bar), so that Rerun draws
+    /// what Foxglove draws; the defaults for a recording without it.
+    pub scene: schemas::markers::SceneRead,
 }
 
 fn bad(file: &str, detail: String) -> Error {
@@ -140,7 +145,7 @@ impl Run {
                 (None, None) => None,
             };
             let offset_m = point.and_then(|p| p.get("offset")).and_then(vec3).unwrap_or([0.0; 3]);
-            contacts.push(ContactPoint { name: cname.clone(), link, offset_m, plane, tangents: info.map(|i| (i.t1, i.t2)) });
+            contacts.push(ContactPoint { name: cname.clone(), link, offset_m, plane, tangents: info.map(|i| (i.t1, i.t2)), friction: info.and_then(|i| i.friction) });
         }
         let mut other_planes = Vec::new();
         for c in &scene_contacts {
@@ -231,6 +236,7 @@ impl Run {
             contact_states,
             events,
             result,
+            scene: rec.messages(schemas::topics::SCENE).and_then(|m| m.first()).map(|(_, v)| schemas::markers::SceneRead::from_message(v)).unwrap_or_default(),
         })
     }
 
