@@ -348,7 +348,8 @@ function checkScene(rec) {
       const a = arrowEnt.arrows[0];
       if (!sameRgb(a.color, MODE_COLORS[mode])) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: arrow colour for mode ${mode}`);
       const scale = Number(arrowEnt.metadata.find((kv) => kv.key === "scale_m_per_n").value);
-      const minLen = Number(arrowEnt.metadata.find((kv) => kv.key === "min_length_m").value);
+      const minLen = Number(arrowEnt.metadata.find((kv) => kv.key === "min_length_m")?.value);
+      if (!(minLen > 0)) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: no min_length_m in its metadata`);
       if (scale !== sceneScale) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: scale ${scale} m/N, /scene says ${sceneScale}`);
       const len = a.shaft_length + a.head_length;
       const norm = Math.hypot(fn, ft[0], ft[1]);

@@ -709,3 +709,165 @@ fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], m
     out.extend(series(paths.signal(RESIDUAL), &energy_t, residual, &name, color, width));
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use arrow_array::cast::AsArray;
+    use arrow_array::types::Float32Type;
+    use arrow_array::Array;
+
+    use super::*;
+    use schemas::markers::{CONTACT_MARKER_RADIUS_M, MIN_ARROW_LENGTH_M};
+
+    /// The 3-vectors of column `field` of `chunk`, one row each (the first of the row).
+    fn vec3_rows(chunk: &Chunk, field: &str) -> Vec<[f64; 3]> {
+        let col = chunk.columns.iter().find(|c| c.field == field).unwrap_or_else(|| panic!("{}: no {field}", chunk.entity_path));
+        let list = col.values.as_list::<i32>();
+        (0..list.len())
+            .map(|r| {
+                let row = list.value(r);
+                let fixed = row.as_fixed_size_list();
+                let v = fixed.value(0);
+                let v = v.as_primitive::<Float32Type>();
+                [v.value(0) as f64, v.value(1) as f64, v.value(2) as f64]
+            })
+            .collect()
+    }
+
+    fn strings(chunk: &Chunk, field: &str) -> Vec<String> {
+        let col = chunk.columns.iter().find(|c| c.field == field).unwrap();
+        let list = col.values.as_list::<i32>();
+        (0..list.len()).map(|r| list.value(r).as_string::<i32>().value(0).to_string()).collect()
+    }
+
+    fn find<'a>(chunks: &'a [Chunk], path: &str, temporal: bool) -> &'a Chunk {
+        chunks.iter().find(|c| c.entity_path == path && c.is_static() != temporal).unwrap_or_else(|| panic!("no chunk {path}"))
+    }
+
+    /// Length of the segment a-b outside the ball (c, r), m.
+    fn outside(a: [f64; 3], b: [f64; 3], c: [f64; 3], r: f64) -> f64 {
+        let d = [0, 1, 2].map(|i| b[i] - a[i]);
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let u = d.map(|x| x / len);
+        let m = [0, 1, 2].map(|i| a[i] - c[i]);
+        let bq = u[0] * m[0] + u[1] * m[1] + u[2] * m[2];
+        let disc = bq * bq - (m[0] * m[0] + m[1] * m[1] + m[2] * m[2] - r * r);
+        if disc <= 0.0 {
+            return len;
+        }
+        len - ((-bq + disc.sqrt()).clamp(0.0, len) - (-bq - disc.sqrt()).clamp(0.0, len))
+    }
+
+    /// Issue 27's acceptance, Rerun side: in the paper's two-elbow recording (the archive),
+    /// every nonzero contact force (every sample of `/constraints`, both elbows) is drawn as an
+    /// arrow that leaves its marker by at least 20 mm, from the contact point's projection on
+    /// the table (1e-6 m, f32), max(|F| × scale, 60 mm) long (1e-6 relative) at the scale of
+    /// `/scene` (the arm's: 10 mm per N), which is the scale of the recording's Foxglove arrows;
+    /// the marker is larger than the URDF's sphere at the contact; the label gives |F| to
+    /// 0.1 N; the table is `/scene`'s; the hand trail never holds a position after its time.
+    #[test]
+    fn every_nonzero_force_is_drawn_outside_its_marker_in_the_paper_two_elbow_run() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../recordings/paper-archive-two-elbow.mcap");
+        let input = super::super::read_input(&path).unwrap();
+        let run = &input.run;
+        assert!(run.scene.scale_recorded, "the archive records its force scale on /scene");
+        let scale = run.scene.force_scale;
+        assert_eq!(scale.m_per_n, 0.01);
+        // Foxglove's arrows in the same file: the same scale
+        let rec = schemas::read_recording(&path).unwrap();
+        let markers = rec.messages(schemas::topics::CONTACT_MARKERS).unwrap();
+        let fox_scale = markers[0].1.get("entities.1.metadata.1.value").and_then(schemas::Value::as_str).unwrap().parse::<f64>().unwrap();
+        assert_eq!(fox_scale, scale.m_per_n);
+
+        let paths = Paths { prefix: String::new(), run: None, index: 0 };
+        let (chunks, _) = run_chunks(run, &paths);
+        let mut nonzero = 0;
+        let mut min_outside = f64::INFINITY;
+        for (ci, c) in run.contacts.iter().enumerate() {
+            let base = format!("/world/contacts/{}", c.name);
+            let marker = vec3_rows(find(&chunks, &base, true), "positions");
+            let radius = {
+                let col = find(&chunks, &base, false).columns.iter().find(|c| c.field == "radii").unwrap().values.clone();
+                col.as_list::<i32>().value(0).as_primitive::<Float32Type>().value(0) as f64
+            };
+            assert!((radius - CONTACT_MARKER_RADIUS_M).abs() < 1e-7);
+            let link_sphere = run.visuals[c.link.as_ref().unwrap()]
+                .iter()
+                .filter_map(|v| match v.shape {
+                    Shape::Sphere { radius_m } => Some(radius_m),
+                    _ => None,
+                })
+                .fold(0.0, f64::max);
+            assert!(link_sphere > 0.0 && radius > link_sphere, "{}: marker {radius} m, URDF sphere {link_sphere} m", c.name);
+            let arrows = find(&chunks, &format!("{base}/force"), true);
+            let (origins, vectors, labels) = (vec3_rows(arrows, "origins"), vec3_rows(arrows, "vectors"), strings(arrows, "labels"));
+            assert_eq!(origins.len(), run.constraints.len());
+            for (k, (_, s)) in run.constraints.iter().enumerate() {
+                let f = s.normal_force[ci].abs();
+                let len = vectors[k].iter().map(|x| x * x).sum::<f64>().sqrt();
+                let want = if f > 0.0 { (f * scale.m_per_n).max(MIN_ARROW_LENGTH_M) } else { 0.0 };
+                assert!((len - want).abs() <= 1e-6 * want.max(1.0), "{} sample {k}: {len} m for {f} N", c.name);
+                assert!(origins[k][2].abs() < 1e-6, "{} sample {k}: the arrow starts {} m off the table", c.name, origins[k][2]);
+                assert!((origins[k][0] - marker[k][0]).abs() < 1e-6 && (origins[k][1] - marker[k][1]).abs() < 1e-6);
+                let value: f64 = labels[k].split(' ').nth(1).unwrap().parse().unwrap();
+                assert!((value - f).abs() <= 0.05 + 1e-9, "{}: label {:?} for {f} N", c.name, labels[k]);
+                if f > 0.0 {
+                    let tip = [0, 1, 2].map(|i| origins[k][i] + vectors[k][i]);
+                    let o = outside(origins[k], tip, marker[k], radius);
+                    assert!(o >= 0.02, "{} sample {k}: |F| = {f} N, {o} m outside its marker", c.name);
+                    min_outside = min_outside.min(o);
+                    nonzero += 1;
+                }
+            }
+        }
+        assert_eq!(nonzero, 2 * run.constraints.len(), "both elbows carry a force at every sample");
+        assert!(min_outside >= 0.02, "{min_outside}");
+
+        // the table is /scene's (the size Foxglove draws)
+        let table = find(&chunks, "/world/table0", false);
+        let half = vec3_rows(table, "half_sizes")[0];
+        let fox = run.scene.tables[0].size;
+        assert!((2.0 * half[0] - fox[0]).abs() < 1e-6 && (2.0 * half[1] - fox[1]).abs() < 1e-6, "{half:?} vs {fox:?}");
+        // the trail up to the current time
+        let trail = find(&chunks, "/world/hand_trail", true);
+        let Index::SimTime(t) = &trail.index else { panic!() };
+        let list = trail.columns.iter().find(|c| c.field == "strips").unwrap().values.as_list::<i32>().clone();
+        for (r, t_r) in t.iter().enumerate() {
+            let strips = list.value(r);
+            let points = strips.as_list::<i32>().value(0);
+            let n = points.len();
+            assert!(n <= TRAIL_POINTS + 1);
+            let last = points.as_fixed_size_list().value(n - 1);
+            let last = last.as_primitive::<Float32Type>();
+            let k = run.hand.iter().position(|(th, _)| super::ns(*th) == *t_r).unwrap();
+            let h = &run.hand[k].1.actual;
+            assert_eq!([last.value(0), last.value(1), last.value(2)], [h.x as f32, h.y as f32, h.z as f32], "row {r}: ends at its own time");
+        }
+        assert_eq!(*t.last().unwrap(), super::ns(run.hand.last().unwrap().0));
+    }
+
+    /// The trail: at most TRAIL_UPDATES rows, each ending at its own sample, none longer than
+    /// TRAIL_POINTS + 1, the last at the last sample; one row per sample for short runs.
+    #[test]
+    fn the_trail_is_bounded_and_never_ahead() {
+        for n in [1usize, 2, 399, 400, 401, 1000, 100_001] {
+            let times: Vec<i64> = (0..n as i64).collect();
+            let pts: Vec<[f64; 3]> = (0..n).map(|k| [k as f64, 0.0, 0.0]).collect();
+            let (t, rows) = trail_updates(&times, &pts);
+            assert!(t.len() <= TRAIL_UPDATES + 1 && t.len() == rows.len(), "{n}");
+            assert_eq!(*t.last().unwrap(), n as i64 - 1);
+            for (tr, row) in t.iter().zip(&rows) {
+                let strip = &row[0];
+                assert!(strip.len() <= TRAIL_POINTS + 1);
+                assert_eq!(strip.last().unwrap()[0], *tr as f32);
+                assert!(strip.iter().all(|p| p[0] <= *tr as f32));
+                assert_eq!(strip[0][0], 0.0);
+            }
+            if n <= TRAIL_UPDATES {
+                assert_eq!(t.len(), n);
+            }
+        }
+    }
+}

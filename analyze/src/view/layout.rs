@@ -3,13 +3,14 @@
 //! One run (issue 27: readable at 1440×900 and 1920×1080, at most three plots to a tab, short
 //! titles, legends in the corner the data leaves empty, [`legend_corner`]): tabs
 //! - "arm": the arm in 3D from the side (the table edge-on, so that an elbow below it shows),
-//!   beside a close-up of the hand above the contact normal forces (and friction forces);
+//!   beside a close-up of the hand above the contact normal forces;
 //! - "motors": currents above voltages, per joint;
 //! - "slip / stick" (runs with unilateral or compliant contacts): slip speed `|v_t|`,
-//!   `|f_t|/(μ f_n)` (1 = on the friction cone) and the mode per contact, beside the events;
+//!   `|f_t|/(μ f_n)` (1 = on the friction cone) and the mode per contact;
+//! - "friction, events" (same runs): the friction forces above the contact events table, full
+//!   width (the events also mark the time panel);
 //! - "energy": the totals above E_j (electric, per motor) and W_j (link work, per joint);
-//! - "balance": the balance residual alone, on a y range fitted to it ([`residual_range`]);
-//! - "events" (when the run has contact events): the events table, full width.
+//! - "balance": the balance residual alone, on a y range fitted to it ([`residual_range`]).
 //!
 //! Several runs: one 3D view per run side by side, and below them tabs that overlay the energy
 //! totals and the residual of every run (coloured by run), then one tab per signal with a plot
@@ -203,17 +204,21 @@ pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     let mut tabs = Vec::new();
     let mut side = vec![Node::View(hand)];
     side.extend(take(signal::NORMAL_FORCE));
-    side.extend(take(signal::FRICTION_FORCE));
     tabs.push(row(vec![Node::View(arm), column(side)]).shares(&[3.0, 2.0]).named("arm"));
     let motors: Vec<Node> = [signal::CURRENT, signal::VOLTAGE].iter().filter_map(|k| take(k)).collect();
     tabs.push(column(motors).named("motors"));
-    let events = (!run.events.is_empty()).then(|| Node::View(View::new(ViewClass::TextLog, "contact events", format!("{}/events", paths.prefix))));
     let slip: Vec<Node> = [signal::SLIP_SPEED, signal::FRICTION_RATIO, signal::CONTACT_MODE].iter().filter_map(|k| take(k)).collect();
     if !slip.is_empty() {
-        let mut children = vec![column(slip)];
-        children.extend(events.clone());
-        let shares: &[f32] = if children.len() == 2 { &[2.0, 1.0] } else { &[1.0] };
-        tabs.push(row(children).shares(shares).named("slip / stick"));
+        tabs.push(column(slip).named("slip / stick"));
+    }
+    // friction forces above the events table (full width, so its times are not cut)
+    let mut contacts: Vec<Node> = take(signal::FRICTION_FORCE).into_iter().collect();
+    if !run.events.is_empty() {
+        contacts.push(Node::View(View::new(ViewClass::TextLog, "contact events", format!("{}/events", paths.prefix))));
+    }
+    if !contacts.is_empty() {
+        let shares: &[f32] = if contacts.len() == 2 { &[1.0, 1.0] } else { &[1.0] };
+        tabs.push(column(contacts).shares(shares).named("friction, events"));
     }
     let totals = View::new(ViewClass::TimeSeries, "energy totals [J]", format!("/{}", signal::ENERGY)).legend(Corner::LeftTop);
     let per_joint: Vec<Node> = [signal::ELECTRIC_ENERGY, signal::LINK_WORK].iter().filter_map(|k| take(k)).collect();
@@ -221,9 +226,6 @@ pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     let residual: Vec<f64> = run.energy.iter().map(|(_, e)| e.balance_residual).collect();
     let balance = View::new(ViewClass::TimeSeries, "balance residual [J]", paths.signal(signal::RESIDUAL)).y_range(Some(residual_range(&residual))).legend(Corner::RightBottom);
     tabs.push(column(vec![Node::View(balance)]).named("balance"));
-    if let Some(ev) = events {
-        tabs.push(column(vec![ev]).named("events"));
-    }
     Node::container(ContainerKind::Tabs, tabs)
 }
 
@@ -270,4 +272,56 @@ pub fn comparison(runs: &[(&Run, &Paths, &Bounds)]) -> Node {
 /// The entity prefix of run `label` in a comparison.
 pub fn prefix(label: &str) -> String {
     format!("/{}", escape(label))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A growing series leaves the left-top corner empty; a falling one the right-top... and
+    /// the residual range is symmetric, 1.2 times the largest magnitude.
+    #[test]
+    fn legends_go_where_the_data_is_not() {
+        let rising: Vec<(f64, Vec<f64>)> = (0..100).map(|k| (k as f64, vec![k as f64])).collect();
+        assert_eq!(legend_corner(&rising, None), Corner::LeftTop);
+        let falling: Vec<(f64, Vec<f64>)> = (0..100).map(|k| (k as f64, vec![-(k as f64)])).collect();
+        assert_eq!(legend_corner(&falling, None), Corner::RightTop);
+        // one series high everywhere, one low until 60 % of the run: the bottom right is empty
+        let high: Vec<(f64, Vec<f64>)> = (0..100).map(|k| (k as f64, vec![if k < 70 { 1.0 } else { 0.9 }, 0.5 * f64::from(u8::from(k >= 60))])).collect();
+        assert_eq!(legend_corner(&high, None), Corner::RightBottom);
+        assert_eq!(residual_range(&[1e-12, -3e-12, 2e-12]), [-1.2 * 3e-12, 1.2 * 3e-12]);
+        assert_eq!(residual_range(&[0.0, 0.0]), [-1.0, 1.0]);
+    }
+
+    /// One run: tabs, at most three views to a tab, the slip / stick tab for a unilateral run
+    /// with |f_t|/(mu f_n) on [0, 1.2], the residual on its fitted range.
+    #[test]
+    fn one_run_is_laid_out_in_readable_tabs() {
+        let dir = tempfile::tempdir().unwrap();
+        let (s, _) = schemas::synth::unilateral();
+        let input = super::super::read_input(&s.write_in(dir.path())).unwrap();
+        let paths = Paths { prefix: String::new(), run: None, index: 0 };
+        let (_, bounds) = super::super::entities::run_chunks(&input.run, &paths);
+        let root = single(&input.run, &paths, &bounds);
+        let Node::Container { kind: ContainerKind::Tabs, children, .. } = &root else { panic!("not tabs: {root:?}") };
+        let names: Vec<String> = children
+            .iter()
+            .map(|c| match c {
+                Node::Container { name, .. } => name.clone().unwrap_or_default(),
+                Node::View(v) => v.name.clone(),
+            })
+            .collect();
+        assert_eq!(names[..2], ["arm", "motors"]);
+        assert!(names.contains(&"slip / stick".to_string()) && names.contains(&"balance".to_string()), "{names:?}");
+        for c in children {
+            assert!(c.views().len() <= 3, "{:?}", c.views().iter().map(|v| &v.name).collect::<Vec<_>>());
+        }
+        let views = root.views();
+        let ratio = views.iter().find(|v| v.origin == format!("/{}", signal::FRICTION_RATIO)).expect("the friction ratio plot");
+        assert_eq!(ratio.y_range, Some([0.0, 1.2]));
+        let res = views.iter().find(|v| v.origin == format!("/{}", signal::RESIDUAL)).unwrap();
+        let r: Vec<f64> = input.run.energy.iter().map(|(_, e)| e.balance_residual).collect();
+        assert_eq!(res.y_range, Some(residual_range(&r)));
+        assert!(views.iter().all(|v| v.name.chars().count() <= 36), "{:?}", views.iter().map(|v| &v.name).collect::<Vec<_>>());
+    }
 }
