@@ -583,6 +583,25 @@ impl SceneRead {
     }
 }
 
+impl SceneRead {
+    /// What `rec`'s [`topics::SCENE`] says (its first message); the defaults when it has none
+    /// or did not decode it.
+    pub fn from_recording(rec: &crate::Recording) -> SceneRead {
+        rec.messages(crate::topics::SCENE).and_then(|m| m.first()).map(|(_, v)| SceneRead::from_message(v)).unwrap_or_default()
+    }
+}
+
+/// The `scale_m_per_n` of the first force arrow of `rec`'s first [`topics::CONTACT_MARKERS`]
+/// message (what Foxglove draws the run's arrows at), when it has one.
+pub fn recorded_arrow_scale(rec: &crate::Recording) -> Option<f64> {
+    use crate::Value;
+    let (_, msg) = rec.messages(crate::topics::CONTACT_MARKERS)?.first()?;
+    let entities = msg.get("entities")?.as_list()?;
+    let force = entities.iter().find(|e| e.get("id").and_then(Value::as_str).is_some_and(|id| id.starts_with("force/")))?;
+    let meta = force.get("metadata")?.as_list()?;
+    meta.iter().find(|kv| kv.get("key").and_then(Value::as_str) == Some("scale_m_per_n"))?.get("value")?.as_str()?.parse().ok()
+}
+
 /// `v` turned by the unit quaternion `q = [x, y, z, w]`.
 pub fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
     let [x, y, z, w] = q;

@@ -777,9 +777,7 @@ mod tests {
         assert_eq!(scale.m_per_n, 0.01);
         // Foxglove's arrows in the same file: the same scale
         let rec = schemas::read_recording(&path).unwrap();
-        let markers = rec.messages(schemas::topics::CONTACT_MARKERS).unwrap();
-        let fox_scale = markers[0].1.get("entities.1.metadata.1.value").and_then(schemas::Value::as_str).unwrap().parse::<f64>().unwrap();
-        assert_eq!(fox_scale, scale.m_per_n);
+        assert_eq!(schemas::markers::recorded_arrow_scale(&rec), Some(scale.m_per_n));
 
         let paths = Paths { prefix: String::new(), run: None, index: 0 };
         let (chunks, _) = run_chunks(run, &paths);

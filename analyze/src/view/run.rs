@@ -236,7 +236,7 @@ impl Run {
             contact_states,
             events,
             result,
-            scene: rec.messages(schemas::topics::SCENE).and_then(|m| m.first()).map(|(_, v)| schemas::markers::SceneRead::from_message(v)).unwrap_or_default(),
+            scene: schemas::markers::SceneRead::from_recording(rec),
         })
     }
 
