@@ -857,7 +857,7 @@ mod tests {
         let hd = msg.entities[5].spheres[0].pose.as_ref().unwrap().position.as_ref().unwrap();
         assert_eq!((hd.x, hd.y, hd.z), (1.0, 2.0, 3.5));
         assert_eq!(msg.entities[4].timestamp, Some(timestamp(5_000_000)));
-        assert!(HAND_ACTUAL_RADIUS_M > 0.015 && HAND_DESIRED_RADIUS_M > HAND_ACTUAL_RADIUS_M);
+        const { assert!(HAND_ACTUAL_RADIUS_M > 0.015 && HAND_DESIRED_RADIUS_M > HAND_ACTUAL_RADIUS_M) };
         // no force: no arrow
         let none = [ContactSample { point: [0.0; 3], force: [0.0; 3], mode: MarkerMode::Separated }; 2];
         let msg = m.update(6_000_000, none, [0.0; 3], [0.0; 3]);

@@ -43,7 +43,7 @@ fn updating_the_contact_markers_does_not_allocate() {
     let modes = [MarkerMode::Separated, MarkerMode::Sticking, MarkerMode::Sliding, MarkerMode::Pushing, MarkerMode::Pulling];
     let sample = |k: usize, i: usize| ContactSample {
         point: [0.1 * k as f64, 0.01 * i as f64, 0.0],
-        force: if i % 7 == 0 { [0.0; 3] } else if i % 11 == 0 { [1e300, 0.0, 0.0] } else { [0.5 * i as f64, -1.0, 30.0 - i as f64] },
+        force: if i.is_multiple_of(7) { [0.0; 3] } else if i.is_multiple_of(11) { [1e300, 0.0, 0.0] } else { [0.5 * i as f64, -1.0, 30.0 - i as f64] },
         mode: modes[(i + k) % modes.len()],
     };
     m.update(0, (0..3).map(|k| sample(k, 0)), [0.0; 3], [0.0; 3]);
