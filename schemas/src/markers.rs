@@ -589,6 +589,12 @@ impl SceneRead {
     pub fn from_recording(rec: &crate::Recording) -> SceneRead {
         rec.messages(crate::topics::SCENE).and_then(|m| m.first()).map(|(_, v)| SceneRead::from_message(v)).unwrap_or_default()
     }
+
+    /// What a [`topics::SCENE`] message handed to a [`crate::Visitor`] says (a streamed read:
+    /// `analyze view`'s survey takes the first).
+    pub fn from_decoded(m: &crate::DecodedMessage<'_>) -> SceneRead {
+        SceneRead::from_message(&m.value())
+    }
 }
 
 /// The `scale_m_per_n` of the first force arrow of `rec`'s first [`topics::CONTACT_MARKERS`]

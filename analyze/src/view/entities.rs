@@ -168,13 +168,6 @@ pub struct Bounds {
     pub base: [f64; 3],
 }
 
-fn grow(min: &mut [f64; 3], max: &mut [f64; 3], p: [f64; 3]) {
-    for i in 0..3 {
-        min[i] = min[i].min(p[i]);
-        max[i] = max[i].max(p[i]);
-    }
-}
-
 /// Radius of the largest sphere among the URDF visuals (the hand's, in the paper's arm), m.
 fn hand_sphere_radius(run: &Run) -> f64 {
     run.visuals
@@ -254,28 +247,12 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
-    // world positions: arm bounds (every frame origin, a few hundred samples) and contact points
-    let mut bounds = Bounds {
-        arm_min: [f64::INFINITY; 3],
-        arm_max: [f64::NEG_INFINITY; 3],
-        hand_min: [f64::INFINITY; 3],
-        hand_max: [f64::NEG_INFINITY; 3],
-        base: [0.0; 3],
-    };
-    if let Some((base, _)) = run.frames.iter().find(|(_, f)| f.parent == run.root_frame) {
-        if !times.is_empty() {
-            bounds.base = run.world_poses(0).get(base.as_str()).map_or([0.0; 3], |p| p.translation);
-        }
-    }
-    let stride = (times.len() / 200).max(1);
+    // the bounds are the whole run's (`Run::survey`); the contact points those of the window
+    let w = &run.whole;
+    let bounds = Bounds { arm_min: w.arm_min, arm_max: w.arm_max, hand_min: w.hand_min, hand_max: w.hand_max, base: w.base };
     let mut contact_points: Vec<Vec<[f64; 3]>> = vec![Vec::with_capacity(times.len()); run.contacts.len()];
     for k in 0..times.len() {
         let poses = run.world_poses(k);
-        if k % stride == 0 || k + 1 == times.len() {
-            for p in poses.values() {
-                grow(&mut bounds.arm_min, &mut bounds.arm_max, p.translation);
-            }
-        }
         for (c, pts) in run.contacts.iter().zip(contact_points.iter_mut()) {
             if let Some(link) = &c.link {
                 pts.push(poses.get(link.as_str()).map_or([0.0; 3], |p: &Pose| p.apply(c.offset_m)));
@@ -283,15 +260,11 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
-    // the hand: path, trail, points now
+    // the hand: path, trail (the whole run's), points now
     let hand_times: Vec<i64> = run.hand.iter().map(|(t, _)| ns(*t)).collect();
     let v3 = |v: &schemas::Vec3| [v.x, v.y, v.z];
     let desired: Vec<[f64; 3]> = run.hand.iter().map(|(_, h)| v3(&h.desired)).collect();
     let actual: Vec<[f64; 3]> = run.hand.iter().map(|(_, h)| v3(&h.actual)).collect();
-    for p in desired.iter().chain(&actual) {
-        grow(&mut bounds.hand_min, &mut bounds.hand_max, *p);
-        grow(&mut bounds.arm_min, &mut bounds.arm_max, *p);
-    }
     let r_hand = hand_sphere_radius(run);
     // larger than the hand sphere, so that the actual point shows around it
     let r_point = if r_hand > 0.0 { 1.35 * r_hand } else { 0.02 };
@@ -300,12 +273,14 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             Chunk::new(format!("{world}/target_path"), Index::Static)
                 .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_desired()]]))
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.002]]))
-                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![desired.iter().copied().map(f3).collect()]])),
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![w.target_path.iter().copied().map(f3).collect()]])),
         );
-        // the trail up to the current time: the actual positions so far, re-logged at most
-        // TRAIL_UPDATES times, each strip at most TRAIL_POINTS points (bounded: a long run's
-        // trail is thinned, never a strip per sample of every sample before it)
-        let (trail_t, trail) = trail_updates(&hand_times, &actual);
+        // the trail up to the current time: the actual positions so far (the whole run's,
+        // `Run::survey`), re-logged at most TRAIL_UPDATES times over the run, each strip at most
+        // TRAIL_POINTS points (bounded: a long run's trail is thinned, never a strip per sample
+        // of every sample before it); this window's updates
+        let window = (hand_times[0], hand_times[hand_times.len() - 1]);
+        let (trail_t, trail) = trail_updates(&w.hand_trail_t, &w.hand_trail, window);
         out.push(
             Chunk::new(format!("{world}/hand_trail"), Index::SimTime(trail_t))
                 .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&trail)),
@@ -494,8 +469,9 @@ pub const TRAIL_POINTS: usize = 400;
 /// The hand trail up to the current time: `(times, rows)`, one row per update (a strip of the
 /// actual positions from the first sample to that update's, thinned to at most
 /// [`TRAIL_POINTS`], its own sample last), at most [`TRAIL_UPDATES`] updates, the last at the
-/// last sample. No row holds a position after its time.
-pub fn trail_updates(times: &[i64], actual: &[[f64; 3]]) -> (Vec<i64>, Vec<Vec<Vec<[f32; 3]>>>) {
+/// last sample; of those, the updates at times within `window` (ns, both ends included: the
+/// time window being drawn). No row holds a position after its time.
+pub fn trail_updates(times: &[i64], actual: &[[f64; 3]], window: (i64, i64)) -> (Vec<i64>, Vec<Vec<Vec<[f32; 3]>>>) {
     let n = times.len().min(actual.len());
     if n == 0 {
         return (Vec::new(), Vec::new());
@@ -505,6 +481,7 @@ pub fn trail_updates(times: &[i64], actual: &[[f64; 3]]) -> (Vec<i64>, Vec<Vec<V
     if ks.last() != Some(&(n - 1)) {
         ks.push(n - 1);
     }
+    ks.retain(|&k| (window.0..=window.1).contains(&times[k]));
     let rows = ks
         .iter()
         .map(|&k| {
@@ -631,7 +608,7 @@ fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], m
         let jp = escape(joint);
         let current = run.motors.iter().map(|(_, m)| m.current[j]).collect();
         out.extend(series(format!("{}/{jp}", paths.signal(CURRENT)), &motor_t, current, &format!("{joint} [A]"), color, width));
-        if run.motors.iter().all(|(_, m)| m.voltage.len() == run.joints.len()) && !run.motors.is_empty() {
+        if run.whole.voltage_every_joint {
             let v = run.motors.iter().map(|(_, m)| m.voltage[j]).collect();
             out.extend(series(format!("{}/{jp}", paths.signal(VOLTAGE)), &motor_t, v, &format!("{joint} [V]"), color, width));
         }
@@ -771,7 +748,7 @@ mod tests {
     fn every_nonzero_force_is_drawn_outside_its_marker_in_the_paper_two_elbow_run() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../recordings/paper-archive-two-elbow.mcap");
         let input = super::super::read_input(&path).unwrap();
-        let run = &input.run;
+        let run = &super::super::window::whole_run(&path, &input.run).unwrap();
         assert!(run.scene.scale_recorded, "the archive records its force scale on /scene");
         let scale = run.scene.force_scale;
         assert_eq!(scale.m_per_n, 0.01);
@@ -853,7 +830,7 @@ mod tests {
         for n in [1usize, 2, 399, 400, 401, 1000, 100_001] {
             let times: Vec<i64> = (0..n as i64).collect();
             let pts: Vec<[f64; 3]> = (0..n).map(|k| [k as f64, 0.0, 0.0]).collect();
-            let (t, rows) = trail_updates(&times, &pts);
+            let (t, rows) = trail_updates(&times, &pts, (i64::MIN, i64::MAX));
             assert!(t.len() <= TRAIL_UPDATES + 1 && t.len() == rows.len(), "{n}");
             assert_eq!(*t.last().unwrap(), n as i64 - 1);
             for (tr, row) in t.iter().zip(&rows) {

@@ -18,7 +18,7 @@
 
 use super::blueprint::{ContainerKind, Corner, Eye, Node, View, ViewClass};
 use super::entities::{signal, Bounds, Paths};
-use super::run::{escape, Run};
+use super::run::{escape, Envelope, Run};
 
 fn center(min: [f64; 3], max: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|i| 0.5 * (min[i] + max[i]))
@@ -67,58 +67,39 @@ fn plot(name: &str, origin: String) -> Node {
     Node::View(View::new(ViewClass::TimeSeries, name, origin))
 }
 
-/// A y range that leaves out a start-up transient: the range of the samples after the first
-/// 5 % of the run, padded by 10 %, when the whole range is more than 3 times wider (else
-/// `None`: the viewer fits every sample).
-pub fn range_after_transient(samples: &[(f64, Vec<f64>)]) -> Option<[f64; 2]> {
-    let t_end = samples.last()?.0;
-    let t0 = samples.first()?.0;
-    let skip = t0 + 0.05 * (t_end - t0);
-    let span = |it: &mut dyn Iterator<Item = f64>| it.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], x| [a.min(x), b.max(x)]);
-    let [lo_all, hi_all] = span(&mut samples.iter().flat_map(|(_, v)| v.iter().copied()));
-    let [lo, hi] = span(&mut samples.iter().filter(|(t, _)| *t >= skip).flat_map(|(_, v)| v.iter().copied()));
-    if !(lo.is_finite() && hi.is_finite()) || hi_all - lo_all <= 3.0 * (hi - lo) {
-        return None;
-    }
-    let pad = 0.1 * (hi - lo).max(1e-9);
-    Some([lo - pad, hi + pad])
-}
+pub use super::run::range_after_transient;
 
 /// The corner of a plot whose legend covers the fewest samples: each corner's box (a third of
-/// the time axis, the top or bottom third of the y range shown) is counted over every series;
-/// the first of left top, right top, left bottom, right bottom with the fewest wins.
-pub fn legend_corner(samples: &[(f64, Vec<f64>)], y_range: Option<[f64; 2]>) -> Corner {
-    let (Some(first), Some(last)) = (samples.first(), samples.last()) else { return Corner::LeftTop };
-    let (t0, t1) = (first.0, last.0);
-    let [lo, hi] = y_range.unwrap_or_else(|| {
-        samples.iter().flat_map(|(_, v)| v.iter().copied()).filter(|x| x.is_finite()).fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], x| [a.min(x), b.max(x)])
-    });
-    if !(hi > lo) || !(t1 > t0) {
+/// the time axis, the top or bottom third of the y range shown, `y_range` or the envelope's)
+/// counts the columns of the [`Envelope`] with a sample in it; the first of left top, right
+/// top, left bottom, right bottom with the fewest wins.
+pub fn legend_corner(envelope: &Envelope, y_range: Option<[f64; 2]>) -> Corner {
+    let Some([lo, hi]) = y_range.or_else(|| envelope.range()) else { return Corner::LeftTop };
+    if !(hi > lo) {
         return Corner::LeftTop;
     }
+    let n = envelope.columns.len() as f64;
     let mut counts = [0usize; 4];
-    for (t, v) in samples {
-        let x = (t - t0) / (t1 - t0);
-        for y in v.iter().map(|y| (y - lo) / (hi - lo)) {
-            let left = x <= 1.0 / 3.0;
-            let right = x >= 2.0 / 3.0;
-            let top = y >= 2.0 / 3.0;
-            let bottom = y <= 1.0 / 3.0;
-            for (k, hit) in [left && top, right && top, left && bottom, right && bottom].into_iter().enumerate() {
-                counts[k] += usize::from(hit);
-            }
+    for (k, [c_lo, c_hi]) in envelope.columns.iter().enumerate().filter(|(_, c)| c[0] <= c[1]) {
+        let x = (k as f64 + 0.5) / n;
+        let (left, right) = (x <= 1.0 / 3.0, x >= 2.0 / 3.0);
+        // a sample in the top (bottom) third: the column's highest (lowest) one is
+        let top = (c_hi - lo) / (hi - lo) >= 2.0 / 3.0;
+        let bottom = (c_lo - lo) / (hi - lo) <= 1.0 / 3.0;
+        for (i, hit) in [left && top, right && top, left && bottom, right && bottom].into_iter().enumerate() {
+            counts[i] += usize::from(hit);
         }
     }
     let best = (0..4).min_by_key(|&k| counts[k]).unwrap_or(0);
     [Corner::LeftTop, Corner::RightTop, Corner::LeftBottom, Corner::RightBottom][best]
 }
 
-/// The y range of the balance residual: symmetric about 0, 1.2 times its largest magnitude
-/// (so the line is drawn across the plot even when it is 1e-12 J), `[-1, 1]` J when it is 0.
-pub fn residual_range(residual: &[f64]) -> [f64; 2] {
-    let m = residual.iter().filter(|x| x.is_finite()).fold(0.0f64, |a, x| a.max(x.abs()));
-    if m > 0.0 {
-        [-1.2 * m, 1.2 * m]
+/// The y range of the balance residual whose largest magnitude is `max_abs`, J: symmetric
+/// about 0, 1.2 times it (so the line is drawn across the plot even when it is 1e-12 J),
+/// `[-1, 1]` J when it is 0.
+pub fn residual_range(max_abs: f64) -> [f64; 2] {
+    if max_abs > 0.0 && max_abs.is_finite() {
+        [-1.2 * max_abs, 1.2 * max_abs]
     } else {
         [-1.0, 1.0]
     }
@@ -140,49 +121,54 @@ impl Plot {
     }
 }
 
-/// The plots one run has.
+/// The plots one run has: only those with data in the recording (a plot whose [`Envelope`]
+/// stayed empty is left out: no voltages when none are recorded, no `|f_t|/(μ f_n)` when no
+/// contact has friction or none pushes, no slip plot without `/contacts`).
 fn plots(run: &Run, paths: &Paths) -> Vec<Plot> {
-    let p = |key: &'static str, title: &str, y_range, samples: &[(f64, Vec<f64>)]| Plot {
+    let p = |key: &'static str, title: &str, y_range, env: &Envelope| Plot {
         key,
         title: title.to_string(),
         origin: paths.signal(key),
         y_range,
-        legend: legend_corner(samples, y_range),
+        legend: legend_corner(env, y_range),
     };
-    let currents: Vec<(f64, Vec<f64>)> = run.motors.iter().map(|(t, m)| (*t, m.current.clone())).collect();
-    let r = range_after_transient(&currents);
-    let title = if r.is_some() { "currents [A] (start-up off scale)" } else { "currents [A]" };
-    let mut v = vec![p(signal::CURRENT, title, r, &currents)];
-    if run.motors.first().is_some_and(|(_, m)| !m.voltage.is_empty()) {
-        let volts: Vec<(f64, Vec<f64>)> = run.motors.iter().map(|(t, m)| (*t, m.voltage.clone())).collect();
-        let r = range_after_transient(&volts);
+    // the y ranges and the legends' corners are the whole run's (`Run::survey`)
+    let w = &run.whole;
+    let e = &w.envelopes;
+    let mut v = Vec::new();
+    if !e.current.is_empty() {
+        let r = w.current_range;
+        let title = if r.is_some() { "currents [A] (start-up off scale)" } else { "currents [A]" };
+        v.push(p(signal::CURRENT, title, r, &e.current));
+    }
+    if w.voltage_every_joint && !e.voltage.is_empty() {
+        let r = w.voltage_range;
         let title = if r.is_some() { "voltages [V] (start-up off scale)" } else { "voltages [V]" };
-        v.push(p(signal::VOLTAGE, title, r, &volts));
+        v.push(p(signal::VOLTAGE, title, r, &e.voltage));
     }
-    if !run.contacts.is_empty() {
-        let f: Vec<(f64, Vec<f64>)> = match &run.contact_states {
-            Some(s) => s.iter().map(|(t, c)| (*t, c.normal_force.clone())).collect(),
-            None => run.constraints.iter().map(|(t, c)| (*t, c.normal_force.clone())).collect(),
-        };
-        v.push(p(signal::NORMAL_FORCE, "normal force f_n [N] (< 0: pull)", None, &f));
+    if !run.contacts.is_empty() && !e.normal_force.is_empty() {
+        v.push(p(signal::NORMAL_FORCE, "normal force f_n [N] (< 0: pull)", None, &e.normal_force));
     }
-    if let Some(states) = run.contact_states.as_ref().filter(|_| !run.contacts.is_empty()) {
-        let none: &[(f64, Vec<f64>)] = &[];
-        let slip: Vec<(f64, Vec<f64>)> = states
-            .iter()
-            .map(|(t, s)| (*t, s.slip_velocity_t1.iter().zip(&s.slip_velocity_t2).map(|(a, b)| (a * a + b * b).sqrt()).collect()))
-            .collect();
-        v.push(p(signal::SLIP_SPEED, "slip speed |v_t| [m/s]", None, &slip));
-        if run.contacts.iter().any(|c| c.friction.is_some_and(|m| m > 0.0)) {
-            v.push(p(signal::FRICTION_RATIO, "|f_t| / (μ f_n) (1: sliding)", Some([0.0, 1.2]), none));
+    if w.has_contact_states && !run.contacts.is_empty() {
+        if !e.slip_speed.is_empty() {
+            v.push(p(signal::SLIP_SPEED, "slip speed |v_t| [m/s]", None, &e.slip_speed));
         }
-        v.push(p(signal::FRICTION_FORCE, "friction |f_t| [N]", None, none));
-        v.push(p(signal::CONTACT_MODE, "mode (0 sep., 1 stick, 2 slide)", Some([-0.2, 3.2]), none));
+        if !e.friction_ratio.is_empty() {
+            v.push(p(signal::FRICTION_RATIO, "|f_t| / (μ f_n) (1: sliding)", Some([0.0, 1.2]), &e.friction_ratio));
+        }
+        if !e.friction_force.is_empty() {
+            v.push(p(signal::FRICTION_FORCE, "friction |f_t| [N]", None, &e.friction_force));
+        }
+        if !e.contact_mode.is_empty() {
+            v.push(p(signal::CONTACT_MODE, "mode (0 sep., 1 stick, 2 slide)", Some([-0.2, 3.2]), &e.contact_mode));
+        }
     }
-    let e: Vec<(f64, Vec<f64>)> = run.energy.iter().map(|(t, e)| (*t, e.electric_energy.clone())).collect();
-    v.push(p(signal::ELECTRIC_ENERGY, "E_j electric [J]", None, &e));
-    let w: Vec<(f64, Vec<f64>)> = run.energy.iter().map(|(t, e)| (*t, e.link_work.clone())).collect();
-    v.push(p(signal::LINK_WORK, "W_j link work [J]", None, &w));
+    if !e.electric_energy.is_empty() {
+        v.push(p(signal::ELECTRIC_ENERGY, "E_j electric [J]", None, &e.electric_energy));
+    }
+    if !e.link_work.is_empty() {
+        v.push(p(signal::LINK_WORK, "W_j link work [J]", None, &e.link_work));
+    }
     v
 }
 
@@ -213,7 +199,7 @@ pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     }
     // friction forces above the events table (full width, so its times are not cut)
     let mut contacts: Vec<Node> = take(signal::FRICTION_FORCE).into_iter().collect();
-    if !run.events.is_empty() {
+    if run.whole.has_events {
         contacts.push(Node::View(View::new(ViewClass::TextLog, "contact events", format!("{}/events", paths.prefix))));
     }
     if !contacts.is_empty() {
@@ -223,8 +209,9 @@ pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     let totals = View::new(ViewClass::TimeSeries, "energy totals [J]", format!("/{}", signal::ENERGY)).legend(Corner::LeftTop);
     let per_joint: Vec<Node> = [signal::ELECTRIC_ENERGY, signal::LINK_WORK].iter().filter_map(|k| take(k)).collect();
     tabs.push(column(vec![Node::View(totals), row(per_joint)]).named("energy"));
-    let residual: Vec<f64> = run.energy.iter().map(|(_, e)| e.balance_residual).collect();
-    let balance = View::new(ViewClass::TimeSeries, "balance residual [J]", paths.signal(signal::RESIDUAL)).y_range(Some(residual_range(&residual))).legend(Corner::RightBottom);
+    let balance = View::new(ViewClass::TimeSeries, "balance residual [J]", paths.signal(signal::RESIDUAL))
+        .y_range(Some(residual_range(run.whole.residual_max_abs)))
+        .legend(Corner::RightBottom);
     tabs.push(column(vec![Node::View(balance)]).named("balance"));
     Node::container(ContainerKind::Tabs, tabs)
 }
@@ -277,32 +264,54 @@ pub fn prefix(label: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::view::chunk::Chunk;
+    use crate::view::run::Envelope;
+
+    /// The envelope of `samples` over their time span.
+    fn envelope(samples: &[(f64, Vec<f64>)]) -> Envelope {
+        let mut e = Envelope::new(samples[0].0, samples[samples.len() - 1].0);
+        for (t, v) in samples {
+            e.push(*t, v.iter().copied());
+        }
+        e
+    }
 
     /// A growing series leaves the left-top corner empty; a falling one the right-top... and
     /// the residual range is symmetric, 1.2 times the largest magnitude.
     #[test]
     fn legends_go_where_the_data_is_not() {
         let rising: Vec<(f64, Vec<f64>)> = (0..100).map(|k| (k as f64, vec![k as f64])).collect();
-        assert_eq!(legend_corner(&rising, None), Corner::LeftTop);
+        assert_eq!(legend_corner(&envelope(&rising), None), Corner::LeftTop);
         let falling: Vec<(f64, Vec<f64>)> = (0..100).map(|k| (k as f64, vec![-(k as f64)])).collect();
-        assert_eq!(legend_corner(&falling, None), Corner::RightTop);
+        assert_eq!(legend_corner(&envelope(&falling), None), Corner::RightTop);
         // one series high everywhere, one low until 60 % of the run: the bottom right is empty
         let high: Vec<(f64, Vec<f64>)> = (0..100).map(|k| (k as f64, vec![if k < 70 { 1.0 } else { 0.9 }, 0.5 * f64::from(u8::from(k >= 60))])).collect();
-        assert_eq!(legend_corner(&high, None), Corner::RightBottom);
-        assert_eq!(residual_range(&[1e-12, -3e-12, 2e-12]), [-1.2 * 3e-12, 1.2 * 3e-12]);
-        assert_eq!(residual_range(&[0.0, 0.0]), [-1.0, 1.0]);
+        assert_eq!(legend_corner(&envelope(&high), None), Corner::RightBottom);
+        // on a y range that puts the rising line in the top third from the start: the bottom
+        // corners are empty, left bottom first
+        assert_eq!(legend_corner(&envelope(&rising), Some([-200.0, 10.0])), Corner::LeftBottom);
+        assert_eq!(legend_corner(&Envelope::new(0.0, 1.0), None), Corner::LeftTop);
+        assert_eq!(residual_range(3e-12), [-1.2 * 3e-12, 1.2 * 3e-12]);
+        assert_eq!(residual_range(0.0), [-1.0, 1.0]);
+    }
+
+    /// The run of the synthetic recording `s` with every sample, its chunks and its blueprint.
+    fn laid_out(s: &schemas::synth::Synth) -> (Run, Vec<Chunk>, Node) {
+        let dir = tempfile::tempdir().unwrap();
+        let input = super::super::read_input(&s.write_in(dir.path())).unwrap();
+        let run = super::super::window::whole_run(&input.path, &input.run).unwrap();
+        let paths = Paths { prefix: String::new(), run: None, index: 0 };
+        let (chunks, bounds) = super::super::entities::run_chunks(&run, &paths);
+        let root = single(&run, &paths, &bounds);
+        (run, chunks, root)
     }
 
     /// One run: tabs, at most three views to a tab, the slip / stick tab for a unilateral run
     /// with |f_t|/(mu f_n) on [0, 1.2], the residual on its fitted range.
     #[test]
     fn one_run_is_laid_out_in_readable_tabs() {
-        let dir = tempfile::tempdir().unwrap();
         let (s, _) = schemas::synth::unilateral();
-        let input = super::super::read_input(&s.write_in(dir.path())).unwrap();
-        let paths = Paths { prefix: String::new(), run: None, index: 0 };
-        let (_, bounds) = super::super::entities::run_chunks(&input.run, &paths);
-        let root = single(&input.run, &paths, &bounds);
+        let (run, _, root) = laid_out(&s);
         let Node::Container { kind: ContainerKind::Tabs, children, .. } = &root else { panic!("not tabs: {root:?}") };
         let names: Vec<String> = children
             .iter()
@@ -320,8 +329,64 @@ mod tests {
         let ratio = views.iter().find(|v| v.origin == format!("/{}", signal::FRICTION_RATIO)).expect("the friction ratio plot");
         assert_eq!(ratio.y_range, Some([0.0, 1.2]));
         let res = views.iter().find(|v| v.origin == format!("/{}", signal::RESIDUAL)).unwrap();
-        let r: Vec<f64> = input.run.energy.iter().map(|(_, e)| e.balance_residual).collect();
-        assert_eq!(res.y_range, Some(residual_range(&r)));
+        let r = run.energy.iter().map(|(_, e)| e.balance_residual.abs()).fold(0.0, f64::max);
+        assert_eq!(res.y_range, Some(residual_range(r)));
         assert!(views.iter().all(|v| v.name.chars().count() <= 36), "{:?}", views.iter().map(|v| &v.name).collect::<Vec<_>>());
+    }
+
+    /// The time series views of `root` whose origin has no sample in `chunks` (no temporal
+    /// chunk with rows at the origin or below it).
+    fn empty_plots(root: &Node, chunks: &[Chunk]) -> Vec<String> {
+        root.views()
+            .iter()
+            .filter(|v| v.class == ViewClass::TimeSeries)
+            .filter(|v| !chunks.iter().any(|c| !c.is_static() && c.rows > 0 && (c.entity_path == v.origin || c.entity_path.starts_with(&format!("{}/", v.origin)))))
+            .map(|v| format!("{} ({})", v.name, v.origin))
+            .collect()
+    }
+
+    /// Layouts with only the series the recording has (issue 27 item 4): every plot of the
+    /// blueprint has samples in the run's entities, for a unilateral run, the same without a
+    /// friction coefficient or without a contact that pushes (no |f_t|/(μ f_n) plot: the
+    /// layout of before had one, empty), and a bilateral run without `/contacts`
+    /// or voltages (no slip / stick tab, no friction, no voltages); a plot for each signal the
+    /// run records.
+    #[test]
+    fn every_plot_has_data_and_only_what_is_recorded_is_plotted() {
+        let has = |root: &Node, key: &str| root.views().iter().any(|v| v.origin == format!("/{key}"));
+        let (s, _) = schemas::synth::unilateral();
+        let (_, chunks, root) = laid_out(&s);
+        assert_eq!(empty_plots(&root, &chunks), Vec::<String>::new());
+        for key in [signal::CURRENT, signal::VOLTAGE, signal::NORMAL_FORCE, signal::SLIP_SPEED, signal::FRICTION_RATIO, signal::FRICTION_FORCE, signal::CONTACT_MODE, signal::RESIDUAL] {
+            assert!(has(&root, key), "{key}");
+        }
+
+        let (mut s, _) = schemas::synth::unilateral();
+        for c in &mut s.contacts_record.as_mut().unwrap().contacts {
+            c.friction = None;
+        }
+        let (_, chunks, root) = laid_out(&s);
+        assert_eq!(empty_plots(&root, &chunks), Vec::<String>::new());
+        assert!(!has(&root, signal::FRICTION_RATIO) && has(&root, signal::SLIP_SPEED));
+
+        // friction, but no contact ever pushes (f_n = 0 throughout): |f_t|/(μ f_n) has no sample
+        let (mut s, _) = schemas::synth::unilateral();
+        let f = s.contacts.take().unwrap();
+        s.contacts = Some(Box::new(move |t| schemas::ContactState { normal_force: vec![0.0; 2], mode: vec![0; 2], ..f(t) }));
+        let (_, chunks, root) = laid_out(&s);
+        assert_eq!(empty_plots(&root, &chunks), Vec::<String>::new());
+        assert!(!has(&root, signal::FRICTION_RATIO) && has(&root, signal::FRICTION_FORCE));
+
+        // a bilateral run whose `/motors` records no voltages
+        let mut s = schemas::synth::Synth::new("bilateral", &["elbow4"], 3);
+        s.motors = Some(Box::new(|t| schemas::MotorState { current: vec![t, -t, 2.0 * t], ..Default::default() }));
+        let (_, chunks, root) = laid_out(&s);
+        assert_eq!(empty_plots(&root, &chunks), Vec::<String>::new());
+        for key in [signal::SLIP_SPEED, signal::FRICTION_RATIO, signal::FRICTION_FORCE, signal::CONTACT_MODE, signal::VOLTAGE] {
+            assert!(!has(&root, key), "{key}");
+        }
+        assert!(has(&root, signal::NORMAL_FORCE));
+        let Node::Container { children, .. } = &root else { panic!() };
+        assert!(children.iter().all(|c| !matches!(c, Node::Container { name: Some(n), .. } if n == "slip / stick")));
     }
 }

@@ -15,6 +15,7 @@ pub mod rnea;
 pub mod samples;
 pub mod spatial;
 pub mod spd;
+pub mod thermal;
 pub mod urdf;
 pub mod walker_orin;
 

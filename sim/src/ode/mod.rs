@@ -15,7 +15,10 @@
 //! scenes that have them (so the paper's layout is unchanged): `E_conv = ∫ Σ (K_e − K_t) k i q̇
 //! dt` when some back-EMF constant differs from the torque constant (`dynamics/motor.rs`), and
 //! `E_s = ∫ Σ c q̇² [beyond a limit] dt` when soft joint stops are configured
-//! (`joint_limits.rs`).
+//! (`joint_limits.rs`). With the motors' thermal model on (`dynamics/thermal.rs`, scene
+//! `thermal`), the winding and housing temperatures `T_w (n) | T_h (n)` follow the currents
+//! (R(T_w) feeds back into eq 11, so they are coupled states, before the quadratures) and the
+//! heat given to the ambient `Q_a` comes last; the copper loss `E_R` is then `∫ Σ R(T_w) i² dt`.
 //!
 //! Energy balance (SCENE.md; ideal constraints do no work):
 //! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm [+ E_conv] [+ ΔV_s + E_s]`, T including
