@@ -386,9 +386,10 @@ impl LayoutInput {
     }
 }
 
-/// The layout's file name for scene `scene` (beside its recordings).
-pub fn file_name(scene: &str) -> String {
-    format!("{scene}.foxglove-layout.json")
+/// The layout's file name for `name`: a recording's file stem (`sim` writes one beside each
+/// recording, `<scene>-<run>.foxglove-layout.json`) or a scene's name (`analyze layout -o`).
+pub fn file_name(name: &str) -> String {
+    format!("{name}.foxglove-layout.json")
 }
 
 /// Every topic a layout names (its 3D panel's topics and its plots' paths' topics), sorted,
