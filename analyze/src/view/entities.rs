@@ -466,12 +466,15 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
 pub const TRAIL_UPDATES: usize = 400;
 pub const TRAIL_POINTS: usize = 400;
 
+/// The line strips of one row of a `LineStrips3D` entity, points in the world frame (f32).
+pub type Strips = Vec<Vec<[f32; 3]>>;
+
 /// The hand trail up to the current time: `(times, rows)`, one row per update (a strip of the
 /// actual positions from the first sample to that update's, thinned to at most
 /// [`TRAIL_POINTS`], its own sample last), at most [`TRAIL_UPDATES`] updates, the last at the
 /// last sample; of those, the updates at times within `window` (ns, both ends included: the
 /// time window being drawn). No row holds a position after its time.
-pub fn trail_updates(times: &[i64], actual: &[[f64; 3]], window: (i64, i64)) -> (Vec<i64>, Vec<Vec<Vec<[f32; 3]>>>) {
+pub fn trail_updates(times: &[i64], actual: &[[f64; 3]], window: (i64, i64)) -> (Vec<i64>, Vec<Strips>) {
     let n = times.len().min(actual.len());
     if n == 0 {
         return (Vec::new(), Vec::new());

@@ -75,7 +75,7 @@ pub use super::run::range_after_transient;
 /// top, left bottom, right bottom with the fewest wins.
 pub fn legend_corner(envelope: &Envelope, y_range: Option<[f64; 2]>) -> Corner {
     let Some([lo, hi]) = y_range.or_else(|| envelope.range()) else { return Corner::LeftTop };
-    if !(hi > lo) {
+    if hi.is_nan() || lo.is_nan() || hi <= lo {
         return Corner::LeftTop;
     }
     let n = envelope.columns.len() as f64;
