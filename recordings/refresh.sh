@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Re-make the archived paper runs, their energy table, their Foxglove layout and the manifest.
+# Re-make the archived paper runs, their energy table, their Foxglove layouts and the manifest.
 #   recordings/refresh.sh           refresh the archive in place (then review and commit the diff)
 #   recordings/refresh.sh --check   re-make into a temporary directory and compare with the archive
 #                                   (byte for byte, and the energy table line by line); exit 1 if
@@ -28,7 +28,7 @@ make_archive() {  # $1 = output directory
     echo "  \"command\": \"sim run recordings/paper-archive.json -o recordings -j 1\","
     echo "  \"files\": ["
     local first=1
-    for f in "$dir"/paper-archive-*.mcap "$dir/paper-archive-energy.csv" "$dir/paper-archive.foxglove-layout.json"; do
+    for f in "$dir"/paper-archive-*.mcap "$dir/paper-archive-energy.csv" "$dir"/paper-archive-*.foxglove-layout.json; do
       [ $first = 1 ] || echo ","
       first=0
       printf '    {"name": "%s", "bytes": %s, "sha256": "%s"}' "$(basename "$f")" "$(stat -c %s "$f")" "$(sha256sum "$f" | cut -d' ' -f1)"
@@ -50,7 +50,7 @@ if [ "${1:-}" = "--check" ]; then
   # ... and the current code re-makes them from the scene
   make_archive "$tmp/new"
   status=0
-  for f in recordings/paper-archive-*.mcap recordings/paper-archive-energy.csv recordings/paper-archive.foxglove-layout.json recordings/MANIFEST.json; do
+  for f in recordings/paper-archive-*.mcap recordings/paper-archive-energy.csv recordings/paper-archive-*.foxglove-layout.json recordings/MANIFEST.json; do
     if ! cmp -s "$f" "$tmp/new/$(basename "$f")"; then
       echo "archive: $(basename "$f") differs from a fresh run" >&2
       status=1

@@ -72,17 +72,21 @@ fn unit(topic: &str, field: &str) -> &'static str {
     units::unit(topic, field).unwrap_or("1")
 }
 
+/// A plot panel; its legend above the plot (`legendDisplay: "top"`) for up to four series, in
+/// a sidebar on the left for more (never floating over the data).
 fn plot(title: &str, y_label: &str, paths: Vec<Value>) -> Value {
+    let series = paths.iter().filter(|p| p["value"].as_str().is_some_and(|v| v.starts_with('/'))).count();
+    let (legend, sidebar) = if series <= 4 { ("top", 240) } else { ("left", 170) };
     json!({
         "paths": paths,
         "showLegend": true,
-        "legendDisplay": "floating",
-        "showPlotValuesInLegend": true,
+        "legendDisplay": legend,
+        "showPlotValuesInLegend": false,
         "showXAxisLabels": true,
         "showYAxisLabels": true,
         "isSynced": true,
         "xAxisVal": "timestamp",
-        "sidebarDimension": 240,
+        "sidebarDimension": sidebar,
         "yAxisLabel": y_label,
         "foxglovePanelTitle": title,
         "lichtblickPanelTitle": title,
@@ -130,11 +134,24 @@ fn zero_line() -> Value {
     json!({"value": "0", "enabled": true, "timestampMethod": "receiveTime", "label": "0", "color": "#7f7f7f"})
 }
 
-/// The plot panels, `(id, config)`, in layout order.
-fn plots(input: &LayoutInput) -> Vec<(String, Value)> {
+/// A plot panel: its id, config and the tab it goes in.
+struct PlotPanel {
+    id: String,
+    tab: &'static str,
+    config: Value,
+}
+
+/// The tabs of the plots, in order (a tab without plots is left out); the unilateral and
+/// compliant contacts' forces get their own tab when bilateral ones share the layout.
+const TABS: [&str; 6] = ["motors", "contacts", "contacts (unilateral)", "slip / stick", "energy", "balance"];
+
+/// The plot panels, in layout order: only series the runs record (a contact index that no run
+/// has is not plotted; a scene's layout, [`foxglove`], is for runs with the same topics).
+fn plots(input: &LayoutInput) -> Vec<PlotPanel> {
     let mut out = Vec::new();
-    out.push(("Plot!currents".to_string(), plot("Motor currents", "current [A]", per_joint(input, topics::MOTORS, "current", "i"))));
-    out.push(("Plot!voltages".to_string(), plot("Motor voltages", "voltage [V]", per_joint(input, topics::MOTORS, "voltage", "v"))));
+    let mut add = |id: &str, tab: &'static str, config: Value| out.push(PlotPanel { id: id.to_string(), tab, config });
+    add("Plot!currents", "motors", plot("Currents", "current [A]", per_joint(input, topics::MOTORS, "current", "i")));
+    add("Plot!voltages", "motors", plot("Voltages", "voltage [V]", per_joint(input, topics::MOTORS, "voltage", "v")));
     // bilateral runs: /constraints; blue above 0 (the table pushes), below 0 it pulls
     let nb = contact_count(input, false);
     if nb > 0 {
@@ -149,32 +166,32 @@ fn plots(input: &LayoutInput) -> Vec<(String, Value)> {
             })
             .collect();
         paths.push(zero_line());
-        out.push(("Plot!constraint_forces".to_string(), plot("Contact normal forces (bilateral: below 0 the table pulls)", "force [N]", paths)));
+        add("Plot!constraint_forces", "contacts", plot("Normal forces (< 0: pull)", "force [N]", paths));
     }
     let nu = contact_count(input, true);
     if nu > 0 {
         let t = topics::CONTACTS;
-        let mut forces = Vec::new();
-        let mut modes = Vec::new();
+        let (mut normal, mut friction, mut slip, mut modes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for k in 0..nu {
             let name = contact_label(input, k, true);
             let c = PALETTE[k % PALETTE.len()];
-            forces.push(path(format!("{t}.normal_force[{k}]"), format!("{name} f_n [{}]", unit(t, "normal_force")), c));
-            forces.push(path(format!("{t}.friction_force_t1[{k}]"), format!("{name} f_t1 [{}]", unit(t, "friction_force_t1")), c));
-            forces.push(path(format!("{t}.friction_force_t2[{k}]"), format!("{name} f_t2 [{}]", unit(t, "friction_force_t2")), c));
+            normal.push(path(format!("{t}.normal_force[{k}]"), format!("{name} f_n [{}]", unit(t, "normal_force")), c));
+            for (field, what) in [("friction_force_t1", "f_t1"), ("friction_force_t2", "f_t2")] {
+                friction.push(path(format!("{t}.{field}[{k}]"), format!("{name} {what} [{}]", unit(t, field)), c));
+            }
+            for (field, what) in [("slip_velocity_t1", "v_t1"), ("slip_velocity_t2", "v_t2")] {
+                slip.push(path(format!("{t}.{field}[{k}]"), format!("{name} {what} [{}]", unit(t, field)), c));
+            }
             modes.push(path(format!("{t}.mode[{k}]"), format!("{name} mode"), c));
         }
-        forces.push(zero_line());
-        out.push(("Plot!contact_forces".to_string(), plot("Contact forces (normal, friction)", "force [N]", forces)));
-        out.push((
-            "Plot!contact_modes".to_string(),
-            plot("Contact modes (0 separated, 1 sticking, 2 sliding, 3 bilateral)", "mode code", modes),
-        ));
+        normal.push(zero_line());
+        let tab = if nb > 0 { "contacts (unilateral)" } else { "contacts" };
+        add("Plot!contact_forces", tab, plot("Normal forces", "force [N]", normal));
+        add("Plot!friction_forces", tab, plot("Friction forces", "force [N]", friction));
+        add("Plot!slip", "slip / stick", plot("Slip velocity", "velocity [m/s]", slip));
+        add("Plot!contact_modes", "slip / stick", plot("Mode (0 sep., 1 stick, 2 slide)", "mode code", modes));
     }
-    out.push((
-        "Plot!energy_per_joint".to_string(),
-        plot("Electric energy per joint", "energy [J]", per_joint(input, topics::ENERGY, "electric_energy", "E")),
-    ));
+    add("Plot!energy_per_joint", "energy", plot("Electric energy per joint", "energy [J]", per_joint(input, topics::ENERGY, "electric_energy", "E")));
     let e = topics::ENERGY;
     let totals = [
         ("electric_energy_total", "E total (electric in)"),
@@ -186,22 +203,19 @@ fn plots(input: &LayoutInput) -> Vec<(String, Value)> {
         ("friction_loss", "friction loss (D + D_m)"),
     ];
     let paths = totals.iter().enumerate().map(|(k, (f, l))| path(format!("{e}.{f}"), format!("{l} [{}]", unit(e, f)), PALETTE[k])).collect();
-    out.push(("Plot!energy_totals".to_string(), plot("Energies, totals", "energy [J]", paths)));
-    out.push((
-        "Plot!balance".to_string(),
-        plot(
-            "Energy balance residual",
-            "residual [J]",
-            vec![path(format!("{e}.balance_residual"), format!("residual [{}]", unit(e, "balance_residual")), PALETTE[3]), zero_line()],
-        ),
-    ));
+    add("Plot!energy_totals", "energy", plot("Energy totals", "energy [J]", paths));
+    add(
+        "Plot!balance",
+        "balance",
+        plot("Balance residual", "residual [J]", vec![path(format!("{e}.balance_residual"), format!("residual [{}]", unit(e, "balance_residual")), PALETTE[3]), zero_line()]),
+    );
     let h = topics::HAND;
     let paths = [("error_norm", "|r - r_d|"), ("error.x", "x error"), ("error.y", "y error"), ("error.z", "z error")]
         .iter()
         .enumerate()
         .map(|(k, (f, l))| path(format!("{h}.{f}"), format!("{l} [{}]", unit(h, f)), PALETTE[k]))
         .collect();
-    out.push(("Plot!hand_error".to_string(), plot("Hand error", "error [m]", paths)));
+    add("Plot!hand_error", "balance", plot("Hand error", "error [m]", paths));
     out
 }
 
@@ -277,30 +291,56 @@ fn even_split(ids: &[String], direction: &str) -> Value {
     }
 }
 
-/// The Foxglove layout (see the module docs): the 3D panel on the left (40 %), the plots in two
-/// columns on the right.
+/// The Foxglove layout (see the module docs): the 3D panel on the left (45 %), on the right a
+/// Tab panel (`Tab!plots`, Foxglove's `TabPanelConfig`: `{activeTabIdx, tabs: [{title,
+/// layout}]}`) with at most two plots per tab, one above the other (readable at 1440×900).
 pub fn foxglove(input: &LayoutInput) -> Value {
     let plots = plots(input);
     let mut config = serde_json::Map::new();
     config.insert("3D!arm".into(), three_d(input));
-    for (id, c) in &plots {
-        config.insert(id.clone(), c.clone());
+    let mut tabs = Vec::new();
+    for tab in TABS {
+        let ids: Vec<String> = plots.iter().filter(|p| p.tab == tab).map(|p| p.id.clone()).collect();
+        if !ids.is_empty() {
+            tabs.push(json!({"title": tab, "layout": even_split(&ids, "column")}));
+        }
     }
-    let ids: Vec<String> = plots.iter().map(|(id, _)| id.clone()).collect();
-    let half = ids.len().div_ceil(2);
-    let right = json!({
-        "direction": "row",
-        "first": even_split(&ids[..half], "column"),
-        "second": even_split(&ids[half..], "column"),
-        "splitPercentage": 50.0,
-    });
+    for p in plots {
+        config.insert(p.id, p.config);
+    }
+    config.insert("Tab!plots".into(), json!({"activeTabIdx": 0, "tabs": tabs}));
     json!({
         "configById": config,
         "globalVariables": {},
         "userNodes": {},
         "playbackConfig": {"speed": 1.0},
-        "layout": {"direction": "row", "first": "3D!arm", "second": right, "splitPercentage": 40.0},
+        "layout": {"direction": "row", "first": "3D!arm", "second": "Tab!plots", "splitPercentage": 45.0},
     })
+}
+
+/// Every panel id of `layout`: the leaves of its mosaic tree and of its Tab panels' trees.
+pub fn panel_ids(layout: &Value) -> Vec<String> {
+    fn leaves(v: &Value, configs: &Value, out: &mut Vec<String>) {
+        match v {
+            Value::String(s) => {
+                out.push(s.clone());
+                for t in configs[s.as_str()]["tabs"].as_array().into_iter().flatten() {
+                    leaves(&t["layout"], configs, out);
+                }
+            }
+            Value::Object(o) => {
+                for k in ["first", "second"] {
+                    if let Some(c) = o.get(k) {
+                        leaves(c, configs, out);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    leaves(&layout["layout"], &layout["configById"], &mut out);
+    out
 }
 
 /// Where the camera looks and from how far, for a hand that moves through `points` (world
@@ -346,9 +386,10 @@ impl LayoutInput {
     }
 }
 
-/// The layout's file name for scene `scene` (beside its recordings).
-pub fn file_name(scene: &str) -> String {
-    format!("{scene}.foxglove-layout.json")
+/// The layout's file name for `name`: a recording's file stem (`sim` writes one beside each
+/// recording, `<scene>-<run>.foxglove-layout.json`) or a scene's name (`analyze layout -o`).
+pub fn file_name(name: &str) -> String {
+    format!("{name}.foxglove-layout.json")
 }
 
 /// Every topic a layout names (its 3D panel's topics and its plots' paths' topics), sorted,
@@ -398,18 +439,7 @@ mod tests {
     fn the_layout_is_consistent_and_labelled() {
         let l = foxglove(&input());
         let configs = l["configById"].as_object().unwrap();
-        fn leaves(v: &Value, out: &mut Vec<String>) {
-            match v {
-                Value::String(s) => out.push(s.clone()),
-                Value::Object(o) => {
-                    leaves(&o["first"], out);
-                    leaves(&o["second"], out);
-                }
-                _ => panic!("bad node {v}"),
-            }
-        }
-        let mut ids = Vec::new();
-        leaves(&l["layout"], &mut ids);
+        let mut ids = panel_ids(&l);
         let mut keys: Vec<String> = configs.keys().cloned().collect();
         ids.sort();
         keys.sort();
@@ -427,6 +457,43 @@ mod tests {
         for t in ["/contacts", "/constraints", "/motors", "/energy", "/hand", "/scene", "/contact_markers", "/hand_points", "/robot_description"] {
             assert!(named.contains(&t.to_string()), "{t}: {named:?}");
         }
+    }
+
+    /// Readable (issue 27): a Tab panel, at most two plots per tab, every plot in a tab, no
+    /// legend over the data, short titles (at most 32 characters).
+    #[test]
+    fn the_layout_is_tabbed_and_readable() {
+        let l = foxglove(&input());
+        let configs = l["configById"].as_object().unwrap();
+        let tabs = configs["Tab!plots"]["tabs"].as_array().unwrap();
+        let titles: Vec<&str> = tabs.iter().map(|t| t["title"].as_str().unwrap()).collect();
+        assert_eq!(titles, ["motors", "contacts", "contacts (unilateral)", "slip / stick", "energy", "balance"]);
+        let mut in_tabs = 0;
+        for t in tabs {
+            let mut ids = Vec::new();
+            fn leaves(v: &Value, out: &mut Vec<String>) {
+                match v {
+                    Value::String(s) => out.push(s.clone()),
+                    Value::Object(o) => {
+                        leaves(&o["first"], out);
+                        leaves(&o["second"], out);
+                    }
+                    _ => panic!("bad node {v}"),
+                }
+            }
+            leaves(&t["layout"], &mut ids);
+            assert!((1..=2).contains(&ids.len()), "{}: {ids:?}", t["title"]);
+            in_tabs += ids.len();
+        }
+        let plots: Vec<(&String, &Value)> = configs.iter().filter(|(k, _)| k.starts_with("Plot!")).collect();
+        assert_eq!(in_tabs, plots.len());
+        for (id, c) in plots {
+            assert_ne!(c["legendDisplay"], "floating", "{id}");
+            let series = c["paths"].as_array().unwrap().iter().filter(|p| p["value"].as_str().unwrap().starts_with('/')).count();
+            assert_eq!(c["legendDisplay"], if series <= 4 { "top" } else { "left" }, "{id}");
+            assert!(c["foxglovePanelTitle"].as_str().unwrap().chars().count() <= 32, "{id}: {}", c["foxglovePanelTitle"]);
+        }
+        assert_eq!(l["layout"]["second"], "Tab!plots");
     }
 
     /// A scene without contacts has neither contact plot.

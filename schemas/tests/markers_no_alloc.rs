@@ -1,11 +1,12 @@
 //! `/contact_markers` costs no allocation per sample: after the first update, updating the
-//! message (every mode, forces of both signs, zero force, moving points and hands) allocates
+//! message (every mode, forces of both signs, zero force, huge forces whose labels are longest,
+//! moving points and hands, the labels rewritten) allocates
 //! nothing (a counting global allocator, per thread).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use schemas::markers::{ContactMarkers, ContactSample, MarkerMode};
+use schemas::markers::{ContactMarkers, ContactSample, ForceScale, MarkerContact, MarkerMode};
 
 struct Counting;
 
@@ -36,12 +37,13 @@ fn allocs() -> u64 {
 
 #[test]
 fn updating_the_contact_markers_does_not_allocate() {
-    let names: Vec<String> = ["elbow4", "elbow7", "hand"].iter().map(|s| s.to_string()).collect();
-    let mut m = ContactMarkers::new("world", &names);
+    let contacts: Vec<MarkerContact> =
+        ["elbow4", "elbow7", "hand"].iter().map(|s| MarkerContact { name: s.to_string(), normal: [0.0, 0.6, 0.8], offset: 0.05 }).collect();
+    let mut m = ContactMarkers::new("world", &contacts, ForceScale::for_arm(1.0, 3.0, 10));
     let modes = [MarkerMode::Separated, MarkerMode::Sticking, MarkerMode::Sliding, MarkerMode::Pushing, MarkerMode::Pulling];
     let sample = |k: usize, i: usize| ContactSample {
         point: [0.1 * k as f64, 0.01 * i as f64, 0.0],
-        force: if i % 7 == 0 { [0.0; 3] } else { [0.5 * i as f64, -1.0, 30.0 - i as f64] },
+        force: if i.is_multiple_of(7) { [0.0; 3] } else if i.is_multiple_of(11) { [1e300, 0.0, 0.0] } else { [0.5 * i as f64, -1.0, 30.0 - i as f64] },
         mode: modes[(i + k) % modes.len()],
     };
     m.update(0, (0..3).map(|k| sample(k, 0)), [0.0; 3], [0.0; 3]);

@@ -8,10 +8,11 @@
 //! Every recording also has the scene entities for Foxglove's 3D panel (format version 3,
 //! `schemas::markers`): `/scene` at t = 0 (the table: every distinct contact plane of the scene,
 //! drawn fainter when this run has no contact on it, so that the no-elbow arm's sinking below
-//! the table shows; the hand's target path, sampled on the output grid before the run) and
-//! `/contact_markers` every sample (the contact points coloured by mode, the contact force
-//! arrows, the actual and desired hand), from [`Outputs::contact_point`], `normal_force` and
-//! `contacts`.
+//! the table shows; the hand's target path, sampled on the output grid before the run; the
+//! force arrows' scale bar, [`force_scale`]: one scale per scene, from the arm) and
+//! `/contact_markers` every sample (the contact points coloured by mode, their rings on the
+//! table, the contact force arrows from the table's surface with their labels, the actual and
+//! desired hand), from [`Outputs::contact_point`], `normal_force` and `contacts`.
 //!
 //! Runs with a non-bilateral contact (issue 11: rigid unilateral contacts after Pfeiffer &
 //! Glocker, *Multibody Dynamics with Unilateral Contacts*, 1996; compliant ones) also get
@@ -29,7 +30,7 @@ use schemas::{
     JointState, Mirror, ModelInfo, MotorState, MotorThermalState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
-use schemas::markers::{self, ContactMarkers, ContactSample, MarkerMode, SceneDescription, TablePlane};
+use schemas::markers::{self, ContactMarkers, ContactSample, ForceScale, MarkerContact, MarkerMode, SceneDescription, TablePlane};
 use schemas::{Quaternion, Vector3, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA};
 
 use crate::dynamics::contact::{Contact, ContactEvent, ContactModel, ContactOutput, ContactSettings};
@@ -98,6 +99,15 @@ pub fn target_path(scene: &Scene) -> (Vec<[f64; 3]>, f64) {
 /// point's offset, summed (an upper bound).
 pub fn reach(scene: &Scene) -> f64 {
     scene.model.urdf_joints.iter().map(|j| j.origin.translation.vector.norm()).sum::<f64>() + scene.hand.p_body.norm()
+}
+
+/// The scale of the force arrows of every run of `scene` ([`ForceScale::for_arm`]): from the
+/// arm's mass (every body of the model), its [`reach`] and its number of links (URDF joints
+/// with a nonzero origin, the segments the reach sums), not from any run.
+pub fn force_scale(scene: &Scene) -> ForceScale {
+    let mass: f64 = scene.model.bodies.iter().map(|b| b.inertia.mass).sum();
+    let links = scene.model.urdf_joints.iter().filter(|j| j.origin.translation.vector.norm() > 0.0).count() + usize::from(scene.hand.p_body.norm() > 0.0);
+    ForceScale::for_arm(mass, reach(scene), links)
 }
 
 /// The distinct contact planes of `scene` (every run's), each with the contacts of `run` on it.
@@ -330,6 +340,7 @@ impl<'a> Recorder<'a> {
             half_size_m: reach(scene).max(0.25),
             target_path: &path_points,
             target_dt_s: path_dt,
+            force_scale: force_scale(scene),
         });
         writer.write(topics::SCENE, 0, &scene_msg).map_err(err)?;
         // world -> root (none when the URDF's root link is itself named `world`, as UR5's and
@@ -356,7 +367,17 @@ impl<'a> Recorder<'a> {
             monitor: LimitMonitor::for_scene(scene, 1.0 / scene.output_rate),
             terms: [0.0; 3],
             hybrid,
-            markers: ContactMarkers::new(WORLD_FRAME, &contact_names),
+            markers: ContactMarkers::new(
+                WORLD_FRAME,
+                &contacts
+                    .iter()
+                    .map(|c| {
+                        let n = c.plane.normal_world;
+                        MarkerContact { name: c.name().to_string(), normal: [n.x, n.y, n.z], offset: c.plane.offset }
+                    })
+                    .collect::<Vec<_>>(),
+                force_scale(scene),
+            ),
             contact_state: ContactState { name: contact_names, ..Default::default() },
             contact_event: ContactEventMsg::default(),
             contact_terms: [0.0; 3],

@@ -150,7 +150,7 @@ part_races() {
       esac
     done
     cmp -s "$ref" "$d/small-free.mcap" || fail "race $t: the final file differs from a lone run's"
-    local left; left="$(ls -A "$d" | grep -v -e '^small-free.mcap$' -e '^small.foxglove-layout.json$' || true)"
+    local left; left="$(ls -A "$d" | grep -v -e '^small-free.mcap$' -e '^small-free.foxglove-layout.json$' || true)"
     [ -z "$left" ] || fail "race $t: left behind: $left"
     rm -rf "$d" "$d".err*
   done

@@ -1,5 +1,5 @@
 //! The Foxglove view of the recordings, checked with Foxglove's own libraries (issue 13,
-//! acceptance): `sim` writes one layout per scene beside its recordings and `analyze layout`
+//! acceptance): `sim` writes one layout per recording beside it and `analyze layout`
 //! writes one for any recordings; `tests/foxglove/check.mjs` (node: ajv, @mcap/core, protobufjs,
 //! @foxglove/schemas, pinned in its package-lock.json) validates each layout against the schema
 //! derived from Foxglove's types, resolves every topic and plot path in the recordings, and
@@ -71,9 +71,10 @@ fn layouts_and_scene_entities_pass_foxglove_checks() {
     let paper = mcaps(out, "paper-").into_iter().filter(|p| !p.to_string_lossy().contains("unilateral")).collect::<Vec<_>>();
     let unilateral = mcaps(out, "paper-unilateral-");
     assert_eq!((paper.len(), unilateral.len()), (3, 3));
-    for (layout, recs) in [("paper.foxglove-layout.json", &paper), ("paper-unilateral.foxglove-layout.json", &unilateral)] {
-        let (code, stdout, stderr) = check(&node_dir, &out.join(layout), recs);
-        assert_eq!(code, 0, "{layout}: {stderr}\n{stdout}");
+    for rec in paper.iter().chain(&unilateral) {
+        let layout = rec.with_extension("foxglove-layout.json");
+        let (code, stdout, stderr) = check(&node_dir, &layout, std::slice::from_ref(rec));
+        assert_eq!(code, 0, "{}: {stderr}\n{stdout}", layout.display());
         let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
         assert_eq!(summary["failures"], 0);
         // every contact of every sample had its arrow checked
@@ -108,4 +109,69 @@ fn layouts_and_scene_entities_pass_foxglove_checks() {
 #[allow(non_snake_case)]
 fn OsStr(s: &str) -> std::ffi::OsString {
     s.into()
+}
+
+/// The value at message path `path` (`field`, `field.sub`, `field[k]`) of `msg`, if any.
+fn at<'a>(msg: &'a schemas::Value, path: &str) -> Option<&'a schemas::Value> {
+    let mut v = msg;
+    for part in path.split('.') {
+        let (name, index) = match part.split_once('[') {
+            Some((n, k)) => (n, Some(k.trim_end_matches(']').parse::<usize>().ok()?)),
+            None => (part, None),
+        };
+        v = v.get(name)?;
+        if let Some(k) = index {
+            v = v.as_list()?.get(k)?;
+        }
+    }
+    Some(v)
+}
+
+/// Layouts with only the series the recording has (issue 27 item 4): `sim` writes one layout
+/// per recording, and every plot path of each resolves to a value in every message of its
+/// topic in that recording (no series left empty), while every contact of the run has its
+/// normal force plotted. Measured here: the series per layout (the scene-wide layouts of
+/// before had 80 for the unilateral scene, 28 of them empty for the two-elbow run).
+#[test]
+fn each_recording_gets_a_layout_with_only_its_series() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path();
+    let o = run_sim(&["--duration", "0.05", "-q", "-f", "csv", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "sim: {}", String::from_utf8_lossy(&o.stderr));
+    let recs = mcaps(out, "paper-");
+    assert_eq!(recs.len(), 6);
+    let mut counts = Vec::new();
+    for rec in &recs {
+        let layout_path = rec.with_extension("foxglove-layout.json");
+        let layout: serde_json::Value = serde_json::from_slice(&std::fs::read(&layout_path).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", layout_path.display()));
+        let r = schemas::read_recording(rec).unwrap();
+        let contacts = r.run().unwrap().contacts.clone();
+        let mut series = 0;
+        let mut normal_forces = std::collections::BTreeSet::new();
+        for c in layout["configById"].as_object().unwrap().values() {
+            for p in c["paths"].as_array().into_iter().flatten() {
+                let value = p["value"].as_str().unwrap();
+                if !value.starts_with('/') {
+                    continue; // a reference line
+                }
+                series += 1;
+                let (topic, field) = value.split_once('.').unwrap();
+                let msgs = r.messages(topic).unwrap_or_else(|| panic!("{}: {value}: no topic {topic} in the recording", layout_path.display()));
+                assert!(!msgs.is_empty(), "{value}");
+                for (k, (_, m)) in msgs.iter().enumerate() {
+                    assert!(at(m, field).is_some(), "{}: {value} has no value in message #{k}", layout_path.display());
+                }
+                if field.starts_with("normal_force[") {
+                    normal_forces.insert(field.to_string());
+                }
+                if let Some(label) = p["label"].as_str().filter(|_| field.contains("force[") || field.contains("velocity_") || field.starts_with("mode[")) {
+                    assert!(contacts.iter().any(|c| label.starts_with(c.as_str())), "{value}: label {label:?} names no contact of {contacts:?}");
+                }
+            }
+        }
+        assert_eq!(normal_forces.len(), contacts.len(), "{}: {normal_forces:?} for {contacts:?}", layout_path.display());
+        counts.push((rec.file_name().unwrap().to_string_lossy().into_owned(), series));
+    }
+    eprintln!("series per layout: {counts:?}");
+    assert!(!out.join("paper.foxglove-layout.json").exists() && !out.join("paper-unilateral.foxglove-layout.json").exists());
 }

@@ -83,9 +83,9 @@ fn racing_writers_never_leave_a_corrupt_file() {
         let rec = schemas::read_recording(&final_path);
         assert!(rec.is_ok(), "trial {trial}: the final file does not read: {:?}", rec.err());
         assert!(std::fs::read(&final_path).unwrap() == reference, "trial {trial}: the final file differs from a lone run's");
-        // the recording and the scene's Foxglove layout (one racer wrote it, the others left it)
-        assert_eq!(listing(dir.path()), ["small-free.mcap", "small.foxglove-layout.json"], "trial {trial}: temporary or lock files left");
-        serde_json::from_slice::<serde_json::Value>(&std::fs::read(dir.path().join("small.foxglove-layout.json")).unwrap()).unwrap();
+        // the recording and its Foxglove layout (one racer wrote it, the others left it)
+        assert_eq!(listing(dir.path()), ["small-free.foxglove-layout.json", "small-free.mcap"], "trial {trial}: temporary or lock files left");
+        serde_json::from_slice::<serde_json::Value>(&std::fs::read(dir.path().join("small-free.foxglove-layout.json")).unwrap()).unwrap();
     }
     eprintln!(
         "{RACE_TRIALS} trials x {RACERS} processes: {wrote} wrote the file, {refused} refused, {:.1} s",
@@ -131,7 +131,7 @@ fn a_killed_writer_leaves_no_final_file_and_the_next_run_cleans_up() {
     let o = sim().arg("run").arg(&scene).args(["--duration", "0.02", "--quiet", "-o"]).arg(dir.path()).output().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     // the killed run wrote no layout (it is written after the runs); the next one did
-    assert_eq!(listing(dir.path()), ["long-60s-plain-two-elbow.mcap", "long-60s-plain.foxglove-layout.json"]);
+    assert_eq!(listing(dir.path()), ["long-60s-plain-two-elbow.foxglove-layout.json", "long-60s-plain-two-elbow.mcap"]);
     schemas::read_recording(&dir.path().join("long-60s-plain-two-elbow.mcap")).unwrap();
 }
 

@@ -12,9 +12,14 @@
 // (c) every /scene and /contact_markers message decodes (protobufjs on the embedded descriptor,
 //     whose foxglove.* message fields are compared with @foxglove/schemas' definitions by the
 //     .proto text @foxglove/schemas generates), with the entity counts, the mode colours, the
-//     arrow lengths |F| x scale (1e-9 m), the arrows' normal component f_n (1e-9 N), the contact
-//     spheres on their constraint value C or gap (1e-9 m), the hand spheres on /hand (exact),
-//     and /hand_points coloured purple (actual) and orange (desired).
+//     arrow lengths max(|F| x scale, shortest) (1e-9 m) at the one scale of /scene's scale bar
+//     (the same in every recording given), the arrows' normal component f_n (1e-9 N), each
+//     arrow starting on the plane at the contact point's projection, every nonzero force's
+//     arrow at least 20 mm outside its marker sphere (larger than the 20 mm elbow sphere), the
+//     rings on the table, the labels (name, |F| to 0.1 N, mode), the contact spheres on their
+//     constraint value C or gap (1e-9 m), the hand spheres on /hand (exact), and /hand_points
+//     coloured purple (actual) and orange (desired); the layout's legends never float over a
+//     plot and no tab holds more than two plots.
 //
 // Prints one JSON summary on stdout; exit 0 if every check passed, 1 if one failed (each
 // failure on stderr), 2 on bad input.
@@ -106,14 +111,34 @@ function checkLayout(layout) {
   if (!validate(layout)) {
     for (const e of validate.errors) fail(`layout: ${e.instancePath || "/"} ${e.message} ${JSON.stringify(e.params)}`);
   }
+  // the mosaic tree's leaves, and those of each Tab panel's tabs
   const leaves = [];
-  const walk = (n) => (typeof n === "string" ? leaves.push(n) : n && (walk(n.first), walk(n.second)));
+  const walk = (n) => {
+    if (typeof n === "string") {
+      leaves.push(n);
+      for (const t of layout.configById?.[n]?.tabs ?? []) walk(t.layout);
+    } else if (n) {
+      walk(n.first);
+      walk(n.second);
+    }
+  };
   walk(layout.layout);
   const ids = Object.keys(layout.configById ?? {});
   if (JSON.stringify([...leaves].sort()) !== JSON.stringify([...ids].sort())) {
     fail(`layout: the mosaic tree names ${JSON.stringify(leaves)} but configById has ${JSON.stringify(ids)}`);
   }
-  return { panels: ids.length };
+  // readable (issue 27): no legend floats over its plot; at most two plots in a tab
+  for (const [id, c] of Object.entries(layout.configById ?? {})) {
+    if (id.startsWith("Plot!") && c.legendDisplay === "floating") fail(`layout: ${id}: its legend floats over the data`);
+    for (const t of c.tabs ?? []) {
+      const inTab = [];
+      const w = (n) => (typeof n === "string" ? inTab.push(n) : n && (w(n.first), w(n.second)));
+      w(t.layout);
+      if (inTab.length > 2) fail(`layout: ${id}: tab ${t.title} has ${inTab.length} plots (at most 2)`);
+    }
+  }
+  const series = Object.values(layout.configById ?? {}).flatMap((c) => (c.paths ?? []).filter((p) => p.value.startsWith("/")));
+  return { panels: ids.length, tabs: Object.values(layout.configById ?? {}).reduce((n, c) => n + (c.tabs?.length ?? 0), 0), series: series.length };
 }
 
 // A plot path `/topic.a.b[k]` -> {topic, steps: [{field, index}]}; a number is a reference line.
@@ -284,7 +309,21 @@ function checkScene(rec) {
   if (markers.length !== hand.length) fail(`${rec.path}: ${markers.length} /contact_markers, ${hand.length} /hand`);
   const modesSeen = {};
   let arrows = 0;
+  let labels = 0;
+  let nonzero = 0;
+  let minOutside = Infinity;
   let maxArrowErr = 0;
+  // the one force scale of the scene, on /scene
+  const legend = ents.find((e) => e.id === "legend/force_scale");
+  const sceneScale = legend ? Number(legend.metadata.find((kv) => kv.key === "scale_m_per_n").value) : NaN;
+  if (contacts.length > 0 && !(sceneScale > 0)) fail(`${rec.path}: /scene has no legend/force_scale with a scale`);
+  if (legend) {
+    const a = legend.arrows[0];
+    const bar = Number(legend.metadata.find((kv) => kv.key === "bar_force_n").value);
+    if (!close(a.shaft_length + a.head_length, bar * sceneScale, TOL)) fail(`${rec.path}: the scale bar is ${a.shaft_length + a.head_length} m for ${bar} N at ${sceneScale} m/N`);
+    if (!legend.texts[0]?.text.startsWith(`${bar} N = `)) fail(`${rec.path}: the scale bar's text is ${JSON.stringify(legend.texts[0]?.text)}`);
+  }
+  out.force_scale_m_per_n = sceneScale;
   for (const [i, { logTime, msg }] of markers.entries()) {
     if (msg.entities.length !== 2 * contacts.length + 2) {
       fail(`${rec.path}: /contact_markers at ${logTime} has ${msg.entities.length} entities, want ${2 * contacts.length + 2}`);
@@ -309,23 +348,53 @@ function checkScene(rec) {
       const a = arrowEnt.arrows[0];
       if (!sameRgb(a.color, MODE_COLORS[mode])) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: arrow colour for mode ${mode}`);
       const scale = Number(arrowEnt.metadata.find((kv) => kv.key === "scale_m_per_n").value);
+      const minLen = Number(arrowEnt.metadata.find((kv) => kv.key === "min_length_m")?.value);
+      if (!(minLen > 0)) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: no min_length_m in its metadata`);
+      if (scale !== sceneScale) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: scale ${scale} m/N, /scene says ${sceneScale}`);
       const len = a.shaft_length + a.head_length;
       const norm = Math.hypot(fn, ft[0], ft[1]);
-      const err = Math.abs(len - norm * scale);
+      // |F| x scale, at least the shortest length for a nonzero force, none for no force
+      const want = norm > 0 ? Math.max(norm * scale, minLen) : 0;
+      const err = Math.abs(len - want);
       maxArrowErr = Math.max(maxArrowErr, err);
-      if (err > TOL) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: length ${len} m, |F| x scale = ${norm * scale} m`);
-      // the arrow's normal component is f_n; the sphere is at the contact point (C or gap)
+      if (err > TOL) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: length ${len} m, max(|F| x scale, ${minLen}) = ${want} m`);
+      // the arrow's normal component has f_n's sign and share of |F|; the sphere is at the
+      // contact point (C or gap); the arrow starts on the plane, below or above the sphere
       const plane = planeOf.get(name);
       const n = plane.normal;
+      const d = plane.offset ?? 0;
       const dir = rotateX(a.pose.orientation);
       if (norm > 0) {
-        const fnDrawn = (len / scale) * (dir[0] * n[0] + dir[1] * n[1] + dir[2] * n[2]);
+        const fnDrawn = norm * (dir[0] * n[0] + dir[1] * n[1] + dir[2] * n[2]);
         if (!close(fnDrawn, fn, TOL * Math.max(1, Math.abs(fn)))) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: normal component ${fnDrawn} N, f_n = ${fn} N`);
       }
       const p = marker.spheres[0].pose.position;
-      const cq = n[0] * p.x + n[1] * p.y + n[2] * p.z - (plane.offset ?? 0);
-      const want = hybrid ? f.gap[k] : c.position[k];
-      if (!close(cq, want, TOL)) fail(`${rec.path}: ${marker.id} at ${logTime}: sphere at C = ${cq} m, recorded ${want} m`);
+      const cq = n[0] * p.x + n[1] * p.y + n[2] * p.z - d;
+      const wantC = hybrid ? f.gap[k] : c.position[k];
+      if (!close(cq, wantC, TOL)) fail(`${rec.path}: ${marker.id} at ${logTime}: sphere at C = ${cq} m, recorded ${wantC} m`);
+      const tail = a.pose.position;
+      const tq = n[0] * tail.x + n[1] * tail.y + n[2] * tail.z - d;
+      const along = Math.hypot(tail.x - (p.x - cq * n[0]), tail.y - (p.y - cq * n[1]), tail.z - (p.z - cq * n[2]));
+      if (!close(tq, 0, TOL) || !close(along, 0, TOL)) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: the arrow starts ${tq} m off the plane, ${along} m from the point's projection`);
+      // visible: a nonzero force's arrow leaves the marker sphere by at least 20 mm
+      const r = marker.spheres[0].size.x / 2;
+      if (!(r > 0.02)) fail(`${rec.path}: ${marker.id}: sphere radius ${r} m, not larger than the 20 mm elbow sphere`);
+      if (norm > 0) {
+        const tip = [tail.x + len * dir[0], tail.y + len * dir[1], tail.z + len * dir[2]];
+        const outside = lengthOutsideBall([tail.x, tail.y, tail.z], tip, [p.x, p.y, p.z], r);
+        minOutside = Math.min(minOutside, outside);
+        if (!(outside >= 0.02)) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: |F| = ${norm} N drawn ${len} m, only ${outside} m outside its ${r} m marker`);
+        nonzero++;
+      }
+      // the ring on the table around the point's projection, in the mode's colour
+      const ring = marker.lines[0];
+      const rp = ring?.pose.position;
+      if (!ring || !close(n[0] * rp.x + n[1] * rp.y + n[2] * rp.z - d, 0, TOL) || !sameRgb(ring.color, MODE_COLORS[mode])) fail(`${rec.path}: ${marker.id} at ${logTime}: no ring on the table in the mode's colour`);
+      // the label: name, |F| to 0.1 N, mode
+      const text = arrowEnt.texts[0]?.text ?? "";
+      const m = /^(\S+) (\S+) N (.+)$/.exec(text);
+      if (!m || m[1] !== name || Math.abs(Number(m[2]) - norm) > 0.05 + 1e-9 * norm) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: label ${JSON.stringify(text)} for |F| = ${norm} N`);
+      else labels++;
       arrows++;
     }
     const [actual, desired] = msg.entities.slice(2 * contacts.length);
@@ -339,6 +408,9 @@ function checkScene(rec) {
   }
   out.contact_marker_messages = markers.length;
   out.arrows_checked = arrows;
+  out.labels_checked = labels;
+  out.nonzero_forces = nonzero;
+  out.min_length_outside_marker_m = nonzero ? minOutside : null;
   out.max_arrow_length_error_m = maxArrowErr;
   out.modes = modesSeen;
 
@@ -365,6 +437,22 @@ function checkScene(rec) {
   return out;
 }
 
+// Length of the segment a-b outside the ball (c, r).
+function lengthOutsideBall(a, b, c, r) {
+  const d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+  const len = Math.hypot(...d);
+  if (len === 0) return 0;
+  const u = d.map((x) => x / len);
+  const m = [a[0] - c[0], a[1] - c[1], a[2] - c[2]];
+  const bq = u[0] * m[0] + u[1] * m[1] + u[2] * m[2];
+  const cq = m[0] * m[0] + m[1] * m[1] + m[2] * m[2] - r * r;
+  const disc = bq * bq - cq;
+  if (disc <= 0) return len;
+  const t0 = Math.min(Math.max(-bq - Math.sqrt(disc), 0), len);
+  const t1 = Math.min(Math.max(-bq + Math.sqrt(disc), 0), len);
+  return len - (t1 - t0);
+}
+
 function rotateZ(q) {
   // the image of +z under the unit quaternion q
   const { x, y, z, w } = q;
@@ -382,6 +470,9 @@ async function main() {
   const recs = [];
   for (const p of recPaths) recs.push(await readMcap(p, decompressHandlers));
   const summary = { layout: checkLayout(layout), paths: checkPaths(layout, recs), recordings: recs.map(checkScene) };
+  // one force scale for every run of the scene
+  const scales = new Set(summary.recordings.map((r) => r.force_scale_m_per_n).filter((x) => !Number.isNaN(x)));
+  if (scales.size > 1) fail(`the recordings draw forces at ${scales.size} scales: ${[...scales].join(", ")} m/N`);
   summary.failures = failures.length;
   console.log(JSON.stringify(summary, null, 1));
   for (const f of failures.slice(0, 50)) console.error(`FAIL ${f}`);

@@ -77,15 +77,33 @@ pub struct View {
     pub eye: Option<Eye>,
     /// The y axis range of a time series view (else the viewer fits all data).
     pub y_range: Option<[f64; 2]>,
+    /// Where a time series view's legend sits.
+    pub legend: Corner,
+}
+
+/// A plot legend's corner (`rerun.blueprint.components.Corner2D`: 1 left top, 2 right top,
+/// 3 left bottom, 4 right bottom), or hidden.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Corner {
+    LeftTop = 1,
+    RightTop = 2,
+    LeftBottom = 3,
+    RightBottom = 4,
+    Hidden = 0,
 }
 
 impl View {
     pub fn new(class: ViewClass, name: impl Into<String>, origin: impl Into<String>) -> Self {
-        View { class, name: name.into(), origin: origin.into(), contents: Vec::new(), eye: None, y_range: None }
+        View { class, name: name.into(), origin: origin.into(), contents: Vec::new(), eye: None, y_range: None, legend: Corner::LeftTop }
     }
 
     pub fn y_range(mut self, range: Option<[f64; 2]>) -> Self {
         self.y_range = range;
+        self
+    }
+
+    pub fn legend(mut self, corner: Corner) -> Self {
+        self.legend = corner;
         self
     }
 
@@ -236,11 +254,12 @@ fn emit(node: &Node, ids: &mut Ids, out: &mut Vec<Chunk>) -> String {
                 );
             }
             if v.class == ViewClass::TimeSeries {
-                // legend top right (1 = left top, 2 = right top), shown
+                // the legend in the corner the view asks for (where its data leaves room), or hidden
+                let corner = if v.legend == Corner::Hidden { Corner::LeftTop } else { v.legend };
                 out.push(
                     Chunk::new(format!("{path}/PlotLegend"), Index::Blueprint)
-                        .with(LEGEND, "corner", "rerun.blueprint.components.Corner2D", u8_lists(&[vec![2]]))
-                        .with(LEGEND, "visible", "rerun.components.Visible", bool_lists(&[vec![true]])),
+                        .with(LEGEND, "corner", "rerun.blueprint.components.Corner2D", u8_lists(&[vec![corner as u8]]))
+                        .with(LEGEND, "visible", "rerun.components.Visible", bool_lists(&[vec![v.legend != Corner::Hidden]])),
                 );
             }
             format!("view/{id}")

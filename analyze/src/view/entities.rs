@@ -73,16 +73,8 @@ fn hand_actual() -> u32 {
 fn hand_desired() -> u32 {
     shared(schemas::markers::colors::HAND_DESIRED)
 }
-const TABLE: u32 = rgba(176, 140, 96, 70);
+const TABLE: u32 = rgba(0x8c, 0x6d, 0x46, 70);
 const ARM: u32 = rgba(170, 180, 200, 255);
-
-/// A contact marker's colour: the mode the Foxglove markers give it ([`schemas::markers::MarkerMode`]:
-/// a `/contacts` code, else a bilateral contact pushing or pulling by the sign of f_n).
-fn mode_color(mode: Option<u32>, f_n: f64) -> u32 {
-    use schemas::markers::MarkerMode;
-    let marker = mode.map_or_else(|| MarkerMode::bilateral(f_n), |code| MarkerMode::from_code(code, f_n));
-    shared(marker.hex())
-}
 
 fn f3(p: [f64; 3]) -> [f32; 3] {
     p.map(|x| x as f32)
@@ -124,6 +116,11 @@ pub mod signal {
     pub const NORMAL_FORCE: &str = "normal_force_N";
     pub const FRICTION_FORCE: &str = "friction_force_N";
     pub const CONTACT_MODE: &str = "contact_mode";
+    /// The slip speed `|v_t|` of a unilateral or compliant contact, m/s.
+    pub const SLIP_SPEED: &str = "slip_speed_mps";
+    /// `|f_t| / (μ f_n)`: 1 on the friction cone (sliding), below it sticking (samples with
+    /// `f_n > 0` only).
+    pub const FRICTION_RATIO: &str = "friction_ratio";
     pub const ELECTRIC_ENERGY: &str = "electric_energy_J";
     pub const LINK_WORK: &str = "link_work_J";
     pub const ENERGY: &str = "energy_J";
@@ -251,11 +248,20 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.002]]))
                 .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![w.target_path.iter().copied().map(f3).collect()]])),
         );
+        // the trail up to the current time: the actual positions so far (the whole run's,
+        // `Run::survey`), re-logged at most TRAIL_UPDATES times over the run, each strip at most
+        // TRAIL_POINTS points (bounded: a long run's trail is thinned, never a strip per sample
+        // of every sample before it); this window's updates
+        let window = (hand_times[0], hand_times[hand_times.len() - 1]);
+        let (trail_t, trail) = trail_updates(&w.hand_trail_t, &w.hand_trail, window);
+        out.push(
+            Chunk::new(format!("{world}/hand_trail"), Index::SimTime(trail_t))
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&trail)),
+        );
         out.push(
             Chunk::new(format!("{world}/hand_trail"), Index::Static)
                 .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_actual()]]))
-                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.0015]]))
-                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![w.hand_trail.iter().copied().map(f3).collect()]])),
+                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.0015]])),
         );
         for (name, pts, color, label, r) in
             [("actual", &actual, hand_actual(), "hand (actual)", r_point), ("desired", &desired, hand_desired(), "target (desired)", 0.75 * r_point)]
@@ -273,7 +279,8 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
-    // the table: every contact plane, a thin translucent box whose top face is the plane,
+    // the table: the boxes of `/scene` (what Foxglove draws, the same size); for a recording
+    // without them every contact plane, a thin translucent box whose top face is the plane,
     // covering the arm's reach
     let mut planes: Vec<Plane> = Vec::new();
     for p in run.contacts.iter().filter_map(|c| c.plane).chain(run.other_planes.iter().copied()) {
@@ -281,35 +288,64 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             planes.push(p);
         }
     }
-    for (k, plane) in planes.iter().enumerate() {
-        let n = plane.normal;
-        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
-        let n = n.map(|x| x / norm);
-        let d = plane.offset_m / norm;
-        let q = quat_z_to(n);
-        // the arm's bounds, projected on the plane: centre and half extent
-        let c = [0, 1, 2].map(|i| 0.5 * (bounds.arm_min[i] + bounds.arm_max[i]));
-        let half = [0, 1, 2].map(|i| 0.5 * (bounds.arm_max[i] - bounds.arm_min[i])).iter().fold(0.0f64, |a, b| a.max(*b)) + 0.15;
-        let dist = n[0] * c[0] + n[1] * c[1] + n[2] * c[2] - d;
-        let on_plane = [0, 1, 2].map(|i| c[i] - dist * n[i]);
-        let thickness = 0.01;
-        let center = [0, 1, 2].map(|i| on_plane[i] - 0.5 * thickness * n[i]);
+    let mut boxes: Vec<schemas::markers::TableBox> = run.scene.tables.clone();
+    if boxes.is_empty() {
+        for plane in &planes {
+            let n = plane.normal;
+            let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
+            let n = n.map(|x| x / norm);
+            let d = plane.offset_m / norm;
+            // the arm's bounds, projected on the plane: centre and half extent
+            let c = [0, 1, 2].map(|i| 0.5 * (bounds.arm_min[i] + bounds.arm_max[i]));
+            let half = [0, 1, 2].map(|i| 0.5 * (bounds.arm_max[i] - bounds.arm_min[i])).iter().fold(0.0f64, |a, b| a.max(*b)) + 0.15;
+            let dist = n[0] * c[0] + n[1] * c[1] + n[2] * c[2] - d;
+            let on_plane = [0, 1, 2].map(|i| c[i] - dist * n[i]);
+            let thickness = 0.01;
+            let center = [0, 1, 2].map(|i| on_plane[i] - 0.5 * thickness * n[i]);
+            boxes.push(schemas::markers::TableBox { center, rotation: quat_z_to(n), size: [2.0 * half, 2.0 * half, thickness], alpha: 70.0 / 255.0 });
+        }
+    }
+    for (k, b) in boxes.iter().enumerate() {
+        let [r, g, bl, _] = TABLE.to_be_bytes();
+        let alpha = (b.alpha.clamp(0.05, 1.0) * 255.0).round() as u8;
         out.push(
             Chunk::new(format!("{world}/table{k}"), Index::Static)
-                .with(BOXES, "centers", "rerun.components.Translation3D", vec3_lists(&[vec![f3(center)]]))
-                .with(BOXES, "colors", "rerun.components.Color", u32_lists(&[vec![TABLE]]))
+                .with(BOXES, "centers", "rerun.components.Translation3D", vec3_lists(&[vec![f3(b.center)]]))
+                .with(BOXES, "colors", "rerun.components.Color", u32_lists(&[vec![rgba(r, g, bl, alpha)]]))
                 .with(BOXES, "fill_mode", "rerun.components.FillMode", u8_lists(&[vec![4]]))
-                .with(BOXES, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![[half as f32, half as f32, (0.5 * thickness) as f32]]]))
+                .with(BOXES, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![f3(b.size.map(|x| 0.5 * x))]]))
                 .with(BOXES, "labels", "rerun.components.Text", str_lists(&[vec!["table".to_string()]]))
-                .with(BOXES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(q)]])),
+                .with(BOXES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(b.rotation)]])),
         );
     }
+    // the force arrows' scale bar, where Foxglove draws it, with its legend
+    let scale = run.scene.force_scale;
+    if !run.contacts.is_empty() {
+        let bar = run.scene.scale_bar.clone().or_else(|| {
+            // a recording without one: a bar on the first plane, at the base's projection
+            planes.first().map(|p| {
+                let f = scale.bar_force_n();
+                let n = p.normal;
+                let gap = n[0] * bounds.base[0] + n[1] * bounds.base[1] + n[2] * bounds.base[2] - p.offset_m;
+                let tail = [0, 1, 2].map(|i| bounds.base[i] - gap * n[i]);
+                schemas::markers::ScaleBar { tail, vector: n.map(|x| x * f * scale.m_per_n), text: format!("{f} N = {:.3} m", f * scale.m_per_n) }
+            })
+        });
+        if let Some(bar) = bar {
+            out.push(
+                Chunk::new(format!("{world}/force_scale"), Index::Static)
+                    .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&[vec![shared(schemas::markers::colors::SCALE_BAR)]]))
+                    .with(ARROWS, "labels", "rerun.components.Text", str_lists(&[vec![format!("{} ({})", bar.text, scale_words(&scale))]]))
+                    .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&[vec![f3(bar.tail)]]))
+                    .with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::ARROW_SHAFT_DIAMETER_M) as f32]]))
+                    .with(ARROWS, "vectors", "rerun.components.Vector3D", vec3_lists(&[vec![f3(bar.vector)]])),
+            );
+        }
+    }
 
-    // contacts: marker and force arrow per sample, coloured by mode
+    // contacts: marker, ring and force arrow per sample, coloured by mode, at the scene's one
+    // scale (`/scene`), as Foxglove draws them (`schemas::markers`)
     let (f_n, f_t, modes) = contact_forces(run);
-    // the largest force after the start-up transient (the first 5 % of the samples, where an
-    // impulse-like peak would shrink every arrow) is drawn 0.25 m long (`Run::survey`)
-    let scale = w.force_scale;
     let force_times: Vec<i64> = if run.contact_states.is_some() {
         run.contact_states.iter().flatten().map(|(t, _)| ns(*t)).collect()
     } else {
@@ -321,41 +357,56 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             continue; // where it acts is unknown: plots only
         }
         let base = format!("{world}/contacts/{}", escape(&c.name));
-        let norm = c.plane.map_or([0.0, 0.0, 1.0], |p| p.normal);
-        let mut colors = Vec::with_capacity(n_rows);
-        let mut origins = Vec::with_capacity(n_rows);
-        let mut vectors = Vec::with_capacity(n_rows);
-        for k in 0..n_rows {
-            let fn_k = f_n[ci][k];
-            let mode = modes.as_ref().map(|m| m[ci][k]);
-            colors.push(vec![mode_color(mode, fn_k)]);
-            let p = contact_points[ci][k];
-            origins.push(vec![f3(p)]);
-            let mut f = norm.map(|x| x * fn_k);
-            if let (Some((t1, t2)), Some(ft)) = (c.tangents, f_t.get(ci)) {
-                let (a, b) = ft.get(2 * k).copied().zip(ft.get(2 * k + 1).copied()).unwrap_or((0.0, 0.0));
-                f = [0, 1, 2].map(|i| f[i] + a * t1[i] + b * t2[i]);
-            }
-            vectors.push(vec![f3(f.map(|x| x * scale))]);
-        }
+        let d = contact_drawing(c, &contact_points[ci][..n_rows], &f_n[ci], f_t.get(ci).map(Vec::as_slice), modes.as_ref().map(|m| m[ci].as_slice()), &scale);
+        let colors: Vec<Vec<u32>> = d.modes.iter().map(|m| vec![shared(m.hex())]).collect();
+        let translucent: Vec<Vec<u32>> = d.modes.iter().map(|m| vec![shared(m.hex()) & 0xffff_ff00 | 0x90]).collect();
         let ft = Index::SimTime(force_times[..n_rows].to_vec());
         out.push(
             Chunk::new(&base, ft.clone())
-                .with(POINTS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&origins)),
+                .with(POINTS, "colors", "rerun.components.Color", u32_lists(&translucent))
+                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&d.points.iter().map(|p| vec![f3(*p)]).collect::<Vec<_>>())),
         );
         out.push(
             Chunk::new(&base, Index::Static)
                 .with(POINTS, "labels", "rerun.components.Text", str_lists(&[vec![c.name.clone()]]))
-                .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.6 * r_point) as f32]])),
+                .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![schemas::markers::CONTACT_MARKER_RADIUS_M as f32]])),
         );
+        let rings: Vec<Vec<Vec<[f32; 3]>>> = d.glyphs.iter().map(|g| vec![ring(g.tail, d.normal)]).collect();
+        out.push(
+            Chunk::new(format!("{base}/ring"), ft.clone())
+                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&colors))
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&rings)),
+        );
+        out.push(
+            Chunk::new(format!("{base}/ring"), Index::Static)
+                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::RING_LINE_WIDTH_M) as f32]])),
+        );
+        let mut label = String::with_capacity(schemas::markers::label_capacity(&c.name));
+        let labels: Vec<Vec<String>> = d
+            .glyphs
+            .iter()
+            .zip(&d.modes)
+            .map(|(g, m)| {
+                schemas::markers::write_label(&mut label, &c.name, g.magnitude_n, *m);
+                vec![label.clone()]
+            })
+            .collect();
         out.push(
             Chunk::new(format!("{base}/force"), ft)
                 .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&origins))
-                .with(ARROWS, "vectors", "rerun.components.Vector3D", vec3_lists(&vectors)),
+                .with(ARROWS, "labels", "rerun.components.Text", str_lists(&labels))
+                .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.tail)]).collect::<Vec<_>>()))
+                .with(
+                    ARROWS,
+                    "vectors",
+                    "rerun.components.Vector3D",
+                    vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.direction.map(|x| x * g.length_m))]).collect::<Vec<_>>()),
+                ),
         );
-        out.push(Chunk::new(format!("{base}/force"), Index::Static).with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.006]])));
+        out.push(
+            Chunk::new(format!("{base}/force"), Index::Static)
+                .with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::ARROW_SHAFT_DIAMETER_M) as f32]])),
+        );
     }
 
     // contact events
@@ -382,6 +433,111 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
 
     out.extend(signal_chunks(run, paths, &f_n, &f_t, modes.as_deref()));
     (out, bounds)
+}
+
+/// How many times the hand trail is re-logged, at most, and how many points each has, at most.
+pub const TRAIL_UPDATES: usize = 400;
+pub const TRAIL_POINTS: usize = 400;
+
+/// The line strips of one row of a `LineStrips3D` entity, points in the world frame (f32).
+pub type Strips = Vec<Vec<[f32; 3]>>;
+
+/// The hand trail up to the current time: `(times, rows)`, one row per update (a strip of the
+/// actual positions from the first sample to that update's, thinned to at most
+/// [`TRAIL_POINTS`], its own sample last), at most [`TRAIL_UPDATES`] updates, the last at the
+/// last sample; of those, the updates at times within `window` (ns, both ends included: the
+/// time window being drawn). No row holds a position after its time.
+pub fn trail_updates(times: &[i64], actual: &[[f64; 3]], window: (i64, i64)) -> (Vec<i64>, Vec<Strips>) {
+    let n = times.len().min(actual.len());
+    if n == 0 {
+        return (Vec::new(), Vec::new());
+    }
+    let stride = n.div_ceil(TRAIL_UPDATES).max(1);
+    let mut ks: Vec<usize> = (0..n).step_by(stride).collect();
+    if ks.last() != Some(&(n - 1)) {
+        ks.push(n - 1);
+    }
+    ks.retain(|&k| (window.0..=window.1).contains(&times[k]));
+    let rows = ks
+        .iter()
+        .map(|&k| {
+            let thin = (k + 1).div_ceil(TRAIL_POINTS).max(1);
+            let mut strip: Vec<[f32; 3]> = (0..=k).step_by(thin).map(|i| f3(actual[i])).collect();
+            if (k % thin) != 0 {
+                strip.push(f3(actual[k]));
+            }
+            vec![strip]
+        })
+        .collect();
+    (ks.iter().map(|&k| times[k]).collect(), rows)
+}
+
+/// A contact's drawing, sample by sample: where its marker is, its mode, its force glyph.
+#[derive(Debug, Clone)]
+pub struct ContactDrawing {
+    /// The contact point (the marker's centre), world frame, m.
+    pub points: Vec<[f64; 3]>,
+    pub modes: Vec<schemas::markers::MarkerMode>,
+    pub glyphs: Vec<schemas::markers::ForceGlyph>,
+    /// The plane's unit normal.
+    pub normal: [f64; 3],
+}
+
+/// The drawing of contact `c` at its `points` (per sample) with normal forces `f_n`, friction
+/// components `f_t` (`(t1, t2)` interleaved, when recorded) and mode codes (when recorded), at
+/// `scale`: the geometry of `schemas::markers` (Foxglove's), so that both viewers draw the same.
+pub fn contact_drawing(
+    c: &super::run::ContactPoint,
+    points: &[[f64; 3]],
+    f_n: &[f64],
+    f_t: Option<&[f64]>,
+    modes: Option<&[u32]>,
+    scale: &schemas::markers::ForceScale,
+) -> ContactDrawing {
+    use schemas::markers::{ForceGlyph, MarkerMode};
+    let (normal, offset) = c.plane.map_or(([0.0, 0.0, 1.0], 0.0), |p| {
+        let n = p.normal;
+        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
+        (n.map(|x| x / norm), p.offset_m / norm)
+    });
+    let mut d = ContactDrawing { points: points.to_vec(), modes: Vec::with_capacity(points.len()), glyphs: Vec::with_capacity(points.len()), normal };
+    for (k, p) in points.iter().enumerate() {
+        let fn_k = f_n.get(k).copied().unwrap_or(0.0);
+        let mode = modes.and_then(|m| m.get(k)).map_or_else(|| MarkerMode::bilateral(fn_k), |code| MarkerMode::from_code(*code, fn_k));
+        let mut f = normal.map(|x| x * fn_k);
+        if let (Some((t1, t2)), Some(ft)) = (c.tangents, f_t) {
+            let (a, b) = ft.get(2 * k).copied().zip(ft.get(2 * k + 1).copied()).unwrap_or((0.0, 0.0));
+            f = [0, 1, 2].map(|i| f[i] + a * t1[i] + b * t2[i]);
+        }
+        d.modes.push(mode);
+        d.glyphs.push(ForceGlyph::new(*p, normal, offset, f, scale));
+    }
+    d
+}
+
+/// The ring around a contact's point on the table: a closed strip of
+/// [`schemas::markers::CONTACT_RING_POINTS`] points about `center` in the plane of `normal`.
+fn ring(center: [f64; 3], normal: [f64; 3]) -> Vec<[f32; 3]> {
+    let q = quat_z_to(normal);
+    let r = schemas::markers::CONTACT_RING_RADIUS_M;
+    let n = schemas::markers::CONTACT_RING_POINTS;
+    (0..=n)
+        .map(|k| {
+            let a = std::f64::consts::TAU * (k % n) as f64 / n as f64;
+            let v = schemas::markers::rotate(q, [r * a.cos(), r * a.sin(), 0.0]);
+            f3([0, 1, 2].map(|i| center[i] + v[i]))
+        })
+        .collect()
+}
+
+/// "10 mm per N" (the scale in words).
+fn scale_words(s: &schemas::markers::ForceScale) -> String {
+    let mm = s.m_per_n * 1e3;
+    if mm >= 0.01 {
+        format!("{} mm per N", (mm * 1e4).round() / 1e4)
+    } else {
+        format!("{:e} m per N", s.m_per_n)
+    }
 }
 
 /// Per contact and sample: normal force, friction components `(t1, t2)` interleaved, and mode
@@ -451,6 +607,26 @@ fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], m
             let mag = ft.chunks(2).map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt()).collect();
             out.extend(series(format!("{}/{cp}", paths.signal(FRICTION_FORCE)), &force_t, mag, &format!("{} |f_t| [N]", contact.name), color, width));
         }
+        if let (Some(states), Some(ft)) = (&run.contact_states, f_t.get(c).filter(|v| !v.is_empty())) {
+            let slip = states
+                .iter()
+                .map(|(_, s)| {
+                    let (a, b) = (s.slip_velocity_t1.get(c).copied().unwrap_or(0.0), s.slip_velocity_t2.get(c).copied().unwrap_or(0.0));
+                    (a * a + b * b).sqrt()
+                })
+                .collect();
+            out.extend(series(format!("{}/{cp}", paths.signal(SLIP_SPEED)), &force_t, slip, &format!("{} |v_t| [m/s]", contact.name), color, width));
+            if let Some(mu) = contact.friction.filter(|m| *m > 0.0) {
+                let (t, v): (Vec<i64>, Vec<f64>) = ft
+                    .chunks(2)
+                    .zip(&f_n[c])
+                    .zip(&force_t)
+                    .filter(|((_, n), _)| **n > 0.0)
+                    .map(|((p, n), t)| (*t, (p[0] * p[0] + p[1] * p[1]).sqrt() / (mu * n)))
+                    .unzip();
+                out.extend(series(format!("{}/{cp}", paths.signal(FRICTION_RATIO)), &t, v, &format!("{} |f_t|/(μ f_n)", contact.name), color, width));
+            }
+        }
         if let Some(m) = modes {
             let v = m[c].iter().map(|&x| f64::from(x)).collect();
             out.extend(series(
@@ -485,4 +661,164 @@ fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], m
     let color = if paths.run.is_some() { palette(paths.index) } else { rgba(90, 90, 90, 255) };
     out.extend(series(paths.signal(RESIDUAL), &energy_t, residual, &name, color, width));
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use arrow_array::cast::AsArray;
+    use arrow_array::types::Float32Type;
+    use arrow_array::Array;
+
+    use super::*;
+    use schemas::markers::{CONTACT_MARKER_RADIUS_M, MIN_ARROW_LENGTH_M};
+
+    /// The 3-vectors of column `field` of `chunk`, one row each (the first of the row).
+    fn vec3_rows(chunk: &Chunk, field: &str) -> Vec<[f64; 3]> {
+        let col = chunk.columns.iter().find(|c| c.field == field).unwrap_or_else(|| panic!("{}: no {field}", chunk.entity_path));
+        let list = col.values.as_list::<i32>();
+        (0..list.len())
+            .map(|r| {
+                let row = list.value(r);
+                let fixed = row.as_fixed_size_list();
+                let v = fixed.value(0);
+                let v = v.as_primitive::<Float32Type>();
+                [v.value(0) as f64, v.value(1) as f64, v.value(2) as f64]
+            })
+            .collect()
+    }
+
+    fn strings(chunk: &Chunk, field: &str) -> Vec<String> {
+        let col = chunk.columns.iter().find(|c| c.field == field).unwrap();
+        let list = col.values.as_list::<i32>();
+        (0..list.len()).map(|r| list.value(r).as_string::<i32>().value(0).to_string()).collect()
+    }
+
+    fn find<'a>(chunks: &'a [Chunk], path: &str, temporal: bool) -> &'a Chunk {
+        chunks.iter().find(|c| c.entity_path == path && c.is_static() != temporal).unwrap_or_else(|| panic!("no chunk {path}"))
+    }
+
+    /// Length of the segment a-b outside the ball (c, r), m.
+    fn outside(a: [f64; 3], b: [f64; 3], c: [f64; 3], r: f64) -> f64 {
+        let d = [0, 1, 2].map(|i| b[i] - a[i]);
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let u = d.map(|x| x / len);
+        let m = [0, 1, 2].map(|i| a[i] - c[i]);
+        let bq = u[0] * m[0] + u[1] * m[1] + u[2] * m[2];
+        let disc = bq * bq - (m[0] * m[0] + m[1] * m[1] + m[2] * m[2] - r * r);
+        if disc <= 0.0 {
+            return len;
+        }
+        len - ((-bq + disc.sqrt()).clamp(0.0, len) - (-bq - disc.sqrt()).clamp(0.0, len))
+    }
+
+    /// Issue 27's acceptance, Rerun side: in the paper's two-elbow recording (the archive),
+    /// every nonzero contact force (every sample of `/constraints`, both elbows) is drawn as an
+    /// arrow that leaves its marker by at least 20 mm, from the contact point's projection on
+    /// the table (1e-6 m, f32), max(|F| × scale, 60 mm) long (1e-6 relative) at the scale of
+    /// `/scene` (the arm's: 10 mm per N), which is the scale of the recording's Foxglove arrows;
+    /// the marker is larger than the URDF's sphere at the contact; the label gives |F| to
+    /// 0.1 N; the table is `/scene`'s; the hand trail never holds a position after its time.
+    #[test]
+    fn every_nonzero_force_is_drawn_outside_its_marker_in_the_paper_two_elbow_run() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../recordings/paper-archive-two-elbow.mcap");
+        let input = super::super::read_input(&path).unwrap();
+        let run = &super::super::window::whole_run(&path, &input.run).unwrap();
+        assert!(run.scene.scale_recorded, "the archive records its force scale on /scene");
+        let scale = run.scene.force_scale;
+        assert_eq!(scale.m_per_n, 0.01);
+        // Foxglove's arrows in the same file: the same scale
+        let rec = schemas::read_recording(&path).unwrap();
+        assert_eq!(schemas::markers::recorded_arrow_scale(&rec), Some(scale.m_per_n));
+
+        let paths = Paths { prefix: String::new(), run: None, index: 0 };
+        let (chunks, _) = run_chunks(run, &paths);
+        let mut nonzero = 0;
+        let mut min_outside = f64::INFINITY;
+        for (ci, c) in run.contacts.iter().enumerate() {
+            let base = format!("/world/contacts/{}", c.name);
+            let marker = vec3_rows(find(&chunks, &base, true), "positions");
+            let radius = {
+                let col = find(&chunks, &base, false).columns.iter().find(|c| c.field == "radii").unwrap().values.clone();
+                col.as_list::<i32>().value(0).as_primitive::<Float32Type>().value(0) as f64
+            };
+            assert!((radius - CONTACT_MARKER_RADIUS_M).abs() < 1e-7);
+            let link_sphere = run.visuals[c.link.as_ref().unwrap()]
+                .iter()
+                .filter_map(|v| match v.shape {
+                    Shape::Sphere { radius_m } => Some(radius_m),
+                    _ => None,
+                })
+                .fold(0.0, f64::max);
+            assert!(link_sphere > 0.0 && radius > link_sphere, "{}: marker {radius} m, URDF sphere {link_sphere} m", c.name);
+            let arrows = find(&chunks, &format!("{base}/force"), true);
+            let (origins, vectors, labels) = (vec3_rows(arrows, "origins"), vec3_rows(arrows, "vectors"), strings(arrows, "labels"));
+            assert_eq!(origins.len(), run.constraints.len());
+            for (k, (_, s)) in run.constraints.iter().enumerate() {
+                let f = s.normal_force[ci].abs();
+                let len = vectors[k].iter().map(|x| x * x).sum::<f64>().sqrt();
+                let want = if f > 0.0 { (f * scale.m_per_n).max(MIN_ARROW_LENGTH_M) } else { 0.0 };
+                assert!((len - want).abs() <= 1e-6 * want.max(1.0), "{} sample {k}: {len} m for {f} N", c.name);
+                assert!(origins[k][2].abs() < 1e-6, "{} sample {k}: the arrow starts {} m off the table", c.name, origins[k][2]);
+                assert!((origins[k][0] - marker[k][0]).abs() < 1e-6 && (origins[k][1] - marker[k][1]).abs() < 1e-6);
+                let value: f64 = labels[k].split(' ').nth(1).unwrap().parse().unwrap();
+                assert!((value - f).abs() <= 0.05 + 1e-9, "{}: label {:?} for {f} N", c.name, labels[k]);
+                if f > 0.0 {
+                    let tip = [0, 1, 2].map(|i| origins[k][i] + vectors[k][i]);
+                    let o = outside(origins[k], tip, marker[k], radius);
+                    assert!(o >= 0.02, "{} sample {k}: |F| = {f} N, {o} m outside its marker", c.name);
+                    min_outside = min_outside.min(o);
+                    nonzero += 1;
+                }
+            }
+        }
+        assert_eq!(nonzero, 2 * run.constraints.len(), "both elbows carry a force at every sample");
+        assert!(min_outside >= 0.02, "{min_outside}");
+
+        // the table is /scene's (the size Foxglove draws)
+        let table = find(&chunks, "/world/table0", false);
+        let half = vec3_rows(table, "half_sizes")[0];
+        let fox = run.scene.tables[0].size;
+        assert!((2.0 * half[0] - fox[0]).abs() < 1e-6 && (2.0 * half[1] - fox[1]).abs() < 1e-6, "{half:?} vs {fox:?}");
+        // the trail up to the current time
+        let trail = find(&chunks, "/world/hand_trail", true);
+        let Index::SimTime(t) = &trail.index else { panic!() };
+        let list = trail.columns.iter().find(|c| c.field == "strips").unwrap().values.as_list::<i32>().clone();
+        for (r, t_r) in t.iter().enumerate() {
+            let strips = list.value(r);
+            let points = strips.as_list::<i32>().value(0);
+            let n = points.len();
+            assert!(n <= TRAIL_POINTS + 1);
+            let last = points.as_fixed_size_list().value(n - 1);
+            let last = last.as_primitive::<Float32Type>();
+            let k = run.hand.iter().position(|(th, _)| super::ns(*th) == *t_r).unwrap();
+            let h = &run.hand[k].1.actual;
+            assert_eq!([last.value(0), last.value(1), last.value(2)], [h.x as f32, h.y as f32, h.z as f32], "row {r}: ends at its own time");
+        }
+        assert_eq!(*t.last().unwrap(), super::ns(run.hand.last().unwrap().0));
+    }
+
+    /// The trail: at most TRAIL_UPDATES rows, each ending at its own sample, none longer than
+    /// TRAIL_POINTS + 1, the last at the last sample; one row per sample for short runs.
+    #[test]
+    fn the_trail_is_bounded_and_never_ahead() {
+        for n in [1usize, 2, 399, 400, 401, 1000, 100_001] {
+            let times: Vec<i64> = (0..n as i64).collect();
+            let pts: Vec<[f64; 3]> = (0..n).map(|k| [k as f64, 0.0, 0.0]).collect();
+            let (t, rows) = trail_updates(&times, &pts, (i64::MIN, i64::MAX));
+            assert!(t.len() <= TRAIL_UPDATES + 1 && t.len() == rows.len(), "{n}");
+            assert_eq!(*t.last().unwrap(), n as i64 - 1);
+            for (tr, row) in t.iter().zip(&rows) {
+                let strip = &row[0];
+                assert!(strip.len() <= TRAIL_POINTS + 1);
+                assert_eq!(strip.last().unwrap()[0], *tr as f32);
+                assert!(strip.iter().all(|p| p[0] <= *tr as f32));
+                assert_eq!(strip[0][0], 0.0);
+            }
+            if n <= TRAIL_UPDATES {
+                assert_eq!(t.len(), n);
+            }
+        }
+    }
 }

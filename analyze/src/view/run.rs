@@ -46,6 +46,8 @@ pub struct ContactPoint {
     pub plane: Option<Plane>,
     /// Tangent basis of the friction forces (world frame), from the `contacts` record.
     pub tangents: Option<([f64; 3], [f64; 3])>,
+    /// Friction coefficient μ, from the `contacts` record (unilateral and compliant contacts).
+    pub friction: Option<f64>,
 }
 
 /// A frame of the `/tf` tree and its poses.
@@ -85,6 +87,9 @@ pub struct Run {
     pub events: Vec<(f64, ContactEventMsg)>,
     /// The run's status and reason (record `result`), when the recording has one.
     pub result: Option<RunResult>,
+    /// What `/scene` says (the force scale, the tables, the scale bar), so that Rerun draws
+    /// what Foxglove draws; the defaults for a recording without it ([`Run::survey`]).
+    pub scene: schemas::markers::SceneRead,
     /// What needs the whole run ([`Run::survey`]).
     pub whole: Whole,
 }
@@ -117,12 +122,11 @@ pub struct Whole {
     pub hand_max: [f64; 3],
     /// The arm's base (the first frame below the root), at t = 0.
     pub base: [f64; 3],
-    /// Arrow length per newton: the largest force after the first 5 % of the samples is drawn
-    /// 0.25 m long (0 when no force).
-    pub force_scale: f64,
-    /// The desired and the actual hand positions (world), every sample or evenly decimated.
+    /// The desired and the actual hand positions (world), every sample or evenly decimated,
+    /// and the times of the actual ones, ns (the trail up to the current time).
     pub target_path: Vec<[f64; 3]>,
     pub hand_trail: Vec<[f64; 3]>,
+    pub hand_trail_t: Vec<i64>,
     /// [`range_after_transient`] of the motor currents and voltages.
     pub current_range: Option<[f64; 2]>,
     pub voltage_range: Option<[f64; 2]>,
@@ -134,6 +138,10 @@ pub struct Whole {
     pub has_events: bool,
     /// Messages per drawn topic.
     pub counts: BTreeMap<String, usize>,
+    /// Where each plot's samples lie (the legends' corners; an empty one: no plot).
+    pub envelopes: Envelopes,
+    /// The largest |balance residual| of `/energy`, J (the residual plot's range).
+    pub residual_max_abs: f64,
 }
 
 impl Default for Whole {
@@ -144,9 +152,9 @@ impl Default for Whole {
             hand_min: [f64::INFINITY; 3],
             hand_max: [f64::NEG_INFINITY; 3],
             base: [0.0; 3],
-            force_scale: 0.0,
             target_path: Vec::new(),
             hand_trail: Vec::new(),
+            hand_trail_t: Vec::new(),
             current_range: None,
             voltage_range: None,
             has_voltage: false,
@@ -154,8 +162,77 @@ impl Default for Whole {
             has_contact_states: false,
             has_events: false,
             counts: BTreeMap::new(),
+            envelopes: Envelopes::default(),
+            residual_max_abs: 0.0,
         }
     }
+}
+
+/// Columns of an [`Envelope`] over the run's time span.
+pub const ENVELOPE_COLUMNS: usize = 60;
+
+/// Where the samples of a plot lie, gathered as they stream by in O(1) memory: over
+/// [`ENVELOPE_COLUMNS`] equal columns of the time span `[t0, t_end]` (a sample outside goes in
+/// the nearest column), the lowest and highest value of every series in each column. Whether
+/// a sample of the plot lies in a band at the top or bottom of the y range is then exact per
+/// column (`layout::legend_corner`); no samples at all means the plot has no data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Envelope {
+    t0: f64,
+    t_end: f64,
+    /// Per column: `[min, max]` (`[inf, -inf]` for an empty column).
+    pub columns: Vec<[f64; 2]>,
+    /// Finite samples pushed.
+    pub samples: usize,
+}
+
+impl Default for Envelope {
+    fn default() -> Self {
+        Envelope::new(0.0, 0.0)
+    }
+}
+
+impl Envelope {
+    pub fn new(t0: f64, t_end: f64) -> Self {
+        Envelope { t0, t_end, columns: vec![[f64::INFINITY, f64::NEG_INFINITY]; ENVELOPE_COLUMNS], samples: 0 }
+    }
+
+    /// The values of the series at time `t`, s (non-finite ones are left out).
+    pub fn push(&mut self, t: f64, values: impl IntoIterator<Item = f64>) {
+        let span = self.t_end - self.t0;
+        let x = if span > 0.0 { ((t - self.t0) / span).clamp(0.0, 1.0) } else { 0.0 };
+        let k = ((x * ENVELOPE_COLUMNS as f64) as usize).min(ENVELOPE_COLUMNS - 1);
+        let c = &mut self.columns[k];
+        for y in values.into_iter().filter(|y| y.is_finite()) {
+            *c = [c[0].min(y), c[1].max(y)];
+            self.samples += 1;
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.samples == 0
+    }
+
+    /// The lowest and highest value, `None` when empty.
+    pub fn range(&self) -> Option<[f64; 2]> {
+        (!self.is_empty()).then(|| self.columns.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], c| [a.min(c[0]), b.max(c[1])]))
+    }
+}
+
+/// The [`Envelope`] of each plot of a run (`layout::plots`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Envelopes {
+    pub current: Envelope,
+    pub voltage: Envelope,
+    pub normal_force: Envelope,
+    /// `|v_t|` of `/contacts`.
+    pub slip_speed: Envelope,
+    /// `|f_t| / (μ f_n)` of the samples with `f_n > 0` of the contacts with `μ > 0`.
+    pub friction_ratio: Envelope,
+    pub friction_force: Envelope,
+    pub contact_mode: Envelope,
+    pub electric_energy: Envelope,
+    pub link_work: Envelope,
 }
 
 /// The most points of the static target path and hand trail: a longer run is decimated evenly
@@ -172,6 +249,19 @@ pub const DRAWN: [&str; 7] = [
     schemas::topics::CONSTRAINTS,
     schemas::topics::CONTACTS,
     schemas::topics::CONTACT_EVENTS,
+];
+
+/// The topics [`Run::survey`] reads: the drawn ones and `/scene` (the force scale, the tables
+/// and the scale bar Foxglove draws: one small message).
+pub const SURVEYED: [&str; 8] = [
+    schemas::topics::TF,
+    schemas::topics::HAND,
+    schemas::topics::MOTORS,
+    schemas::topics::ENERGY,
+    schemas::topics::CONSTRAINTS,
+    schemas::topics::CONTACTS,
+    schemas::topics::CONTACT_EVENTS,
+    schemas::topics::SCENE,
 ];
 
 pub fn grow(min: &mut [f64; 3], max: &mut [f64; 3], p: [f64; 3]) {
@@ -331,18 +421,18 @@ struct Survey<'a> {
     sizes: ArraySizes,
     tree: FrameTree,
     whole: Whole,
-    /// Samples of `/tf`, `/hand` and of the force topic (from the file's counts).
+    /// Samples of `/tf` and `/hand` (from the file's counts).
     n_tf: usize,
     n_hand: usize,
-    n_force: usize,
     force_topic: &'static str,
     hand_k: usize,
-    force_k: usize,
     motors: Option<(RangeAfter, RangeAfter)>,
     motor_times: Option<(f64, f64)>,
-    f_max: f64,
     joints: usize,
-    contacts: usize,
+    /// The friction coefficient μ of each active contact (0: none recorded).
+    friction: Vec<f64>,
+    /// The first `/scene` message, read.
+    scene: Option<schemas::markers::SceneRead>,
     /// The error that stopped the reading (returned instead of the reader's).
     error: Option<Error>,
 }
@@ -385,7 +475,7 @@ impl Survey<'_> {
         Ok(())
     }
 
-    fn hand(&mut self, h: &HandState) {
+    fn hand(&mut self, t: f64, h: &HandState) {
         let v3 = |v: &schemas::Vec3| [v.x, v.y, v.z];
         let (desired, actual) = (v3(&h.desired), v3(&h.actual));
         let w = &mut self.whole;
@@ -397,6 +487,7 @@ impl Survey<'_> {
         if self.hand_k.is_multiple_of(stride) || self.hand_k + 1 == self.n_hand {
             w.target_path.push(desired);
             w.hand_trail.push(actual);
+            w.hand_trail_t.push(ns(t));
         }
         self.hand_k += 1;
     }
@@ -408,25 +499,33 @@ impl Survey<'_> {
             self.whole.has_voltage = !m.voltage.is_empty();
         }
         cur.push(t, &m.current);
+        self.whole.envelopes.current.push(t, m.current.iter().copied());
         if self.whole.has_voltage {
             volt.push(t, &m.voltage);
+            self.whole.envelopes.voltage.push(t, m.voltage.iter().copied());
         }
         self.whole.voltage_every_joint &= m.voltage.len() == self.joints;
     }
 
-    /// One sample of the contact forces: `f_n` and the friction components of each contact.
-    fn forces(&mut self, f_n: &[f64], f_t: &[(f64, f64)]) {
-        let after = self.force_k >= self.n_force / 20;
-        if after {
-            for c in 0..self.contacts {
-                let f = f_n.get(c).copied().unwrap_or(0.0);
-                self.f_max = self.f_max.max(f.abs());
-                if let Some((a, b)) = f_t.get(c) {
-                    self.f_max = self.f_max.max(a.abs()).max(b.abs());
-                }
-            }
+    /// One sample of `/contacts`: normal and friction forces, slip speeds, the friction use
+    /// `|f_t| / (μ f_n)` where `f_n > 0` and `μ > 0`, the modes.
+    fn contacts(&mut self, t: f64, s: &ContactState) {
+        let e = &mut self.whole.envelopes;
+        let norm = |a: &[f64], b: &[f64], c: usize| a.get(c).copied().unwrap_or(0.0).hypot(b.get(c).copied().unwrap_or(0.0));
+        let n = s.normal_force.len();
+        e.normal_force.push(t, s.normal_force.iter().copied());
+        if !s.slip_velocity_t1.is_empty() {
+            e.slip_speed.push(t, (0..n).map(|c| norm(&s.slip_velocity_t1, &s.slip_velocity_t2, c)));
         }
-        self.force_k += 1;
+        if !s.friction_force_t1.is_empty() {
+            e.friction_force.push(t, (0..n).map(|c| norm(&s.friction_force_t1, &s.friction_force_t2, c)));
+            let ratio = (0..n).filter_map(|c| {
+                let (mu, f_n) = (self.friction.get(c).copied().unwrap_or(0.0), s.normal_force[c]);
+                (mu > 0.0 && f_n > 0.0).then(|| norm(&s.friction_force_t1, &s.friction_force_t2, c) / (mu * f_n))
+            });
+            e.friction_ratio.push(t, ratio);
+        }
+        e.contact_mode.push(t, s.mode.iter().map(|&m| f64::from(m)));
     }
 }
 
@@ -442,31 +541,35 @@ impl schemas::Visitor for Survey<'_> {
             }
             schemas::topics::HAND => {
                 let h = m.decode_ref::<HandState>(None)?;
-                self.hand(&h);
+                self.hand(m.t_s(), &h);
             }
             schemas::topics::MOTORS => {
                 let s = m.decode_ref::<MotorState>(sizes)?;
                 self.motors(m.t_s(), &s);
             }
             schemas::topics::ENERGY => {
-                m.decode_ref::<EnergyState>(sizes)?;
+                let e = m.decode_ref::<EnergyState>(sizes)?;
+                let w = &mut self.whole;
+                w.envelopes.electric_energy.push(m.t_s(), e.electric_energy.iter().copied());
+                w.envelopes.link_work.push(m.t_s(), e.link_work.iter().copied());
+                if e.balance_residual.is_finite() {
+                    w.residual_max_abs = w.residual_max_abs.max(e.balance_residual.abs());
+                }
             }
             schemas::topics::CONSTRAINTS => {
                 let s = m.decode_ref::<ConstraintState>(sizes)?;
                 if self.force_topic == schemas::topics::CONSTRAINTS {
-                    self.forces(&s.normal_force, &[]);
+                    self.whole.envelopes.normal_force.push(m.t_s(), s.normal_force.iter().copied());
                 }
             }
             schemas::topics::CONTACTS => {
                 let s = m.decode_ref::<ContactState>(sizes)?;
-                let f_t: Vec<(f64, f64)> = (0..self.contacts)
-                    .map(|c| (s.friction_force_t1.get(c).copied().unwrap_or(0.0), s.friction_force_t2.get(c).copied().unwrap_or(0.0)))
-                    .collect();
-                self.forces(&s.normal_force, &f_t);
+                self.contacts(m.t_s(), &s);
             }
             schemas::topics::CONTACT_EVENTS => {
                 m.decode_ref::<ContactEventMsg>(None)?;
             }
+            schemas::topics::SCENE if self.scene.is_none() => self.scene = Some(schemas::markers::SceneRead::from_decoded(&m)),
             _ => {}
         }
         Ok(())
@@ -506,31 +609,44 @@ impl Run {
                 has_contact_states: has_contacts,
                 has_events: count(schemas::topics::CONTACT_EVENTS) > 0,
                 counts: DRAWN.iter().map(|t| (t.to_string(), count(t))).collect(),
+                envelopes: {
+                    let (t0, t_end) = times.0.unwrap_or((0.0, 0.0));
+                    let e = Envelope::new(t0, t_end);
+                    Envelopes {
+                        current: e.clone(),
+                        voltage: e.clone(),
+                        normal_force: e.clone(),
+                        slip_speed: e.clone(),
+                        friction_ratio: e.clone(),
+                        friction_force: e.clone(),
+                        contact_mode: e.clone(),
+                        electric_energy: e.clone(),
+                        link_work: e,
+                    }
+                },
                 ..Whole::default()
             },
             n_tf: count(schemas::topics::TF),
             n_hand: count(schemas::topics::HAND),
-            n_force: count(force_topic),
             force_topic,
             hand_k: 0,
-            force_k: 0,
             motors: None,
             motor_times: times.0,
-            f_max: 0.0,
             joints: run.joints.len(),
-            contacts: run.contacts.len(),
+            friction: run.contacts.iter().map(|c| c.friction.unwrap_or(0.0)).collect(),
+            scene: None,
             error: None,
         };
-        let read = schemas::stream_recording(path, Some(&DRAWN), &mut survey);
+        let read = schemas::stream_recording(path, Some(&SURVEYED), &mut survey);
         first_error(read, survey.error.take())?;
-        let Survey { tree, mut whole, motors, f_max, .. } = survey;
+        let Survey { tree, mut whole, motors, scene, .. } = survey;
+        run.scene = scene.unwrap_or_default();
         if let Some((cur, volt)) = motors {
             whole.current_range = cur.finish();
             whole.voltage_range = if whole.has_voltage { volt.finish() } else { None };
         } else {
             whole.voltage_every_joint = false;
         }
-        whole.force_scale = if f_max > 0.0 { 0.25 / f_max } else { 0.0 };
         run.root_frame = tree.root(&file)?;
         for c in &mut run.contacts {
             match &c.link {
@@ -595,7 +711,7 @@ impl Run {
                 (None, None) => None,
             };
             let offset_m = point.and_then(|p| p.get("offset")).and_then(vec3).unwrap_or([0.0; 3]);
-            contacts.push(ContactPoint { name: cname.clone(), link, offset_m, plane, tangents: info.map(|i| (i.t1, i.t2)) });
+            contacts.push(ContactPoint { name: cname.clone(), link, offset_m, plane, tangents: info.map(|i| (i.t1, i.t2)), friction: info.and_then(|i| i.friction) });
         }
         let mut other_planes = Vec::new();
         for c in &scene_contacts {
@@ -622,6 +738,7 @@ impl Run {
             contact_states: None,
             events: Vec::new(),
             result: rec.result()?,
+            scene: schemas::markers::SceneRead::default(),
             whole: Whole::default(),
         })
     }

@@ -129,13 +129,12 @@ impl<M> Queue<M> {
     }
 }
 
-/// The windowed drawing of one run: a [`schemas::Visitor`] of [`draw_run`].
-struct Windows<'a, W: Write> {
+/// The windows of one run: a [`schemas::Visitor`] of [`for_each_window`].
+struct Windows<'a> {
     run: Run,
     sizes: ArraySizes,
-    paths: &'a Paths,
-    store: &'a StoreId,
-    sink: &'a mut Sink<W>,
+    /// What is done with each window's run (its samples those of the window).
+    each: &'a mut dyn FnMut(&Run) -> Result<(), Error>,
     window_rows: usize,
     /// Windows written.
     windows: usize,
@@ -146,15 +145,13 @@ struct Windows<'a, W: Write> {
     constraints: Queue<ConstraintState>,
     contacts: Queue<ContactState>,
     events: Vec<(f64, ContactEventMsg)>,
-    /// The static chunks written: entity and component fields.
-    statics: std::collections::BTreeSet<(String, String)>,
     /// Each frame's latest pose in its parent (kept from one window to the next).
     latest: Vec<Pose>,
     frame_index: BTreeMap<String, usize>,
     error: Option<Error>,
 }
 
-impl<W: Write> Windows<'_, W> {
+impl Windows<'_> {
     fn queued(&self) -> [usize; 6] {
         [self.tf.items.len(), self.hand.items.len(), self.motors.items.len(), self.energy.items.len(), self.constraints.items.len(), self.contacts.items.len()]
     }
@@ -182,7 +179,7 @@ impl<W: Write> Windows<'_, W> {
         let mut n = counts(t_cut, self);
         if !last && n.iter().all(|&k| k == 0) {
             // the topics do not interleave: cut by size
-            if self.queued().iter().any(|&k| k >= 8 * self.window_rows) {
+            if self.queued().iter().any(|&k| k >= self.window_rows.saturating_mul(8)) {
                 t_cut = f64::INFINITY;
                 n = counts(t_cut, self);
             } else {
@@ -218,20 +215,7 @@ impl<W: Write> Windows<'_, W> {
         self.run.contact_states = self.run.whole.has_contact_states.then(|| self.contacts.take(n_contacts));
         self.run.events = std::mem::take(&mut self.events);
 
-        let (chunks, _) = entities::run_chunks(&self.run, self.paths);
-        for c in &chunks {
-            // each static chunk once (with the first window that has it); no temporal chunk
-            // without rows (an entity whose topic has no sample in this window, or none at all)
-            if c.is_static() {
-                let key = (c.entity_path.clone(), c.columns.iter().map(|k| k.field).collect::<Vec<_>>().join(","));
-                if !self.statics.insert(key) {
-                    continue;
-                }
-            } else if c.rows == 0 {
-                continue;
-            }
-            self.sink.push(self.store, c)?;
-        }
+        (self.each)(&self.run)?;
         self.windows += 1;
         self.run.clear_samples();
         Ok(())
@@ -278,7 +262,7 @@ impl<W: Write> Windows<'_, W> {
     }
 }
 
-impl<W: Write> schemas::Visitor for Windows<'_, W> {
+impl schemas::Visitor for Windows<'_> {
     fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
         match self.take(m) {
             Ok(()) => Ok(()),
@@ -303,6 +287,32 @@ pub fn draw_run<W: Write>(
     sink: &mut Sink<W>,
     window_rows: usize,
 ) -> Result<usize, Error> {
+    // the static chunks written: entity and component fields
+    let mut statics = std::collections::BTreeSet::new();
+    for_each_window(path, run, window_rows, &mut |window: &Run| {
+        let (chunks, _) = entities::run_chunks(window, paths);
+        for c in &chunks {
+            // each static chunk once (with the first window that has it); no temporal chunk
+            // without rows (an entity whose topic has no sample in this window, or none at all)
+            if c.is_static() {
+                let key = (c.entity_path.clone(), c.columns.iter().map(|k| k.field).collect::<Vec<_>>().join(","));
+                if !statics.insert(key) {
+                    continue;
+                }
+            } else if c.rows == 0 {
+                continue;
+            }
+            sink.push(store, c)?;
+        }
+        Ok(())
+    })
+}
+
+/// Hands `each` the run (surveyed into `run`) with the samples of one time window of the
+/// recording at `path` at a time, windows of at most about `window_rows` samples per topic
+/// (`usize::MAX`: the whole run at once, for tests and small files). Returns the number of
+/// windows.
+pub fn for_each_window(path: &Path, run: &Run, window_rows: usize, each: &mut dyn FnMut(&Run) -> Result<(), Error>) -> Result<usize, Error> {
     let count = |topic: &str| run.whole.counts.get(topic).copied().unwrap_or(0);
     let mut run = run.clone();
     run.clear_samples();
@@ -312,9 +322,7 @@ pub fn draw_run<W: Write>(
         latest: vec![Pose::IDENTITY; run.frames.len()],
         frame_index,
         run,
-        paths,
-        store,
-        sink,
+        each,
         window_rows: window_rows.max(1),
         windows: 0,
         tf: Queue::new(count(schemas::topics::TF)),
@@ -324,11 +332,21 @@ pub fn draw_run<W: Write>(
         constraints: Queue::new(count(schemas::topics::CONSTRAINTS)),
         contacts: Queue::new(count(schemas::topics::CONTACTS)),
         events: Vec::new(),
-        statics: Default::default(),
         error: None,
     };
     let read = schemas::stream_recording(path, Some(&DRAWN), &mut w);
     first_error(read, w.error.take())?;
     w.cut(true)?;
     Ok(w.windows)
+}
+
+/// The run surveyed into `run` with every sample of the recording at `path` (one window: memory
+/// grows with the recording; for tests and checks of small files).
+pub fn whole_run(path: &Path, run: &Run) -> Result<Run, Error> {
+    let mut out = None;
+    for_each_window(path, run, usize::MAX, &mut |r: &Run| {
+        out = Some(r.clone());
+        Ok(())
+    })?;
+    Ok(out.unwrap_or_else(|| run.clone()))
 }

@@ -116,9 +116,10 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     let live = live::Session::start(&a.live, &live::about(&[(&scene, names)], &a.out), v.quiet)?;
     let budget = a.live.budget(a.wall_time.budget(), scene.duration());
     let done = run_all_live(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
-    let layout = write_layout(&scene, &done, &a.out, v);
-    let code = finish(&done, a.format, a.baseline.as_deref(), v).map(|c| if layout.is_err() { c.max(exit::BAD_INPUT) } else { c });
-    report_layouts(&[layout], v);
+    let layouts = write_layouts(&scene, &done, v);
+    let failed = layouts.iter().any(Result::is_err);
+    let code = finish(&done, a.format, a.baseline.as_deref(), v).map(|c| if failed { c.max(exit::BAD_INPUT) } else { c });
+    report_layouts(&layouts, v);
     // messages the live view dropped (said on stderr) make the command's status 1
     let dropped = live.is_some_and(live::Session::close);
     code.map(|c| if dropped { c.max(exit::FAILED) } else { c })
@@ -158,7 +159,7 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
     for (scene, runs) in scenes.iter().zip(&picked).filter(|(_, r)| !r.is_empty()) {
         let budget = a.live.budget(a.wall_time.budget(), scene.duration());
         let scene_done = run_all_live(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
-        layouts.push(write_layout(scene, &scene_done, &a.out, v));
+        layouts.extend(write_layouts(scene, &scene_done, v));
         done.extend(scene_done);
     }
     let failed = layouts.iter().any(Result::is_err);
@@ -168,22 +169,31 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
     code.map(|c| if dropped { c.max(exit::FAILED) } else { c })
 }
 
-/// Write the Foxglove layout of `scene`'s recordings, `<out>/<scene>.foxglove-layout.json`
-/// (`schemas::layout`): one per scene, for every run of the scene (the runs of a scene share
-/// their joints; contact series the runs name differently are labelled per run), so a user
-/// imports it once and opens any of the scene's recordings with it. Written atomically
-/// (`schemas::atomic`) after the runs, and only when one of them wrote a recording (a run that
-/// wrote nothing leaves nothing behind). Another `sim` writing the same layout at the same moment
-/// (two runs of one scene into one directory) writes the same bytes: it is left to that one
-/// (`Ok(None)`). Any other failure is the error's text (reported, exit status 2).
-pub fn write_layout(scene: &Scene, done: &[Done], out: &Path, v: Verbosity) -> Result<Option<PathBuf>, String> {
-    if !done.iter().any(|d| d.path.is_some()) {
-        return Ok(None);
+/// Write the Foxglove layout of each recording of `scene` beside it,
+/// `<scene>-<run>.foxglove-layout.json` (`schemas::layout`): one per run, with only the series
+/// that run records (its own contacts, not every contact of the scene: issue 27), so a user
+/// imports the layout of the recording they open. Written atomically (`schemas::atomic`) after
+/// the runs, and only for a run that wrote a recording (a run that wrote nothing leaves nothing
+/// behind). Another `sim` writing the same layout at the same moment (the same run into one
+/// directory) writes the same bytes: it is left to that one (`Ok(None)`). Any other failure is
+/// the error's text (reported, exit status 2).
+pub fn write_layouts(scene: &Scene, done: &[Done], v: Verbosity) -> Vec<Result<Option<PathBuf>, String>> {
+    let input = sim::record::layout_input(scene);
+    let mut out = Vec::new();
+    for recording in done.iter().filter_map(|d| d.path.as_ref()) {
+        let stem = recording.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let mut one = input.clone();
+        one.runs.retain(|r| format!("{}-{}", scene.spec().name, r.run) == stem);
+        out.push(write_layout(&one, &recording.with_file_name(schemas::layout::file_name(&stem)), v));
     }
-    let layout = schemas::layout::foxglove(&sim::record::layout_input(scene));
-    let path = out.join(schemas::layout::file_name(&scene.spec().name));
+    out
+}
+
+/// Write the layout of `input` to `path` ([`write_layouts`]).
+fn write_layout(input: &schemas::layout::LayoutInput, path: &Path, v: Verbosity) -> Result<Option<PathBuf>, String> {
+    let layout = schemas::layout::foxglove(input);
     let text = serde_json::to_string_pretty(&layout).map_err(|e| format!("the Foxglove layout as JSON: {e}"))?;
-    match schemas::atomic::write_file(&path, text + "\n") {
+    match schemas::atomic::write_file(path, text + "\n") {
         Ok(p) => Ok(Some(p)),
         Err(schemas::Error::Busy { .. }) => {
             if !v.quiet {
