@@ -3,7 +3,9 @@
 //! `cargo bench -p sim --bench dynamics`; results and ratios in BENCHMARKS.md.
 //!
 //! Groups (criterion ids, also the directories under `target/criterion/`):
-//! - `paper_arm/{rnea, crba, walker_orin}`: at q = q0 and a random q̇ (and q̈ for RNEA).
+//! - `paper_arm/{rnea, crba, crba_world, walker_orin}`: at q = q0 and a random q̇ (and q̈ for
+//!   RNEA); `crba_world` (the world-aligned CRBA the right-hand side uses) at the placements of
+//!   one forward-kinematics call.
 //! - `paper_arm/forward/{crba,walker-orin}-{schur,kkt}`: eq 21 with the two elbow contacts,
 //!   random q̇, currents and voltages, and the scene's constraint stabilisation.
 //! - `paper_rhs/{two-elbow, one-elbow, no-elbow}`: `ArmSystem::rhs` (IK targets, PD voltages,
@@ -50,6 +52,13 @@ fn kernels(c: &mut Criterion) {
     g.bench_function("crba", |b| {
         b.iter(|| {
             crba::crba(model, &mut data, black_box(&q));
+            black_box(data.m[(0, 0)])
+        })
+    });
+    sim::dynamics::kinematics::forward_kinematics(model, &mut data, &q);
+    g.bench_function("crba_world", |b| {
+        b.iter(|| {
+            crba::crba_world(model, black_box(&mut data));
             black_box(data.m[(0, 0)])
         })
     });

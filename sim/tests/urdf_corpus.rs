@@ -6,7 +6,8 @@
 use std::collections::BTreeMap;
 
 use nalgebra::{DVector, Vector3};
-use sim::dynamics::crba::crba;
+use sim::dynamics::crba::{crba, crba_world};
+use sim::dynamics::kinematics::forward_kinematics;
 use sim::dynamics::model::{JointKind, Model, UrdfOptions};
 use sim::dynamics::rnea::{bias_forces, rnea};
 use sim::dynamics::samples::SplitMix64;
@@ -23,7 +24,9 @@ fn load(name: &str, locked: &[(&str, f64)]) -> Result<Model, String> {
 }
 
 /// M(q) symmetric positive definite; CRBA M q̈ + RNEA(q, q̇, 0) = RNEA(q, q̇, q̈) to 1e-10
-/// relative; Walker–Orin = CRBA to 1e-12 relative; at 5 random states within the joint limits.
+/// relative; Walker–Orin = CRBA to 1e-12 relative; the world-aligned CRBA = the body-frame one
+/// to 1e-14 of √(M_ii M_jj) per entry and their q̈ = M⁻¹ b to 1e-13 relative; at 5 random
+/// states within the joint limits.
 fn check_dynamics(model: &Model) {
     let mut rng = SplitMix64(0xC0FFEE ^ model.nv as u64);
     let mut data = Data::new(model);
@@ -50,6 +53,22 @@ fn check_dynamics(model: &Model) {
         let m_wo = walker_orin::mass_matrix(model, &mut data, &q).clone();
         let err = (&m - &m_wo).amax() / m.amax().max(1.0);
         assert!(err < 1e-12, "{}: |M_crba - M_wo| = {err:e}", model.name);
+        // the world-aligned CRBA the right-hand side uses (forward.rs) against the body-frame
+        // one, entry by entry on each entry's scale, and q̈ = M⁻¹ b from each (issue 24 item 4)
+        forward_kinematics(model, &mut data, &q);
+        let m_world = crba_world(model, &mut data).clone();
+        let n = model.nv;
+        for i in 0..n {
+            for j in 0..n {
+                let e = (m[(i, j)] - m_world[(i, j)]).abs() / (m[(i, i)] * m[(j, j)]).sqrt();
+                assert!(e < 1e-14, "{}: M[{i},{j}] world-aligned vs body frame {e:e}", model.name);
+            }
+        }
+        let b = DVector::from_column_slice(&rng.vector(n, -1.0, 1.0));
+        let qdd_body = m.clone().cholesky().expect("M is positive definite").solve(&b);
+        let qdd_world = m_world.cholesky().expect("M is positive definite").solve(&b);
+        let err = (&qdd_world - &qdd_body).norm() / qdd_body.norm();
+        assert!(err < 1e-13, "{}: q̈ world-aligned vs body frame {err:e}", model.name);
     }
 }
 

@@ -24,10 +24,10 @@ pub struct Data {
     pub f_body: Vec<Force>,
     /// Joint torques of inverse dynamics (nv), N m; `rnea::rnea`.
     pub tau: DVector<f64>,
-    /// Composite inertias (nv): in body coordinates after `crba::crba`, in world coordinates
-    /// about the world origin after `crba::crba_world`.
+    /// Composite inertias (nv): in body coordinates after `crba::crba`; with world axes about
+    /// joint i's origin after `crba::crba_world`.
     pub ic: Vec<Inertia>,
-    /// Joint motion subspaces `(z, o × z)` in world coordinates (nv); `crba::crba_world`.
+    /// Joint motion subspaces with world axes at each joint's own origin, `(z, 0)` or `(0, z)` (nv); `crba::crba_world`.
     pub s_world: Vec<Motion>,
     /// Joint-space inertia M(q) (nv x nv), both triangles filled; `crba::crba` or `walker_orin::mass_matrix`.
     pub m: DMatrix<f64>,

@@ -220,6 +220,30 @@ impl Inertia {
         Inertia { mass: m, h: rh + p * m, i_o }
     }
 
+    /// [`Inertia::to_parent_x`] with a pure rotation `R` (the origin kept): `h' = R h`,
+    /// `I_o' = R I_o Rᵀ`.
+    #[inline]
+    pub fn rotated(&self, r: &Matrix3<f64>) -> Inertia {
+        Inertia { mass: self.mass, h: r * self.h, i_o: r * self.i_o * r.transpose() }
+    }
+
+    /// [`Inertia::to_parent_x`] with a pure translation: the same inertia about a point `p`
+    /// away, axes kept (`p` is this frame's origin in the new one; RBDA eq 2.66 with R = 1):
+    /// `h' = h + m p`, `I_o' = I_o + (2 h·p + m p·p) 1 − p hᵀ − h pᵀ − m p pᵀ`.
+    #[inline]
+    pub fn translated(&self, p: &Vector3<f64>) -> Inertia {
+        let (m, h) = (self.mass, self.h);
+        let mut i_o = self.i_o;
+        let s = 2.0 * h.dot(p) + m * p.dot(p);
+        for c in 0..3 {
+            for k in 0..3 {
+                i_o[(k, c)] -= p[k] * h[c] + h[k] * p[c] + m * p[k] * p[c];
+            }
+            i_o[(c, c)] += s;
+        }
+        Inertia { mass: m, h: h + p * m, i_o }
+    }
+
     #[inline]
     pub fn add(&self, o: &Inertia) -> Inertia {
         Inertia { mass: self.mass + o.mass, h: self.h + o.h, i_o: self.i_o + o.i_o }
@@ -265,6 +289,24 @@ mod tests {
         assert!((a.n - b.n).norm() < 1e-15 && (a.f - b.f).norm() < 1e-15);
         let (a, b) = (i.to_parent(&x), i.to_parent_x(&xm));
         assert!((a.i_o - b.i_o).norm() < 1e-15 && (a.h - b.h).norm() < 1e-15);
+    }
+
+    /// A rotation then a translation equals the whole placement (1e-15): the world-aligned
+    /// CRBA's two steps are `to_parent_x` split in two.
+    #[test]
+    fn rotation_then_translation_is_the_placement() {
+        let x = placement();
+        let xm = Xform::from(&x);
+        let i = Inertia::from_com(0.7, Vector3::new(0.01, 0.02, 0.15), Matrix3::new(0.003, 0.0001, 0.0, 0.0001, 0.002, 0.0, 0.0, 0.0, 0.001));
+        let whole = i.to_parent_x(&xm);
+        let split = i.rotated(&xm.rot).translated(&xm.trans);
+        assert!((whole.i_o - split.i_o).norm() < 1e-15 && (whole.h - split.h).norm() < 1e-15 && whole.mass == split.mass);
+        let rot_only = i.to_parent_x(&Xform { rot: xm.rot, trans: Vector3::zeros() });
+        assert!((rot_only.i_o - i.rotated(&xm.rot).i_o).norm() < 1e-15);
+        // the translated inertia about the new origin has the same I_com and a moved centre
+        let moved = i.translated(&xm.trans);
+        assert!((moved.com() - (i.com() + xm.trans)).norm() < 1e-15);
+        assert!((moved.i_com() - i.i_com()).norm() < 1e-15);
     }
 
     /// Inertia transform agrees with transforming momentum: X^T I X m = X^T (I (X m)), to 1e-14.
