@@ -142,7 +142,7 @@ pub fn simulate_outputs(
         }
         sink(&out)
     };
-    let result = if sys.is_hybrid() {
+    let result = if sys.is_event_driven() {
         // unilateral or compliant contacts: event-driven, with the scene's `events` settings
         let cs = &scene.contact_settings;
         let settings = crate::integrate::EventSettings {

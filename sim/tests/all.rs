@@ -33,6 +33,8 @@ mod convergence;
 mod drives;
 #[path = "fuzz_scenes.rs"]
 mod fuzz_scenes;
+#[path = "gear_supply.rs"]
+mod gear_supply;
 #[path = "hard_cases.rs"]
 mod hard_cases;
 #[path = "paper.rs"]

@@ -8,6 +8,7 @@ pub mod crba;
 pub mod data;
 pub mod energy;
 pub mod forward;
+pub mod gear_friction;
 pub mod kinematics;
 pub mod model;
 pub mod motor;
@@ -15,6 +16,7 @@ pub mod rnea;
 pub mod samples;
 pub mod spatial;
 pub mod spd;
+pub mod supply;
 pub mod urdf;
 pub mod walker_orin;
 

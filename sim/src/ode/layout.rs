@@ -18,6 +18,12 @@ pub struct Layout {
     /// non-bilateral contact (0 otherwise, so the paper's layout is unchanged). Per contact k,
     /// three follow the stops': impact loss, friction work, damping loss.
     pub contacts: usize,
+    /// The gears' Coulomb and efficiency loss `E_g` is present (`gear_friction`); it follows
+    /// the contacts' quadratures.
+    pub gear: bool,
+    /// The supply's four quadratures (energy delivered, regenerated, dumped, conversion loss)
+    /// are present (`supply`); they come last.
+    pub supply: bool,
 }
 
 impl Layout {
@@ -26,7 +32,15 @@ impl Layout {
         self.electrical.states(self.nv)
     }
     pub fn dim(&self) -> usize {
-        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * self.contacts
+        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * self.contacts + usize::from(self.gear) + 4 * usize::from(self.supply)
+    }
+    /// `E_g`, when [`Layout::gear`].
+    pub fn loss_gear(&self) -> Option<usize> {
+        self.gear.then(|| self.impact_loss(self.contacts))
+    }
+    /// The first of the supply's `E_supply, E_regen, E_dump, E_sloss`, when [`Layout::supply`].
+    pub fn supply(&self) -> Option<usize> {
+        self.supply.then(|| self.impact_loss(self.contacts) + usize::from(self.gear))
     }
     pub fn q(&self) -> std::ops::Range<usize> {
         0..self.nv
@@ -100,6 +114,10 @@ impl Layout {
             "back-EMF conversion energy".into()
         } else if Some(k) == self.loss_stop() {
             "joint stop damping loss".into()
+        } else if Some(k) == self.loss_gear() {
+            "gear Coulomb and efficiency loss".into()
+        } else if let Some(s) = self.supply().filter(|&s| k >= s) {
+            ["supply energy", "supply energy regenerated", "supply energy dumped", "supply conversion loss"][(k - s).min(3)].into()
         } else {
             let first = self.impact_loss(0);
             let c = (k - first) / 3;

@@ -32,6 +32,7 @@
 
 mod arm;
 mod describe;
+mod drive_modes;
 mod hybrid;
 mod jacobian;
 mod layout;
@@ -41,7 +42,8 @@ mod stop_slip;
 mod workspace;
 
 pub use arm::ArmSystem;
+pub use drive_modes::GearEvent;
 pub use layout::Layout;
-pub use outputs::{OutputLevel, Outputs};
+pub use outputs::{OutputLevel, Outputs, SupplyOutput};
 #[cfg(test)]
 mod hybrid_tests;

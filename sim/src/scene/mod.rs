@@ -10,6 +10,7 @@ pub mod schema;
 pub mod schema_key;
 pub mod spec;
 mod spec_contacts;
+mod spec_gear_supply;
 mod target;
 
 use std::path::Path;
@@ -94,6 +95,10 @@ pub struct Scene {
     /// The URDF's `<mesh>` references and what became of them (`urdf_xml` holds the resolved
     /// URIs).
     pub(crate) meshes: Vec<MeshInfo>,
+    /// Coulomb friction and efficiency of the gears (`gear_friction`), when the scene has them.
+    pub(crate) gear_friction: Option<crate::dynamics::gear_friction::GearFriction>,
+    /// The supply behind the drives (`supply`), when the scene has one.
+    pub(crate) supply: Option<crate::dynamics::supply::Supply>,
 }
 
 /// Read access (the fields are private to the crate: a scene never changes after validation).
@@ -125,6 +130,14 @@ impl Scene {
     /// The controller: law and gains.
     pub fn controller(&self) -> &Controller {
         &self.controller
+    }
+    /// The gears' Coulomb friction and efficiency, if configured.
+    pub fn gear_friction(&self) -> Option<&crate::dynamics::gear_friction::GearFriction> {
+        self.gear_friction.as_ref()
+    }
+    /// The supply behind the drives, if configured.
+    pub fn supply(&self) -> Option<&crate::dynamics::supply::Supply> {
+        self.supply.as_ref()
     }
     /// The soft joint stops, if configured.
     pub fn stops(&self) -> Option<&JointStops> {
@@ -558,6 +571,8 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     }
 
     let integrator = Integrator::from_spec(&spec.integrator, file, duration, 1.0 / output_rate)?;
+    let gear_friction = spec_gear_supply::gear_friction(&c, spec.gear_friction.as_ref(), nv, &drives.passive)?;
+    let supply = spec_gear_supply::supply(&c, spec.supply.as_ref(), nv)?;
     if integrator.method() == "imex" && drives.electrical == Electrical::Inductive && controller.reads_current() {
         return Err(c.err(
             "controller.current_gain",
@@ -592,6 +607,8 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
         output_rate,
         dir: dir.map(Path::to_path_buf),
         meshes,
+        gear_friction,
+        supply,
         spec,
     })
 }
