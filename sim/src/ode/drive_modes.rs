@@ -211,6 +211,17 @@ impl ArmSystem<'_> {
         Ok(())
     }
 
+    /// For the structured Jacobian (`jacobian.rs`): joint j's gear efficiency factor c on K_m
+    /// and `s ∂τ_f/∂q̇` (the friction torque's slope, as a damping) while it slides; (1, 0)
+    /// otherwise.
+    pub(super) fn gear_jacobian_terms(&self, j: usize, qd: f64) -> (f64, f64) {
+        let (Some(g), Some(m)) = (&self.scene.gear_friction, &self.drive_modes) else { return (1.0, 0.0) };
+        match m.gear[j] {
+            GearMode::Slide { dir, driving } => (g.factor(j, driving), g.sliding_friction_slope(j, qd) * f64::from(dir)),
+            GearMode::Stick => (1.0, 0.0),
+        }
+    }
+
     /// The electric powers `p_j = i_j v_j` of this evaluation into the scratch.
     fn powers_into_scratch(&mut self, y: &[f64]) {
         let l = self.layout;
@@ -331,22 +342,53 @@ impl ArmSystem<'_> {
         }
     }
 
-    /// Set joint j's speed to 0 (slide → stick): the kinetic energy it carried, with M_J of
-    /// the evaluation at y, is booked as gear loss, the rotor's part into W_j as at impacts.
+    /// Set joint j's speed to 0 (it stops): the M_J-weighted velocity projection that keeps the
+    /// bilateral constraints' velocity rows and the sticking joints at rest (as the contacts'
+    /// slip → stick, `stop_slip.rs`; in a closed chain other joints move with j), its
+    /// kinetic-energy change booked as gear loss, the rotors' share into W_j as at impacts.
+    /// Uses M and J_c of the evaluation at y. Allocates (an event, not the step loop).
     fn stop_joint(&mut self, y: &mut [f64], j: usize) {
+        use nalgebra::{DMatrix, DVector};
         let l = self.layout;
         let nv = l.nv;
         let d = &self.scene.drives;
         let m = &self.ws.data.m;
-        let qd = &y[l.qd()];
-        let dq = -qd[j];
-        // ΔT = (q̇ᵀ M_J e_j) Δ + ½ M_J,jj Δ²
-        let mut row = d.jm[j] * qd[j];
-        for c in 0..nv {
-            row += m[(j, c)] * qd[c];
+        let modes = self.drive_modes.as_ref().expect("drive modes");
+        let qd = DVector::from_column_slice(&y[l.qd()]);
+        let mut m_j = m.clone();
+        for k in 0..nv {
+            m_j[(k, k)] += d.jm[k];
         }
-        let d_t = row * dq + 0.5 * (m[(j, j)] + d.jm[j]) * dq * dq;
-        y[l.work().start + j] += -d.jm[j] * (0.0 - qd[j] * qd[j]) / 2.0;
+        // rows: the bilateral constraints (a hybrid run's contact rows are the contacts' own
+        // and are left to their handler), the sticking joints, and j
+        let nc = if self.hybrid.is_some() { 0 } else { self.contacts.len() };
+        let held: Vec<usize> = (0..nv).filter(|&k| k == j || modes.gear[k] == GearMode::Stick).collect();
+        let rows = nc + held.len();
+        let mut a = DMatrix::zeros(rows, nv);
+        let mut b = DVector::zeros(rows);
+        for r in 0..nc {
+            for c in 0..nv {
+                a[(r, c)] = self.ws.fd.jac[(r, c)];
+            }
+        }
+        for (r, &k) in held.iter().enumerate() {
+            a[(nc + r, k)] = 1.0;
+            b[nc + r] = -qd[k];
+        }
+        let Some(chol) = m_j.clone().cholesky() else { return };
+        let minv_at = chol.solve(&a.transpose());
+        let s = &a * &minv_at;
+        let mu = match s.svd(true, true).solve(&b, 1e-12) {
+            Ok(mu) => mu,
+            Err(_) => return,
+        };
+        let dq = &minv_at * mu;
+        let d_t = qd.dot(&(&m_j * &dq)) + 0.5 * dq.dot(&(&m_j * &dq));
+        for k in 0..nv {
+            let (before, after) = (qd[k], qd[k] + dq[k]);
+            y[l.work().start + k] += -d.jm[k] * (after * after - before * before) / 2.0;
+            y[l.qd().start + k] = after;
+        }
         y[l.qd().start + j] = 0.0;
         if let Some(k) = l.loss_gear() {
             y[k] -= d_t;
@@ -372,16 +414,20 @@ impl ArmSystem<'_> {
                 self.log_gear(t, j, GearMode::slide(qd, km_i));
                 continue;
             }
-            // try sticking: the holding torque with j locked
+            // the joint stops: the speed the root location leaves (|q̇| of the order of the
+            // dense output's error at the root) is removed, its kinetic energy booked as gear
+            // loss; then it sticks if the holding torque is in the band, else it slides from
+            // rest the way that torque pushes
+            if qd != 0.0 {
+                self.evaluate(t, y)?;
+                self.stop_joint(y, j);
+                moved = true;
+            }
             self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::Stick;
             self.evaluate(t, y)?;
             let km_i = self.km_i(y, j);
             let lambda = self.drive_modes.as_ref().expect("drive modes").gear_torque[j];
             if g.stick_margin(j, km_i, lambda) >= 0.0 {
-                if qd != 0.0 {
-                    self.stop_joint(y, j);
-                    moved = true;
-                }
                 self.log_gear(t, j, GearMode::Stick);
             } else {
                 let dir = if lambda > 0.0 { -1.0 } else { 1.0 };
