@@ -31,6 +31,12 @@ pub const CONTACTS: &str = "/contacts";
 /// with a non-bilateral contact; not in [`ALL`].
 pub const CONTACT_EVENTS: &str = "/contact_events";
 
+/// [`crate::SupplyState`]: the supply's power and energies (delivered, regenerated, dumped,
+/// lost). Only in runs whose scene has a `supply` ([`SUPPLY_TOPICS`]); not in [`ALL`].
+pub const SUPPLY: &str = "/supply";
+/// The topics only runs with a `supply` have.
+pub const SUPPLY_TOPICS: [&str; 1] = [SUPPLY];
+
 /// `foxglove.SceneUpdate`, written once at t = 0: what does not move in the run, for the 3D
 /// panels of Foxglove (Rerun draws it from its own `.rrd`, `analyze view`): the table (each
 /// contact plane), the target path of the hand. Since format version 3.

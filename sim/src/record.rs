@@ -218,6 +218,11 @@ pub struct Recorder<'a> {
     markers: ContactMarkers,
     /// Each contact's plane normal and tangents `(n, t1, t2)`, world frame, in the run's order.
     contact_frames: Vec<[nalgebra::Vector3<f64>; 3]>,
+    /// `/supply`, reused every sample (`Some` when the scene has a `supply`).
+    supply: Option<schemas::SupplyState>,
+    /// The last sample's gear loss and supply energy, regenerated, dumped, loss (record
+    /// `energy_terms`, scenes with `gear_friction` or `supply`).
+    drive_terms: [f64; 5],
 }
 
 impl<'a> Recorder<'a> {
@@ -346,6 +351,8 @@ impl<'a> Recorder<'a> {
             contact_event: ContactEventMsg::default(),
             contact_terms: [0.0; 3],
             contact_frames: contacts.iter().map(|c| [c.plane.normal_world.into_inner(), c.t1, c.t2]).collect(),
+            supply: scene.supply.is_some().then(schemas::SupplyState::default),
+            drive_terms: [0.0; 5],
         })
     }
 
@@ -459,6 +466,20 @@ impl<'a> Recorder<'a> {
             self.contact_terms = [cs.impact_loss.iter().sum(), cs.friction_work.iter().sum(), cs.damping_loss.iter().sum()];
             self.writer.write(topics::CONTACTS, t_ns, &self.contact_state).map_err(&err)?;
         }
+        self.drive_terms[0] = o.loss_gear;
+        if let (Some(st), Some(sup)) = (self.supply.as_mut(), o.supply) {
+            *st = schemas::SupplyState {
+                time: o.t,
+                power: sup.power,
+                bus_power: sup.bus_power,
+                energy: sup.energy,
+                regenerated: sup.regenerated,
+                dumped: sup.dumped,
+                loss: sup.loss,
+            };
+            self.drive_terms[1..].copy_from_slice(&[sup.energy, sup.regenerated, sup.dumped, sup.loss]);
+            self.writer.write(topics::SUPPLY, t_ns, &*st).map_err(&err)?;
+        }
         Ok(())
     }
 
@@ -538,7 +559,8 @@ impl<'a> Recorder<'a> {
             self.writer.write_record(&rec).map_err(err)?;
         }
         let (conv, stops, hybrid) = (self.scene.drives.has_conversion, self.scene.stops.is_some(), self.hybrid);
-        if conv || stops || hybrid {
+        let (gear, supply) = (self.scene.gear_friction.is_some(), self.scene.supply.is_some());
+        if conv || stops || hybrid || gear || supply {
             let [c, e, l] = self.terms;
             let [imp, fric, damp] = self.contact_terms;
             let rec = EnergyTermsRecord {
@@ -548,6 +570,11 @@ impl<'a> Recorder<'a> {
                 impact_loss: hybrid.then_some(imp),
                 friction_work: hybrid.then_some(fric),
                 damping_loss: hybrid.then_some(damp),
+                gear_loss: gear.then_some(self.drive_terms[0]),
+                supply_energy: supply.then_some(self.drive_terms[1]),
+                supply_regenerated: supply.then_some(self.drive_terms[2]),
+                supply_dumped: supply.then_some(self.drive_terms[3]),
+                supply_loss: supply.then_some(self.drive_terms[4]),
             };
             self.writer.write_record(&rec).map_err(err)?;
         }

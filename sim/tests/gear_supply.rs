@@ -255,3 +255,34 @@ fn the_energy_balance_closes_with_every_new_term() {
         eprintln!("{run}: E = {:.6} J, supply {:.6} J, dumped {:.6} J, gear loss {:.6} J", last.electric_energy.iter().sum::<f64>(), last.supply.unwrap().energy, last.supply.unwrap().dumped, last.loss_gear);
     }
 }
+
+/// The recording: `/supply` every sample (energy non-decreasing without regeneration, the last
+/// one the hand integral) and the `energy_terms` record with the supply's and the gears' totals;
+/// a scene without a supply has no `/supply` topic and none of those keys.
+#[test]
+fn the_supply_and_the_gear_loss_are_recorded() {
+    let (_, e_plus, e_minus) = lowering_by_hand(0.3);
+    let scale = e_plus.abs() + e_minus.abs();
+    let dir = tempfile::tempdir().unwrap();
+    for (with_supply, name) in [(true, "supply"), (false, "plain")] {
+        let supply = with_supply.then(|| SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: None });
+        let scene = lift(-1000.0, supply);
+        let path = dir.path().join(format!("{name}.mcap"));
+        sim::run::run_to_file(&scene, scene.run("lift").unwrap(), &path, |_| {}).unwrap();
+        let rec = schemas::read_recording(&path).unwrap();
+        let terms: schemas::EnergyTermsRecord = rec.record_opt().unwrap().expect("energy_terms (the scene has gear friction)");
+        assert!(terms.gear_loss.unwrap() > 0.0, "{terms:?}");
+        if !with_supply {
+            assert!(rec.read::<schemas::SupplyState>().is_err() && terms.supply_energy.is_none(), "{name}: {terms:?}");
+            continue;
+        }
+        let supply: Vec<(f64, schemas::SupplyState)> = rec.read().unwrap();
+        assert_eq!(supply.len(), 301, "one message per sample");
+        assert!(supply.windows(2).all(|w| w[1].1.energy >= w[0].1.energy - 1e-15), "the energy delivered without regeneration never falls");
+        let last = &supply.last().unwrap().1;
+        assert!((last.energy - e_plus).abs() < 1e-9 * scale && (last.dumped + e_minus).abs() < 1e-9 * scale, "{last:?}");
+        assert!(last.power == 0.0 && last.bus_power == 0.0, "regenerating at the end: the drive clips to 0 W: {last:?}");
+        assert_eq!(terms.supply_energy, Some(last.energy));
+        assert_eq!((terms.supply_dumped, terms.supply_regenerated), (Some(last.dumped), Some(0.0)));
+    }
+}
