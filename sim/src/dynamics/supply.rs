@@ -133,11 +133,13 @@ mod tests {
         // all regenerating on a bus of 0.9: P_b = −15 W, the supply takes back 13.5 W
         let s = Supply { regeneration: vec![true; 3], bus: Some(Bus { efficiency: 0.9, regeneration: true }) };
         let mut pos = [false; 3];
-        let w = s.powers(&p, &pos, s.sides(&p, &mut pos));
+        let bus_pos = s.sides(&p, &mut pos);
+        let w = s.powers(&p, &pos, bus_pos);
         assert!((w.supply + 13.5).abs() < 1e-12 && (w.regenerated - 13.5).abs() < 1e-12);
         // no regeneration anywhere, separate supplies: 35 W delivered, 50 W dumped
         let s = Supply { regeneration: vec![false; 3], bus: None };
-        let w = s.powers(&p, &pos, s.sides(&p, &mut pos));
+        let bus_pos = s.sides(&p, &mut pos);
+        let w = s.powers(&p, &pos, bus_pos);
         assert!((w.supply - 35.0).abs() < 1e-12 && (w.dumped - 50.0).abs() < 1e-12 && w.regenerated == 0.0);
     }
 }
