@@ -355,6 +355,9 @@ fn findings(all: &[RunMetrics], base: usize, links: &[LinkComparison], why_not: 
         if let (Some(e), Some(l)) = (t.stop_energy, t.stop_loss) {
             parts.push(format!("joint stops: stored {e:.4e} J, damping loss {l:.4e} J"));
         }
+        if let Some(g) = t.gear_loss {
+            parts.push(format!("gear Coulomb and efficiency loss {g:.4e} J"));
+        }
         if !parts.is_empty() {
             out.push(format!("{}: the energy balance (residual above) also holds {}.", r.run, parts.join("; ")));
         }
@@ -384,6 +387,24 @@ fn findings(all: &[RunMetrics], base: usize, links: &[LinkComparison], why_not: 
         r.run,
         fixed(r.e_total(), 3)
     ));
+    // the energy the supply delivers (issue 26), over the compared runs whose scene models it:
+    // ranked beside E, as what a real arm draws (regeneration and the DC bus decide it)
+    let supplied: Vec<(&RunMetrics, f64, f64)> = compared
+        .iter()
+        .filter_map(|r| {
+            let t = r.energy_terms.as_ref()?;
+            Some((r, t.supply_energy?, t.supply_dumped.unwrap_or(0.0)))
+        })
+        .collect();
+    if !supplied.is_empty() {
+        let mut order = supplied.clone();
+        order.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let list: Vec<String> = order
+            .iter()
+            .map(|(r, es, dumped)| format!("{} {} J (E {} J, dumped {} J)", r.run, fixed(*es, 3), fixed(r.e_total(), 3), fixed(*dumped, 3)))
+            .collect();
+        out.push(format!("Least energy from the supply: {}; in order: {}.", order[0].0.run, list.join(", ")));
+    }
     let z = argmin(&|r| r.hand().z.rms_m);
     let r = &compared[z];
     let (rms, max) = (r.hand().z.rms_m * 1e3, r.hand().z.max_abs_m * 1e3);
