@@ -13,6 +13,8 @@
 //! - the energy balance closing with every new term (gear loss, supply identity) to 1e-9 of E on
 //!   the small arm with every feature on, at tight tolerance.
 
+#![allow(clippy::result_large_err)] // the sinks return RunError, as `sim::run`'s
+
 use std::f64::consts::PI;
 
 use sim::dynamics::gear_friction::GearMode;
@@ -265,7 +267,7 @@ fn the_supply_and_the_gear_loss_are_recorded() {
     let scale = e_plus.abs() + e_minus.abs();
     let dir = tempfile::tempdir().unwrap();
     for (with_supply, name) in [(true, "supply"), (false, "plain")] {
-        let supply = with_supply.then(|| SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: None });
+        let supply = with_supply.then_some(SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: None });
         let scene = lift(-1000.0, supply);
         let path = dir.path().join(format!("{name}.mcap"));
         sim::run::run_to_file(&scene, scene.run("lift").unwrap(), &path, |_| {}).unwrap();

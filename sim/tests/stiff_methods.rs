@@ -331,6 +331,7 @@ fn the_fastest_modes_are_the_ones_stated() {
 /// `∂q̈/∂q̇`; and RODAS's forward differences over the coupled columns against central ones.
 /// Without the gear terms in `jacobian.rs` (c = 1, no slope) (a) and (b) fail.
 #[test]
+#[allow(clippy::result_large_err)] // Scene::from_json's reader closure
 fn jacobians_match_differences_with_gear_friction_and_a_supply() {
     use sim::integrate::fd_jacobian_columns;
     use sim::scene::spec::{BusSpec, GearFrictionSpec, PerJointFlag, SupplySpec};

@@ -26,6 +26,8 @@
 //! state; each integrand is smooth between events, so the adaptive methods integrate them to
 //! their order.
 
+#![allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `run.rs`
+
 use crate::dynamics::gear_friction::GearMode;
 use crate::dynamics::motor::Electrical;
 use crate::error::{DynamicsError, RunError};
@@ -175,7 +177,6 @@ impl ArmSystem<'_> {
         if n == 0 {
             return Ok(());
         }
-        let nv = self.layout.nv;
         m.qdd0.copy_from_slice(self.ws.fd.qdd.as_slice());
         for a in 0..n {
             let j = self.drive_modes.as_ref().expect("drive modes").stuck[a];
@@ -202,7 +203,6 @@ impl ArmSystem<'_> {
             self.ws.fd.tau_joint[j] += m.lambda[a];
             m.gear_torque[j] = m.lambda[a];
         }
-        let _ = nv;
         self.solve_eq21(t, y)?;
         let m = self.drive_modes.as_ref().expect("drive modes");
         for &j in &m.stuck {
