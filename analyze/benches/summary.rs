@@ -36,6 +36,10 @@ impl schemas::Visitor for Generic {
     fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
         schemas::Visitor::message(&mut self.0, m)
     }
+
+    fn metadata(&mut self, name: &str, entries: &std::collections::BTreeMap<String, String>) {
+        schemas::Visitor::metadata(&mut self.0, name, entries)
+    }
 }
 
 fn generic_metrics(p: &Path) -> analyze::metrics::RunMetrics {

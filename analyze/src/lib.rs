@@ -50,7 +50,7 @@ pub use diff::{read_input, render_diff, Diff, DiffError, Tolerance};
 pub use error::Error;
 pub use metrics::{
     read_run_metrics, read_run_metrics_recover, run_metrics, run_metrics_recovered,
-    stream_run_metrics, LimitsMetrics, Reductions, RunMetrics, Status,
+    stream_run_metrics, ContactAuditMetrics, LimitsMetrics, Reductions, RunMetrics, Status,
 };
 pub use render::{render_comparison, render_comparison_brief, render_comparison_fitted, render_metrics, render_metrics_fitted, Format};
 pub use schemas::RecoverReport;

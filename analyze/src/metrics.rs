@@ -211,6 +211,38 @@ pub struct RunMetrics {
     /// friction needed to stick ([`contacts`] module docs).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub contact_states: Vec<ContactStateMetrics>,
+    /// The contact laws checked at every `/contacts` sample (runs with a unilateral or
+    /// compliant contact): recomputed from the samples, beside what the run recorded.
+    #[serde(default)]
+    pub contact_audit: Option<ContactAuditMetrics>,
+}
+
+/// The contact audit of a run ([`schemas::ContactAuditor`]: each law of each contact's model,
+/// its worst value and the samples beyond its bound).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactAuditMetrics {
+    /// Computed here from the samples, with the bounds of the run's `contacts` record.
+    pub audit: schemas::ContactAudit,
+    /// What the run itself counted (`result.contact_law_breaches`), when it did.
+    pub recorded_breaches: Option<u64>,
+}
+
+impl ContactAuditMetrics {
+    /// Why the audit fails: a law broken at some sample (named, with its worst value, bound
+    /// and times), or the run's own count disagreeing with the samples; `None` when every law
+    /// held at every sample and the run says so.
+    pub fn failure(&self) -> Option<String> {
+        let mut why = self.audit.verdict();
+        match self.recorded_breaches {
+            Some(n) if n != self.audit.breaches => {
+                let s = format!("the run recorded {n} breaches, its samples show {}", self.audit.breaches);
+                why = Some(why.map_or(s.clone(), |w| format!("{w}; {s}")));
+            }
+            _ => {}
+        }
+        why
+    }
 }
 
 /// The `limits` record of a run: limits exceeded and drive saturations, joint and kind each
@@ -250,6 +282,7 @@ impl RunMetrics {
             limits: None,
             energy_terms: None,
             contact_states: Vec::new(),
+            contact_audit: None,
         }
     }
 
@@ -262,6 +295,10 @@ impl RunMetrics {
     /// exceeded", "complete, 1 saturation" (never silent about a limit).
     pub fn status_text(&self) -> String {
         let s = crate::render::status(self.status).to_string();
+        let s = match self.contact_audit.as_ref().map(|a| a.audit.breaches.max(a.recorded_breaches.unwrap_or(0))) {
+            Some(n) if n > 0 => format!("{s}, contact laws broken ({n} sample{})", if n == 1 { "" } else { "s" }),
+            _ => s,
+        };
         match &self.limits {
             Some(l) => schemas::RunResult {
                 limits_exceeded: Some(l.exceeded),

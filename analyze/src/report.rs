@@ -43,6 +43,9 @@ pub fn read_run(path: &Path, check_from: f64, series: bool) -> Result<(RunMetric
             }
             Ok(())
         }
+        fn metadata(&mut self, name: &str, entries: &std::collections::BTreeMap<String, String>) {
+            self.metrics.metadata(name, entries);
+        }
     }
     let topics: Vec<&str> = METRIC_TOPICS.iter().chain(&INTEGRAL_TOPICS).copied().collect();
     let mut tee = Tee { metrics: Reductions::default(), samples: IntegralSamples::default(), series: series.then(Default::default) };

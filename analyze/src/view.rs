@@ -9,7 +9,9 @@
 //! follows what the Rerun 0.41 Python SDK writes for the same archetypes and blueprint, and the
 //! acceptance test loads the result back with that SDK (TESTING.md).
 //!
-//! - [`run`]: one recording read for drawing (typed reader of `schemas`);
+//! - [`run`]: one recording surveyed for drawing (typed reader of `schemas`, streamed);
+//!   [`window`]: its samples drawn one time window at a time as the file streams by, so that
+//!   memory is bounded by the window, not by the recording (issue 29);
 //! - [`entities`]: a run's entities as chunks; [`layout`]: the blueprint; [`blueprint`]: a
 //!   blueprint tree as chunks; [`urdf`], [`pose`]: the geometry.
 //!
@@ -25,6 +27,8 @@ pub mod entities;
 #[cfg(feature = "rerun")]
 pub mod layout;
 #[cfg(feature = "rerun")]
+pub mod manifest;
+#[cfg(feature = "rerun")]
 pub mod pose;
 #[cfg(feature = "rerun")]
 pub mod rrd;
@@ -32,14 +36,15 @@ pub mod rrd;
 pub mod run;
 #[cfg(feature = "rerun")]
 pub mod urdf;
-
+#[cfg(feature = "rerun")]
+pub mod window;
 
 #[cfg(feature = "rerun")]
 mod encode;
 #[cfg(all(test, feature = "rerun"))]
 mod tests;
 #[cfg(feature = "rerun")]
-pub use encode::{encode, fnv1a, labels, read_input, Input};
+pub use encode::{encode, encode_to, fnv1a, labels, read_input, Input};
 
 use std::path::{Path, PathBuf};
 
@@ -68,13 +73,19 @@ pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<Co
             progress();
         }
         let app_id = out.file_stem().map_or_else(|| "recording".to_string(), |s| s.to_string_lossy().into_owned());
-        let bytes = encode(&read, &app_id)?;
         if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|source| Error::Io { file: dir.display().to_string(), op: "creating the directory", source })?;
         }
-        schemas::atomic::write_file(out, &bytes)?;
+        // streamed into the temporary file, renamed when whole
+        let label = out.display().to_string();
+        let mut bytes = 0;
+        schemas::atomic::write_with(out, |f| -> Result<(), Error> {
+            let (_, n) = encode_to(&read, &app_id, std::io::BufWriter::with_capacity(1 << 20, f), &label, window::WINDOW_ROWS)?;
+            bytes = n;
+            Ok(())
+        })?;
         let results = inputs.iter().zip(&read).map(|(p, i)| (p.clone(), i.run.result.clone())).collect();
-        Ok(Converted { bytes: bytes.len() as u64, results })
+        Ok(Converted { bytes, results })
     }
     #[cfg(not(feature = "rerun"))]
     {

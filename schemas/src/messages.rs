@@ -61,6 +61,27 @@ pub struct MotorState {
     pub name: Vec<String>,
 }
 
+/// The motors' thermal state (topic [`crate::topics::MOTOR_TEMPERATURES`], runs with the
+/// thermal model only): the two-node network of each motor (winding, housing) after the
+/// datasheet's thermal data. Arrays have one entry per actuated joint (a passive joint's stay
+/// at the initial temperature, with no copper loss).
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
+pub struct MotorThermalState {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Winding temperature T_w, °C.
+    pub winding_temperature: Vec<f64>,
+    /// Housing temperature T_h, °C.
+    pub housing_temperature: Vec<f64>,
+    /// Winding resistance R(T_w) = R_ref (1 + α_20 (T_w − 20)) / (1 + α_20 (T_ref − 20)), Ω.
+    pub resistance: Vec<f64>,
+    /// Copper loss R(T_w) i², W: the heat into the winding.
+    pub copper_loss: Vec<f64>,
+    /// Joint names, in array order (= metadata `run.joint_names`).
+    #[serde(default)]
+    pub name: Vec<String>,
+}
+
 /// State of every constraint (topic [`crate::topics::CONSTRAINTS`]), one entry per constraint.
 #[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
 pub struct ConstraintState {
@@ -268,6 +289,9 @@ impl TopicMessage for HandState {
 impl TopicMessage for EnergyState {
     const TOPIC: &'static str = topics::ENERGY;
 }
+impl TopicMessage for MotorThermalState {
+    const TOPIC: &'static str = topics::MOTOR_TEMPERATURES;
+}
 impl TopicMessage for ContactState {
     const TOPIC: &'static str = topics::CONTACTS;
 }
@@ -406,7 +430,7 @@ macro_rules! protobuf_message {
     )*};
 }
 
-protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg, SupplyState);
+protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg, MotorThermalState, SupplyState);
 
 // every Foxglove well-known schema, so `sim` can record any of them without touching this crate
 use foxglove::messages as fm;

@@ -18,11 +18,13 @@
 //! | `result` | `status` (`complete`/`failed`) | 0 |
 //! | `result` | `rhs_evals`, `steps`, `rejected` (complete), `error`, `error_time` (failed) | 1 |
 //! | `result` | `limits_exceeded`, `saturations` (only runs whose scene monitors limits) | 2 |
+//! | `result` | `contact_law_breaches` (only runs with a non-bilateral contact) | 2+ |
 //! | `limits` | `monitored`, `resolution`, `exceeded`, `saturations`, `events` (JSON array) — only runs whose scene monitors limits | 2 |
 //! | `energy_terms` | `emf_conversion`, `stop_energy`, `stop_loss` — only the terms a scene has | 2 |
 //! | `energy_terms` | `impact_loss`, `friction_work`, `damping_loss` (totals over the contacts) — only runs with a non-bilateral contact | 2+ |
 //! | `energy_terms` | `gear_loss` (scenes with `gear_friction`), `supply_energy`, `supply_regenerated`, `supply_dumped`, `supply_loss` (scenes with a `supply`) | 3+ |
 //! | `contacts` | `contacts` (JSON array of [`ContactInfo`]), `time_tolerance`, `gap_tolerance`, `velocity_tolerance`, `rest_velocity`, `max_events` — only runs with a non-bilateral contact | 2+ |
+//! | `contact_audit` | `bounds` (JSON), `contacts` (JSON array of [`ContactLaws`]), `samples`, `breaches` — only runs with a non-bilateral contact ([`ContactAuditor`], issue 23) | 2+ |
 //!
 //! `2+`: added within format 2 by issue 11 (contacts), with the topics `/contacts` and
 //! `/contact_events`, all only in runs with a non-bilateral contact. The version was NOT bumped,
@@ -38,6 +40,8 @@ use std::collections::BTreeMap;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+mod audit;
+pub use audit::{AuditBounds, ContactAudit, ContactAuditRecord, ContactAuditor, ContactLaws, Worst};
 mod contacts;
 pub use contacts::{ContactInfo, ContactsRecord};
 mod typed;
@@ -47,6 +51,12 @@ pub use typed::{typed_records, typed_value};
 pub trait MetadataRecord: Serialize + DeserializeOwned {
     /// The MCAP metadata record name.
     const NAME: &'static str;
+
+    /// The record from its keys and text values (what [`crate::Visitor::metadata`] gets); the
+    /// error names the missing or bad key.
+    fn from_metadata(entries: &BTreeMap<String, String>) -> Result<Self, String> {
+        from_entries(entries)
+    }
 }
 
 /// Record `recording`: which format, written by which tool. [`crate::RecordingWriter::create`]
@@ -282,17 +292,23 @@ pub struct RunResult {
     /// Drive saturations (voltage, current window), when limits were monitored.
     #[serde(default, skip_serializing_if = "Option::is_none", with = "text_opt")]
     pub saturations: Option<u64>,
+    /// Samples × laws the contact audit found broken (runs with a non-bilateral contact; the
+    /// record `contact_audit` has the details). A run with breaches is not "complete".
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "text_opt")]
+    pub contact_law_breaches: Option<u64>,
 }
 
 impl RunResult {
     /// "complete", "complete, 3 limits exceeded", "failed, 1 limit exceeded, 2 saturations":
     /// the status and what the limits monitor found (never silent).
     pub fn status_text(&self) -> String {
-        let mut s = match self.status {
-            RunStatus::Complete => "complete".to_string(),
-            RunStatus::Failed => "failed".to_string(),
-        };
         let plural = |n: u64| if n == 1 { "" } else { "s" };
+        let mut s = match (self.status, self.contact_law_breaches.filter(|&n| n > 0)) {
+            (RunStatus::Complete, None) => "complete".to_string(),
+            (RunStatus::Complete, Some(n)) => format!("ran to the end, contact laws broken ({n} sample{})", plural(n)),
+            (RunStatus::Failed, None) => "failed".to_string(),
+            (RunStatus::Failed, Some(n)) => format!("failed, contact laws broken ({n} sample{})", plural(n)),
+        };
         if let Some(n) = self.limits_exceeded.filter(|&n| n > 0) {
             s += &format!(", {n} limit{} exceeded", plural(n));
         }
@@ -386,6 +402,14 @@ pub struct EnergyTermsRecord {
     /// The supply's conversion loss, J (scenes with a `supply`).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
     pub supply_loss: Option<f64>,
+    /// The heat stored in the motors at the end, `Σ C_w ΔT_w + C_h ΔT_h`, J (runs with the
+    /// thermal model; with `heat_to_ambient` it books the resistive loss: E_R = the two).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub heat_stored: Option<f64>,
+    /// The heat the motors' housings gave to the ambient, `∫ Σ (T_h − T_a) / R_th2 dt`, J
+    /// (runs with the thermal model).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub heat_to_ambient: Option<f64>,
 }
 
 impl MetadataRecord for EnergyTermsRecord {
@@ -420,6 +444,7 @@ impl RunResult {
             error_time_s: None,
             limits_exceeded: None,
             saturations: None,
+            contact_law_breaches: None,
         }
     }
 
@@ -434,6 +459,7 @@ impl RunResult {
             error_time_s: time_s,
             limits_exceeded: None,
             saturations: None,
+            contact_law_breaches: None,
         }
     }
 }

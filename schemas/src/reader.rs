@@ -395,6 +395,7 @@ impl State {
                     self.check_format_version(&m.metadata)?;
                 }
                 let run = m.name == crate::meta::RunNames::NAME || m.name == crate::meta::RecordingInfo::NAME;
+                visitor.metadata(&m.name, &m.metadata);
                 self.metadata.entry(m.name).or_default().extend(m.metadata);
                 if run {
                     self.update_run();

@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use foxglove::messages as fm;
 use prost_reflect::{Cardinality, DescriptorPool, Kind};
 
-use crate::messages::{ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, Message, MotorState, RosString, SupplyState};
+use crate::messages::{ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, Message, MotorState, MotorThermalState, RosString, SupplyState};
 use crate::topics::{self, ArrayIndex};
 use crate::units;
 
@@ -61,6 +61,11 @@ fn topic_docs() -> Vec<TopicDoc> {
         doc::<ContactState>(topics::CONTACTS, CONTACTS_EVERY, "per contact: mode, gap, gap rate, normal and friction force, slip velocity, cumulative losses"),
         doc::<ContactEventMsg>(topics::CONTACT_EVENTS, CONTACTS, "one message per contact event (lift-off, touch-down, impact, rest, stick ↔ slip), at its time"),
         doc::<SupplyState>(topics::SUPPLY, "runs whose scene has a `supply`, every sample", "the supply's power, the bus power, and the energy delivered, regenerated, dumped and lost, cumulative"),
+        doc::<MotorThermalState>(
+            topics::MOTOR_TEMPERATURES,
+            "runs with the motors' thermal model (scene `thermal`), every sample",
+            "per motor: winding and housing temperature, winding resistance R(T_w), copper loss",
+        ),
         doc::<fm::SceneUpdate>(topics::SCENE, "every recording (format ≥ 3), once at t = 0", "the table (each contact plane) and the hand's target path, for 3D panels"),
         doc::<fm::SceneUpdate>(
             topics::CONTACT_MARKERS,
@@ -227,7 +232,7 @@ mod tests {
     #[test]
     fn every_topic_and_every_unit_is_on_the_page() {
         let page = topics_markdown();
-        for t in topics::ALL.iter().chain(&topics::CONTACT_TOPICS).chain(&topics::SUPPLY_TOPICS).chain(&topics::VIEWER_TOPICS) {
+        for t in topics::ALL.iter().chain(&topics::CONTACT_TOPICS).chain(&topics::VIEWER_TOPICS).chain(&topics::THERMAL_TOPICS).chain(&topics::SUPPLY_TOPICS) {
             assert!(page.contains(&format!("\n## {t}\n")), "{t} has no section");
         }
         // every unit of the units table appears on its topic's section

@@ -37,6 +37,14 @@ pub const SUPPLY: &str = "/supply";
 /// The topics only runs with a `supply` have.
 pub const SUPPLY_TOPICS: [&str; 1] = [SUPPLY];
 
+/// [`crate::MotorThermalState`]: each motor's winding and housing temperature, winding
+/// resistance and copper loss. Only in runs whose scene turns the thermal model on
+/// ([`THERMAL_TOPICS`]); not in [`ALL`].
+pub const MOTOR_TEMPERATURES: &str = "/motor_temperatures";
+
+/// The topics only runs with the motors' thermal model have, registered after the others.
+pub const THERMAL_TOPICS: [&str; 1] = [MOTOR_TEMPERATURES];
+
 /// `foxglove.SceneUpdate`, written once at t = 0: what does not move in the run, for the 3D
 /// panels of Foxglove (Rerun draws it from its own `.rrd`, `analyze view`): the table (each
 /// contact plane), the target path of the hand. Since format version 3.
@@ -123,6 +131,7 @@ pub fn array_index(topic: &str, field: &str) -> Option<ArrayIndex> {
             | "slip_velocity_t2" | "impact_loss" | "friction_work" | "damping_loss",
         ) => Some(ArrayIndex::Contact),
         (JOINT_STATES, "position" | "velocity" | "effort") => Some(ArrayIndex::Joint),
+        (MOTOR_TEMPERATURES, "winding_temperature" | "housing_temperature" | "resistance" | "copper_loss" | "name") => Some(ArrayIndex::Joint),
         _ => None,
     }
 }

@@ -22,6 +22,7 @@ pub fn fields(topic: &str) -> &'static [(&'static str, &'static str)] {
             ("electric_power", "W"),
             ("torque", "N·m"),
         ],
+        topics::MOTOR_TEMPERATURES => &[("time", "s"), ("winding_temperature", "°C"), ("housing_temperature", "°C"), ("resistance", "Ω"), ("copper_loss", "W")],
         topics::CONSTRAINTS => &[("time", "s"), ("normal_force", "N"), ("position", "m"), ("velocity", "m/s")],
         topics::HAND => &[
             ("time", "s"),
@@ -142,6 +143,7 @@ mod tests {
         check::<crate::EnergyState>(topics::ENERGY);
         check::<crate::ContactState>(topics::CONTACTS);
         check::<crate::ContactEventMsg>(topics::CONTACT_EVENTS);
+        check::<crate::MotorThermalState>(topics::MOTOR_TEMPERATURES);
     }
 
     #[test]

@@ -96,6 +96,10 @@ pub enum LimitKind {
     Current,
     VoltageSaturation,
     CurrentLimit,
+    /// The winding temperature above the datasheet's maximum (thermal model on), °C.
+    WindingTemperature,
+    /// The torque delivered to the link above the gearhead's max intermittent torque, N m.
+    GearTorque,
 }
 
 impl LimitKind {
@@ -107,6 +111,8 @@ impl LimitKind {
             LimitKind::Current => "current",
             LimitKind::VoltageSaturation => "voltage-saturation",
             LimitKind::CurrentLimit => "current-limit",
+            LimitKind::WindingTemperature => "winding-temperature",
+            LimitKind::GearTorque => "gear-torque",
         }
     }
 
@@ -213,6 +219,36 @@ pub struct LimitMonitor {
 }
 
 impl LimitMonitor {
+    /// The monitor of a scene's run: [`LimitMonitor::new`], plus the datasheet drives'
+    /// ratings: the max winding temperature (thermal model on) and the gearhead's max
+    /// intermittent torque.
+    pub fn for_scene(scene: &crate::scene::Scene, dt: f64) -> Option<Self> {
+        let mut extra = Vec::new();
+        if let Some(th) = scene.thermal() {
+            for (j, p) in th.params.iter().enumerate() {
+                if let Some(p) = p {
+                    extra.push((j, LimitKind::WindingTemperature, p.max_winding_temperature));
+                }
+            }
+        }
+        for (j, d) in scene.datasheets().iter().enumerate() {
+            if let Some(t) = d.as_ref().and_then(|d| d.gear_torque_intermittent) {
+                if !scene.drives().passive[j] {
+                    extra.push((j, LimitKind::GearTorque, t));
+                }
+            }
+        }
+        let mut m = Self::new(scene.model(), scene.drives(), scene.monitors_joint_limits() || !extra.is_empty(), dt)?;
+        if !extra.is_empty() {
+            m.monitored += if m.monitored.is_empty() { "" } else { "; " };
+            m.monitored += "datasheet ratings (max winding temperature, gearhead max intermittent torque)";
+        }
+        for (joint, kind, limit) in extra {
+            m.slots.push(Slot { joint, kind, limit, first_time: None, samples: 0, peak: 0.0, bound: 0.0, inside_interval: false, intervals: Vec::new(), interval_count: 0 });
+        }
+        Some(m)
+    }
+
     /// The monitor of a scene: joints' limits when `joints` (the scene has `"joint_limits"`),
     /// the drives' when they have limits; `None` when neither (nothing is monitored).
     pub fn new(model: &Model, drives: &Drives, joints: bool, dt: f64) -> Option<Self> {
@@ -306,15 +342,25 @@ impl LimitMonitor {
                 // the supply clips what the driver's current window leaves of the command
                 LimitKind::VoltageSaturation => match o.voltage_command.get(j) {
                     Some(&v) => {
-                        let w = self.r[j] * self.i_max[j];
+                        let w = o.resistance.get(j).copied().unwrap_or(self.r[j]) * self.i_max[j];
                         let v = if w.is_finite() { v.clamp(self.ke[j] * o.qd[j] - w, self.ke[j] * o.qd[j] + w) } else { v };
                         (v.abs() > s.limit, Some(v.abs()))
                     }
                     None => (false, None),
                 },
+                LimitKind::WindingTemperature => match o.winding_temperature.get(j) {
+                    Some(&t) => (t > s.limit, Some(t)),
+                    None => (false, None),
+                },
+                LimitKind::GearTorque => match o.tau_motor.get(j) {
+                    Some(t) => (t.abs() > s.limit, Some(t.abs())),
+                    None => (false, None),
+                },
                 LimitKind::CurrentLimit => match o.voltage_command.get(j) {
                     Some(v) => {
-                        let asked = (v - self.ke[j] * o.qd[j]).abs() / self.r[j];
+                        // at the winding's resistance now (R(T_w) with the thermal model)
+                        let r = o.resistance.get(j).copied().unwrap_or(self.r[j]);
+                        let asked = (v - self.ke[j] * o.qd[j]).abs() / r;
                         (asked > s.limit, Some(asked))
                     }
                     None => (false, None),

@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use schemas::{
     frame_transform, hand_points, set_hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactInfo, ContactState,
     ContactsRecord, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
-    JointState, Mirror, ModelInfo, MotorState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
+    JointState, Mirror, ModelInfo, MotorState, MotorThermalState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
 };
 use schemas::markers::{self, ContactMarkers, ContactSample, MarkerMode, SceneDescription, TablePlane};
@@ -223,6 +223,13 @@ pub struct Recorder<'a> {
     /// The last sample's gear loss and supply energy, regenerated, dumped, loss (record
     /// `energy_terms`, scenes with `gear_friction` or `supply`).
     drive_terms: [f64; 5],
+    /// The contact audit (hybrid runs): every `/contacts` sample checked against its model's
+    /// laws; record `contact_audit` and the count in `result` at the end.
+    audit: Option<schemas::ContactAuditor>,
+    /// `/motor_temperatures`, when the scene has the thermal model (names set once).
+    thermal: Option<MotorThermalState>,
+    /// The last sample's heat stored and heat to the ambient (record `energy_terms`).
+    heat: [f64; 2],
 }
 
 impl<'a> Recorder<'a> {
@@ -308,9 +315,13 @@ impl<'a> Recorder<'a> {
                 repaired_inertias: crate::dynamics::model::repair_summary(&scene.model.repaired_inertias),
             })
             .map_err(err)?;
-        if hybrid {
-            writer.write_record(&contacts_record(contacts, settings)).map_err(err)?;
-        }
+        let audit = if hybrid {
+            let record = contacts_record(contacts, settings);
+            writer.write_record(&record).map_err(err)?;
+            Some(schemas::ContactAuditor::new(&record))
+        } else {
+            None
+        };
 
         writer
             .write(topics::ROBOT_DESCRIPTION, 0, &RosString { data: scene.urdf_xml.clone() })
@@ -326,9 +337,13 @@ impl<'a> Recorder<'a> {
             target_dt_s: path_dt,
         });
         writer.write(topics::SCENE, 0, &scene_msg).map_err(err)?;
-        // world -> root, then every URDF joint (fixed ones too), in this order every sample
+        // world -> root (none when the URDF's root link is itself named `world`, as UR5's and
+        // Z1's: a frame is not its own parent), then every URDF joint (fixed ones too), in this
+        // order every sample
         let mut tf = FrameTransforms { transforms: Vec::with_capacity(scene.model.urdf_joints.len() + 1) };
-        tf.transforms.push(frame_transform(0, WORLD_FRAME, &scene.model.root_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+        if scene.model.root_link != WORLD_FRAME {
+            tf.transforms.push(frame_transform(0, WORLD_FRAME, &scene.model.root_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
+        }
         for j in &scene.model.urdf_joints {
             tf.transforms.push(frame_transform(0, &j.parent_link, &j.child_link, [0.0; 3], [0.0, 0.0, 0.0, 1.0]));
         }
@@ -343,7 +358,7 @@ impl<'a> Recorder<'a> {
             constraints: ConstraintState { name: contact_names.clone(), ..Default::default() },
             energy: EnergyState { name: joint_names.clone(), ..Default::default() },
             joint_state: JointState { name: joint_names, ..Default::default() },
-            monitor: LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, 1.0 / scene.output_rate),
+            monitor: LimitMonitor::for_scene(scene, 1.0 / scene.output_rate),
             terms: [0.0; 3],
             hybrid,
             markers: ContactMarkers::new(WORLD_FRAME, &contact_names),
@@ -353,6 +368,9 @@ impl<'a> Recorder<'a> {
             contact_frames: contacts.iter().map(|c| [c.plane.normal_world.into_inner(), c.t1, c.t2]).collect(),
             supply: scene.supply.is_some().then(schemas::SupplyState::default),
             drive_terms: [0.0; 5],
+            audit,
+            thermal: scene.thermal.as_ref().map(|_| MotorThermalState { name: scene.model.joint_names(), ..Default::default() }),
+            heat: [0.0; 2],
         })
     }
 
@@ -381,8 +399,9 @@ impl<'a> Recorder<'a> {
         // transforms: world -> root (identity), then every URDF joint (fixed ones too); the
         // frame names were set by `create` (no allocation per sample)
         let stamp = Some(timestamp(t_ns));
-        let (root, joints) = self.tf.transforms.split_at_mut(1);
-        root[0].timestamp = stamp;
+        let roots = self.tf.transforms.len() - model.urdf_joints.len();
+        let (root, joints) = self.tf.transforms.split_at_mut(roots);
+        root.iter_mut().for_each(|r| r.timestamp = stamp);
         for (j, tr) in model.urdf_joints.iter().zip(joints) {
             let x = match j.dof {
                 Some(d) => model.bodies[d].after(&j.origin, o.q[d]),
@@ -404,6 +423,15 @@ impl<'a> Recorder<'a> {
         set(&mut m.electric_power, &o.electric_power);
         set(&mut m.torque, &o.tau_motor);
         self.writer.write(topics::MOTORS, t_ns, &self.motors).map_err(&err)?;
+        if let Some(th) = &mut self.thermal {
+            th.time = o.t;
+            set(&mut th.winding_temperature, &o.winding_temperature);
+            set(&mut th.housing_temperature, &o.housing_temperature);
+            set(&mut th.resistance, &o.resistance);
+            set(&mut th.copper_loss, &o.copper_loss);
+            self.heat = [o.heat_stored, o.heat_to_ambient];
+            self.writer.write(topics::MOTOR_TEMPERATURES, t_ns, th).map_err(&err)?;
+        }
 
         let c = &mut self.constraints;
         c.time = o.t;
@@ -464,6 +492,9 @@ impl<'a> Recorder<'a> {
             set_with(&mut cs.friction_work, &o.contacts, |c| c.friction_work);
             set_with(&mut cs.damping_loss, &o.contacts, |c| c.damping_loss);
             self.contact_terms = [cs.impact_loss.iter().sum(), cs.friction_work.iter().sum(), cs.damping_loss.iter().sum()];
+            if let Some(audit) = self.audit.as_mut() {
+                audit.sample(o.t, cs);
+            }
             self.writer.write(topics::CONTACTS, t_ns, &self.contact_state).map_err(&err)?;
         }
         self.drive_terms[0] = o.loss_gear;
@@ -535,7 +566,7 @@ impl<'a> Recorder<'a> {
         let err = |source| RunError::Recording { path: path.clone(), source };
         // a scene that sets no limits of its own (no `joint_limits`, no drive limits) is still
         // watched against its URDF's limits, and says so only when one was crossed
-        let configured = self.scene.spec.joint_limits.is_some() || self.scene.drives.has_limits;
+        let configured = self.scene.spec.joint_limits.is_some() || self.scene.drives.has_limits || self.scene.thermal.is_some();
         let summary = self.monitor.as_ref().map(LimitMonitor::summary).filter(|s| configured || s.exceeded() + s.saturated() > 0);
         if let Some(sum) = summary {
             let (exceeded, saturations) = (sum.exceeded() as u64, sum.saturated() as u64);
@@ -560,7 +591,8 @@ impl<'a> Recorder<'a> {
         }
         let (conv, stops, hybrid) = (self.scene.drives.has_conversion, self.scene.stops.is_some(), self.hybrid);
         let (gear, supply) = (self.scene.gear_friction.is_some(), self.scene.supply.is_some());
-        if conv || stops || hybrid || gear || supply {
+        let thermal = self.thermal.is_some();
+        if conv || stops || hybrid || thermal || gear || supply {
             let [c, e, l] = self.terms;
             let [imp, fric, damp] = self.contact_terms;
             let rec = EnergyTermsRecord {
@@ -575,7 +607,14 @@ impl<'a> Recorder<'a> {
                 supply_regenerated: supply.then_some(self.drive_terms[2]),
                 supply_dumped: supply.then_some(self.drive_terms[3]),
                 supply_loss: supply.then_some(self.drive_terms[4]),
+                heat_stored: thermal.then_some(self.heat[0]),
+                heat_to_ambient: thermal.then_some(self.heat[1]),
             };
+            self.writer.write_record(&rec).map_err(err)?;
+        }
+        if let Some(audit) = self.audit.take() {
+            let rec = schemas::ContactAuditRecord::from(audit.finish());
+            result.contact_law_breaches = Some(rec.breaches);
             self.writer.write_record(&rec).map_err(err)?;
         }
         self.writer.write_record(&result).map_err(err)?;

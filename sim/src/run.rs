@@ -123,7 +123,7 @@ pub fn simulate_outputs(
     let mut probe = ArmSystem::new(scene, run);
     // limits are monitored on the full outputs only (they need τ, i and the command)
     let mut monitor =
-        if level == OutputLevel::Full { LimitMonitor::new(&scene.model, &scene.drives, scene.monitor_joints, dt_out) } else { None };
+        if level == OutputLevel::Full { LimitMonitor::for_scene(scene, dt_out) } else { None };
     // one sample; `hybrid`: the stepper's system of an event-driven run, whose modes the probe
     // takes over first and whose event log (since the last sample) moves into the outputs
     let mut on_sample = |t: f64, y: &[f64], hybrid: Option<&mut ArmSystem<'_>>| -> Result<(), RunError> {

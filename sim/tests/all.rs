@@ -53,6 +53,8 @@ mod robot_spec;
 mod runaway;
 #[path = "stiff_methods.rs"]
 mod stiff_methods;
+#[path = "thermal.rs"]
+mod thermal;
 #[path = "targets.rs"]
 mod targets;
 #[path = "urdf_corpus.rs"]

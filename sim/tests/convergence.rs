@@ -26,7 +26,7 @@ fn hand(scene: &Scene) -> (Vec<Vector3<f64>>, u64) {
 }
 
 /// Least-squares slope of log y against log x.
-fn slope(x: &[f64], y: &[f64]) -> f64 {
+pub(crate) fn slope(x: &[f64], y: &[f64]) -> f64 {
     let (lx, ly): (Vec<f64>, Vec<f64>) = (x.iter().map(|v| v.ln()).collect(), y.iter().map(|v| v.ln()).collect());
     let n = lx.len() as f64;
     let (mx, my) = (lx.iter().sum::<f64>() / n, ly.iter().sum::<f64>() / n);

@@ -22,7 +22,7 @@ fn with_currents<'a>(scene: &'a Scene, run: &'a sim::scene::Run) -> (ArmSystem<'
 }
 
 /// Central differences of the right-hand side (h relative to each component).
-fn central_jacobian(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {
+pub(crate) fn central_jacobian(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {
     let dim = y.len();
     let mut jac = vec![0.0; dim * dim];
     let (mut yp, mut fp, mut fm) = (y.to_vec(), vec![0.0; dim], vec![0.0; dim]);

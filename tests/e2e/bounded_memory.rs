@@ -114,6 +114,62 @@ fn long_recordings_are_exported_in_bounded_memory() {
     }
 }
 
+/// `view` on the 300 s recording within 200 MB (issue 29: 1.84 GB on main, where the whole
+/// recording was decoded before the `.rrd` was encoded): the recording is surveyed in a
+/// streamed pass, then drawn in time windows as it is read again (`analyze::view::window`).
+/// The `.rrd` holds every sample: read back frame by frame (the RRD framing, each chunk an
+/// Arrow IPC stream), each joint's current has 300 001 rows from 0 to 300 s in several
+/// chunks, and the largest is the known peak, 3 A on joint 3.
+#[test]
+fn long_recordings_are_viewed_in_bounded_memory() {
+    use analyze::view::rrd::{ArrowMsg, KIND_ARROW_MSG};
+    use arrow_array::cast::AsArray;
+    use prost::Message;
+    let dir = tempfile::tempdir().unwrap();
+    let path = long_recording(dir.path());
+    let rrd = dir.path().join("long.rrd");
+    let out = analyze_limited(200_000, &["view", path.to_str().unwrap(), "-o", rrd.to_str().unwrap(), "-q"]);
+    assert_eq!(out.status.code(), Some(0), "view within 200 MB: {}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&rrd).unwrap();
+    // per current entity: rows, chunks, first and last time, largest |value|
+    let mut currents: std::collections::BTreeMap<String, (usize, usize, i64, i64, f64)> = Default::default();
+    let mut i = 12;
+    while i < bytes.len() {
+        let kind = u64::from_le_bytes(bytes[i..i + 8].try_into().unwrap());
+        let len = u64::from_le_bytes(bytes[i + 8..i + 16].try_into().unwrap()) as usize;
+        let payload = &bytes[i + 16..i + 16 + len];
+        i += 16 + len;
+        if kind == analyze::view::rrd::KIND_END {
+            break;
+        }
+        if kind != KIND_ARROW_MSG {
+            continue;
+        }
+        let m = ArrowMsg::decode(payload).unwrap();
+        let batch = analyze::view::rrd::payload_batch(&m).unwrap();
+        let entity = batch.schema().metadata()["rerun:entity_path"].clone();
+        let Some(t) = batch.column_by_name("sim_time") else { continue };
+        if !entity.starts_with("/current_A/") {
+            continue;
+        }
+        let t = t.as_primitive::<arrow_array::types::DurationNanosecondType>();
+        let v = batch.column_by_name("Scalars:scalars").unwrap().as_list::<i32>().values().as_primitive::<arrow_array::types::Float64Type>().clone();
+        let e = currents.entry(entity).or_insert((0, 0, i64::MAX, i64::MIN, 0.0));
+        e.0 += batch.num_rows();
+        e.1 += 1;
+        e.2 = e.2.min(t.value(0));
+        e.3 = e.3.max(t.value(t.len() - 1));
+        e.4 = v.values().iter().fold(e.4, |a, x| a.max(x.abs()));
+    }
+    assert_eq!(currents.len(), 3, "{currents:?}");
+    for (entity, &(rows, chunks, t0, t1, _)) in &currents {
+        assert_eq!((rows, t0, t1), (300_001, 0, 300_000_000_000), "{entity}");
+        assert!(chunks > 1, "{entity}: drawn in windows, {chunks} chunk");
+    }
+    let peak = currents.values().map(|c| c.4).fold(0.0, f64::max);
+    assert!((peak - 3.0).abs() < 1e-9, "{peak}");
+}
+
 /// A recording whose messages carry 5 002-entry arrays while its `run` record declares 3
 /// joints (issue 29: `export` took 530–610 MB on such a 343 KB file): refused as damage under
 /// 200 MB, naming the file, the topic, the field and the time, exit 2, no table left.

@@ -9,6 +9,7 @@ mod analyze_figures;
 mod analyze_tables;
 mod bounded_memory;
 mod cli_voice;
+mod contact_audit;
 mod docs_book;
 mod every_reader;
 mod format_ownership;

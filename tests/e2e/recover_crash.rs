@@ -38,6 +38,9 @@ fn restricted(intact: &Path, t_end_ns: u64) -> RunMetrics {
         fn typed(&self) -> bool {
             self.0.typed()
         }
+        fn metadata(&mut self, name: &str, entries: &std::collections::BTreeMap<String, String>) {
+            self.0.metadata(name, entries);
+        }
     }
     let mut v = Upto(Reductions::default(), t_end_ns);
     let rec = schemas::stream_recording(intact, Some(&METRIC_TOPICS), &mut v).unwrap();

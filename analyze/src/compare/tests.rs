@@ -48,6 +48,7 @@ pub(crate) fn run(name: &str, contacts: &[&str], e: &[f64], w: &[f64], z_rms: f6
         limits: None,
         energy_terms: None,
         contact_states: Vec::new(),
+        contact_audit: None,
         error: None,
         error_time_s: None,
         hand_error: Some(HandError {

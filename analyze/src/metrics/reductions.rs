@@ -118,6 +118,9 @@ pub struct Reductions {
     /// `/contacts` and `/contact_events` (runs with contact models).
     contact_states: ContactReductions,
     contact_state_samples: Samples,
+    /// The contact audit of `/contacts` ([`schemas::ContactAuditor`]), from the `contacts`
+    /// record on (it comes before the samples in every recording `sim` writes).
+    audit: Option<schemas::ContactAuditor>,
 }
 
 /// An array of `len` entries (one per `per`) where the first message of the run had `*seen`.
@@ -263,6 +266,11 @@ impl Reductions {
             0 => Vec::new(),
             _ => self.contact_states.finish(&rec.source, &run.contacts, rec.record_opt::<schemas::ContactsRecord>()?.as_ref())?,
         };
+        let recorded_breaches = rec.result()?.and_then(|r| r.contact_law_breaches);
+        let contact_audit = match (self.audit, self.contact_state_samples.count) {
+            (Some(audit), n) if n > 0 => Some(super::ContactAuditMetrics { audit: audit.finish(), recorded_breaches }),
+            _ => None,
+        };
         let joint_names = run.joint_names;
         let contacts = run.contacts;
         let n = self.hand_samples.count;
@@ -337,6 +345,7 @@ impl Reductions {
             },
             energy_terms: rec.record_opt::<schemas::EnergyTermsRecord>()?,
             contact_states,
+            contact_audit,
         })
     }
 }
@@ -348,6 +357,15 @@ impl schemas::Visitor for Reductions {
     /// generic tree).
     fn typed(&self) -> bool {
         true
+    }
+
+    /// The `contacts` record starts the contact audit (a record that does not parse is left
+    /// to the typed reading at the end, which names it).
+    fn metadata(&mut self, name: &str, entries: &std::collections::BTreeMap<String, String>) {
+        use schemas::MetadataRecord;
+        if name == schemas::ContactsRecord::NAME {
+            self.audit = schemas::ContactsRecord::from_metadata(entries).ok().map(|r| schemas::ContactAuditor::new(&r));
+        }
     }
 
     fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), schemas::Error> {
@@ -418,6 +436,9 @@ impl Reductions {
                 let c = m.decode_ref::<ContactState>(sizes)?;
                 let t = Self::sample(&mut self.contact_state_samples, m)?;
                 self.contact_states.state(t, &c);
+                if let Some(audit) = self.audit.as_mut() {
+                    audit.sample(t, &c);
+                }
             }
             topics::CONTACT_EVENTS => {
                 let e = m.decode::<ContactEventMsg>(sizes)?;

@@ -326,6 +326,10 @@ impl schemas::Visitor for Generic {
     fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
         schemas::Visitor::message(&mut self.0, m)
     }
+
+    fn metadata(&mut self, name: &str, entries: &std::collections::BTreeMap<String, String>) {
+        schemas::Visitor::metadata(&mut self.0, name, entries)
+    }
 }
 
 pub(super) fn generic_metrics(path: &Path) -> Result<RunMetrics, Error> {

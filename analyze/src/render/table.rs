@@ -338,6 +338,31 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
         t.write(&mut out, markdown, width);
     }
 
+    // the contact audit (runs with `/contacts`): each law's worst value over the run and the
+    // samples beyond its bound ([`schemas::ContactAuditor`])
+    if runs.iter().any(|r| r.contact_audit.is_some()) {
+        let bounds = runs.iter().find_map(|r| r.contact_audit.as_ref()).map(|a| a.audit.bounds).expect("some run has an audit");
+        let mut t = Table::new(
+            &format!(
+                "Contact laws at every sample (worst value; bounds: closed |g| {:.0e} m, |ġ| {:.0e} m/s, force {:.0e} N, slip angle {:.0e} rad; \
+                 breaches = samples beyond a bound, 0 when every law held)",
+                bounds.gap_m, bounds.gap_rate_m_s, bounds.force_n, bounds.angle_rad
+            ),
+            &["run", "contact", "closed |g| [m]", "closed |ġ| [m/s]", "inside while open [m]", "pull [N]", "|f| while open [N]", "outside cone [N]", "∠(−f_t, v_t) [rad]", "breaches"],
+        );
+        t.table.left = 2;
+        for (k, r) in runs.iter().enumerate() {
+            let Some(a) = &r.contact_audit else { continue };
+            for c in a.audit.contacts.iter().filter(|c| c.model != "bilateral") {
+                let mut row = vec![name(k), c.contact.clone()];
+                row.extend(c.laws(&a.audit.bounds).iter().map(|l| e(l.2.value)));
+                row.push(c.breaches().to_string());
+                t.table.rows.push(row);
+            }
+        }
+        t.write(&mut out, markdown, width);
+    }
+
     // energy balance
     // the report explains the balance in its own section (report.rs)
     if !markdown {

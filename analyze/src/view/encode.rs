@@ -1,24 +1,28 @@
 //! The `.rrd` of recordings: read each ([`read_input`]), lay the runs out and encode the
 //! stream ([`encode`]).
 
-use std::path::Path;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 use super::chunk::{str_lists, Chunk, Index};
-use super::entities::{self, Paths};
-use super::rrd::{RrdStream, StoreId, StoreKind, Tuid};
+use super::entities::{Bounds, Paths};
+use super::rrd::{RrdStream, StoreId, StoreKind};
 use super::run::Run;
+use super::window::{self, Ids, Sink, WINDOW_ROWS};
 use super::{blueprint, layout};
 
 use crate::Error;
 
 /// What wrote the stores (`StoreSource::Other`).
 const SOURCE: &str = "elbow-sim analyze view";
-/// The first id: 2026-01-01T00:00:00Z in ns (ids count up from it).
-const ID_TIME0_NS: u64 = 1_767_225_600_000_000_000;
 
-/// A recording read for `analyze view`: the run, its label and a hash of the file's bytes.
+/// A recording surveyed for `analyze view` ([`Run::survey`]: what is drawn but the samples,
+/// which are read again window by window as the `.rrd` is written), its label and a hash of
+/// the file's bytes.
 pub struct Input {
     pub run: Run,
+    /// The recording.
+    pub path: PathBuf,
     /// The file stem.
     pub stem: String,
     /// FNV-1a of the file's bytes (the recording id).
@@ -30,14 +34,13 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3))
 }
 
-/// Reads the recording at `path` for [`encode`], through the reader's guard (a regular file
+/// Surveys the recording at `path` for [`encode`], through the reader's guard (a regular file
 /// with the MCAP magic, bounded records, read streamed: a FIFO, a device or a 20 GB file of
 /// anything else is refused before it is read).
 pub fn read_input(path: &Path) -> Result<Input, Error> {
-    let rec = schemas::read_recording(path)?;
     let stem = path.file_stem().map_or_else(|| "recording".to_string(), |s| s.to_string_lossy().into_owned());
-    let run = Run::read(&rec, &stem)?;
-    Ok(Input { run, stem, hash: fnv1a_file(path)? })
+    let run = Run::survey(path, &stem)?;
+    Ok(Input { run, path: path.to_path_buf(), stem, hash: fnv1a_file(path)? })
 }
 
 /// [`fnv1a`] of the file at `path`, read in blocks (the file has passed the reader's guard).
@@ -59,30 +62,6 @@ fn fnv1a_file(path: &Path) -> Result<u64, Error> {
     }
 }
 
-struct Ids {
-    next: u64,
-    inc: u64,
-}
-
-impl Ids {
-    /// `n` consecutive ids; the first.
-    fn take(&mut self, n: u64) -> Tuid {
-        let t = Tuid::new(ID_TIME0_NS + self.next, self.inc);
-        self.next += n.max(1);
-        t
-    }
-}
-
-fn push(stream: &mut RrdStream, store: &StoreId, ids: &mut Ids, chunk: &Chunk) -> Result<(), Error> {
-    let chunk_id = ids.take(1);
-    let first_row = ids.take(chunk.rows as u64);
-    let ipc = chunk
-        .to_ipc(chunk_id, first_row)
-        .map_err(|e| Error::View { file: chunk.entity_path.clone(), detail: format!("encoding the chunk as Arrow IPC: {e}") })?;
-    stream.arrow_msg(store, chunk_id, chunk.is_static(), ipc);
-    Ok(())
-}
-
 /// The labels of the runs in a comparison: their run names when those differ, else the file
 /// stems (which differ, or the caller has refused the inputs).
 pub fn labels(inputs: &[Input]) -> Vec<String> {
@@ -97,34 +76,47 @@ pub fn labels(inputs: &[Input]) -> Vec<String> {
     }
 }
 
-/// The `.rrd` bytes of `inputs` under application id `app_id`: one run as is, several side by
-/// side (entity prefix per run, see [`entities`]), with the blueprint of [`layout`].
+/// The bounds the views of `run` place their cameras by (the whole run's).
+fn bounds(run: &Run) -> Bounds {
+    let w = &run.whole;
+    Bounds { arm_min: w.arm_min, arm_max: w.arm_max, hand_min: w.hand_min, hand_max: w.hand_max, base: w.base }
+}
+
+/// The `.rrd` bytes of `inputs` under application id `app_id` ([`encode_to`] into memory).
 pub fn encode(inputs: &[Input], app_id: &str) -> Result<Vec<u8>, Error> {
+    let (bytes, _) = encode_to(inputs, app_id, Vec::with_capacity(1 << 20), "the .rrd", WINDOW_ROWS)?;
+    Ok(bytes)
+}
+
+/// Writes the `.rrd` of `inputs` under application id `app_id` to `out` (`label` names it in
+/// errors): one run as is, several side by side (entity prefix per run, see
+/// [`super::entities`]), with the blueprint of [`layout`]. Each recording is read again and
+/// drawn in time windows of about `window_rows` samples ([`window`]), so memory does not grow
+/// with the recordings; the footer lists every chunk ([`super::manifest`]). Returns the writer
+/// and the bytes written.
+pub fn encode_to<W: Write>(inputs: &[Input], app_id: &str, out: W, label: &str, window_rows: usize) -> Result<(W, u64), Error> {
     let hash = inputs.iter().fold(fnv1a(app_id.as_bytes()), |h, i| h.rotate_left(5) ^ i.hash);
     let recording = StoreId::new(StoreKind::Recording, app_id, &format!("{app_id}-{hash:016x}"));
     let blueprint_id = StoreId::new(StoreKind::Blueprint, app_id, &format!("{app_id}-{hash:016x}-blueprint"));
-    let mut ids = Ids { next: 0, inc: hash };
+    let io = |source| Error::Io { file: label.to_string(), op: "writing", source };
+    let mut sink = Sink { stream: RrdStream::new(out).map_err(io)?, ids: Ids::new(hash), manifests: Default::default(), label: label.to_string() };
 
-    // the entities of every run
+    // where each run goes, and the blueprint (from the surveys: the whole runs' bounds)
     let single = inputs.len() == 1;
     let labels = labels(inputs);
-    let mut chunks = vec![Chunk::new("/__properties", Index::Static).with(
-        "rerun.archetypes.RecordingInfo",
-        "name",
-        "rerun.components.Name",
-        str_lists(&[vec![app_id.to_string()]]),
-    )];
-    let mut placed = Vec::with_capacity(inputs.len());
-    for (k, (input, label)) in inputs.iter().zip(&labels).enumerate() {
-        let paths = if single {
-            Paths { prefix: String::new(), run: None, index: 0 }
-        } else {
-            Paths { prefix: layout::prefix(label), run: Some(label.clone()), index: k }
-        };
-        let (c, bounds) = entities::run_chunks(&input.run, &paths);
-        chunks.extend(c);
-        placed.push((paths, bounds));
-    }
+    let placed: Vec<(Paths, Bounds)> = inputs
+        .iter()
+        .zip(&labels)
+        .enumerate()
+        .map(|(k, (input, label))| {
+            let paths = if single {
+                Paths { prefix: String::new(), run: None, index: 0 }
+            } else {
+                Paths { prefix: layout::prefix(label), run: Some(label.clone()), index: k }
+            };
+            (paths, bounds(&input.run))
+        })
+        .collect();
     let root = if single {
         layout::single(&inputs[0].run, &placed[0].0, &placed[0].1)
     } else {
@@ -132,17 +124,25 @@ pub fn encode(inputs: &[Input], app_id: &str) -> Result<Vec<u8>, Error> {
         layout::comparison(&refs)
     };
 
-    let mut stream = RrdStream::new();
     // the blueprint first (as the SDK does), made the default of the application id
-    stream.set_store_info(ids.take(1), &blueprint_id, SOURCE);
+    let store_info = sink.ids.take(1);
+    sink.stream.set_store_info(store_info, &blueprint_id, SOURCE).map_err(io)?;
     for c in blueprint::chunks(&root, hash) {
-        push(&mut stream, &blueprint_id, &mut ids, &c)?;
+        sink.push(&blueprint_id, &c)?;
     }
-    stream.activate_blueprint(&blueprint_id);
-    stream.set_store_info(ids.take(1), &recording, SOURCE);
-    for c in &chunks {
-        push(&mut stream, &recording, &mut ids, c)?;
+    sink.stream.activate_blueprint(&blueprint_id).map_err(io)?;
+    let store_info = sink.ids.take(1);
+    sink.stream.set_store_info(store_info, &recording, SOURCE).map_err(io)?;
+    let properties = Chunk::new("/__properties", Index::Static).with(
+        "rerun.archetypes.RecordingInfo",
+        "name",
+        "rerun.components.Name",
+        str_lists(&[vec![app_id.to_string()]]),
+    );
+    sink.push(&recording, &properties)?;
+    // the entities of every run, window by window
+    for (input, (paths, _)) in inputs.iter().zip(&placed) {
+        window::draw_run(&input.path, &input.run, paths, &recording, &mut sink, window_rows)?;
     }
-    Ok(stream.into_bytes())
+    sink.finish()
 }
-

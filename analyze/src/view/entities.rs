@@ -171,13 +171,6 @@ pub struct Bounds {
     pub base: [f64; 3],
 }
 
-fn grow(min: &mut [f64; 3], max: &mut [f64; 3], p: [f64; 3]) {
-    for i in 0..3 {
-        min[i] = min[i].min(p[i]);
-        max[i] = max[i].max(p[i]);
-    }
-}
-
 /// Radius of the largest sphere among the URDF visuals (the hand's, in the paper's arm), m.
 fn hand_sphere_radius(run: &Run) -> f64 {
     run.visuals
@@ -257,28 +250,12 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
-    // world positions: arm bounds (every frame origin, a few hundred samples) and contact points
-    let mut bounds = Bounds {
-        arm_min: [f64::INFINITY; 3],
-        arm_max: [f64::NEG_INFINITY; 3],
-        hand_min: [f64::INFINITY; 3],
-        hand_max: [f64::NEG_INFINITY; 3],
-        base: [0.0; 3],
-    };
-    if let Some((base, _)) = run.frames.iter().find(|(_, f)| f.parent == run.root_frame) {
-        if !times.is_empty() {
-            bounds.base = run.world_poses(0).get(base.as_str()).map_or([0.0; 3], |p| p.translation);
-        }
-    }
-    let stride = (times.len() / 200).max(1);
+    // the bounds are the whole run's (`Run::survey`); the contact points those of the window
+    let w = &run.whole;
+    let bounds = Bounds { arm_min: w.arm_min, arm_max: w.arm_max, hand_min: w.hand_min, hand_max: w.hand_max, base: w.base };
     let mut contact_points: Vec<Vec<[f64; 3]>> = vec![Vec::with_capacity(times.len()); run.contacts.len()];
     for k in 0..times.len() {
         let poses = run.world_poses(k);
-        if k % stride == 0 || k + 1 == times.len() {
-            for p in poses.values() {
-                grow(&mut bounds.arm_min, &mut bounds.arm_max, p.translation);
-            }
-        }
         for (c, pts) in run.contacts.iter().zip(contact_points.iter_mut()) {
             if let Some(link) = &c.link {
                 pts.push(poses.get(link.as_str()).map_or([0.0; 3], |p: &Pose| p.apply(c.offset_m)));
@@ -286,15 +263,11 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
-    // the hand: path, trail, points now
+    // the hand: path, trail (the whole run's), points now
     let hand_times: Vec<i64> = run.hand.iter().map(|(t, _)| ns(*t)).collect();
     let v3 = |v: &schemas::Vec3| [v.x, v.y, v.z];
     let desired: Vec<[f64; 3]> = run.hand.iter().map(|(_, h)| v3(&h.desired)).collect();
     let actual: Vec<[f64; 3]> = run.hand.iter().map(|(_, h)| v3(&h.actual)).collect();
-    for p in desired.iter().chain(&actual) {
-        grow(&mut bounds.hand_min, &mut bounds.hand_max, *p);
-        grow(&mut bounds.arm_min, &mut bounds.arm_max, *p);
-    }
     let r_hand = hand_sphere_radius(run);
     // larger than the hand sphere, so that the actual point shows around it
     let r_point = if r_hand > 0.0 { 1.35 * r_hand } else { 0.02 };
@@ -303,13 +276,13 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             Chunk::new(format!("{world}/target_path"), Index::Static)
                 .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_desired()]]))
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.002]]))
-                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![desired.iter().copied().map(f3).collect()]])),
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![w.target_path.iter().copied().map(f3).collect()]])),
         );
         out.push(
             Chunk::new(format!("{world}/hand_trail"), Index::Static)
                 .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_actual()]]))
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.0015]]))
-                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![actual.iter().copied().map(f3).collect()]])),
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[vec![w.hand_trail.iter().copied().map(f3).collect()]])),
         );
         for (name, pts, color, label, r) in
             [("actual", &actual, hand_actual(), "hand (actual)", r_point), ("desired", &desired, hand_desired(), "target (desired)", 0.75 * r_point)]
@@ -362,14 +335,8 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
     // contacts: marker and force arrow per sample, coloured by mode
     let (f_n, f_t, modes) = contact_forces(run);
     // the largest force after the start-up transient (the first 5 % of the samples, where an
-    // impulse-like peak would shrink every arrow) is drawn 0.25 m long
-    let skip = |v: &Vec<f64>, per: usize| v.len() / (20 * per) * per;
-    let f_max = f_n
-        .iter()
-        .flat_map(|v| v[skip(v, 1)..].iter())
-        .chain(f_t.iter().flat_map(|v| v[skip(v, 2)..].iter()))
-        .fold(0.0f64, |a, f| a.max(f.abs()));
-    let scale = if f_max > 0.0 { 0.25 / f_max } else { 0.0 };
+    // impulse-like peak would shrink every arrow) is drawn 0.25 m long (`Run::survey`)
+    let scale = w.force_scale;
     let force_times: Vec<i64> = if run.contact_states.is_some() {
         run.contact_states.iter().flatten().map(|(t, _)| ns(*t)).collect()
     } else {
@@ -488,7 +455,7 @@ fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], m
         let jp = escape(joint);
         let current = run.motors.iter().map(|(_, m)| m.current[j]).collect();
         out.extend(series(format!("{}/{jp}", paths.signal(CURRENT)), &motor_t, current, &format!("{joint} [A]"), color, width));
-        if run.motors.iter().all(|(_, m)| m.voltage.len() == run.joints.len()) && !run.motors.is_empty() {
+        if run.whole.voltage_every_joint {
             let v = run.motors.iter().map(|(_, m)| m.voltage[j]).collect();
             out.extend(series(format!("{}/{jp}", paths.signal(VOLTAGE)), &motor_t, v, &format!("{joint} [V]"), color, width));
         }

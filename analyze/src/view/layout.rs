@@ -59,22 +59,7 @@ fn plot(name: &str, origin: String) -> Node {
     Node::View(View::new(ViewClass::TimeSeries, name, origin))
 }
 
-/// A y range that leaves out a start-up transient: the range of the samples after the first
-/// 5 % of the run, padded by 10 %, when the whole range is more than 3 times wider (else
-/// `None`: the viewer fits every sample).
-pub fn range_after_transient(samples: &[(f64, Vec<f64>)]) -> Option<[f64; 2]> {
-    let t_end = samples.last()?.0;
-    let t0 = samples.first()?.0;
-    let skip = t0 + 0.05 * (t_end - t0);
-    let span = |it: &mut dyn Iterator<Item = f64>| it.fold([f64::INFINITY, f64::NEG_INFINITY], |[a, b], x| [a.min(x), b.max(x)]);
-    let [lo_all, hi_all] = span(&mut samples.iter().flat_map(|(_, v)| v.iter().copied()));
-    let [lo, hi] = span(&mut samples.iter().filter(|(t, _)| *t >= skip).flat_map(|(_, v)| v.iter().copied()));
-    if !(lo.is_finite() && hi.is_finite()) || hi_all - lo_all <= 3.0 * (hi - lo) {
-        return None;
-    }
-    let pad = 0.1 * (hi - lo).max(1e-9);
-    Some([lo - pad, hi + pad])
-}
+pub use super::run::range_after_transient;
 
 /// A plot of one run: title, entity root, fixed y range.
 struct Plot {
@@ -94,20 +79,19 @@ impl Plot {
 /// The plots one run has.
 fn plots(run: &Run, paths: &Paths) -> Vec<Plot> {
     let p = |key: &'static str, title: &str, y_range| Plot { key, title: title.to_string(), origin: paths.signal(key), y_range };
-    let currents: Vec<(f64, Vec<f64>)> = run.motors.iter().map(|(t, m)| (*t, m.current.clone())).collect();
-    let r = range_after_transient(&currents);
+    // the y ranges are the whole run's (`Run::survey`)
+    let r = run.whole.current_range;
     let title = if r.is_some() { "motor currents [A] (start-up transient off scale)" } else { "motor currents [A]" };
     let mut v = vec![p(signal::CURRENT, title, r)];
-    if run.motors.first().is_some_and(|(_, m)| !m.voltage.is_empty()) {
-        let volts: Vec<(f64, Vec<f64>)> = run.motors.iter().map(|(t, m)| (*t, m.voltage.clone())).collect();
-        let r = range_after_transient(&volts);
+    if run.whole.has_voltage {
+        let r = run.whole.voltage_range;
         let title = if r.is_some() { "motor voltages [V] (start-up transient off scale)" } else { "motor voltages [V]" };
         v.push(p(signal::VOLTAGE, title, r));
     }
     if !run.contacts.is_empty() {
         v.push(p(signal::NORMAL_FORCE, "contact normal forces f_n [N] (< 0: the table pulls)", None));
     }
-    if run.contact_states.is_some() && !run.contacts.is_empty() {
+    if run.whole.has_contact_states && !run.contacts.is_empty() {
         v.push(p(signal::FRICTION_FORCE, "friction forces |f_t| [N]", None));
         v.push(p(signal::CONTACT_MODE, "contact modes (0 separated, 1 sticking, 2 sliding, 3 bilateral)", Some([-0.2, 3.2])));
     }
@@ -124,7 +108,7 @@ pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     let mut grid: Vec<Node> = plots(run, paths).iter().map(|p| p.node(&p.title)).collect();
     grid.push(plot("energy totals [J]", format!("/{}", signal::ENERGY)));
     grid.push(plot("energy balance residual [J]", paths.signal(signal::RESIDUAL)));
-    if !run.events.is_empty() {
+    if run.whole.has_events {
         grid.push(Node::View(View::new(ViewClass::TextLog, "contact events", format!("{}/events", paths.prefix))));
     }
     Node::container(

@@ -2,18 +2,20 @@
 //!
 //! Framing, as Rerun 0.36-0.41 write and read it (`re_log_encoding/src/rrd/frames.rs` and
 //! `encoder.rs` in <https://github.com/rerun-io/rerun>, checked against files the 0.41 Python SDK
-//! writes):
+//! and `rerun rrd migrate` write):
 //! - a 12-byte stream header: FourCC `RRF2`, the writer's version `[major, minor, patch, 0]`,
-//!   and the options `[compression, serializer, 0, 0]` (compression
-//!   0 = off, serializer 2 = protobuf);
+//!   and the options `[compression, serializer, 0, 0]` (compression 1 = LZ4, serializer 2 =
+//!   protobuf);
 //! - messages, each a 16-byte header (`kind: u64 LE`, `len: u64 LE`; kind 1 = `SetStoreInfo`,
-//!   2 = `ArrowMsg`, 3 = `BlueprintActivationCommand`) then `len` bytes of that protobuf message
-//!   (`rerun/v1alpha1/log_msg.proto`, `common.proto`);
-//! - no footer: the footer (an index of the chunks, `End` message + `RRF2FOOT`) is optional, and
-//!   a stream without it is read in order (Rerun's own `Encoder::do_not_emit_footer`).
+//!   2 = `ArrowMsg`, 3 = `BlueprintActivationCommand`, 0 = `End`) then `len` bytes of that
+//!   protobuf message (`rerun/v1alpha1/log_msg.proto`, `common.proto`);
+//! - the `End` message with the footer, the manifests of every chunk ([`super::manifest`]),
+//!   then the 32-byte stream footer that points at it (`…RRF2FOOT`): what `rerun rrd verify`
+//!   and the Python reader of 0.41 require of a current file.
 //!
 //! An `ArrowMsg`'s payload is an Arrow IPC *stream* holding one record batch, the chunk
-//! ([`super::chunk`]), left uncompressed (`COMPRESSION_NONE`).
+//! ([`super::chunk`]), LZ4-compressed (block format, the size in `uncompressed_size`; Rerun's
+//! own writer compresses the same way).
 
 use prost::Message;
 
@@ -128,7 +130,7 @@ pub struct StoreVersion {
 pub struct ArrowMsg {
     #[prost(message, optional, tag = "1")]
     pub store_id: Option<StoreId>,
-    /// `Compression`: 1 = none.
+    /// `Compression`: [`COMPRESSION_OFF`] or [`COMPRESSION_LZ4`].
     #[prost(int32, tag = "2")]
     pub compression: i32,
     #[prost(uint64, tag = "3")]
@@ -154,74 +156,134 @@ pub struct BlueprintActivationCommand {
     pub make_default: bool,
 }
 
+/// `Compression` of an [`ArrowMsg`] payload: 1 = none, 2 = LZ4 (block format, no size
+/// prefix; the size is `uncompressed_size`).
+pub const COMPRESSION_OFF: i32 = 1;
+pub const COMPRESSION_LZ4: i32 = 2;
+
 /// Message kinds of the frame header.
+pub const KIND_END: u64 = 0;
 pub const KIND_SET_STORE_INFO: u64 = 1;
 pub const KIND_ARROW_MSG: u64 = 2;
 pub const KIND_BLUEPRINT_ACTIVATION: u64 = 3;
 
-/// An RRD stream being written into memory (the caller writes the bytes atomically).
-pub struct RrdStream {
-    bytes: Vec<u8>,
+/// An RRD stream being written to `W` (a file, or memory), message by message.
+pub struct RrdStream<W: std::io::Write> {
+    out: W,
+    /// Bytes written so far.
+    written: u64,
+    /// One message's bytes (reused).
+    scratch: Vec<u8>,
 }
 
-impl Default for RrdStream {
-    fn default() -> Self {
-        Self::new()
+impl RrdStream<Vec<u8>> {
+    /// A stream into memory.
+    pub fn in_memory() -> std::io::Result<Self> {
+        RrdStream::new(Vec::with_capacity(1 << 20))
+    }
+
+    pub fn into_bytes(self) -> Vec<u8> {
+        self.out
     }
 }
 
-impl RrdStream {
-    /// A stream with its header.
-    pub fn new() -> Self {
+impl<W: std::io::Write> RrdStream<W> {
+    /// A stream with its header written to `out`.
+    pub fn new(mut out: W) -> std::io::Result<Self> {
         let (major, minor, patch) = RERUN_VERSION;
-        let mut bytes = Vec::with_capacity(1 << 20);
-        bytes.extend_from_slice(b"RRF2");
-        bytes.extend_from_slice(&[major, minor, patch, 0]);
-        // compression off, protobuf
-        bytes.extend_from_slice(&[0, 2, 0, 0]);
-        RrdStream { bytes }
+        let mut header = Vec::with_capacity(12);
+        header.extend_from_slice(b"RRF2");
+        header.extend_from_slice(&[major, minor, patch, 0]);
+        // LZ4, protobuf
+        header.extend_from_slice(&[1, 2, 0, 0]);
+        out.write_all(&header)?;
+        Ok(RrdStream { out, written: header.len() as u64, scratch: Vec::new() })
     }
 
-    fn message(&mut self, kind: u64, msg: &impl Message) {
-        self.bytes.extend_from_slice(&kind.to_le_bytes());
-        self.bytes.extend_from_slice(&(msg.encoded_len() as u64).to_le_bytes());
-        msg.encode_raw(&mut self.bytes);
+    /// Bytes written so far.
+    pub fn written(&self) -> u64 {
+        self.written
+    }
+
+    fn message(&mut self, kind: u64, msg: &impl Message) -> std::io::Result<()> {
+        self.scratch.clear();
+        self.scratch.extend_from_slice(&kind.to_le_bytes());
+        self.scratch.extend_from_slice(&(msg.encoded_len() as u64).to_le_bytes());
+        msg.encode_raw(&mut self.scratch);
+        self.out.write_all(&self.scratch)?;
+        self.written += self.scratch.len() as u64;
+        Ok(())
     }
 
     /// Opens a store (a recording or a blueprint): what every later message of it refers to.
-    pub fn set_store_info(&mut self, row_id: Tuid, store: &StoreId, source: &str) {
+    pub fn set_store_info(&mut self, row_id: Tuid, store: &StoreId, source: &str) -> std::io::Result<()> {
         let (major, minor, patch) = RERUN_VERSION;
         let info = StoreInfo {
             store_id: Some(store.clone()),
             store_source: Some(StoreSource { kind: 6, extra: Some(StoreSourceExtra { payload: source.as_bytes().to_vec() }) }),
             store_version: Some(StoreVersion { crate_version_bits: (i32::from(major) << 16) | (i32::from(minor) << 8) | i32::from(patch) }),
         };
-        self.message(KIND_SET_STORE_INFO, &SetStoreInfo { row_id: Some(row_id), info: Some(info) });
+        self.message(KIND_SET_STORE_INFO, &SetStoreInfo { row_id: Some(row_id), info: Some(info) })
     }
 
-    /// One chunk: `ipc` is an Arrow IPC stream of one record batch.
-    pub fn arrow_msg(&mut self, store: &StoreId, chunk_id: Tuid, is_static: bool, ipc: Vec<u8>) {
+    /// One chunk: `ipc` is an Arrow IPC stream of one record batch, written LZ4-compressed.
+    /// Returns where the message lies after its header: offset and length (the footer's).
+    pub fn arrow_msg(&mut self, store: &StoreId, chunk_id: Tuid, is_static: bool, ipc: Vec<u8>) -> std::io::Result<(u64, u64)> {
+        let payload = lz4::block::compress(&ipc, None, false)?;
         let msg = ArrowMsg {
             store_id: Some(store.clone()),
-            compression: 1,
+            compression: COMPRESSION_LZ4,
             uncompressed_size: ipc.len() as u64,
             encoding: 1,
-            payload: ipc,
+            payload,
             chunk_id: Some(chunk_id),
             is_static: Some(is_static),
         };
-        self.message(KIND_ARROW_MSG, &msg);
+        let start = self.written + 16;
+        self.message(KIND_ARROW_MSG, &msg)?;
+        Ok((start, self.written - start))
+    }
+
+    /// Ends the stream: the `End` message carrying `footer` (the protobuf `RrdFooter`), then
+    /// the stream footer that points at it.
+    pub fn end(&mut self, footer: &[u8]) -> std::io::Result<()> {
+        let mut out = Vec::with_capacity(footer.len() + 48);
+        out.extend_from_slice(&KIND_END.to_le_bytes());
+        out.extend_from_slice(&(footer.len() as u64).to_le_bytes());
+        let offset = self.written + 16;
+        out.extend_from_slice(footer);
+        out.extend_from_slice(&super::manifest::stream_footer(offset, footer));
+        self.out.write_all(&out)?;
+        self.written += out.len() as u64;
+        Ok(())
     }
 
     /// Makes `blueprint` the default blueprint of its application id.
-    pub fn activate_blueprint(&mut self, blueprint: &StoreId) {
+    pub fn activate_blueprint(&mut self, blueprint: &StoreId) -> std::io::Result<()> {
         self.message(
             KIND_BLUEPRINT_ACTIVATION,
             &BlueprintActivationCommand { blueprint_id: Some(blueprint.clone()), make_active: false, make_default: true },
-        );
+        )
     }
 
-    pub fn into_bytes(self) -> Vec<u8> {
-        self.bytes
+    /// Flushes and gives the writer back.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        self.out.flush()?;
+        Ok(self.out)
     }
+}
+
+/// The chunk an [`ArrowMsg`] carries, as a record batch (its payload decompressed when it is
+/// LZ4-compressed): how a reader gets it back, for the tests.
+pub fn payload_batch(msg: &ArrowMsg) -> Result<arrow_array::RecordBatch, String> {
+    let ipc = match msg.compression {
+        COMPRESSION_LZ4 => {
+            let size = i32::try_from(msg.uncompressed_size).map_err(|_| format!("uncompressed size {} too large", msg.uncompressed_size))?;
+            lz4::block::decompress(&msg.payload, Some(size)).map_err(|e| format!("LZ4: {e}"))?
+        }
+        _ => msg.payload.clone(),
+    };
+    let mut r = arrow_ipc::reader::StreamReader::try_new(ipc.as_slice(), None).map_err(|e| e.to_string())?;
+    let batch = r.next().ok_or("no record batch")?.map_err(|e| e.to_string())?;
+    Ok(batch)
 }

@@ -2,16 +2,23 @@
 //! visuals, the contact planes and points, and the typed signals (`/motors`, `/energy`,
 //! `/constraints` or `/contacts`, `/hand`, `/contact_events`).
 //!
-//! Everything comes through the typed reader of `schemas` ([`Recording::read_sized`], the
-//! metadata records); the contact points and planes come from the `contacts` record when the
+//! Read streamed, never whole (issue 29: memory bounded by the work, not the file): [`Run::survey`]
+//! reads the metadata and, in a streamed pass with O(1) memory per series, what needs the whole
+//! run ([`Whole`]: bounds, force scale, y ranges, the hand paths decimated); the samples come
+//! later, one time window at a time (`super::window`), into the same [`Run`]. Messages are
+//! decoded by the typed reader of `schemas` (its array checks, the metadata records); a `/tf`
+//! transform from a frame to itself (a URDF whose root link is named `world`, as UR5's and Z1's
+//! of example-robot-data, under the recording's `world` → root) is left out of the tree. The
+//! contact points and planes come from the `contacts` record when the
 //! recording has one, and from the scene the recording embeds (its `contacts[].point` and
 //! `.plane`, the scene's own keys) for the points and for the planes of a run without an active
 //! contact (the paper's no-elbow run still shows the table its scene defines).
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
 use schemas::{
-    RunResult, RunStatus, ArraySizes, ConstraintState, ContactEventMsg, ContactState, ContactsRecord, EnergyState, HandState, MotorState, Recording,
+    ArraySizes, ConstraintState, ContactEventMsg, ContactState, ContactsRecord, EnergyState, HandState, MotorState, Recording, RunResult, RunStatus,
     Transforms,
 };
 
@@ -45,11 +52,12 @@ pub struct ContactPoint {
 #[derive(Debug, Clone)]
 pub struct Frame {
     pub parent: String,
-    /// Pose in the parent frame, per sample.
+    /// Pose in the parent frame, per sample of the window.
     pub in_parent: Vec<Pose>,
 }
 
 /// A recording, read for drawing.
+#[derive(Debug, Clone)]
 pub struct Run {
     /// The run's name (metadata `run.run`), or the file stem.
     pub name: String,
@@ -60,9 +68,10 @@ pub struct Run {
     pub other_planes: Vec<Plane>,
     /// The root of the `/tf` tree (`world`).
     pub root_frame: String,
-    /// Frames in the order they first appear (parents before children).
+    /// Frames in the order they first appear (parents before children); their poses are those
+    /// of the time window being drawn.
     pub frames: Vec<(String, Frame)>,
-    /// Times of the `/tf` samples, ns.
+    /// Times of the window's `/tf` samples, ns (the samples below are the window's too).
     pub tf_times_ns: Vec<i64>,
     pub visuals: Visuals,
     pub hand: Vec<(f64, HandState)>,
@@ -74,6 +83,8 @@ pub struct Run {
     pub events: Vec<(f64, ContactEventMsg)>,
     /// The run's status and reason (record `result`), when the recording has one.
     pub result: Option<RunResult>,
+    /// What needs the whole run ([`Run::survey`]).
+    pub whole: Whole,
 }
 
 fn bad(file: &str, detail: String) -> Error {
@@ -90,17 +101,458 @@ fn vec3(v: &serde_json::Value) -> Option<[f64; 3]> {
     Some([a.first()?.as_f64()?, a.get(1)?.as_f64()?, a.get(2)?.as_f64()?])
 }
 
+/// What needs the whole run, gathered by [`Run::survey`] in one streamed pass with O(1)
+/// memory per series (the hand paths are kept decimated to at most [`MAX_PATH_POINTS`]): the
+/// views' cameras, the table's size, the arrows' scale and the plots' y ranges are those of the
+/// whole run, whichever time window is being drawn.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Whole {
+    /// Bounds of the arm (every frame origin at about 200 samples, and the hand), m (world).
+    pub arm_min: [f64; 3],
+    pub arm_max: [f64; 3],
+    /// Bounds of the hand path (actual and desired), m (world).
+    pub hand_min: [f64; 3],
+    pub hand_max: [f64; 3],
+    /// The arm's base (the first frame below the root), at t = 0.
+    pub base: [f64; 3],
+    /// Arrow length per newton: the largest force after the first 5 % of the samples is drawn
+    /// 0.25 m long (0 when no force).
+    pub force_scale: f64,
+    /// The desired and the actual hand positions (world), every sample or evenly decimated.
+    pub target_path: Vec<[f64; 3]>,
+    pub hand_trail: Vec<[f64; 3]>,
+    /// [`range_after_transient`] of the motor currents and voltages.
+    pub current_range: Option<[f64; 2]>,
+    pub voltage_range: Option<[f64; 2]>,
+    /// The first `/motors` message records voltages; every one records one per joint.
+    pub has_voltage: bool,
+    pub voltage_every_joint: bool,
+    /// The run records `/contacts` (modes and friction), `/contact_events` messages.
+    pub has_contact_states: bool,
+    pub has_events: bool,
+    /// Messages per drawn topic.
+    pub counts: BTreeMap<String, usize>,
+}
+
+impl Default for Whole {
+    fn default() -> Self {
+        Whole {
+            arm_min: [f64::INFINITY; 3],
+            arm_max: [f64::NEG_INFINITY; 3],
+            hand_min: [f64::INFINITY; 3],
+            hand_max: [f64::NEG_INFINITY; 3],
+            base: [0.0; 3],
+            force_scale: 0.0,
+            target_path: Vec::new(),
+            hand_trail: Vec::new(),
+            current_range: None,
+            voltage_range: None,
+            has_voltage: false,
+            voltage_every_joint: true,
+            has_contact_states: false,
+            has_events: false,
+            counts: BTreeMap::new(),
+        }
+    }
+}
+
+/// The most points of the static target path and hand trail: a longer run is decimated evenly
+/// (every k-th sample and the last), so that a 300 s run at 1 kHz costs no more than 40 000
+/// points (the viewer cannot show more on a screen either).
+pub const MAX_PATH_POINTS: usize = 20_000;
+
+/// The topics drawn (read by [`Run::survey`] and by the windowed encoder).
+pub const DRAWN: [&str; 7] = [
+    schemas::topics::TF,
+    schemas::topics::HAND,
+    schemas::topics::MOTORS,
+    schemas::topics::ENERGY,
+    schemas::topics::CONSTRAINTS,
+    schemas::topics::CONTACTS,
+    schemas::topics::CONTACT_EVENTS,
+];
+
+pub fn grow(min: &mut [f64; 3], max: &mut [f64; 3], p: [f64; 3]) {
+    for i in 0..3 {
+        min[i] = min[i].min(p[i]);
+        max[i] = max[i].max(p[i]);
+    }
+}
+
+/// [`range_after_transient`] computed as the samples stream by: the skip time is known
+/// beforehand (from the first and last time of the series), and only four numbers are kept.
+#[derive(Debug, Clone, Copy)]
+pub struct RangeAfter {
+    skip_s: f64,
+    all: [f64; 2],
+    after: [f64; 2],
+    any: bool,
+}
+
+impl RangeAfter {
+    /// For samples from `t0` to `t_end`, s.
+    pub fn new(t0: f64, t_end: f64) -> Self {
+        RangeAfter { skip_s: t0 + 0.05 * (t_end - t0), all: [f64::INFINITY, f64::NEG_INFINITY], after: [f64::INFINITY, f64::NEG_INFINITY], any: false }
+    }
+
+    pub fn push(&mut self, t: f64, values: &[f64]) {
+        self.any = true;
+        for &x in values {
+            self.all = [self.all[0].min(x), self.all[1].max(x)];
+            if t >= self.skip_s {
+                self.after = [self.after[0].min(x), self.after[1].max(x)];
+            }
+        }
+    }
+
+    /// The range of [`range_after_transient`].
+    pub fn finish(&self) -> Option<[f64; 2]> {
+        let ([lo_all, hi_all], [lo, hi]) = (self.all, self.after);
+        if !self.any || !lo.is_finite() || !hi.is_finite() || hi_all - lo_all <= 3.0 * (hi - lo) {
+            return None;
+        }
+        let pad = 0.1 * (hi - lo).max(1e-9);
+        Some([lo - pad, hi + pad])
+    }
+}
+
+/// A y range that leaves out a start-up transient: the range of the samples after the first
+/// 5 % of the run, padded by 10 %, when the whole range is more than 3 times wider (else
+/// `None`: the viewer fits every sample).
+pub fn range_after_transient(samples: &[(f64, Vec<f64>)]) -> Option<[f64; 2]> {
+    let mut r = RangeAfter::new(samples.first()?.0, samples.last()?.0);
+    for (t, v) in samples {
+        r.push(*t, v);
+    }
+    r.finish()
+}
+
+/// The `/tf` tree as it streams by: frames in the order they first appear (parents before
+/// children in our recordings), each frame's parent and its latest pose in the parent.
+#[derive(Debug, Clone, Default)]
+pub struct FrameTree {
+    pub frames: Vec<(String, Frame)>,
+    index: BTreeMap<String, usize>,
+    /// The latest pose of each frame in its parent (identity before its first transform).
+    pub latest: Vec<Pose>,
+    /// Messages taken.
+    pub messages: usize,
+}
+
+impl FrameTree {
+    /// Takes `/tf` message #`k` (`self.messages`): a new frame is appended, a known one must keep
+    /// its parent. A frame whose parent is itself (a URDF whose root link has the world's name,
+    /// `world` → `world`) is no frame of the tree: it is left out.
+    pub fn take(&mut self, file: &str, msg: &Transforms) -> Result<(), Error> {
+        let k = self.messages;
+        for e in &msg.transforms {
+            if e.child_frame_id == e.parent_frame_id {
+                continue;
+            }
+            let pose = Pose {
+                translation: [e.translation.x, e.translation.y, e.translation.z],
+                rotation: [e.rotation.x, e.rotation.y, e.rotation.z, e.rotation.w],
+            };
+            let i = match self.index.get(&e.child_frame_id) {
+                Some(&i) => i,
+                None => {
+                    self.frames.push((e.child_frame_id.clone(), Frame { parent: e.parent_frame_id.clone(), in_parent: Vec::new() }));
+                    self.latest.push(Pose::IDENTITY);
+                    self.index.insert(e.child_frame_id.clone(), self.frames.len() - 1);
+                    self.frames.len() - 1
+                }
+            };
+            let f = &self.frames[i].1;
+            if f.parent != e.parent_frame_id {
+                return Err(bad(file, format!("/tf message #{k}: frame {:?} changes parent ({:?} -> {:?})", e.child_frame_id, f.parent, e.parent_frame_id)));
+            }
+            self.latest[i] = pose;
+        }
+        self.messages += 1;
+        Ok(())
+    }
+
+    pub fn contains(&self, frame: &str) -> bool {
+        self.index.contains_key(frame)
+    }
+
+    /// The root: the first parent that is no frame of the tree (`world` for an empty tree).
+    pub fn root(&self, file: &str) -> Result<String, Error> {
+        match self.frames.iter().map(|(_, f)| f.parent.clone()).find(|p| !self.index.contains_key(p)) {
+            Some(root) => Ok(root),
+            None if self.frames.is_empty() => Ok("world".to_string()),
+            None => Err(bad(file, "/tf: every frame has a parent in /tf (a cycle, no root frame)".into())),
+        }
+    }
+}
+
+/// The world pose of every frame of `frames` below `root` (the identity), each frame's pose in
+/// its parent given by `pose(i)`.
+pub fn world_poses<'a>(root: &'a str, frames: &'a [(String, Frame)], pose: impl Fn(usize) -> Pose) -> BTreeMap<&'a str, Pose> {
+    let mut out: BTreeMap<&str, Pose> = BTreeMap::new();
+    out.insert(root, Pose::IDENTITY);
+    // parents come first in `frames` unless a frame appeared before its parent: repeat
+    for _ in 0..frames.len() {
+        let before = out.len();
+        for (i, (name, f)) in frames.iter().enumerate() {
+            if out.contains_key(name.as_str()) {
+                continue;
+            }
+            if let Some(parent) = out.get(f.parent.as_str()).copied() {
+                out.insert(name.as_str(), parent.compose(&pose(i)));
+            }
+        }
+        if out.len() == before {
+            break;
+        }
+    }
+    out
+}
+
+/// Pass 1 of [`Run::survey`]: the first and last time of `/motors` (the skip time of the y
+/// ranges).
+#[derive(Default)]
+struct MotorTimes(Option<(f64, f64)>);
+
+impl schemas::Visitor for MotorTimes {
+    fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        let t = m.t_s();
+        self.0 = Some(self.0.map_or((t, t), |(t0, _)| (t0, t)));
+        Ok(())
+    }
+}
+
+/// Pass 2 of [`Run::survey`]: everything [`Whole`] holds, the frame tree and the checks of
+/// every message (array sizes), as the samples stream by.
+struct Survey<'a> {
+    file: &'a str,
+    sizes: ArraySizes,
+    tree: FrameTree,
+    whole: Whole,
+    /// Samples of `/tf`, `/hand` and of the force topic (from the file's counts).
+    n_tf: usize,
+    n_hand: usize,
+    n_force: usize,
+    force_topic: &'static str,
+    hand_k: usize,
+    force_k: usize,
+    motors: Option<(RangeAfter, RangeAfter)>,
+    motor_times: Option<(f64, f64)>,
+    f_max: f64,
+    joints: usize,
+    contacts: usize,
+    /// The error that stopped the reading (returned instead of the reader's).
+    error: Option<Error>,
+}
+
+/// Keeps `e` in `slot` and gives the reader an error that stops it (the caller returns `e`).
+pub fn stop(slot: &mut Option<Error>, e: Error) -> schemas::Error {
+    let detail = e.to_string();
+    *slot = Some(e);
+    schemas::Error::Malformed { file: String::new(), detail }
+}
+
+/// An error of `analyze view` (`slot`) over the reader's (`read`).
+pub fn first_error<T>(read: Result<T, schemas::Error>, slot: Option<Error>) -> Result<T, Error> {
+    match (read, slot) {
+        (_, Some(e)) => Err(e),
+        (r, None) => Ok(r?),
+    }
+}
+
+impl Survey<'_> {
+    fn tf(&mut self, msg: &Transforms) -> Result<(), Error> {
+        let k = self.tree.messages;
+        self.tree.take(self.file, msg)?;
+        let stride = (self.n_tf / 200).max(1);
+        if k == 0 || k.is_multiple_of(stride) || k + 1 == self.n_tf {
+            let root = self.tree.root(self.file).unwrap_or_else(|_| "world".into());
+            let latest = &self.tree.latest;
+            let poses = world_poses(&root, &self.tree.frames, |i| latest[i]);
+            if k == 0 {
+                if let Some((base, _)) = self.tree.frames.iter().find(|(_, f)| f.parent == root) {
+                    self.whole.base = poses.get(base.as_str()).map_or([0.0; 3], |p| p.translation);
+                }
+            }
+            if k.is_multiple_of(stride) || k + 1 == self.n_tf {
+                for p in poses.values() {
+                    grow(&mut self.whole.arm_min, &mut self.whole.arm_max, p.translation);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn hand(&mut self, h: &HandState) {
+        let v3 = |v: &schemas::Vec3| [v.x, v.y, v.z];
+        let (desired, actual) = (v3(&h.desired), v3(&h.actual));
+        let w = &mut self.whole;
+        for p in [desired, actual] {
+            grow(&mut w.hand_min, &mut w.hand_max, p);
+            grow(&mut w.arm_min, &mut w.arm_max, p);
+        }
+        let stride = self.n_hand.div_ceil(MAX_PATH_POINTS).max(1);
+        if self.hand_k.is_multiple_of(stride) || self.hand_k + 1 == self.n_hand {
+            w.target_path.push(desired);
+            w.hand_trail.push(actual);
+        }
+        self.hand_k += 1;
+    }
+
+    fn motors(&mut self, t: f64, m: &MotorState) {
+        let (t0, t_end) = self.motor_times.unwrap_or((t, t));
+        let (cur, volt) = self.motors.get_or_insert_with(|| (RangeAfter::new(t0, t_end), RangeAfter::new(t0, t_end)));
+        if !cur.any {
+            self.whole.has_voltage = !m.voltage.is_empty();
+        }
+        cur.push(t, &m.current);
+        if self.whole.has_voltage {
+            volt.push(t, &m.voltage);
+        }
+        self.whole.voltage_every_joint &= m.voltage.len() == self.joints;
+    }
+
+    /// One sample of the contact forces: `f_n` and the friction components of each contact.
+    fn forces(&mut self, f_n: &[f64], f_t: &[(f64, f64)]) {
+        let after = self.force_k >= self.n_force / 20;
+        if after {
+            for c in 0..self.contacts {
+                let f = f_n.get(c).copied().unwrap_or(0.0);
+                self.f_max = self.f_max.max(f.abs());
+                if let Some((a, b)) = f_t.get(c) {
+                    self.f_max = self.f_max.max(a.abs()).max(b.abs());
+                }
+            }
+        }
+        self.force_k += 1;
+    }
+}
+
+impl schemas::Visitor for Survey<'_> {
+    fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        let sizes = Some(self.sizes);
+        match m.topic {
+            schemas::topics::TF => {
+                let msg = m.decode_ref::<Transforms>(None)?;
+                if let Err(e) = self.tf(&msg) {
+                    return Err(stop(&mut self.error, e));
+                }
+            }
+            schemas::topics::HAND => {
+                let h = m.decode_ref::<HandState>(None)?;
+                self.hand(&h);
+            }
+            schemas::topics::MOTORS => {
+                let s = m.decode_ref::<MotorState>(sizes)?;
+                self.motors(m.t_s(), &s);
+            }
+            schemas::topics::ENERGY => {
+                m.decode_ref::<EnergyState>(sizes)?;
+            }
+            schemas::topics::CONSTRAINTS => {
+                let s = m.decode_ref::<ConstraintState>(sizes)?;
+                if self.force_topic == schemas::topics::CONSTRAINTS {
+                    self.forces(&s.normal_force, &[]);
+                }
+            }
+            schemas::topics::CONTACTS => {
+                let s = m.decode_ref::<ContactState>(sizes)?;
+                let f_t: Vec<(f64, f64)> = (0..self.contacts)
+                    .map(|c| (s.friction_force_t1.get(c).copied().unwrap_or(0.0), s.friction_force_t2.get(c).copied().unwrap_or(0.0)))
+                    .collect();
+                self.forces(&s.normal_force, &f_t);
+            }
+            schemas::topics::CONTACT_EVENTS => {
+                m.decode_ref::<ContactEventMsg>(None)?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn typed(&self) -> bool {
+        true
+    }
+}
+
 impl Run {
-    /// Reads what is drawn from `rec` (`stem`: the file stem, the name of a run without a `run`
-    /// record).
-    pub fn read(rec: &Recording, stem: &str) -> Result<Run, Error> {
+    /// Reads what is drawn from the recording at `path` except its samples (`stem`: the file
+    /// stem, the name of a run without a `run` record), and what needs the whole run
+    /// ([`Whole`]), in two streamed passes: `/motors` alone for its first and last time, then
+    /// every drawn topic. Memory: the file's metadata, the frame tree and O(1) per series.
+    pub fn survey(path: &Path, stem: &str) -> Result<Run, Error> {
+        let mut times = MotorTimes::default();
+        let rec = schemas::stream_recording(path, Some(&[schemas::topics::MOTORS]), &mut times)?;
+        let mut run = Run::describe(&rec, stem)?;
+        let file = rec.source.clone();
+        let count = |topic: &str| rec.channel(topic).map_or(0, |c| c.message_count);
+        let has_contacts = rec.channel(schemas::topics::CONTACTS).is_some();
+        let force_topic = if has_contacts { schemas::topics::CONTACTS } else { schemas::topics::CONSTRAINTS };
+        // the topics every run has (a run that failed early may have none)
+        let failed = run.result.as_ref().is_some_and(|r| r.status == RunStatus::Failed);
+        for topic in [schemas::topics::HAND, schemas::topics::MOTORS, schemas::topics::ENERGY, schemas::topics::CONSTRAINTS] {
+            if !failed && rec.channel(topic).is_none() {
+                let available = rec.channels.iter().map(|c| c.topic.clone()).collect();
+                return Err(schemas::Error::UnknownTopic { file: file.clone(), topic: topic.into(), available }.into());
+            }
+        }
+        let mut survey = Survey {
+            file: &file,
+            sizes: ArraySizes { joints: run.joints.len(), contacts: run.contacts.len() },
+            tree: FrameTree::default(),
+            whole: Whole {
+                has_contact_states: has_contacts,
+                has_events: count(schemas::topics::CONTACT_EVENTS) > 0,
+                counts: DRAWN.iter().map(|t| (t.to_string(), count(t))).collect(),
+                ..Whole::default()
+            },
+            n_tf: count(schemas::topics::TF),
+            n_hand: count(schemas::topics::HAND),
+            n_force: count(force_topic),
+            force_topic,
+            hand_k: 0,
+            force_k: 0,
+            motors: None,
+            motor_times: times.0,
+            f_max: 0.0,
+            joints: run.joints.len(),
+            contacts: run.contacts.len(),
+            error: None,
+        };
+        let read = schemas::stream_recording(path, Some(&DRAWN), &mut survey);
+        first_error(read, survey.error.take())?;
+        let Survey { tree, mut whole, motors, f_max, .. } = survey;
+        if let Some((cur, volt)) = motors {
+            whole.current_range = cur.finish();
+            whole.voltage_range = if whole.has_voltage { volt.finish() } else { None };
+        } else {
+            whole.voltage_every_joint = false;
+        }
+        whole.force_scale = if f_max > 0.0 { 0.25 / f_max } else { 0.0 };
+        run.root_frame = tree.root(&file)?;
+        for c in &mut run.contacts {
+            match &c.link {
+                Some(link) if !tree.frames.is_empty() && !tree.contains(link) => {
+                    return Err(bad(&file, format!("contact {:?}: link {link:?} has no transform in /tf", c.name)));
+                }
+                Some(_) if tree.frames.is_empty() => c.link = None,
+                _ => {}
+            }
+        }
+        run.frames = tree.frames;
+        run.whole = whole;
+        Ok(run)
+    }
+
+    /// What is drawn from `rec`'s metadata: names, contacts, planes, visuals, result (no
+    /// samples, no frames).
+    pub fn describe(rec: &Recording, stem: &str) -> Result<Run, Error> {
         let file = rec.source.clone();
         let desc = rec.run_opt()?;
         let (name, joints, active) = match desc {
             Some(d) => (d.run, d.joint_names, d.contacts),
             None => (stem.to_string(), Vec::new(), Vec::new()),
         };
-        let sizes = ArraySizes { joints: joints.len(), contacts: active.len() };
 
         // geometry (a recording of another producer may have no URDF: no visuals then)
         let xml = rec.record_opt::<schemas::UrdfRecord>()?.map(|u| u.xml).unwrap_or_default();
@@ -150,110 +602,45 @@ impl Run {
                 }
             }
         }
-
-        // the frame tree (none without /tf)
-        let tf: Vec<(f64, Transforms)> = match rec.channel(schemas::topics::TF) {
-            Some(_) => rec.read()?,
-            None => Vec::new(),
-        };
-        let mut frames: Vec<(String, Frame)> = Vec::new();
-        let mut index: BTreeMap<String, usize> = BTreeMap::new();
-        let mut tf_times_ns = Vec::with_capacity(tf.len());
-        for (k, (t, msg)) in tf.iter().enumerate() {
-            tf_times_ns.push(ns(*t));
-            for e in &msg.transforms {
-                let pose = Pose {
-                    translation: [e.translation.x, e.translation.y, e.translation.z],
-                    rotation: [e.rotation.x, e.rotation.y, e.rotation.z, e.rotation.w],
-                };
-                let i = *index.entry(e.child_frame_id.clone()).or_insert_with(|| {
-                    frames.push((e.child_frame_id.clone(), Frame { parent: e.parent_frame_id.clone(), in_parent: Vec::new() }));
-                    frames.len() - 1
-                });
-                let f = &mut frames[i].1;
-                if f.parent != e.parent_frame_id {
-                    return Err(bad(&file, format!("/tf message #{k}: frame {:?} changes parent ({:?} -> {:?})", e.child_frame_id, f.parent, e.parent_frame_id)));
-                }
-                // a frame missing from a message keeps its last pose
-                while f.in_parent.len() < k {
-                    let last = f.in_parent.last().copied().unwrap_or(Pose::IDENTITY);
-                    f.in_parent.push(last);
-                }
-                f.in_parent.push(pose);
-            }
-        }
-        for (_, f) in &mut frames {
-            while f.in_parent.len() < tf.len() {
-                let last = f.in_parent.last().copied().unwrap_or(Pose::IDENTITY);
-                f.in_parent.push(last);
-            }
-        }
-        let root_frame = match frames.iter().map(|(_, f)| f.parent.clone()).find(|p| !index.contains_key(p)) {
-            Some(root) => root,
-            None if frames.is_empty() => "world".to_string(),
-            None => return Err(bad(&file, "/tf: every frame has a parent in /tf (a cycle, no root frame)".into())),
-        };
-        for c in &mut contacts {
-            match &c.link {
-                Some(link) if !frames.is_empty() && !index.contains_key(link) => {
-                    return Err(bad(&file, format!("contact {:?}: link {link:?} has no transform in /tf", c.name)));
-                }
-                Some(_) if frames.is_empty() => c.link = None,
-                _ => {}
-            }
-        }
-
-        let contact_states = match rec.channel(schemas::topics::CONTACTS) {
-            Some(_) => Some(rec.read_sized::<ContactState>(sizes)?),
-            None => None,
-        };
-        let events = match rec.channel(schemas::topics::CONTACT_EVENTS) {
-            Some(_) => rec.read::<ContactEventMsg>()?,
-            None => Vec::new(),
-        };
-        // a run that failed early may have no samples (t = 0: no topic at all): drawn empty
-        let result = rec.result()?;
-        let failed = result.as_ref().is_some_and(|r| r.status == RunStatus::Failed);
-        let absent = |topic: &str| failed && rec.channel(topic).is_none();
         Ok(Run {
             name,
             joints,
             contacts,
             other_planes,
-            root_frame,
-            frames,
-            tf_times_ns,
+            root_frame: "world".to_string(),
+            frames: Vec::new(),
+            tf_times_ns: Vec::new(),
             visuals,
-            hand: if absent(schemas::topics::HAND) { Vec::new() } else { rec.read()? },
-            motors: if absent(schemas::topics::MOTORS) { Vec::new() } else { rec.read_sized(sizes)? },
-            energy: if absent(schemas::topics::ENERGY) { Vec::new() } else { rec.read_sized(sizes)? },
-            constraints: if absent(schemas::topics::CONSTRAINTS) { Vec::new() } else { rec.read_sized(sizes)? },
-            contact_states,
-            events,
-            result,
+            hand: Vec::new(),
+            motors: Vec::new(),
+            energy: Vec::new(),
+            constraints: Vec::new(),
+            contact_states: None,
+            events: Vec::new(),
+            result: rec.result()?,
+            whole: Whole::default(),
         })
     }
 
-    /// The world pose of every frame at sample `k` (the root is the identity).
-    pub fn world_poses(&self, k: usize) -> BTreeMap<&str, Pose> {
-        let mut out: BTreeMap<&str, Pose> = BTreeMap::new();
-        out.insert(self.root_frame.as_str(), Pose::IDENTITY);
-        // parents come first in `frames` unless a frame appeared before its parent: repeat
-        for _ in 0..self.frames.len() {
-            let before = out.len();
-            for (name, f) in &self.frames {
-                if out.contains_key(name.as_str()) {
-                    continue;
-                }
-                if let Some(parent) = out.get(f.parent.as_str()).copied() {
-                    out.insert(name.as_str(), parent.compose(&f.in_parent[k]));
-                }
-            }
-            if out.len() == before {
-                break;
-            }
+    /// The samples of a time window dropped (the run as [`Run::survey`] left it).
+    pub fn clear_samples(&mut self) {
+        for (_, f) in &mut self.frames {
+            f.in_parent.clear();
         }
-        out
+        self.tf_times_ns.clear();
+        self.hand.clear();
+        self.motors.clear();
+        self.energy.clear();
+        self.constraints.clear();
+        if let Some(c) = &mut self.contact_states {
+            c.clear();
+        }
+        self.events.clear();
+    }
+
+    /// The world pose of every frame at sample `k` of the window (the root is the identity).
+    pub fn world_poses(&self, k: usize) -> BTreeMap<&str, Pose> {
+        world_poses(&self.root_frame, &self.frames, |i| self.frames[i].1.in_parent[k])
     }
 
     /// The entity path of `frame` below `root` (its chain of parents): `root/base/link1/…`.

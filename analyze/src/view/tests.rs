@@ -14,20 +14,31 @@ use prost::Message;
 use super::rrd::{self, ArrowMsg, BlueprintActivationCommand, SetStoreInfo};
 use super::{encode, read_input, Input};
 
-/// Frames of an RRD stream: `(kind, payload)`, after checking the stream header.
-fn frames(bytes: &[u8]) -> Vec<(u64, &[u8])> {
+/// Frames of an RRD stream: `(kind, offset of the payload, payload)`, after checking the stream
+/// header, up to the `End` message; then the stream footer, which must point at the `End`
+/// message's payload with its xxh32 and end the file.
+fn frames(bytes: &[u8]) -> Vec<(u64, usize, &[u8])> {
     assert_eq!(&bytes[..4], b"RRF2");
     assert_eq!(bytes[4..8], [0, 41, 0, 0], "written as Rerun 0.41.0");
-    assert_eq!(bytes[8..12], [0, 2, 0, 0], "uncompressed, protobuf");
+    assert_eq!(bytes[8..12], [1, 2, 0, 0], "LZ4, protobuf");
     let mut out = Vec::new();
     let mut i = 12;
-    while i < bytes.len() {
+    loop {
         let kind = u64::from_le_bytes(bytes[i..i + 8].try_into().unwrap());
         let len = u64::from_le_bytes(bytes[i + 8..i + 16].try_into().unwrap()) as usize;
-        out.push((kind, &bytes[i + 16..i + 16 + len]));
+        out.push((kind, i + 16, &bytes[i + 16..i + 16 + len]));
         i += 16 + len;
+        if kind == rrd::KIND_END {
+            break;
+        }
     }
-    assert_eq!(i, bytes.len(), "the last frame ends at the end of the file");
+    let (_, start, footer) = *out.last().unwrap();
+    assert_eq!(bytes.len(), i + 32, "the stream footer ends the file");
+    let tail = &bytes[i..];
+    assert_eq!(u64::from_le_bytes(tail[..8].try_into().unwrap()) as usize, start);
+    assert_eq!(u64::from_le_bytes(tail[8..16].try_into().unwrap()) as usize, footer.len());
+    assert_eq!(u32::from_le_bytes(tail[16..20].try_into().unwrap()), xxhash_rust::xxh32::xxh32(footer, super::manifest::CRC_SEED));
+    assert_eq!(&tail[20..], b"RRF2FOOT\x01\x00\x00\x00");
     out
 }
 
@@ -40,16 +51,15 @@ struct Decoded {
 
 fn decode(bytes: &[u8]) -> Decoded {
     let mut d = Decoded { stores: Vec::new(), activations: Vec::new(), chunks: BTreeMap::new() };
-    for (kind, payload) in frames(bytes) {
+    for (kind, _, payload) in frames(bytes) {
         match kind {
+            rrd::KIND_END => {}
             rrd::KIND_SET_STORE_INFO => d.stores.push(SetStoreInfo::decode(payload).unwrap()),
             rrd::KIND_BLUEPRINT_ACTIVATION => d.activations.push(BlueprintActivationCommand::decode(payload).unwrap()),
             rrd::KIND_ARROW_MSG => {
                 let m = ArrowMsg::decode(payload).unwrap();
-                assert_eq!((m.compression, m.encoding, m.uncompressed_size), (1, 1, m.payload.len() as u64));
-                let mut r = arrow_ipc::reader::StreamReader::try_new(m.payload.as_slice(), None).unwrap();
-                let batch = r.next().unwrap().unwrap();
-                assert!(r.next().is_none(), "one batch per chunk");
+                assert_eq!((m.compression, m.encoding), (rrd::COMPRESSION_LZ4, 1));
+                let batch = rrd::payload_batch(&m).unwrap();
                 let meta = batch.schema().metadata().clone();
                 assert_eq!(meta["rerun:id"], m.chunk_id.unwrap().chunk_name());
                 assert_eq!(meta["sorbet:version"], "0.1.4");
@@ -170,4 +180,166 @@ fn several_runs_go_side_by_side_under_their_names() {
         assert!(d.chunks.contains_key(&(1, e.to_string())), "no entity {e}");
     }
     assert!(!d.chunks.contains_key(&(1, "/normal_force_N/one-elbow/elbow7".to_string())));
+}
+
+/// Every entity's rows, whatever chunks they are in: per entity of the recording store, its
+/// static cells and its temporal rows (time, then every data column's cell), in time order.
+#[allow(clippy::type_complexity)]
+fn rows_by_entity(d: &Decoded) -> BTreeMap<String, (Vec<(String, arrow_array::ArrayRef)>, Vec<(i64, Vec<(String, arrow_array::ArrayRef)>)>)> {
+    let mut out = BTreeMap::new();
+    for ((store, entity), batches) in &d.chunks {
+        if *store != 1 {
+            continue;
+        }
+        let (statics, temporal): (&mut Vec<_>, &mut Vec<_>) = {
+            let e = out.entry(entity.clone()).or_insert_with(|| (Vec::new(), Vec::new()));
+            (&mut e.0, &mut e.1)
+        };
+        for b in batches {
+            let data: Vec<(String, &arrow_array::ListArray)> = b
+                .schema()
+                .fields()
+                .iter()
+                .zip(b.columns())
+                .filter(|(f, _)| f.metadata().get("rerun:kind").is_some_and(|k| k == "data"))
+                .map(|(f, c)| (f.name().clone(), c.as_list::<i32>()))
+                .collect();
+            match b.column_by_name("sim_time") {
+                None => statics.extend(data.iter().map(|(n, c)| (n.clone(), c.value(0)))),
+                Some(t) => {
+                    let t = t.as_primitive::<DurationNanosecondType>();
+                    for k in 0..b.num_rows() {
+                        temporal.push((t.value(k), data.iter().map(|(n, c)| (n.clone(), c.value(k))).collect()));
+                    }
+                }
+            }
+        }
+        statics.sort_by(|a, b| a.0.cmp(&b.0));
+        temporal.sort_by_key(|(t, _)| *t);
+    }
+    out
+}
+
+/// The windowed encoder (issue 29): a recording drawn in windows of 7 samples holds, entity by
+/// entity, exactly the rows and the static cells of the same recording drawn in one window
+/// (times and values, each cell compared as Arrow data), with each static chunk once, and no
+/// chunk larger than the cut by size allows.
+#[test]
+fn windows_hold_the_rows_of_the_whole_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = synth_input(dir.path());
+    let n = input.run.whole.counts[schemas::topics::MOTORS];
+    assert!(n > 50, "{n} samples: several windows of 7");
+    let encode_rows = |rows: usize| super::encode_to(std::slice::from_ref(&input), "w", Vec::new(), "w.rrd", rows).unwrap().0;
+    let one = decode(&encode_rows(super::window::WINDOW_ROWS));
+    let many = decode(&encode_rows(7));
+    let (a, b) = (rows_by_entity(&one), rows_by_entity(&many));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    for (entity, (sa, ta)) in &a {
+        let (sb, tb) = &b[entity];
+        assert!(sa == sb, "{entity}: static cells differ");
+        assert_eq!(ta.len(), tb.len(), "{entity}: rows");
+        for (ra, rb) in ta.iter().zip(tb) {
+            assert!(ra == rb, "{entity}: the row at {} ns differs", ra.0);
+        }
+    }
+    // one window is one temporal chunk per entity; seven samples, several
+    let chunks = |d: &Decoded, e: &str| d.chunks[&(1, e.to_string())].iter().filter(|b| b.column_by_name("sim_time").is_some()).count();
+    assert_eq!(chunks(&one, "/energy_residual_J"), 1);
+    assert!(chunks(&many, "/energy_residual_J") >= n / (8 * 7), "{} chunks of {n} samples", chunks(&many, "/energy_residual_J"));
+    // no window holds more than 8 times the window's rows (the cut by size of a file whose
+    // topics do not interleave)
+    for ((_, e), batches) in &many.chunks {
+        assert!(batches.iter().all(|b| b.num_rows() <= 8 * 7), "{e}: a chunk of more than 56 rows");
+    }
+    let statics = |d: &Decoded, e: &str| d.chunks[&(1, e.to_string())].iter().filter(|b| b.column_by_name("sim_time").is_none()).count();
+    assert_eq!(statics(&many, "/energy_residual_J"), 1);
+    assert_eq!(statics(&many, "/world/target_path"), 1);
+}
+
+/// A `/tf` whose URDF root link is named like the world (`world` → `world`, then `world` →
+/// `base_link`, as UR5 and Z1 of example-robot-data recorded before the recorder left the
+/// self-transform out): the tree's root is `world` and the self-transform is no frame; a real
+/// cycle is still refused.
+#[test]
+fn a_root_link_named_world_is_the_root_not_a_cycle() {
+    use schemas::{Quat, TransformEntry, Transforms, Vec3};
+    let entry = |parent: &str, child: &str, x: f64| TransformEntry {
+        parent_frame_id: parent.into(),
+        child_frame_id: child.into(),
+        translation: Vec3 { x, y: 0.0, z: 0.0 },
+        rotation: Quat { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
+    };
+    let msg = Transforms { transforms: vec![entry("world", "world", 0.0), entry("world", "base_link", 0.5), entry("base_link", "link1", 0.25)] };
+    let mut tree = super::run::FrameTree::default();
+    tree.take("ur5.mcap", &msg).unwrap();
+    tree.take("ur5.mcap", &msg).unwrap();
+    assert_eq!(tree.root("ur5.mcap").unwrap(), "world");
+    assert_eq!(tree.frames.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["base_link", "link1"]);
+    let latest = &tree.latest;
+    let poses = super::run::world_poses("world", &tree.frames, |i| latest[i]);
+    assert_eq!(poses["link1"].translation, [0.75, 0.0, 0.0]);
+    let cycle = Transforms { transforms: vec![entry("a", "b", 0.0), entry("b", "a", 0.0)] };
+    let mut tree = super::run::FrameTree::default();
+    tree.take("c.mcap", &cycle).unwrap();
+    let err = tree.root("c.mcap").unwrap_err().to_string();
+    assert!(err.contains("c.mcap") && err.contains("no root frame"), "{err}");
+}
+
+/// The RRD footer (issue 27 item 5): one manifest per store, one row per chunk of that store,
+/// each row pointing at its chunk's message (the chunk id in the message at that offset and
+/// length), with the chunk's entity, static flag, rows and first and last `sim_time`; the
+/// sorbet schema names every entity's component.
+#[test]
+fn the_footer_lists_every_chunk_where_it_lies() {
+    use arrow_array::{BooleanArray, DurationNanosecondArray, FixedSizeBinaryArray, StringArray, UInt64Array};
+    let dir = tempfile::tempdir().unwrap();
+    let input = synth_input(dir.path());
+    let bytes = super::encode_to(std::slice::from_ref(&input), "f", Vec::new(), "f.rrd", 7).unwrap().0;
+    let all = frames(&bytes);
+    let footer = super::manifest::RrdFooter::decode(all.last().unwrap().2).unwrap();
+    assert_eq!(footer.manifests.len(), 2);
+    let mut seen = 0;
+    for m in &footer.manifests {
+        let store = m.store_id.clone().unwrap();
+        let part = m.data.as_ref().unwrap();
+        assert_eq!((part.encoder_version, part.compression), (1, 1));
+        let mut r = arrow_ipc::reader::StreamReader::try_new(part.payload.as_deref().unwrap(), None).unwrap();
+        let data = r.next().unwrap().unwrap();
+        let col = |name: &str| data.column_by_name(name).unwrap_or_else(|| panic!("no column {name}")).clone();
+        let (entity, ids, statics) = (col("chunk_entity_path"), col("chunk_id"), col("chunk_is_static"));
+        let entity = entity.as_any().downcast_ref::<StringArray>().unwrap();
+        let ids = ids.as_any().downcast_ref::<FixedSizeBinaryArray>().unwrap();
+        let statics = statics.as_any().downcast_ref::<BooleanArray>().unwrap();
+        let u64s = |name: &str| col(name).as_any().downcast_ref::<UInt64Array>().unwrap().values().to_vec();
+        let (rows, offsets, sizes) = (u64s("chunk_num_rows"), u64s("chunk_byte_offset"), u64s("chunk_byte_size"));
+        let chunks_of_store = all.iter().filter(|(k, _, p)| *k == rrd::KIND_ARROW_MSG && ArrowMsg::decode(*p).unwrap().store_id.as_ref() == Some(&store)).count();
+        assert_eq!(data.num_rows(), chunks_of_store, "one row per chunk of the store");
+        for k in 0..data.num_rows() {
+            let (o, n) = (offsets[k] as usize, sizes[k] as usize);
+            assert!(all.iter().any(|(kind, at, p)| *kind == rrd::KIND_ARROW_MSG && *at == o && p.len() == n), "row {k}: no message at {o}+{n}");
+            let msg = ArrowMsg::decode(&bytes[o..o + n]).unwrap();
+            assert_eq!(msg.chunk_id.unwrap().bytes(), ids.value(k));
+            assert_eq!(msg.is_static, Some(statics.value(k)));
+            let batch = rrd::payload_batch(&msg).unwrap();
+            assert_eq!(batch.schema().metadata()["rerun:entity_path"], entity.value(k));
+            assert_eq!(batch.num_rows() as u64, rows[k]);
+            if let Some(t) = batch.column_by_name("sim_time") {
+                let t = t.as_primitive::<DurationNanosecondType>();
+                let start = col("sim_time:start");
+                let end = col("sim_time:end");
+                let (start, end) = (start.as_any().downcast_ref::<DurationNanosecondArray>().unwrap(), end.as_any().downcast_ref::<DurationNanosecondArray>().unwrap());
+                assert_eq!((start.value(k), end.value(k)), (t.value(0), t.value(t.len() - 1)), "row {k}");
+            }
+            seen += 1;
+        }
+        let schema = arrow_ipc::reader::StreamReader::try_new(m.sorbet_schema.as_ref().unwrap().arrow_schema.as_deref().unwrap(), None).unwrap().schema();
+        if store.kind == 1 {
+            assert!(schema.field_with_name("/energy_residual_J:Scalars:scalars").is_ok());
+            assert!(schema.field_with_name("property:RecordingInfo:name").is_ok());
+            assert_eq!(schema.field_with_name("sim_time").unwrap().data_type(), &DataType::Duration(TimeUnit::Nanosecond));
+        }
+        assert_eq!(m.sorbet_schema_sha256.as_ref().map(Vec::len), Some(32));
+    }
+    assert_eq!(seen, all.iter().filter(|(k, _, _)| *k == rrd::KIND_ARROW_MSG).count());
 }

@@ -141,11 +141,15 @@ impl Recording {
         Ok(())
     }
 
-    /// Hands the decoded messages of `topics` to `visitor`, topic by topic in the order given,
+    /// Hands the metadata records, then the decoded messages of `topics` to `visitor`, topic by topic in the order given,
     /// each in time order, as [`crate::stream_recording`] would (with the `run` record read):
     /// one computation serves a streamed read and a recording already in memory.
     pub fn replay(&self, topics: &[&str], visitor: &mut dyn crate::Visitor) -> Result<(), Error> {
         let run = self.run_opt()?;
+        // the records first, as a streamed reading of a file `sim` wrote meets them
+        for (name, entries) in self.metadata_records() {
+            visitor.metadata(name, entries);
+        }
         for &topic in topics {
             for (index, (log_time_ns, value)) in self.topic_messages(topic)?.iter().enumerate() {
                 let m = crate::DecodedMessage { file: &self.source, topic, index, log_time_ns: *log_time_ns, body: crate::Body::Value(value.clone()), run: run.as_ref() };

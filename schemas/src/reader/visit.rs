@@ -194,6 +194,11 @@ fn check_length(file: &str, topic: &str, index: usize, log_time_ns: u64, field: 
 pub trait Visitor {
     fn message(&mut self, message: DecodedMessage<'_>) -> Result<(), Error>;
 
+    /// A metadata record, in file order (`sim` writes the run's records before its messages
+    /// and `result` last), so a visitor can use a record for the messages that follow it.
+    /// The default ignores it.
+    fn metadata(&mut self, _name: &str, _entries: &std::collections::BTreeMap<String, String>) {}
+
     /// Whether this visitor takes the metric messages typed ([`Body::Known`]) when their schema
     /// is this crate's own (faster: no generic tree); `false` (the default): always a
     /// [`Body::Value`].

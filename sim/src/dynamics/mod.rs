@@ -17,6 +17,7 @@ pub mod samples;
 pub mod spatial;
 pub mod spd;
 pub mod supply;
+pub mod thermal;
 pub mod urdf;
 pub mod walker_orin;
 

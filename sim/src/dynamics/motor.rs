@@ -23,7 +23,10 @@
 //!   a barrier: at `i = I`, `L di/dt = v − R I − K_e k q̇ ≤ 0` (and symmetrically), so `|i| ≤ I`
 //!   up to the integration error (Mohan, Undeland & Robbins, *Power Electronics*, 3rd ed.,
 //!   §13-5: a current-limited drive is a voltage source whose command is clipped);
-//! - passive joints: no motor at all (K_m = K_e k = J_m = D_m = 0, zero voltage, zero current).
+//! - passive joints: no motor at all (K_m = K_e k = J_m = D_m = 0, zero voltage, zero current);
+//! - the motor's thermal data (a datasheet drive): with the scene's thermal model on, R follows
+//!   the winding temperature (`dynamics/thermal.rs`); the ODE then reads its drives with R(T_w)
+//!   from its workspace (`ode/workspace.rs`), the controller the nominal ones.
 //!
 //! Prismatic joints use the same model with link-side units: the gear ratio (lead screw or
 //! rack) is in rad/m, K_m = K_t k in N/A, J_m = I_m k² in kg, D_m in N s/m, and the back EMF
@@ -111,12 +114,15 @@ pub struct DriveSpec {
     pub current_limit: Option<f64>,
     /// No motor on this joint.
     pub passive: bool,
+    /// The motor's thermal data (a datasheet drive; used when the scene turns the thermal
+    /// model on, `dynamics/thermal.rs`).
+    pub thermal: Option<crate::dynamics::thermal::ThermalParams>,
 }
 
 impl DriveSpec {
     /// The paper's drive: K_e = K_t, no limits, a motor.
     pub const fn ideal() -> Self {
-        Self { back_emf_constant: None, voltage_limit: None, current_limit: None, passive: false }
+        Self { back_emf_constant: None, voltage_limit: None, current_limit: None, passive: false, thermal: None }
     }
 }
 
@@ -290,7 +296,7 @@ mod tests {
             torque_constant: 0.2, resistance: 2.0, inductance: 0.01, rotor_inertia: 1e-4,
             gear_ratio: 3.0, gear_damping: 0.0,
         };
-        let spec = DriveSpec { back_emf_constant: Some(0.25), voltage_limit: Some(24.0), current_limit: Some(5.0), passive: false };
+        let spec = DriveSpec { back_emf_constant: Some(0.25), voltage_limit: Some(24.0), current_limit: Some(5.0), ..DriveSpec::ideal() };
         (m, Drives::new(&[m], &[0.0]).with_real_drives(&[m], &[spec]))
     }
 

@@ -41,10 +41,11 @@ impl<'a> ArmSystem<'a> {
             conversion: scene.drives.has_conversion,
             stops: scene.stops.is_some(),
             contacts: if is_hybrid { contacts.len() } else { 0 },
+            thermal: scene.thermal.is_some(),
             gear: scene.gear_friction.is_some(),
             supply: scene.supply.is_some(),
         };
-        let mut ws = Workspace::new(&scene.model, contacts.len(), layout.dim());
+        let mut ws = Workspace::new(&scene.model, &scene.drives, contacts.len(), layout.dim());
         ws.fd.joint_torque = scene.stops.is_some() || scene.gear_friction.is_some();
         ws.want_qdd = matches!(scene.controller.law, crate::control::Law::ComputedTorque { .. });
         let hybrid = is_hybrid.then(|| Box::new(super::hybrid::Hybrid::new(scene, run)));
@@ -72,7 +73,22 @@ impl<'a> ArmSystem<'a> {
         if l.ni() > 0 {
             y[l.current()].copy_from_slice(&self.scene.current0);
         }
+        if let Some(th) = &self.scene.thermal {
+            y[l.winding_temperature()].fill(th.initial);
+            y[l.housing_temperature()].fill(th.initial);
+        }
         y
+    }
+
+    /// The winding resistances R(T_w) at the temperatures of `y`, into the workspace's drives
+    /// (thermal model on; otherwise they stay the scene's).
+    pub(super) fn set_resistance(&mut self, y: &[f64]) {
+        if let Some(th) = &self.scene.thermal {
+            let t_w = &y[self.layout.winding_temperature()];
+            for (j, (r, &t)) in self.ws.drives.r.iter_mut().zip(t_w).enumerate() {
+                *r = th.resistance(j, t);
+            }
+        }
     }
 
     /// T + V + ½ Σ L i² (+ the stops' ½ k δ² when configured), J. Clobbers the kinematics
@@ -101,7 +117,9 @@ impl<'a> ArmSystem<'a> {
             .map_err(|why| DynamicsError::Unreachable { t, why })?;
         let input = crate::control::ControlInput { q, qd, current, q_des: &ws.q_des, qd_des: &ws.qd_des, qdd_des: &ws.qdd_des };
         s.controller.voltage(&s.model, &s.drives, &mut ws.data, &mut ws.ctrl, &input, &mut ws.voltage);
-        let d = &s.drives;
+        // the drive's current window at the winding's resistance now (R(T_w) with the thermal
+        // model; the controller keeps its nominal model: it measures no temperature)
+        let d = &ws.drives;
         if d.has_limits {
             ws.voltage_cmd.copy_from_slice(&ws.voltage);
             for j in 0..q.len() {
@@ -132,6 +150,7 @@ impl<'a> ArmSystem<'a> {
         let (q, qd) = (&y[l.q()], &y[l.qd()]);
         let s = self.scene;
         let current = (l.electrical == Electrical::Inductive).then(|| &y[l.current()]);
+        self.set_resistance(y);
         self.voltage_at(t, q, qd, current)?;
         if let Some(st) = &s.stops {
             for j in 0..l.nv {
@@ -140,7 +159,7 @@ impl<'a> ArmSystem<'a> {
         }
         if l.electrical == Electrical::QuasiStatic && !s.drives.has_limits {
             for j in 0..l.nv {
-                self.ws.current_qs[j] = s.drives.quasi_static_current(j, self.ws.voltage[j], qd[j]);
+                self.ws.current_qs[j] = self.ws.drives.quasi_static_current(j, self.ws.voltage[j], qd[j]);
             }
         }
         self.gear_inputs(y);
@@ -167,7 +186,7 @@ impl<'a> ArmSystem<'a> {
         let s = self.scene;
         let plant = Plant {
             model: &s.model,
-            drives: &s.drives,
+            drives: &self.ws.drives,
             contacts: &self.contacts,
             mass_matrix: s.mass_matrix,
             solver: s.solver,
@@ -194,7 +213,7 @@ impl OdeSystem for ArmSystem<'_> {
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RunError> {
         self.evaluate(t, y)?;
         let l = self.layout;
-        let d = &self.scene.drives;
+        let d = &self.ws.drives;
         let qd = &y[l.qd()];
         let cur = self.currents(y);
         let (fd, voltage) = (&self.ws.fd, &self.ws.voltage);
@@ -223,6 +242,18 @@ impl OdeSystem for ArmSystem<'_> {
         }
         if let (Some(k), Some(st)) = (l.loss_stop(), &self.scene.stops) {
             dydt[k] = st.loss_rate(&y[l.q()], qd);
+        }
+        if let (Some(th), Some(k)) = (&self.scene.thermal, l.heat_to_ambient()) {
+            // the two-node network of each motor, heated by its copper loss R(T_w) i²
+            let (t_w, t_h) = (&y[l.winding_temperature()], &y[l.housing_temperature()]);
+            let mut q_a = 0.0;
+            for j in 0..l.nv {
+                let (a, b) = th.rates(j, d.r[j] * cur[j] * cur[j], t_w[j], t_h[j]);
+                dydt[l.winding_temperature().start + j] = a;
+                dydt[l.housing_temperature().start + j] = b;
+                q_a += th.heat_to_ambient(j, t_h[j]);
+            }
+            dydt[k] = q_a;
         }
         if self.hybrid.is_some() {
             self.contact_loss_rates(dydt);

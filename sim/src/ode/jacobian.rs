@@ -20,7 +20,11 @@
 //!   the quasi-static rows) and its Stribeck slope `s ∂τ_f/∂q̇` adds to the damping; a sticking
 //!   joint's lock (`drive_modes.rs`) is left out (bounded, as the stops).
 //!   `M_c⁻¹` is computed here from M and J_c of the evaluation, whatever constraint solver the
-//!   scene uses (the Schur and the KKT solve leave different scratch behind).
+//!   scene uses (the Schur and the KKT solve leave different scratch behind). With the motors'
+//!   thermal model (`dynamics/thermal.rs`) its rows are exact: `∂Ṫ_w/∂T_w = (±R' i²) / C_w −
+//!   1 / (R_th1 C_w)`, `∂Ṫ_w/∂T_h = 1 / (R_th1 C_w)`, `∂Ṫ_h/∂T_w = 1 / (R_th1 C_h)`,
+//!   `∂Ṫ_h/∂T_h = −(1/R_th1 + 1/R_th2) / C_h`, and the copper loss's `∂Ṫ_w/∂i = 2 R i / C_w`,
+//!   `∂i̇/∂T_w = −R' i / L` (inductive) or through `i = (v − K_e k q̇)/R(T_w)` (L = 0).
 //! - For the classical Rosenbrock methods (`Rodas`), which need the exact Jacobian:
 //!   [`OdeJacobian::coupled_dim`] = the q, q̇, i block (the quadratures never feed back, so
 //!   their columns are zero), and no analytic exact Jacobian, so the stepper differences the
@@ -50,7 +54,7 @@ impl ArmSystem<'_> {
         // M_J⁻¹ there (a bounded approximation, which the W-methods allow; the classical
         // Rosenbrock methods difference f instead)
         let nc = if self.hybrid.is_some() { 0 } else { self.contacts.len() };
-        let d = &self.scene.drives;
+        let d = &self.ws.drives;
         let (data, fd, js) = (&self.ws.data, &self.ws.fd, &mut self.ws.jac);
         js.m_j.copy_from(&data.m);
         for j in 0..nv {
@@ -101,7 +105,7 @@ impl OdeJacobian for ArmSystem<'_> {
         let l = self.layout;
         let (nv, dim) = (l.nv, l.dim());
         let scene = self.scene;
-        let d = &scene.drives;
+        let d = &self.ws.drives;
         let inductive = l.electrical == Electrical::Inductive;
         // the law's diagonal linearisation (k_p', k_d', k_i'): the PD gains for the paper
         let lin = &mut self.ws.jac.lin;
@@ -148,6 +152,42 @@ impl OdeJacobian for ArmSystem<'_> {
                 }
             }
         }
+        if let Some(th) = &scene.thermal {
+            // the two-node networks and R(T_w) (`dynamics/thermal.rs`), exactly: the copper
+            // loss P = R(T_w) i² into the winding, R(T_w) into eq 11 (inductive) or into the
+            // algebraic current i = (v − K_e k q̇) / R(T_w) (quasi-static)
+            let cur = match l.electrical {
+                Electrical::Inductive => &y[l.current()],
+                Electrical::QuasiStatic => &self.ws.current_qs[..],
+            };
+            for j in 0..nv {
+                let Some(p) = &th.params[j] else { continue };
+                let (tw, thj) = (l.winding_temperature().start + j, l.housing_temperature().start + j);
+                let (cw, ch, r1, r2) = (p.c_winding(), p.c_housing(), p.r_winding_housing, p.r_housing_ambient);
+                let (r, dr, i) = (d.r[j], th.resistance_slope(j), cur[j]);
+                set(tw, thj, 1.0 / (r1 * cw));
+                set(thj, tw, 1.0 / (r1 * ch));
+                set(thj, thj, -(1.0 / r1 + 1.0 / r2) / ch);
+                match l.electrical {
+                    Electrical::Inductive => {
+                        set(tw, tw, dr * i * i / cw - 1.0 / (r1 * cw));
+                        set(tw, l.current().start + j, 2.0 * r * i / cw);
+                        set(l.current().start + j, tw, -dr * i / d.l[j]);
+                    }
+                    Electrical::QuasiStatic => {
+                        // ∂P/∂T_w = −R' i², ∂P/∂q = −2 i k_p, ∂P/∂q̇ = −2 i (k_d + K_e k)
+                        let (kp, kd, _) = lin[j];
+                        set(tw, tw, -dr * i * i / cw - 1.0 / (r1 * cw));
+                        set(tw, l.q().start + j, -2.0 * i * kp / cw);
+                        set(tw, l.qd().start + j, -2.0 * i * (kd + d.ke[j]) / cw);
+                        // ∂q̈/∂T_w = M_c⁻¹ K_m ∂i/∂T_w, ∂i/∂T_w = −i R' / R
+                        for r_ in 0..nv {
+                            set(l.qd().start + r_, tw, -minv[(r_, j)] * d.km[j] * i * dr / r);
+                        }
+                    }
+                }
+            }
+        }
         Ok(())
     }
 }
@@ -171,9 +211,9 @@ impl SplitSystem for ArmSystem<'_> {
         }
         // v(t, q, q̇) from the explicit components, then the closed form per motor
         // (a law with a current loop is rejected with imex when the scene is built)
-        let scene = self.scene;
+        self.set_resistance(r);
         self.voltage_at(t, &r[l.q()], &r[l.qd()], Some(&r[l.current()]))?;
-        let (d, voltage) = (&scene.drives, &self.ws.voltage);
+        let (d, voltage) = (&self.ws.drives, &self.ws.voltage);
         for j in 0..l.nv {
             let k = l.current().start + j;
             let qd = r[l.qd().start + j];

@@ -18,11 +18,15 @@ pub struct Layout {
     /// non-bilateral contact (0 otherwise, so the paper's layout is unchanged). Per contact k,
     /// three follow the stops': impact loss, friction work, damping loss.
     pub contacts: usize,
+    /// The thermal model is on (`dynamics/thermal.rs`): the winding and housing temperatures
+    /// of every motor follow the currents (2 nv states, before the quadratures, since R(T_w)
+    /// feeds back into the currents), and the heat to the ambient `Q_a` comes last.
+    pub thermal: bool,
     /// The gears' Coulomb and efficiency loss `E_g` is present (`gear_friction`); it follows
     /// the contacts' quadratures.
     pub gear: bool,
     /// The supply's four quadratures (energy delivered, regenerated, dumped, conversion loss)
-    /// are present (`supply`); they come last.
+    /// are present (`supply`); they follow `E_g` (and come before `Q_a`).
     pub supply: bool,
 }
 
@@ -31,8 +35,16 @@ impl Layout {
     pub fn ni(&self) -> usize {
         self.electrical.states(self.nv)
     }
+    /// Number of temperature states: 2 nv with the thermal model, else 0.
+    pub fn nth(&self) -> usize {
+        if self.thermal { 2 * self.nv } else { 0 }
+    }
+    /// Where the quadratures start: after q, q̇, the currents and the temperatures.
+    fn head(&self) -> usize {
+        2 * self.nv + self.ni() + self.nth()
+    }
     pub fn dim(&self) -> usize {
-        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * self.contacts + usize::from(self.gear) + 4 * usize::from(self.supply)
+        self.head() + 2 * self.nv + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * self.contacts + usize::from(self.gear) + 4 * usize::from(self.supply) + usize::from(self.thermal)
     }
     /// `E_g`, when [`Layout::gear`].
     pub fn loss_gear(&self) -> Option<usize> {
@@ -52,36 +64,51 @@ impl Layout {
     pub fn current(&self) -> std::ops::Range<usize> {
         2 * self.nv..2 * self.nv + self.ni()
     }
-    pub fn work(&self) -> std::ops::Range<usize> {
+    /// The winding temperatures T_w, °C; empty without the thermal model.
+    pub fn winding_temperature(&self) -> std::ops::Range<usize> {
         let s = 2 * self.nv + self.ni();
+        s..s + self.nth() / 2
+    }
+    /// The housing temperatures T_h, °C; empty without the thermal model.
+    pub fn housing_temperature(&self) -> std::ops::Range<usize> {
+        let s = 2 * self.nv + self.ni() + self.nth() / 2;
+        s..s + self.nth() / 2
+    }
+    /// `Q_a = ∫ Σ (T_h − T_a) / R_th2 dt`, the heat given to the ambient, J: the last
+    /// component, with the thermal model.
+    pub fn heat_to_ambient(&self) -> Option<usize> {
+        self.thermal.then(|| self.dim() - 1)
+    }
+    pub fn work(&self) -> std::ops::Range<usize> {
+        let s = self.head();
         s..s + self.nv
     }
     pub fn electric(&self) -> std::ops::Range<usize> {
-        let s = 3 * self.nv + self.ni();
+        let s = self.head() + self.nv;
         s..s + self.nv
     }
     pub fn loss_r(&self) -> usize {
-        4 * self.nv + self.ni()
+        self.head() + 2 * self.nv
     }
     /// `∫ Σ D_j q̇_j² dt`: the joints' own viscous friction.
     pub fn loss_d(&self) -> usize {
-        4 * self.nv + self.ni() + 1
+        self.loss_r() + 1
     }
     /// `∫ Σ D_m,j q̇_j² dt`: the gears' viscous friction, seen at the joint.
     pub fn loss_dm(&self) -> usize {
-        4 * self.nv + self.ni() + 2
+        self.loss_r() + 2
     }
     /// `E_conv`, when [`Layout::conversion`].
     pub fn loss_conversion(&self) -> Option<usize> {
-        self.conversion.then(|| 4 * self.nv + self.ni() + 3)
+        self.conversion.then(|| self.loss_r() + 3)
     }
     /// `E_s`, when [`Layout::stops`].
     pub fn loss_stop(&self) -> Option<usize> {
-        self.stops.then(|| 4 * self.nv + self.ni() + 3 + usize::from(self.conversion))
+        self.stops.then(|| self.loss_r() + 3 + usize::from(self.conversion))
     }
     /// Contact k's kinetic energy lost in impacts (with the rotors'), J.
     pub fn impact_loss(&self, k: usize) -> usize {
-        4 * self.nv + self.ni() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * k
+        self.loss_r() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * k
     }
     /// Contact k's friction work `∫ −f_t · v_t dt`, J.
     pub fn friction_work(&self, k: usize) -> usize {
@@ -100,6 +127,12 @@ impl Layout {
             format!("q' of {j}")
         } else if let Some(j) = within(self.current()) {
             format!("current of {j}")
+        } else if let Some(j) = within(self.winding_temperature()) {
+            format!("winding temperature of {j}")
+        } else if let Some(j) = within(self.housing_temperature()) {
+            format!("housing temperature of {j}")
+        } else if Some(k) == self.heat_to_ambient() {
+            "heat to the ambient".into()
         } else if let Some(j) = within(self.work()) {
             format!("link work of {j}")
         } else if let Some(j) = within(self.electric()) {

@@ -17,7 +17,11 @@
 //! `E_s = ∫ Σ c q̇² [beyond a limit] dt` when soft joint stops are configured
 //! (`joint_limits.rs`). After the contacts' quadratures, again only in the scenes that have
 //! them (`drive_modes.rs`): the gears' Coulomb and efficiency loss `E_g` (`gear_friction`),
-//! then the supply's `E_supply, E_regen, E_dump, E_sloss` (`supply`).
+//! then the supply's `E_supply, E_regen, E_dump, E_sloss` (`supply`). With the motors' thermal
+//! model on (`dynamics/thermal.rs`, scene `thermal`), the winding and housing temperatures
+//! `T_w (n) | T_h (n)` follow the currents (R(T_w) feeds back into eq 11, so they are coupled
+//! states, before the quadratures) and the heat given to the ambient `Q_a` comes last; the
+//! copper loss `E_R` is then `∫ Σ R(T_w) i² dt`.
 //!
 //! Energy balance (SCENE.md; ideal constraints do no work):
 //! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm [+ E_conv] [+ ΔV_s + E_s] [+ E_g]`, T including

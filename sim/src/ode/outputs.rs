@@ -88,6 +88,19 @@ pub struct Outputs {
     pub gear_stuck: Vec<bool>,
     /// The supply's powers and energies (`None` without `supply`).
     pub supply: Option<SupplyOutput>,
+    /// Per joint: the winding and housing temperatures, °C, and the winding resistance R(T_w),
+    /// ohm (empty without the thermal model).
+    pub winding_temperature: Vec<f64>,
+    pub housing_temperature: Vec<f64>,
+    pub resistance: Vec<f64>,
+    /// Per joint: the copper loss R(T_w) i², W (empty without the thermal model, and at the
+    /// kinematic level for quasi-static motors).
+    pub copper_loss: Vec<f64>,
+    /// The heat stored in the motors since t = 0, `Σ C_w (T_w − T_0) + C_h (T_h − T_0)`, J, and
+    /// the heat given to the ambient `Q_a`, J (0 without the thermal model): with the thermal
+    /// model, `E_R = heat_stored + heat_to_ambient` (`dynamics/thermal.rs`).
+    pub heat_stored: f64,
+    pub heat_to_ambient: f64,
 }
 
 /// The supply at one sample (`dynamics/supply.rs`).
@@ -129,6 +142,27 @@ pub enum OutputLevel {
 }
 
 impl ArmSystem<'_> {
+    /// The temperatures, resistances and heat totals of the thermal model at `y` (cleared
+    /// without it); the copper losses are set by the caller, which knows the currents.
+    fn thermal_outputs(&self, y: &[f64], out: &mut Outputs) {
+        let l = self.layout;
+        let Some(th) = &self.scene.thermal else {
+            for v in [&mut out.winding_temperature, &mut out.housing_temperature, &mut out.resistance, &mut out.copper_loss] {
+                v.clear();
+            }
+            (out.heat_stored, out.heat_to_ambient) = (0.0, 0.0);
+            return;
+        };
+        let (t_w, t_h) = (&y[l.winding_temperature()], &y[l.housing_temperature()]);
+        set(&mut out.winding_temperature, t_w);
+        set(&mut out.housing_temperature, t_h);
+        out.resistance.clear();
+        out.resistance.extend((0..l.nv).map(|j| th.resistance(j, t_w[j])));
+        out.copper_loss.clear();
+        out.heat_stored = (0..l.nv).map(|j| th.stored_heat(j, t_w[j], t_h[j])).sum();
+        out.heat_to_ambient = l.heat_to_ambient().map_or(0.0, |k| y[k]);
+    }
+
     /// Everything recorded at (t, y), written into `out` (whose vectors are reused).
     pub fn outputs(&mut self, t: f64, y: &[f64], out: &mut Outputs) -> Result<(), DynamicsError> {
         self.outputs_at(OutputLevel::Full, t, y, out)
@@ -175,6 +209,7 @@ impl ArmSystem<'_> {
             let electric: f64 = y[l.electric()].iter().sum();
             SupplyOutput { power: f64::NAN, bus_power: f64::NAN, energy, regenerated: y[k + 1], dumped, loss, residual: energy - (electric + dumped + loss) }
         });
+        self.thermal_outputs(y, out);
         let data = &self.ws.data;
         out.potential = potential_energy(&s.model, data);
         out.hand = s.hand.position(data);
@@ -199,6 +234,10 @@ impl ArmSystem<'_> {
                     out.magnetic = f64::NAN;
                 }
             }
+            if !out.resistance.is_empty() && l.ni() > 0 {
+                out.copper_loss.clear();
+                out.copper_loss.extend((0..l.nv).map(|j| out.resistance[j] * out.current[j] * out.current[j]));
+            }
             out.kinetic = f64::NAN;
             out.balance_residual = f64::NAN;
             self.contact_outputs(y, false, &mut out.contacts);
@@ -216,6 +255,10 @@ impl ArmSystem<'_> {
         }
         out.electric_power.clear();
         out.electric_power.extend((0..l.nv).map(|j| cur[j] * voltage[j]));
+        if !out.resistance.is_empty() {
+            out.copper_loss.clear();
+            out.copper_loss.extend((0..l.nv).map(|j| out.resistance[j] * cur[j] * cur[j]));
+        }
         set(&mut out.tau_motor, fd.tau_motor.as_slice());
         match &self.hybrid {
             None => set(&mut out.normal_force, fd.f_n.as_slice()),

@@ -7,6 +7,7 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::control::{ControllerScratch, TargetScratch};
 use crate::dynamics::forward::ForwardData;
+use crate::dynamics::motor::Drives;
 use crate::dynamics::{Data, Model};
 
 pub(super) struct Workspace {
@@ -40,10 +41,15 @@ pub(super) struct Workspace {
     pub(super) jac: JacobianScratch,
     /// The projection's matrices (`projection.rs`).
     pub(super) projection: ProjectionScratch,
+    /// The scene's drives with the winding resistances of this evaluation: R(T_w) with the
+    /// thermal model (`ArmSystem::set_resistance`), else the scene's own. What the physics
+    /// reads (eq 11, the copper loss, the drive's current window); the controller keeps the
+    /// scene's nominal drives.
+    pub(super) drives: Drives,
 }
 
 impl Workspace {
-    pub(super) fn new(model: &Model, nc: usize, dim: usize) -> Self {
+    pub(super) fn new(model: &Model, drives: &Drives, nc: usize, dim: usize) -> Self {
         let nv = model.nv;
         Self {
             data: Data::new(model),
@@ -59,6 +65,7 @@ impl Workspace {
             current_qs: vec![0.0; nv],
             jac: JacobianScratch::new(nv, nc, dim),
             projection: ProjectionScratch::new(nv, nc),
+            drives: drives.clone(),
         }
     }
 }

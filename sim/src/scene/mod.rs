@@ -3,14 +3,17 @@
 //! field and the value. The paper's scene is built in ([`Scene::paper`]).
 
 pub mod builtin;
+pub mod catalogue;
 mod contacts;
 mod ctx;
+pub mod drive;
 mod robot;
 pub mod schema;
 pub mod schema_key;
 pub mod spec;
 mod spec_contacts;
 mod spec_gear_supply;
+pub mod spec_drive;
 mod target;
 
 use std::path::Path;
@@ -99,6 +102,10 @@ pub struct Scene {
     pub(crate) gear_friction: Option<crate::dynamics::gear_friction::GearFriction>,
     /// The supply behind the drives (`supply`), when the scene has one.
     pub(crate) supply: Option<crate::dynamics::supply::Supply>,
+    /// The motors' thermal model, when the scene turns it on (`thermal`).
+    pub(crate) thermal: Option<crate::dynamics::thermal::Thermal>,
+    /// Per joint: what its datasheet drive is (`drives`), or `None` (the `motor` values).
+    pub(crate) datasheets: Vec<Option<drive::DatasheetDrive>>,
 }
 
 /// Read access (the fields are private to the crate: a scene never changes after validation).
@@ -202,6 +209,14 @@ impl Scene {
     /// Constraint stabilisation.
     pub fn stabilization(&self) -> Stabilization {
         self.stabilization
+    }
+    /// The motors' thermal model, when on.
+    pub fn thermal(&self) -> Option<&crate::dynamics::thermal::Thermal> {
+        self.thermal.as_ref()
+    }
+    /// Per joint: its datasheet drive, or `None` (the `motor` values).
+    pub fn datasheets(&self) -> &[Option<drive::DatasheetDrive>] {
+        &self.datasheets
     }
     /// The validated integrator.
     pub fn integrator(&self) -> Integrator {
@@ -410,14 +425,18 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     let gear = c.per_joint("motor.gear_ratio", &m.gear_ratio, nv, positive, "must be > 0")?;
     let dmg = c.per_joint("motor.gear_damping", &m.gear_damping, nv, non_negative, "must be >= 0 N m s/rad")?;
     let damping = c.per_joint("joint_damping", &spec.joint_damping, nv, non_negative, "must be >= 0 N m s/rad")?;
-    let motors: Vec<MotorParams> = (0..nv)
+    let mut motors: Vec<MotorParams> = (0..nv)
         .map(|j| MotorParams {
             torque_constant: k[j], resistance: r[j], inductance: l[j], rotor_inertia: im[j], gear_ratio: gear[j],
             gear_damping: dmg[j],
         })
         .collect();
-    let mut drives = Drives::new(&motors, &damping);
     let mut specs = vec![DriveSpec::ideal(); nv];
+    let datasheets = drive::apply_drives(&c, &spec, &model, &mut motors, &mut specs)?;
+    if motors.iter().any(|m| m.inductance == 0.0) && motors.iter().any(|m| m.inductance > 0.0) {
+        return Err(c.err("drives", "(datasheet inductances)", "the datasheet drives have an inductance, so `motor.inductance` must be > 0 on the other joints too (quasi-static motors are all or none)"));
+    }
+    let mut drives = Drives::new(&motors, &damping);
     if let Some(p) = &m.back_emf_constant {
         let ke = c.per_joint("motor.back_emf_constant", p, nv, positive, "must be > 0 V s/rad")?;
         for (s, x) in specs.iter_mut().zip(ke) {
@@ -446,6 +465,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     if specs.iter().any(|s| *s != DriveSpec::ideal()) {
         drives = drives.with_real_drives(&motors, &specs);
     }
+    let thermal = drive::build_thermal(&c, &spec, &model, &specs, &motors.iter().map(|m| m.resistance).collect::<Vec<_>>())?;
     // a joint that moves only massless links has a zero row in M(q): M + J_m is singular at
     // every q unless its motor adds a rotor inertia
     for j in model.massless_dofs() {
@@ -610,6 +630,8 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
         gear_friction,
         supply,
         spec,
+        thermal,
+        datasheets,
     })
 }
 

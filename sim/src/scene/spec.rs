@@ -177,6 +177,14 @@ pub struct SceneSpec {
     /// regenerating supplies: the supply energy is E).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub supply: Option<SupplySpec>,
+    /// Datasheet drives: a catalogue motor (and gearhead) by name, or its datasheet values, per
+    /// joint; each replaces the `motor` values of its joints (default: none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drives: Vec<super::spec_drive::DatasheetDriveSpec>,
+    /// The motors' winding temperature: a two-node thermal model (winding, housing) with R(T)
+    /// in the electrical equation; needs datasheet drives with thermal data (default: off).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<super::spec_drive::ThermalSpec>,
 }
 
 /// How the URDF is loaded (`"robot": {...}`); every key optional.

@@ -64,6 +64,16 @@ pub struct MetricsArgs {
     /// read once). Exit status 1 when any file was damaged.
     #[arg(long)]
     pub recover: bool,
+    /// Check the audits of every run and exit 1 when one fails: the contact laws at every
+    /// sample (recomputed from `/contacts` against the bounds of the run's `contacts` record,
+    /// and the run's own count) and the energy balance, whose largest residual must stay
+    /// within ENERGY_BOUND of E (a run without samples, or damaged, fails too). Each failure
+    /// is named on stderr with the law or the residual, its value, its bound and its time.
+    #[arg(long)]
+    pub check: bool,
+    /// The energy balance's bound for `--check`: the largest |residual| over |E|.
+    #[arg(long, value_name = "REL", default_value_t = 1e-6, requires = "check")]
+    pub energy_bound: f64,
     #[command(flatten)]
     pub format: TableFormat,
 }
@@ -76,22 +86,65 @@ pub fn compare(a: &CompareArgs, v: Verbosity) -> Result<u8> {
 }
 
 pub fn metrics(a: &MetricsArgs, v: Verbosity) -> Result<u8> {
+    if a.check && !(a.energy_bound.is_finite() && a.energy_bound > 0.0) {
+        anyhow::bail!("--energy-bound {}: a relative bound must be a positive number", a.energy_bound);
+    }
     let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
     print_out(&render_metrics_fitted(&runs, a.format.format, cli::terminal_width())?)?;
-    Ok(status(&runs, damaged, v))
+    let code = status(&runs, damaged, v);
+    if !a.check {
+        return Ok(code);
+    }
+    let mut failed = false;
+    for r in &runs {
+        for why in audit_failures(r, a.energy_bound) {
+            failed = true;
+            eprintln!("analyze: --check: {}: run {}: {why}", r.file, r.run);
+        }
+    }
+    Ok(if failed { code.max(exit::FAILED) } else { code })
 }
 
-/// The exit status of a table of `runs`: 1 when a file was damaged or a run did not complete
-/// (each such run is named on stderr: its row has its status and reason), else 0.
+/// Why `r` fails `--check` besides its contact laws (which [`status`] names): no samples, or
+/// its energy balance beyond `energy_bound` of E.
+fn audit_failures(r: &RunMetrics, energy_bound: f64) -> Vec<String> {
+    let mut out = Vec::new();
+    if !r.measured() {
+        out.push("no samples to audit".into());
+        return out;
+    }
+    // (broken contact laws are named, and fail, without --check: see `status`)
+    match r.energy.as_ref() {
+        Some(e) => match e.max_abs_residual_rel {
+            Some(rel) if rel <= energy_bound => {}
+            Some(rel) => out.push(format!(
+                "the energy balance does not close: max |residual| {:.3e} J = {rel:.3e} of E at t = {} s (bound {energy_bound:e})",
+                e.max_abs_residual_j, e.t_max_abs_residual_s
+            )),
+            None => out.push(format!("the energy balance has no relative residual (E = {:e} J)", e.electric_j)),
+        },
+        None => out.push("no energy balance".into()),
+    }
+    out
+}
+
+/// The exit status of a table of `runs`: 1 when a file was damaged, a run did not complete or
+/// its contacts broke their laws at some sample (the contact audit; each such run is named on
+/// stderr: its row has its status and reason), else 0.
 pub fn status(runs: &[RunMetrics], damaged: bool, v: Verbosity) -> u8 {
     let failed: Vec<&RunMetrics> = runs.iter().filter(|r| r.status != Status::Complete).collect();
+    let broken: Vec<(&RunMetrics, String)> =
+        runs.iter().filter_map(|r| r.contact_audit.as_ref().and_then(analyze::ContactAuditMetrics::failure).map(|why| (r, why))).collect();
     if !v.quiet {
         for r in &failed {
             let at = r.error_time_s.map_or(String::new(), |t| format!(" at t = {t:.3} s"));
             eprintln!("analyze: {}: run {} {}{at}: {}", r.file, r.run, r.status_text(), r.error.as_deref().unwrap_or("no reason recorded"));
         }
+        for (r, why) in &broken {
+            eprintln!("analyze: {}: run {}: the contact laws do not hold: {why}", r.file, r.run);
+        }
     }
-    if damaged || !failed.is_empty() {
+    if damaged || !failed.is_empty() || !broken.is_empty() {
         exit::FAILED
     } else {
         exit::SUCCESS

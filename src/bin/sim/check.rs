@@ -68,6 +68,141 @@ struct Description {
     /// Locked joints, mimic followers, repaired inertias, meshes (empty when none).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     robot_options: Vec<String>,
+    /// The datasheet drives' derived model, joints with equal drives grouped (scenes with
+    /// `drives` or `thermal`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    drives: Vec<DriveDescription>,
+    /// The thermal model: ambient and initial temperature, °C (scenes with `thermal`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    thermal: Option<String>,
+}
+
+/// One group of joints with the same drive, as the model sees it (link side, SI).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+struct DriveDescription {
+    joints: Vec<String>,
+    /// Catalogue names, or "datasheet values" / "motor values" (the scene's `motor`).
+    drive: String,
+    km_nm_per_a: f64,
+    ke_v_s_per_rad: f64,
+    jm_kg_m2: f64,
+    dm_nm_s_per_rad: f64,
+    /// R at the ambient (thermal model on) or at the datasheet's reference temperature, ohm.
+    resistance_ohm: f64,
+    resistance_at_c: Option<f64>,
+    inductance_h: f64,
+    gear_ratio_note: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    nominal_voltage_v: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    thermal: Option<ThermalDescription>,
+}
+
+/// A motor's thermal constants (`dynamics/thermal.rs`).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+struct ThermalDescription {
+    c_winding_j_per_k: f64,
+    c_housing_j_per_k: f64,
+    r_winding_housing_k_per_w: f64,
+    r_housing_ambient_k_per_w: f64,
+    tau_winding_s: f64,
+    tau_housing_s: f64,
+    max_winding_temperature_c: f64,
+    alpha_20_per_k: f64,
+    reference_temperature_c: f64,
+}
+
+fn drive_descriptions(s: &Scene) -> Vec<DriveDescription> {
+    if s.datasheets().iter().all(Option::is_none) && s.thermal().is_none() {
+        return Vec::new();
+    }
+    let (d, names) = (s.drives(), s.model().joint_names());
+    let mut out: Vec<DriveDescription> = Vec::new();
+    for (j, name) in names.iter().enumerate() {
+        if d.passive[j] {
+            continue;
+        }
+        let ds = &s.datasheets()[j];
+        let th = s.thermal();
+        let params = th.and_then(|t| t.params[j]).or_else(|| ds.as_ref().and_then(|x| x.thermal));
+        let (resistance_ohm, resistance_at_c) = match (th, &params) {
+            (Some(t), _) => (t.resistance(j, t.ambient), Some(t.ambient)),
+            (None, Some(p)) => (d.r[j], Some(p.reference_temperature)),
+            (None, None) => (d.r[j], None),
+        };
+        let desc = DriveDescription {
+            joints: vec![name.clone()],
+            drive: ds.as_ref().map_or("motor values".into(), |x| x.what.clone()),
+            km_nm_per_a: d.km[j],
+            ke_v_s_per_rad: d.ke[j],
+            jm_kg_m2: d.jm[j],
+            dm_nm_s_per_rad: d.dm[j],
+            resistance_ohm,
+            resistance_at_c,
+            inductance_h: d.l[j],
+            gear_ratio_note: ds.as_ref().and_then(|x| {
+                let mut parts = Vec::new();
+                if let Some(e) = x.gear_efficiency {
+                    parts.push(format!("max efficiency {:.0} % (not modelled: no gear friction model in this drive)", 100.0 * e));
+                }
+                if let Some(t) = x.gear_torque_continuous {
+                    parts.push(format!("{t} N m continuous"));
+                }
+                if let Some(t) = x.gear_torque_intermittent {
+                    parts.push(format!("{t} N m intermittent (monitored)"));
+                }
+                (!parts.is_empty()).then(|| parts.join(", "))
+            }),
+            nominal_voltage_v: ds.as_ref().map(|x| x.nominal_voltage),
+            thermal: params.map(|p| ThermalDescription {
+                c_winding_j_per_k: p.c_winding(),
+                c_housing_j_per_k: p.c_housing(),
+                r_winding_housing_k_per_w: p.r_winding_housing,
+                r_housing_ambient_k_per_w: p.r_housing_ambient,
+                tau_winding_s: p.tau_winding,
+                tau_housing_s: p.tau_housing,
+                max_winding_temperature_c: p.max_winding_temperature,
+                alpha_20_per_k: p.alpha_20,
+                reference_temperature_c: p.reference_temperature,
+            }),
+        };
+        match out.iter_mut().find(|o| DriveDescription { joints: o.joints.clone(), ..desc.clone() } == **o) {
+            Some(o) => o.joints.push(name.clone()),
+            None => out.push(desc),
+        }
+    }
+    out
+}
+
+/// Joint names as a range when they are many: `joint1 … joint10 (10)`.
+fn joint_list(j: &[String]) -> String {
+    if j.len() <= 3 { j.join(", ") } else { format!("{} … {} ({} joints)", j[0], j[j.len() - 1], j.len()) }
+}
+
+fn drive_lines(d: &DriveDescription) -> Vec<String> {
+    let at = d.resistance_at_c.map_or(String::new(), |t| format!(" at {t} °C"));
+    let mut out = vec![format!(
+        "{}: {}; K_m = {:.6} N m/A, K_e k = {:.6} V s/rad, J_m = {:.6e} kg m^2, D_m = {:.4e} N m s/rad, R = {:.6} ohm{at}, L = {:.4e} H{}",
+        joint_list(&d.joints),
+        d.drive,
+        d.km_nm_per_a,
+        d.ke_v_s_per_rad,
+        d.jm_kg_m2,
+        d.dm_nm_s_per_rad,
+        d.resistance_ohm,
+        d.inductance_h,
+        d.nominal_voltage_v.map_or(String::new(), |v| format!(", nominal {v} V")),
+    )];
+    if let Some(t) = &d.thermal {
+        out.push(format!(
+            "  thermal: C_w = {:.4} J/K, C_h = {:.4} J/K (R_th1 = {} K/W, R_th2 = {} K/W, tau_w = {} s, tau_s = {} s), T_max = {} °C, alpha_20 = {} /K, R given at {} °C",
+            t.c_winding_j_per_k, t.c_housing_j_per_k, t.r_winding_housing_k_per_w, t.r_housing_ambient_k_per_w, t.tau_winding_s, t.tau_housing_s, t.max_winding_temperature_c, t.alpha_20_per_k, t.reference_temperature_c
+        ));
+    }
+    if let Some(g) = &d.gear_ratio_note {
+        out.push(format!("  gearhead: {g}"));
+    }
+    out
 }
 
 /// The integrator with every setting that applies, defaults filled in.
@@ -158,6 +293,8 @@ fn describe(s: &Scene) -> Description {
         controller: s.controller().law.name().to_string(),
         limits: limits_phrase(s),
         robot_options: robot_options(s),
+        drives: drive_descriptions(s),
+        thermal: s.thermal().map(|t| format!("two-node winding/housing model on: ambient {} °C, initial {} °C; R(T_w) in eq 11; temperatures recorded on /motor_temperatures", t.ambient, t.initial)),
     }
 }
 
@@ -221,6 +358,14 @@ pub fn run(a: &CheckArgs) -> Result<u8> {
             writeln!(o, "  limits       {}", d.limits)?;
             for r in &d.robot_options {
                 writeln!(o, "  urdf         {r}")?;
+            }
+            if let Some(t) = &d.thermal {
+                writeln!(o, "  thermal      {t}")?;
+            }
+            for dd in &d.drives {
+                for line in drive_lines(dd) {
+                    writeln!(o, "  drive        {line}")?;
+                }
             }
             o
         }

@@ -244,6 +244,10 @@ impl schemas::Visitor for MetricsTap {
     fn message(&mut self, m: schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
         self.0.lock().unwrap_or_else(PoisonError::into_inner).message(m)
     }
+
+    fn metadata(&mut self, name: &str, entries: &std::collections::BTreeMap<String, String>) {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner).metadata(name, entries)
+    }
 }
 
 impl MetricsTap {
@@ -322,7 +326,14 @@ pub fn run_all_live(
                         )
                     });
                 }
-                Done { path: Some(r.path), error: None, io_error: false, metrics: Some(metrics.metrics(tapped)) }
+                let metrics = metrics.metrics(tapped);
+                // a run whose contacts broke their laws is not a result (exit 1), though it ran
+                // to the end: its recording says where (record `contact_audit`)
+                let error = match &metrics {
+                    Ok(m) => m.contact_audit.as_ref().and_then(analyze::ContactAuditMetrics::failure).map(|why| format!("run `{}`: the contact laws do not hold: {why}", run.name)),
+                    Err(_) => None,
+                };
+                Done { path: Some(r.path), error, io_error: false, metrics: Some(metrics) }
             }
             Err(e) => {
                 bar.abandon_with_message(format!("failed at {}", e.time().map_or("?".into(), |t| format!("{t:.3} s"))));

@@ -169,7 +169,17 @@ pub fn run(args: &SweepArgs, v: Verbosity) -> Result<u8> {
             // the metrics from what the run wrote (as `analyze` reads them from the file)
             Ok((rep, tapped)) => {
                 let metrics = metrics.metrics(tapped).map_err(|e| format!("the metrics of {}: {e}", rep.path.display()));
-                Done { metrics: Some(metrics), path: Some(rep.path), error: None, io_error: false }
+                // as `sim run`: a run whose contacts broke their laws is not a result (exit 1)
+                let error = match &metrics {
+                    Ok(m) => m.contact_audit.as_ref().and_then(analyze::ContactAuditMetrics::failure).map(|why| {
+                        format!("{} run `{run_name}` ({}): the contact laws do not hold: {why}", var.name, var.describe())
+                    }),
+                    Err(_) => None,
+                };
+                if let Some(e) = &error {
+                    bar.println(format!("sim: error: {e}"));
+                }
+                Done { metrics: Some(metrics), path: Some(rep.path), error, io_error: false }
             }
             Err(e) => {
                 // a numerical failure still leaves a recording that says when and why
