@@ -29,6 +29,8 @@ mod contacts_scene;
 mod contacts_start;
 #[path = "convergence.rs"]
 mod convergence;
+#[path = "drive_features.rs"]
+mod drive_features;
 #[path = "drives.rs"]
 mod drives;
 #[path = "fuzz_scenes.rs"]

@@ -42,7 +42,7 @@ fn samples(scene: &Scene, run: &str) -> Vec<Outputs> {
 
 /// The gear log of a run, integrated as `sim` does (the scene's integrator, default event
 /// settings).
-fn gear_log(scene: &Scene, run: &str) -> Vec<sim::ode::GearEvent> {
+pub(crate) fn gear_log(scene: &Scene, run: &str) -> Vec<sim::ode::GearEvent> {
     let run = scene.run(run).unwrap().clone();
     let mut sys = ArmSystem::new(scene, &run);
     let y0 = sys.initial_state();

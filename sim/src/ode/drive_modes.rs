@@ -505,6 +505,28 @@ impl ArmSystem<'_> {
         Ok(moved)
     }
 
+    /// The joints whose gear functions are all of `text`'s event functions (the driver's
+    /// "event functions [i, j, ...]" of a chattering error), or `None` when another function is
+    /// among them (a contact's, a supply's) or the text is not such a list.
+    pub fn chattering_gears(&self, text: &str) -> Option<Vec<String>> {
+        let list = text.strip_prefix("event functions [")?.strip_suffix(']')?;
+        let nc = self.contact_n_events();
+        let nv = self.layout.nv;
+        self.scene.gear_friction.as_ref()?;
+        let mut joints: Vec<String> = Vec::new();
+        for part in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let i = part.parse::<usize>().ok()?.checked_sub(nc)?;
+            if i >= 2 * nv {
+                return None;
+            }
+            let name = self.scene.model.bodies[i / 2].joint.clone();
+            if !joints.contains(&name) {
+                joints.push(name);
+            }
+        }
+        (!joints.is_empty()).then_some(joints)
+    }
+
     /// "gear of <joint> (...)" or "supply (...)" for the drives' event function `i`.
     pub(super) fn describe_drive_event(&self, i: usize) -> Option<String> {
         let m = self.drive_modes.as_ref()?;
