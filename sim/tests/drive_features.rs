@@ -3,6 +3,8 @@
 //! regeneration on a shared bus — on the paper arm: how every method converges, the energy
 //! balance at every sample, and the coupled stick decisions of the closed chains.
 
+#![allow(clippy::result_large_err)] // the sinks return RunError, as in convergence.rs
+
 use sim::scene::spec::{AdaptiveSpec, BusSpec, GearFrictionSpec, IntegratorSpec, PerJoint, PerJointFlag, SupplySpec};
 use sim::scene::Scene;
 
