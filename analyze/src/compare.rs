@@ -87,6 +87,56 @@ pub struct Comparison {
     pub links: Vec<LinkComparison>,
     /// Plain sentences (see the module docs).
     pub findings: Vec<String>,
+    /// The compared runs ranked by one quantity, least first ([`Comparison::ranked`],
+    /// `analyze compare --rank-by`); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ranking: Option<Ranking>,
+}
+
+/// What `analyze compare --rank-by` ranks the runs by (least first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RankBy {
+    /// E = Σ ∫ i v dt, the electric energy into the motors (an ideal regenerating supply).
+    #[default]
+    ElectricEnergy,
+    /// The energy the supply delivers (scene `supply`: regeneration, the DC bus, brake
+    /// resistors; issue 26); a run without a `supply` is ranked by its E, which is what an
+    /// ideal regenerating supply delivers, and says so.
+    SupplyEnergy,
+    /// The hand error's RMS |r − r_d|.
+    HandError,
+}
+
+impl RankBy {
+    /// The quantity in words, for the finding.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RankBy::ElectricEnergy => "the electric energy E = Σ ∫ i v dt",
+            RankBy::SupplyEnergy => "the energy the supply delivers",
+            RankBy::HandError => "the hand error's RMS |r − r_d|",
+        }
+    }
+}
+
+/// The compared runs ranked by [`RankBy`], least first.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ranking {
+    pub by: RankBy,
+    pub runs: Vec<RankedRun>,
+}
+
+/// One run's place in a [`Ranking`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RankedRun {
+    pub run: String,
+    /// The ranked quantity: J for the energies, m for the hand error.
+    pub value: f64,
+    /// Ranked by its E because the run models no supply (`--rank-by supply-energy` only).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub ideal_supply: bool,
 }
 
 impl Comparison {
@@ -144,7 +194,49 @@ impl Comparison {
             runs: with_ratios,
             links,
             findings,
+            ranking: None,
         })
+    }
+
+    /// [`Comparison::new`], with the compared runs (measured, over the baseline's interval)
+    /// ranked by `by`, least first, in [`Comparison::ranking`] and as a finding. Ranking by the
+    /// supply energy needs at least one compared run whose scene has a `supply`
+    /// ([`Error::NothingToRank`]).
+    pub fn ranked(runs: &[RunMetrics], baseline: Option<&str>, by: RankBy) -> Result<Self, Error> {
+        let mut c = Self::new(runs, baseline)?;
+        let mut order: Vec<RankedRun> = c
+            .runs
+            .iter()
+            .filter(|r| r.not_compared.is_none())
+            .map(|r| {
+                let m = &r.metrics;
+                let (value, ideal_supply) = match by {
+                    RankBy::ElectricEnergy => (m.e_total(), false),
+                    RankBy::SupplyEnergy => m.supply_energy_j().map_or((m.e_total(), true), |e| (e, false)),
+                    RankBy::HandError => (m.hand().norm.rms_m, false),
+                };
+                RankedRun { run: m.run.clone(), value, ideal_supply }
+            })
+            .collect();
+        if by == RankBy::SupplyEnergy && order.iter().all(|r| r.ideal_supply) {
+            return Err(Error::NothingToRank {
+                by: "supply-energy",
+                why: "no compared run models its supply (scene `supply`, recordings with /supply): each delivers E; rank by electric-energy".into(),
+            });
+        }
+        order.sort_by(|a, b| a.value.total_cmp(&b.value));
+        let unit = |x: f64| match by {
+            RankBy::HandError => format!("{} mm", fixed(x * 1e3, 3)),
+            _ => format!("{} J", fixed(x, 3)),
+        };
+        let list: Vec<String> = order
+            .iter()
+            .enumerate()
+            .map(|(k, r)| format!("{}. {} {}{}", k + 1, r.run, unit(r.value), if r.ideal_supply { " (no supply modelled: E)" } else { "" }))
+            .collect();
+        c.findings.push(format!("Ranked by {}, least first: {}.", by.describe(), list.join(", ")));
+        c.ranking = Some(Ranking { by, runs: order });
+        Ok(c)
     }
 
     /// The runs compared with the baseline (measured, over its interval), in order, and the
@@ -355,6 +447,9 @@ fn findings(all: &[RunMetrics], base: usize, links: &[LinkComparison], why_not: 
         if let (Some(e), Some(l)) = (t.stop_energy, t.stop_loss) {
             parts.push(format!("joint stops: stored {e:.4e} J, damping loss {l:.4e} J"));
         }
+        if let Some(g) = t.gear_loss {
+            parts.push(format!("gear Coulomb and efficiency loss {g:.4e} J"));
+        }
         if !parts.is_empty() {
             out.push(format!("{}: the energy balance (residual above) also holds {}.", r.run, parts.join("; ")));
         }
@@ -384,6 +479,24 @@ fn findings(all: &[RunMetrics], base: usize, links: &[LinkComparison], why_not: 
         r.run,
         fixed(r.e_total(), 3)
     ));
+    // the energy the supply delivers (issue 26), over the compared runs whose scene models it:
+    // ranked beside E, as what a real arm draws (regeneration and the DC bus decide it)
+    let supplied: Vec<(&RunMetrics, f64, f64)> = compared
+        .iter()
+        .filter_map(|r| {
+            let t = r.energy_terms.as_ref()?;
+            Some((r, t.supply_energy?, t.supply_dumped.unwrap_or(0.0)))
+        })
+        .collect();
+    if !supplied.is_empty() {
+        let mut order = supplied.clone();
+        order.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let list: Vec<String> = order
+            .iter()
+            .map(|(r, es, dumped)| format!("{} {} J (E {} J, dumped {} J)", r.run, fixed(*es, 3), fixed(r.e_total(), 3), fixed(*dumped, 3)))
+            .collect();
+        out.push(format!("Least energy from the supply: {}; in order: {}.", order[0].0.run, list.join(", ")));
+    }
     let z = argmin(&|r| r.hand().z.rms_m);
     let r = &compared[z];
     let (rms, max) = (r.hand().z.rms_m * 1e3, r.hand().z.max_abs_m * 1e3);

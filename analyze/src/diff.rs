@@ -13,7 +13,7 @@
 //!
 //! Runs are matched by run name (when each input holds exactly one run they are compared
 //! whatever their names). Compared per run ([`KINDS`]): hand error RMS and max per axis and of
-//! the norm; E and W totals; the peak motor current; the energy balance residual at the end and
+//! the norm; E and W totals; the energy the supply delivered (runs with a `supply`); the peak motor current; the energy balance residual at the end and
 //! its max |·|; per link (matched by joint name) W_j, E_j and the peak current; per contact
 //! (matched by name) the minimum normal force and the time the table pulls.
 //!
@@ -133,6 +133,13 @@ pub const KINDS: &[Kind] = &[
         "J",
         Per::Run,
         Some("E_total_j"),
+    ),
+    kind(
+        "energy_terms.supply_energy",
+        "E supply",
+        "J",
+        Per::Run,
+        Some("E_supply_j"),
     ),
     kind(
         "link_work_total_j",

@@ -121,6 +121,10 @@ pub enum Error {
         available: Vec<String>,
     },
 
+    /// `compare --rank-by`: no compared run has the ranked quantity.
+    #[error("--rank-by {by}: nothing to rank: {why}")]
+    NothingToRank { by: &'static str, why: String },
+
     /// The requested baseline failed before its first sample: it has no numbers to divide by.
     #[error("baseline {name:?} ({file}) has no numbers to compare with: {why}; choose another run with --baseline")]
     UnmeasuredBaseline { name: String, file: String, why: String },

@@ -45,7 +45,7 @@ pub mod metrics;
 pub mod view;
 pub mod render;
 
-pub use compare::Comparison;
+pub use compare::{Comparison, RankBy};
 pub use diff::{read_input, render_diff, Diff, DiffError, Tolerance};
 pub use error::Error;
 pub use metrics::{

@@ -258,6 +258,20 @@ pub struct LimitsMetrics {
 }
 
 impl RunMetrics {
+    /// The energy the supply delivered by the end, `E_supply = ∫ P_s dt`, J (metadata
+    /// `energy_terms.supply_energy`): only runs whose scene has a `supply` (issue 26); without
+    /// one the supply is ideal and regenerating, and what it delivers is E = Σ ∫ i v dt.
+    pub fn supply_energy_j(&self) -> Option<f64> {
+        self.energy_terms.as_ref()?.supply_energy
+    }
+    /// The energy the supply took back (regenerated), J (runs with a `supply`).
+    pub fn supply_regenerated_j(&self) -> Option<f64> {
+        self.energy_terms.as_ref()?.supply_regenerated
+    }
+    /// The energy dumped in brake resistors, J (runs with a `supply`).
+    pub fn supply_dumped_j(&self) -> Option<f64> {
+        self.energy_terms.as_ref()?.supply_dumped
+    }
     /// A run that failed before its first sample: its names, status, error and time from the
     /// metadata, and no numbers (`samples` = 0, every measured value `None` or empty).
     pub fn without_samples(file: String, run: schemas::RunDescription, status: Status, error: Option<String>, error_time_s: Option<f64>) -> Self {

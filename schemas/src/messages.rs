@@ -195,6 +195,27 @@ pub struct ContactState {
     pub damping_loss: Vec<f64>,
 }
 
+/// The electric supply behind the drives (topic [`crate::topics::SUPPLY`]; only runs whose
+/// scene has a `supply`, absent from every other recording). Powers at the sample, energies
+/// cumulative from t = 0; `energy = Σ E_j + dumped + loss` (E_j = ∫ i v dt of `/energy`).
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
+pub struct SupplyState {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Power the supply delivers P_s, W (< 0: it takes energy back).
+    pub power: f64,
+    /// The drives' DC power on the bus (or summed, without a bus) P_b, W.
+    pub bus_power: f64,
+    /// Energy the supply delivered, ∫ P_s dt, J.
+    pub energy: f64,
+    /// Energy the supply took back (regenerated), ∫ max(−P_s, 0) dt, J.
+    pub regenerated: f64,
+    /// Energy dumped in the drives' and the bus's brake resistors, J.
+    pub dumped: f64,
+    /// The supply's conversion loss, J.
+    pub loss: f64,
+}
+
 /// One contact event (topic [`crate::topics::CONTACT_EVENTS`]): log time = event time, written
 /// before the sample that follows the event.
 #[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
@@ -273,6 +294,9 @@ impl TopicMessage for MotorThermalState {
 }
 impl TopicMessage for ContactState {
     const TOPIC: &'static str = topics::CONTACTS;
+}
+impl TopicMessage for SupplyState {
+    const TOPIC: &'static str = topics::SUPPLY;
 }
 impl TopicMessage for ContactEventMsg {
     const TOPIC: &'static str = topics::CONTACT_EVENTS;
@@ -406,7 +430,7 @@ macro_rules! protobuf_message {
     )*};
 }
 
-protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg, MotorThermalState);
+protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg, MotorThermalState, SupplyState);
 
 // every Foxglove well-known schema, so `sim` can record any of them without touching this crate
 use foxglove::messages as fm;

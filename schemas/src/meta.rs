@@ -22,6 +22,7 @@
 //! | `limits` | `monitored`, `resolution`, `exceeded`, `saturations`, `events` (JSON array) — only runs whose scene monitors limits | 2 |
 //! | `energy_terms` | `emf_conversion`, `stop_energy`, `stop_loss` — only the terms a scene has | 2 |
 //! | `energy_terms` | `impact_loss`, `friction_work`, `damping_loss` (totals over the contacts) — only runs with a non-bilateral contact | 2+ |
+//! | `energy_terms` | `gear_loss` (scenes with `gear_friction`), `supply_energy`, `supply_regenerated`, `supply_dumped`, `supply_loss` (scenes with a `supply`) | 3+ |
 //! | `contacts` | `contacts` (JSON array of [`ContactInfo`]), `time_tolerance`, `gap_tolerance`, `velocity_tolerance`, `rest_velocity`, `max_events` — only runs with a non-bilateral contact | 2+ |
 //! | `contact_audit` | `bounds` (JSON), `contacts` (JSON array of [`ContactLaws`]), `samples`, `breaches` — only runs with a non-bilateral contact ([`ContactAuditor`], issue 23) | 2+ |
 //!
@@ -384,6 +385,23 @@ pub struct EnergyTermsRecord {
     /// The compliant contacts' damping loss, summed, J (runs with a non-bilateral contact).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
     pub damping_loss: Option<f64>,
+    /// The gears' Coulomb and efficiency loss `∫ Σ (K_m i − τ_gear) q̇ dt`, J (scenes with
+    /// `gear_friction`; a balance term beside the viscous `gear_friction_loss` of `/energy`).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub gear_loss: Option<f64>,
+    /// Energy the supply delivered at the end, J (scenes with a `supply`; without one it is
+    /// E = Σ ∫ i v dt: an ideal regenerating supply).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub supply_energy: Option<f64>,
+    /// Energy the supply took back, J (scenes with a `supply`).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub supply_regenerated: Option<f64>,
+    /// Energy dumped in brake resistors, J (scenes with a `supply`).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub supply_dumped: Option<f64>,
+    /// The supply's conversion loss, J (scenes with a `supply`).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]
+    pub supply_loss: Option<f64>,
     /// The heat stored in the motors at the end, `Σ C_w ΔT_w + C_h ΔT_h`, J (runs with the
     /// thermal model; with `heat_to_ambient` it books the resistive loss: E_R = the two).
     #[serde(default, skip_serializing_if = "Option::is_none", with = "sci_opt")]

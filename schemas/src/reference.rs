@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use foxglove::messages as fm;
 use prost_reflect::{Cardinality, DescriptorPool, Kind};
 
-use crate::messages::{ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, Message, MotorState, MotorThermalState, RosString};
+use crate::messages::{ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, Message, MotorState, MotorThermalState, RosString, SupplyState};
 use crate::topics::{self, ArrayIndex};
 use crate::units;
 
@@ -60,6 +60,7 @@ fn topic_docs() -> Vec<TopicDoc> {
         doc::<fm::PointCloud>(topics::HAND_POINTS, EVERY, "the actual and desired hand as two coloured points (Foxglove's rgba fields)"),
         doc::<ContactState>(topics::CONTACTS, CONTACTS_EVERY, "per contact: mode, gap, gap rate, normal and friction force, slip velocity, cumulative losses"),
         doc::<ContactEventMsg>(topics::CONTACT_EVENTS, CONTACTS, "one message per contact event (lift-off, touch-down, impact, rest, stick ↔ slip), at its time"),
+        doc::<SupplyState>(topics::SUPPLY, "runs whose scene has a `supply`, every sample", "the supply's power, the bus power, and the energy delivered, regenerated, dumped and lost, cumulative"),
         doc::<MotorThermalState>(
             topics::MOTOR_TEMPERATURES,
             "runs with the motors' thermal model (scene `thermal`), every sample",
@@ -231,7 +232,7 @@ mod tests {
     #[test]
     fn every_topic_and_every_unit_is_on_the_page() {
         let page = topics_markdown();
-        for t in topics::ALL.iter().chain(&topics::CONTACT_TOPICS).chain(&topics::VIEWER_TOPICS).chain(&topics::THERMAL_TOPICS) {
+        for t in topics::ALL.iter().chain(&topics::CONTACT_TOPICS).chain(&topics::VIEWER_TOPICS).chain(&topics::THERMAL_TOPICS).chain(&topics::SUPPLY_TOPICS) {
             assert!(page.contains(&format!("\n## {t}\n")), "{t} has no section");
         }
         // every unit of the units table appears on its topic's section

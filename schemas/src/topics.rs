@@ -31,6 +31,12 @@ pub const CONTACTS: &str = "/contacts";
 /// with a non-bilateral contact; not in [`ALL`].
 pub const CONTACT_EVENTS: &str = "/contact_events";
 
+/// [`crate::SupplyState`]: the supply's power and energies (delivered, regenerated, dumped,
+/// lost). Only in runs whose scene has a `supply` ([`SUPPLY_TOPICS`]); not in [`ALL`].
+pub const SUPPLY: &str = "/supply";
+/// The topics only runs with a `supply` have.
+pub const SUPPLY_TOPICS: [&str; 1] = [SUPPLY];
+
 /// [`crate::MotorThermalState`]: each motor's winding and housing temperature, winding
 /// resistance and copper loss. Only in runs whose scene turns the thermal model on
 /// ([`THERMAL_TOPICS`]); not in [`ALL`].

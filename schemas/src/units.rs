@@ -71,6 +71,15 @@ pub fn fields(topic: &str) -> &'static [(&'static str, &'static str)] {
             ("gap_rate_before", "m/s"),
             ("gap_rate_after", "m/s"),
         ],
+        topics::SUPPLY => &[
+            ("time", "s"),
+            ("power", "W"),
+            ("bus_power", "W"),
+            ("energy", "J"),
+            ("regenerated", "J"),
+            ("dumped", "J"),
+            ("loss", "J"),
+        ],
         topics::TF => &[
             ("transforms.translation.x", "m"),
             ("transforms.translation.y", "m"),

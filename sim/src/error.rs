@@ -108,6 +108,11 @@ pub enum RunError {
     /// `window` s of each other.
     #[error("the run stopped at t = {t:.9} s: {count} contact events in a row at the same instant (within {window:e} s), more than events.max_events_at_one_time = {limit}: the contact modes chatter; {events}. Remedies: raise events.max_events_at_one_time in the scene if the events do settle (a cascade through many contacts); make the contacts compliant (model \"compliant\", no instantaneous mode switches); lower the contacts' friction (a high coefficient can make the rigid contact problem inconsistent, Painleve's paradox); or check the initial state and the target near that time")]
     Chattering { t: f64, count: u32, window: f64, limit: u32, events: String },
+    /// [`RunError::Chattering`] where every event is a gear's (`gear_friction`, issue 26): the
+    /// joints' stick/slide decisions are taken one joint at a time, which coupled joints can
+    /// contradict without end.
+    #[error("the run stopped at t = {t:.9} s: the gears of {joints} switched between stick and slide {count} times in a row at the same instant (within {window:e} s, events.max_events_at_one_time = {limit}): the motions of these joints are coupled (a closed chain through the table, or their shared mass matrix) and their gears' stick decisions, taken one joint at a time, contradict each other. Remedies: leave the Coulomb/static friction off all but one of these joints (gear_friction values per joint: coulomb and breakaway 0; their efficiencies can stay), or run the elbow-free run; solving the joints' stick/slip modes together is not implemented")]
+    GearsChatter { t: f64, count: u32, window: f64, limit: u32, joints: String },
     /// The recording could not be written (I/O error, full disk, another writer of the same
     /// path): `source` names the path and the OS reason.
     #[error("writing the recording: {source}")]
@@ -161,7 +166,8 @@ impl RunError {
             | RunError::NonFiniteState { t, .. }
             | RunError::TooManySteps { t, .. }
             | RunError::TooManyEvents { t, .. }
-            | RunError::Chattering { t, .. } => Some(*t),
+            | RunError::Chattering { t, .. }
+            | RunError::GearsChatter { t, .. } => Some(*t),
             RunError::Recording { .. } => None,
         }
     }

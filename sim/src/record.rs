@@ -228,6 +228,11 @@ pub struct Recorder<'a> {
     markers: ContactMarkers,
     /// Each contact's plane normal and tangents `(n, t1, t2)`, world frame, in the run's order.
     contact_frames: Vec<[nalgebra::Vector3<f64>; 3]>,
+    /// `/supply`, reused every sample (`Some` when the scene has a `supply`).
+    supply: Option<schemas::SupplyState>,
+    /// The last sample's gear loss and supply energy, regenerated, dumped, loss (record
+    /// `energy_terms`, scenes with `gear_friction` or `supply`).
+    drive_terms: [f64; 5],
     /// The contact audit (hybrid runs): every `/contacts` sample checked against its model's
     /// laws; record `contact_audit` and the count in `result` at the end.
     audit: Option<schemas::ContactAuditor>,
@@ -382,6 +387,8 @@ impl<'a> Recorder<'a> {
             contact_event: ContactEventMsg::default(),
             contact_terms: [0.0; 3],
             contact_frames: contacts.iter().map(|c| [c.plane.normal_world.into_inner(), c.t1, c.t2]).collect(),
+            supply: scene.supply.is_some().then(schemas::SupplyState::default),
+            drive_terms: [0.0; 5],
             audit,
             thermal: scene.thermal.as_ref().map(|_| MotorThermalState { name: scene.model.joint_names(), ..Default::default() }),
             heat: [0.0; 2],
@@ -511,6 +518,20 @@ impl<'a> Recorder<'a> {
             }
             self.writer.write(topics::CONTACTS, t_ns, &self.contact_state).map_err(&err)?;
         }
+        self.drive_terms[0] = o.loss_gear;
+        if let (Some(st), Some(sup)) = (self.supply.as_mut(), o.supply) {
+            *st = schemas::SupplyState {
+                time: o.t,
+                power: sup.power,
+                bus_power: sup.bus_power,
+                energy: sup.energy,
+                regenerated: sup.regenerated,
+                dumped: sup.dumped,
+                loss: sup.loss,
+            };
+            self.drive_terms[1..].copy_from_slice(&[sup.energy, sup.regenerated, sup.dumped, sup.loss]);
+            self.writer.write(topics::SUPPLY, t_ns, &*st).map_err(&err)?;
+        }
         Ok(())
     }
 
@@ -590,8 +611,9 @@ impl<'a> Recorder<'a> {
             self.writer.write_record(&rec).map_err(err)?;
         }
         let (conv, stops, hybrid) = (self.scene.drives.has_conversion, self.scene.stops.is_some(), self.hybrid);
+        let (gear, supply) = (self.scene.gear_friction.is_some(), self.scene.supply.is_some());
         let thermal = self.thermal.is_some();
-        if conv || stops || hybrid || thermal {
+        if conv || stops || hybrid || thermal || gear || supply {
             let [c, e, l] = self.terms;
             let [imp, fric, damp] = self.contact_terms;
             let rec = EnergyTermsRecord {
@@ -601,6 +623,11 @@ impl<'a> Recorder<'a> {
                 impact_loss: hybrid.then_some(imp),
                 friction_work: hybrid.then_some(fric),
                 damping_loss: hybrid.then_some(damp),
+                gear_loss: gear.then_some(self.drive_terms[0]),
+                supply_energy: supply.then_some(self.drive_terms[1]),
+                supply_regenerated: supply.then_some(self.drive_terms[2]),
+                supply_dumped: supply.then_some(self.drive_terms[3]),
+                supply_loss: supply.then_some(self.drive_terms[4]),
                 heat_stored: thermal.then_some(self.heat[0]),
                 heat_to_ambient: thermal.then_some(self.heat[1]),
             };

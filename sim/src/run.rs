@@ -142,7 +142,7 @@ pub fn simulate_outputs(
         }
         sink(&out)
     };
-    let result = if sys.is_hybrid() {
+    let result = if sys.is_event_driven() {
         // unilateral or compliant contacts: event-driven, with the scene's `events` settings
         let cs = &scene.contact_settings;
         let settings = crate::integrate::EventSettings {
@@ -159,9 +159,11 @@ pub fn simulate_outputs(
     let stats = result.map_err(|e| match map_err(e, &names, budget, scene.integrator.method(), chatter_limit) {
         // the driver names event-function indices; the system knows the contacts and their
         // current modes (review F5)
-        RunError::Chattering { t, count, window, limit, events } => {
-            RunError::Chattering { t, count, window, limit, events: sys.describe_event_functions(&events) }
-        }
+        RunError::Chattering { t, count, window, limit, events } => match sys.chattering_gears(&events) {
+            // only gears' functions: their stick decisions, not the contacts' (issue 26)
+            Some(joints) => RunError::GearsChatter { t, count, window, limit, joints: joints.join(", ") },
+            None => RunError::Chattering { t, count, window, limit, events: sys.describe_event_functions(&events) },
+        },
         other => other,
     })?;
     Ok(RunReport { stats, samples, last: out, limits: monitor.map(|m| m.summary()) })

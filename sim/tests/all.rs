@@ -29,10 +29,14 @@ mod contacts_scene;
 mod contacts_start;
 #[path = "convergence.rs"]
 mod convergence;
+#[path = "drive_features.rs"]
+mod drive_features;
 #[path = "drives.rs"]
 mod drives;
 #[path = "fuzz_scenes.rs"]
 mod fuzz_scenes;
+#[path = "gear_supply.rs"]
+mod gear_supply;
 #[path = "hard_cases.rs"]
 mod hard_cases;
 #[path = "paper.rs"]

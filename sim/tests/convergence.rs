@@ -73,3 +73,61 @@ fn every_method_converges_at_its_order_on_the_paper_arm() {
         assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");
     }
 }
+
+/// The same orders on the paper arm (its open-chain run) with gear friction (Coulomb, static
+/// and Stribeck, forward and backward efficiencies) and a supply without regeneration on a
+/// dumping bus: the gears' and the supply's mode changes are events located on each method's
+/// dense output, so every phase is smooth and the adaptive methods keep their order, on the
+/// hand path. Measured and NOT yet holding (issue 26, open): rk4 (fixed step) gives h^3.1
+/// instead of h^4, and ROSENBROCK (W-method, rtol 1e-9) takes a different stick/slide
+/// decision at one stop (hand error 5e-5 m where 1e-6..1e-8 give 3e-8..3e-10); the closed
+/// chains (one- and two-elbow runs) chatter between two coupled joints' per-joint stick
+/// decisions. Those are left out here and listed in TESTING.md.
+#[test]
+#[allow(clippy::result_large_err)] // the sink returns RunError
+fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() {
+    use sim::scene::spec::{BusSpec, GearFrictionSpec, PerJoint, PerJointFlag, SupplySpec};
+    let paper = Scene::paper().unwrap();
+    let with = |i: IntegratorSpec| {
+        paper
+            .vary(|s| {
+                s.duration = 0.3;
+                s.integrator = i;
+                s.gear_friction = Some(GearFrictionSpec {
+                    coulomb: Some(PerJoint::All(0.2)),
+                    breakaway: Some(PerJoint::All(0.3)),
+                    stribeck_velocity: Some(PerJoint::All(0.05)),
+                    efficiency: Some(PerJoint::All(0.85)),
+                    back_efficiency: Some(PerJoint::All(0.7)),
+                });
+                s.supply = Some(SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: Some(BusSpec { efficiency: Some(0.9), regeneration: false }) });
+            })
+            .unwrap()
+    };
+    let run_of = |scene: &Scene| {
+        let run = scene.run("no-elbow").unwrap().clone();
+        let mut h = Vec::new();
+        let rep = sim::run::simulate(scene, &run, |o| {
+            h.push(o.hand);
+            Ok(())
+        })
+        .unwrap();
+        (h, rep.stats.rhs_evals)
+    };
+    let (reference, _) = run_of(&with(IntegratorSpec::Dopri45(AdaptiveSpec { rtol: 1e-13, atol: 1e-15, h_max: Some(1e-4), max_steps: None })));
+    let err = |h: &[Vector3<f64>]| h.iter().zip(&reference).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    for (method, order, tols) in [("dopri45", 5.0, &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10][..]), ("imex", 4.0, &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10][..])] {
+        let runs: Vec<(f64, f64)> = tols
+            .iter()
+            .map(|&tol| {
+                let (h, n) = run_of(&with(IntegratorSpec::adaptive(method, tol, Some(0.1)).unwrap()));
+                (err(&h), n as f64)
+            })
+            .collect();
+        let (e, n): (Vec<f64>, Vec<f64>) = runs.iter().copied().unzip();
+        let p = -slope(&n, &e);
+        assert!((p - order).abs() <= 0.75, "{method}: error ~ N^-{p:.2}, order {order} ({runs:?})");
+        let q = slope(tols, &e);
+        assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");
+    }
+}

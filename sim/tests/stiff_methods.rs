@@ -321,3 +321,99 @@ fn the_fastest_modes_are_the_ones_stated() {
         }
     }
 }
+
+/// With gear friction (efficiencies below 1, Stribeck) and a supply on: the structured
+/// Jacobian against central differences on the entries it models exactly, (a) on the paper
+/// arm at rest with currents of both signs (every gear sliding forward and driving, the modes
+/// `ArmSystem::new` starts in: the efficiency factor on K_m in `∂q̈/∂i` and in the quasi-static
+/// rows), (b) on a lead screw lifting a slider (no Coriolis, no gravity stiffness: every
+/// entry of the q̈ rows is modelled) while it moves, where the Stribeck slope enters
+/// `∂q̈/∂q̇`; and RODAS's forward differences over the coupled columns against central ones.
+/// Without the gear terms in `jacobian.rs` (c = 1, no slope) (a) and (b) fail.
+#[test]
+#[allow(clippy::result_large_err)] // Scene::from_json's reader closure
+fn jacobians_match_differences_with_gear_friction_and_a_supply() {
+    use sim::integrate::fd_jacobian_columns;
+    use sim::scene::spec::{BusSpec, GearFrictionSpec, PerJointFlag, SupplySpec};
+    let gear = |s: &mut sim::scene::SceneSpec| {
+        s.gear_friction = Some(GearFrictionSpec {
+            coulomb: Some(PerJoint::All(0.1)),
+            breakaway: Some(PerJoint::All(0.3)),
+            stribeck_velocity: Some(PerJoint::All(0.05)),
+            efficiency: Some(PerJoint::All(0.8)),
+            back_efficiency: Some(PerJoint::All(0.6)),
+        });
+        s.supply = Some(SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: Some(BusSpec { efficiency: Some(0.9), regeneration: false }) });
+    };
+    let lift_urdf = r#"<robot name="lift"><link name="base"/><joint name="screw" type="prismatic"><parent link="base"/><child link="slider"/><axis xyz="0 0 1"/><limit lower="-1e4" upper="1e4" effort="1e4" velocity="1e3"/></joint><link name="slider"><inertial><mass value="2"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#;
+    let mut scenes = Vec::new();
+    for inductance in [0.0017, 0.0] {
+        scenes.push((Scene::paper().unwrap().vary(|s| {
+            s.motor.inductance = PerJoint::All(inductance);
+            gear(s);
+        }).unwrap(), 0.0));
+        let json = format!(
+            r#"{{"name":"lift","urdf":"lift.urdf","gravity":[0,0,-9.81],"duration":0.3,"output_rate":1000,"joint_damping":0.1,
+            "motor":{{"torque_constant":0.05,"resistance":1.0,"inductance":{inductance},"rotor_inertia":1e-6,"gear_ratio":1256.6370614359173,"gear_damping":0}},
+            "controller":{{"kp":10,"kd":1}},"hand":{{"link":"slider"}},
+            "target":{{"kind":"joint-spline","waypoints":[{{"t":0,"q":[0.1]}},{{"t":1,"q":[0.1]}}]}},
+            "initial":{{"q":0}},"integrator":{{"method":"dopri45","rtol":1e-9,"atol":1e-11}},"runs":[{{"name":"lift","contacts":[]}}]}}"#
+        );
+        let lift = Scene::from_json(&json, "lift.json", |_| Ok(lift_urdf.to_string())).unwrap().vary(gear).unwrap();
+        scenes.push((lift, 0.03));
+    }
+    for (scene, speed) in &scenes {
+        for run in scene.runs() {
+            let (mut sys, mut y) = with_currents(scene, run);
+            let l = sys.layout();
+            let dim = l.dim();
+            for v in y[l.qd()].iter_mut() {
+                *v = *speed;
+            }
+            let t = 0.37;
+            let mut f = vec![0.0; dim];
+            sys.rhs(t, &y, &mut f).unwrap();
+            let mut j = vec![0.0; dim * dim];
+            sys.jacobian(t, &y, &f, &mut j).unwrap();
+            let fd = central_jacobian(&mut sys, t, &y);
+            let what = format!("{} L = {} run {}", scene.spec().name, l.ni() > 0, run.name);
+            let blocks: [(Range<usize>, Vec<Range<usize>>); 3] = [
+                (l.q(), vec![l.q(), l.qd(), l.current()]),
+                (l.qd(), vec![l.qd(), l.current()]),
+                (l.current(), vec![l.q(), l.qd(), l.current()]),
+            ];
+            for (rows, column_groups) in &blocks {
+                for cols in column_groups {
+                    let fd = &fd;
+                    let scale = rows.clone().flat_map(|r| cols.clone().map(move |c| fd[r * dim + c].abs())).fold(0.0, f64::max);
+                    for r in rows.clone() {
+                        for c in cols.clone() {
+                            let (a, b) = (j[r * dim + c], fd[r * dim + c]);
+                            let h = 1e-6 * (1.0 + y[c].abs());
+                            let tol = 1e-7 * (b.abs() + scale) + 4.0 * f64::EPSILON * (f[r].abs() + 1.0) / h;
+                            assert!((a - b).abs() <= tol, "{what}: d f[{r}] / d y[{c}]: structured {a}, differences {b} (block scale {scale:e})");
+                        }
+                    }
+                }
+            }
+            // RODAS: forward differences over the coupled columns, the quadratures' columns 0
+            let nc = sys.coupled_dim();
+            let mut jf = vec![0.0; dim * dim];
+            let (mut sy, mut sf) = (vec![0.0; dim], vec![0.0; dim]);
+            fd_jacobian_columns(&mut sys, t, &y, &f, &mut jf, nc, 1e-2, &mut sy, &mut sf).unwrap();
+            let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for r in 0..dim {
+                let scale = (0..nc).map(|c| fd[r * dim + c].abs()).fold(0.0, f64::max);
+                for c in 0..dim {
+                    if c >= nc {
+                        assert_eq!(fd[r * dim + c], 0.0, "{what}: d f[{r}] / d y[{c}] (a quadrature column)");
+                        continue;
+                    }
+                    let delta = f64::EPSILON.sqrt() * y[c].abs().max(1e-2);
+                    let tol = 1e-6 * scale + 128.0 * f64::EPSILON * (fmax + 1.0) / delta;
+                    assert!((jf[r * dim + c] - fd[r * dim + c]).abs() <= tol, "{what}: RODAS d f[{r}] / d y[{c}]");
+                }
+            }
+        }
+    }
+}

@@ -171,7 +171,7 @@ fn the_energy_and_heat_balances_close_with_the_thermal_model() {
 /// paper's electrical time constant keeps the problem what `convergence.rs` measures (with the
 /// RE 40's L / R = 0.28 ms dopri45's steps are bounded by stability, not accuracy, and its
 /// error falls faster than N^-5).
-fn fast_thermal(integrator: IntegratorSpec) -> Scene {
+pub(crate) fn fast_thermal(integrator: IntegratorSpec) -> Scene {
     paper_thermal()
         .vary(|s| {
             s.duration = 0.3;

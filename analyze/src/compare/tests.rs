@@ -398,3 +398,63 @@ fn bilateral_and_unilateral_runs_are_paired_by_the_contacts_that_carried_the_arm
     assert!(has(&c, "\"more elbows → less electric energy and smaller z error\" does not hold in scene paper-unilateral (holds in scene paper with the bilateral table)."), "{:#?}", c.findings);
     assert!(has(&c, "two-elbow → two-elbow-unilateral (same contacts elbow4, elbow7): electric energy 6.000 J → 7.000 J (× 1.167), z error RMS"), "{:#?}", c.findings);
 }
+
+/// Runs whose scene models the supply are ranked by the energy it delivers (issue 26): the
+/// order differs from E's when regeneration is off on the run that brakes most; runs without a
+/// supply get no such sentence.
+#[test]
+fn runs_are_ranked_by_the_energy_the_supply_delivers() {
+    let supplied = |name: &str, e: f64, es: f64, dumped: f64| {
+        let mut r = run(name, &[], &[e], &[0.5 * e], 1e-3);
+        r.energy_terms = Some(schemas::EnergyTermsRecord { supply_energy: Some(es), supply_dumped: Some(dumped), gear_loss: Some(0.1), ..Default::default() });
+        r
+    };
+    let runs = vec![supplied("braking", 10.0, 14.0, 4.0), supplied("smooth", 12.0, 12.5, 0.5)];
+    let c = Comparison::new(&runs, Some("braking")).unwrap();
+    let line = c.findings.iter().find(|f| f.starts_with("Least energy from the supply")).expect("a supply ranking");
+    assert_eq!(line, "Least energy from the supply: smooth; in order: smooth 12.500 J (E 12.000 J, dumped 0.500 J), braking 14.000 J (E 10.000 J, dumped 4.000 J).");
+    assert!(c.findings.iter().any(|f| f.contains("Least total electric energy: braking")), "{:?}", c.findings);
+    assert!(c.findings.iter().any(|f| f.contains("gear Coulomb and efficiency loss 1.0000e-1 J")), "{:?}", c.findings);
+    let plain = vec![run("a", &[], &[1.0], &[0.5], 1e-3), run("b", &[], &[2.0], &[1.0], 1e-3)];
+    let c = Comparison::new(&plain, None).unwrap();
+    assert!(!c.findings.iter().any(|f| f.contains("supply")), "{:?}", c.findings);
+}
+
+/// `--rank-by supply-energy` ranks by the energy the supply delivers, which can reverse E's
+/// order (the run that brakes most and does not regenerate draws the most); a run without a
+/// supply is ranked by its E and marked; with no supply anywhere it is an error, not a ranking
+/// by E under another name. `--rank-by electric-energy` ranks by E.
+#[test]
+fn rank_by_the_supply_energy_is_an_option() {
+    let supplied = |name: &str, e: f64, es: f64, dumped: f64| {
+        let mut r = run(name, &[], &[e], &[0.5 * e], 1e-3);
+        r.energy_terms = Some(schemas::EnergyTermsRecord { supply_energy: Some(es), supply_dumped: Some(dumped), ..Default::default() });
+        r
+    };
+    let runs = vec![supplied("braking", 10.0, 14.0, 4.0), supplied("smooth", 12.0, 12.5, 0.5), run("ideal", &[], &[13.0], &[6.0], 1e-3)];
+    let plain = Comparison::new(&runs, Some("braking")).unwrap();
+    assert_eq!(plain.ranking, None);
+    assert!(!plain.findings.iter().any(|f| f.starts_with("Ranked by")), "{:?}", plain.findings);
+
+    let c = Comparison::ranked(&runs, Some("braking"), RankBy::SupplyEnergy).unwrap();
+    let r = c.ranking.as_ref().expect("a ranking");
+    let order: Vec<(&str, f64, bool)> = r.runs.iter().map(|x| (x.run.as_str(), x.value, x.ideal_supply)).collect();
+    assert_eq!(order, vec![("smooth", 12.5, false), ("ideal", 13.0, true), ("braking", 14.0, false)]);
+    assert!(
+        c.findings.iter().any(|f| f == "Ranked by the energy the supply delivers, least first: 1. smooth 12.500 J, 2. ideal 13.000 J (no supply modelled: E), 3. braking 14.000 J."),
+        "{:#?}",
+        c.findings
+    );
+    // the JSON carries it; a plain comparison's JSON has no such key
+    let json = serde_json::to_value(&c).unwrap();
+    assert_eq!(json["ranking"]["by"], "supply-energy");
+    assert!(serde_json::to_value(&plain).unwrap().get("ranking").is_none());
+
+    let e = Comparison::ranked(&runs, Some("braking"), RankBy::ElectricEnergy).unwrap();
+    let names: Vec<&str> = e.ranking.as_ref().unwrap().runs.iter().map(|x| x.run.as_str()).collect();
+    assert_eq!(names, ["braking", "smooth", "ideal"]);
+
+    let none = vec![run("a", &[], &[1.0], &[0.5], 1e-3), run("b", &[], &[2.0], &[1.0], 1e-3)];
+    let err = Comparison::ranked(&none, None, RankBy::SupplyEnergy).unwrap_err().to_string();
+    assert!(err.contains("--rank-by supply-energy") && err.contains("no compared run models its supply"), "{err}");
+}

@@ -67,6 +67,12 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
     ]
     .map(String::from)
     .to_vec();
+    // the supply's energies (issue 26) only when a run models its supply: the paper's table
+    // keeps its columns
+    let supply = runs.iter().any(|r| r.supply_energy_j().is_some());
+    if supply {
+        head.extend(["E_supply_j", "supply_regenerated_j", "supply_dumped_j"].map(String::from));
+    }
     if cmp.is_some() {
         head.extend(
             [
@@ -154,6 +160,11 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<(&Comparison, &[&Ratios])
         }
         row.opt(r.electric_energy_total_j);
         row.opt(r.link_work_total_j);
+        if supply {
+            row.opt(r.supply_energy_j());
+            row.opt(r.supply_regenerated_j());
+            row.opt(r.supply_dumped_j());
+        }
         if let Some((_, ratios)) = cmp {
             let q = ratios[k];
             for x in [

@@ -177,7 +177,13 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
     t.write(&mut out, markdown, width);
 
     // energy totals
+    // (the supply's columns only when a run models its supply: issue 26; the paper's table
+    // is unchanged)
+    let supply = runs.iter().any(|r| r.supply_energy_j().is_some());
     let mut head = vec!["run", "E = Σ ∫ i v dt [J]", "W = Σ ∫ τ q' dt [J]"];
+    if supply {
+        head.extend(["E_supply [J]", "regenerated [J]", "dumped [J]"]);
+    }
     if cmp.is_some() {
         head.extend(["E / E_base", "W / W_base"]);
     }
@@ -188,6 +194,9 @@ pub(super) fn render(runs: &[&RunMetrics], cmp: Option<&Comparison>, markdown: b
             fo(r.electric_energy_total_j, 4),
             fo(r.link_work_total_j, 4),
         ];
+        if supply {
+            row.extend([r.supply_energy_j(), r.supply_regenerated_j(), r.supply_dumped_j()].map(|x| fo(x, 4)));
+        }
         if let Some(q_) = &ratios {
             row.extend([q(q_[k].electric_energy), q(q_[k].link_work)]);
         }

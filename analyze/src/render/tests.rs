@@ -234,3 +234,37 @@ fn full_tables_fitted_to_a_width_keep_every_number() {
     }
     assert_eq!(render_comparison_fitted(&cmp, Format::Json, Some(60)).unwrap(), render_comparison(&cmp, Format::Json).unwrap());
 }
+
+/// The supply's energies (issue 26) sit beside E in the energy totals (table and CSV) when a
+/// run models its supply, read from its `energy_terms`; the paper's runs get no new column.
+#[test]
+fn the_supply_energy_sits_beside_e_only_when_a_run_has_a_supply() {
+    let plain = paper_runs();
+    for f in [Format::Table, Format::Csv] {
+        let text = render_metrics(&plain, f).unwrap();
+        assert!(!text.contains("supply"), "{f}: {text}");
+    }
+    let mut runs = paper_runs();
+    runs[1].energy_terms = Some(schemas::EnergyTermsRecord {
+        supply_energy: Some(7.25),
+        supply_regenerated: Some(0.5),
+        supply_dumped: Some(0.125),
+        ..Default::default()
+    });
+    let csv = render_metrics(&runs, Format::Csv).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    let head: Vec<&str> = lines[0].split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name} in {head:?}"));
+    let (es, rg, du, e) = (col("E_supply_j"), col("supply_regenerated_j"), col("supply_dumped_j"), col("E_total_j"));
+    assert_eq!(es, col("W_total_j") + 1);
+    let row: Vec<&str> = lines[2].split(',').collect();
+    assert_eq!((row[es], row[rg], row[du]), ("7.25", "0.5", "0.125"));
+    assert_eq!(row[e].parse::<f64>().unwrap(), runs[1].electric_energy_total_j.unwrap());
+    // the runs without a supply: empty cells, not a made-up number
+    let other: Vec<&str> = lines[1].split(',').collect();
+    assert_eq!((other[es], other[rg], other[du]), ("", "", ""));
+    let table = render_metrics(&runs, Format::Table).unwrap();
+    let totals = table.split("Energy totals at t_end").nth(1).unwrap();
+    assert!(totals.contains("E_supply [J]") && totals.contains("regenerated [J]") && totals.contains("dumped [J]"), "{totals}");
+    assert!(totals.contains("7.2500") && totals.contains("0.1250"), "{totals}");
+}

@@ -7,6 +7,7 @@ use crate::metrics::RunMetrics;
 
 /// One DataFrame, one row per entry of `rows`: [`BASE_COLUMNS`] (`min_normal_force_n`: the lowest
 /// over the contacts, `pull_time_s`: the longest; both null without contacts), then `error`, `bytes`,
+/// `E_supply_j`, `supply_regenerated_j`, `supply_dumped_j` when some run has a supply, then
 /// `E.<joint>_j` and `W.<joint>_j` for every joint of any run (null where a run has no such
 /// joint), then for every contact with a contact model in any run (`/contacts`)
 /// `in_contact.<c>_s`, `lift_offs.<c>`, `impacts.<c>`, `impact_loss.<c>_j`, `friction_work.<c>_j`,
@@ -71,6 +72,13 @@ pub fn summary_frame(rows: &[SummaryRow], params: &[String]) -> PolarsResult<Dat
             .map(|r| r.metrics.links.iter().find(|l| l.joint == joint).map(f))
             .collect()
     };
+    // the energy the supply delivered, regenerated and dumped (issue 26), when some run
+    // models its supply (null for the others)
+    if rows.iter().any(|r| r.metrics.supply_energy_j().is_some()) {
+        cols.push(Column::new("E_supply_j".into(), m(&|r| r.supply_energy_j())));
+        cols.push(Column::new("supply_regenerated_j".into(), m(&|r| r.supply_regenerated_j())));
+        cols.push(Column::new("supply_dumped_j".into(), m(&|r| r.supply_dumped_j())));
+    }
     for j in &joints {
         cols.push(Column::new(format!("E.{j}_j").into(), link(j, |l| l.electric_energy_j)));
     }

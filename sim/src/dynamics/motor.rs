@@ -32,10 +32,13 @@
 //! rack) is in rad/m, K_m = K_t k in N/A, J_m = I_m k² in kg, D_m in N s/m, and the back EMF
 //! `K_e k q̇` in V with q̇ in m/s.
 //!
-//! Gear efficiency is not modelled: a constant efficiency η < 1 scales the torque in one power
-//! direction and its inverse in the other, a non-smooth loss `(1 − η)|τ q̇|` that depends on the
-//! sign of the power flow (and on which side drives): a viscous gear loss `D_m q̇²` (eq 12) is
-//! what this model can close the energy balance with exactly, so gear losses belong there.
+//! Gear efficiency and Coulomb friction are not in this file: they make the right-hand side
+//! non-smooth (a constant efficiency η < 1 scales the torque in one power direction and its
+//! inverse in the other; Coulomb friction changes sign with q̇ and holds a joint at rest), so
+//! they are a law with discrete modes, `dynamics/gear_friction.rs`, whose switches are events
+//! of the hybrid driver (`ode/drive_modes.rs`), with their loss as its own term of the balance.
+//! The viscous gear loss `D_m q̇²` of eq 12 stays here. What the supply delivers for the power
+//! `i v` the motors draw (regeneration, a shared DC bus) is `dynamics/supply.rs`.
 
 use nalgebra::DVector;
 

@@ -25,6 +25,9 @@ pub struct ArmSystem<'a> {
     /// The contacts' models, modes and event log: `Some` when the run has a non-bilateral
     /// contact (event-driven), `None` for the paper's runs (today's path, untouched).
     pub(super) hybrid: Option<Box<super::hybrid::Hybrid>>,
+    /// The gears' and the supply's modes (`drive_modes.rs`): `Some` when the scene has
+    /// `gear_friction` or `supply`, `None` for the paper's runs.
+    pub(super) drive_modes: Option<Box<super::drive_modes::DriveModes>>,
 }
 
 impl<'a> ArmSystem<'a> {
@@ -39,12 +42,15 @@ impl<'a> ArmSystem<'a> {
             stops: scene.stops.is_some(),
             contacts: if is_hybrid { contacts.len() } else { 0 },
             thermal: scene.thermal.is_some(),
+            gear: scene.gear_friction.is_some(),
+            supply: scene.supply.is_some(),
         };
         let mut ws = Workspace::new(&scene.model, &scene.drives, contacts.len(), layout.dim());
-        ws.fd.joint_torque = scene.stops.is_some();
+        ws.fd.joint_torque = scene.stops.is_some() || scene.gear_friction.is_some();
         ws.want_qdd = matches!(scene.controller.law, crate::control::Law::ComputedTorque { .. });
         let hybrid = is_hybrid.then(|| Box::new(super::hybrid::Hybrid::new(scene, run)));
-        let mut sys = Self { scene, contacts, layout, ws, stored0: 0.0, hybrid };
+        let drive_modes = (layout.gear || layout.supply).then(|| Box::new(super::drive_modes::DriveModes::new(nv)));
+        let mut sys = Self { scene, contacts, layout, ws, stored0: 0.0, hybrid, drive_modes };
         sys.stored0 = sys.stored_energy(&scene.q0, &scene.qd0, &scene.current0);
         if sys.hybrid.is_some() {
             // the compliant contacts' ½ k δ² at t = 0 (kinematics at q0 from stored_energy)
@@ -156,6 +162,7 @@ impl<'a> ArmSystem<'a> {
                 self.ws.current_qs[j] = self.ws.drives.quasi_static_current(j, self.ws.voltage[j], qd[j]);
             }
         }
+        self.gear_inputs(y);
         Ok(())
     }
 
@@ -164,6 +171,16 @@ impl<'a> ArmSystem<'a> {
     /// its contacts' active rows in the current modes (`dynamics/contact/forward.rs`).
     pub(super) fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
         self.inputs(t, y)?;
+        self.solve_eq21(t, y)?;
+        if self.drive_modes.is_some() {
+            self.lock_stuck(t, y)?;
+        }
+        Ok(())
+    }
+
+    /// Eq 21 at (t, y) with the inputs in the workspace (the contacts' active rows in a hybrid
+    /// run).
+    pub(super) fn solve_eq21(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
         let l = self.layout;
         let (q, qd) = (&y[l.q()], &y[l.qd()]);
         let s = self.scene;
@@ -240,6 +257,9 @@ impl OdeSystem for ArmSystem<'_> {
         }
         if self.hybrid.is_some() {
             self.contact_loss_rates(dydt);
+        }
+        if self.drive_modes.is_some() {
+            self.drive_loss_rates(y, dydt);
         }
         Ok(())
     }

@@ -12,6 +12,10 @@ impl ArmSystem<'_> {
     /// "contact elbow4 (lift-off function)"; `None` if the run is not hybrid or `i` is out of
     /// range.
     pub fn describe_event_function(&self, i: usize) -> Option<String> {
+        let nc = self.hybrid.as_ref().map_or(0, |h| 2 * h.contacts.len());
+        if i >= nc {
+            return self.describe_drive_event(i - nc);
+        }
         let h = self.hybrid.as_ref()?;
         let c = h.contacts.get(i / 2)?;
         let first = i % 2 == 0;

@@ -30,7 +30,7 @@ use crate::dynamics::forward::Plant;
 use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
 use crate::dynamics::motor::Electrical;
 use crate::error::{DynamicsError, RunError};
-use crate::integrate::{HybridSystem, Watch};
+use crate::integrate::Watch;
 use crate::scene::{Run, Scene};
 
 use super::arm::ArmSystem;
@@ -122,6 +122,11 @@ impl ArmSystem<'_> {
             h.state.mode.copy_from_slice(&o.state.mode);
             h.state.slip.copy_from_slice(&o.state.slip);
             h.s_ref.copy_from_slice(&o.s_ref);
+        }
+        if let (Some(m), Some(o)) = (&mut self.drive_modes, &other.drive_modes) {
+            m.gear.copy_from_slice(&o.gear);
+            m.pos.copy_from_slice(&o.pos);
+            m.bus_pos = o.bus_pos;
         }
     }
 
@@ -365,12 +370,14 @@ impl ArmSystem<'_> {
     }
 }
 
-impl HybridSystem for ArmSystem<'_> {
-    fn n_events(&self) -> usize {
+/// The contacts' part of the [`HybridSystem`] (`drive_modes.rs` has the drives' part; the
+/// trait's implementation there joins them: the contacts' functions come first).
+impl ArmSystem<'_> {
+    pub(super) fn contact_n_events(&self) -> usize {
         self.hybrid.as_ref().map_or(0, |h| 2 * h.contacts.len())
     }
 
-    fn event_direction(&self, i: usize) -> i8 {
+    pub(super) fn contact_event_direction(&self, i: usize) -> i8 {
         let Some(h) = &self.hybrid else { return 0 };
         match h.contacts[i / 2].model {
             ContactModel::Compliant { .. } => 0,
@@ -383,7 +390,7 @@ impl HybridSystem for ArmSystem<'_> {
     /// negative (or leave the friction cone) by more than 1e-8 N, a slip speed fall by more than
     /// `vel_tol` (m/s) — far above the solver's noise at f_n = 0, far below any force that
     /// matters — before the event is taken at the restart itself.
-    fn event_tolerance(&self, i: usize) -> Option<f64> {
+    pub(super) fn contact_event_tolerance(&self, i: usize) -> Option<f64> {
         let h = self.hybrid.as_ref()?;
         let k = i / 2;
         let cs = &self.scene.contact_settings;
@@ -395,7 +402,7 @@ impl HybridSystem for ArmSystem<'_> {
         }
     }
 
-    fn events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
+    pub(super) fn contact_events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
         if self.hybrid.is_none() {
             return Ok(());
         }
@@ -423,7 +430,7 @@ impl HybridSystem for ArmSystem<'_> {
         Ok(())
     }
 
-    fn init_modes(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
+    pub(super) fn contact_init_modes(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
         if self.hybrid.is_none() {
             return Ok(false);
         }
@@ -465,7 +472,7 @@ impl HybridSystem for ArmSystem<'_> {
         Ok(moved)
     }
 
-    fn handle_events(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> Result<bool, RunError> {
+    pub(super) fn contact_handle_events(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> Result<bool, RunError> {
         if self.hybrid.is_none() {
             return Ok(false);
         }
@@ -568,7 +575,7 @@ impl HybridSystem for ArmSystem<'_> {
         Ok(moved)
     }
 
-    fn after_step(&mut self, _t: f64, y: &[f64]) {
+    pub(super) fn contact_after_step(&mut self, y: &[f64]) {
         self.refresh_slip_reference(y);
     }
 }

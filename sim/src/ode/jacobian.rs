@@ -16,6 +16,9 @@
 //!   model-scaled gains for computed torque); the drive's saturation, the feed-forward's slope
 //!   and the soft stops' stiffness are left out (bounded, so the W-method keeps its order; the
 //!   stops' k can make steps shorter while a joint is beyond its limit).
+//!   With `gear_friction` a sliding gear's efficiency factor c multiplies K_m in `∂q̈/∂i` (and
+//!   the quasi-static rows) and its Stribeck slope `s ∂τ_f/∂q̇` adds to the damping; a sticking
+//!   joint's lock (`drive_modes.rs`) is left out (bounded, as the stops).
 //!   `M_c⁻¹` is computed here from M and J_c of the evaluation, whatever constraint solver the
 //!   scene uses (the Schur and the KKT solve leave different scratch behind). With the motors'
 //!   thermal model (`dynamics/thermal.rs`) its rows are exact: `∂Ṫ_w/∂T_w = (±R' i²) / C_w −
@@ -119,15 +122,19 @@ impl OdeJacobian for ArmSystem<'_> {
         for r in 0..nv {
             for c in 0..nv {
                 let m = minv[(r, c)];
+                // a sliding gear's efficiency factor on K_m and its Stribeck slope (1 and 0
+                // without `gear_friction`; `drive_modes.rs`)
+                let (eff, slope) = self.gear_jacobian_terms(c, y[l.qd().start + c]);
+                let km = eff * d.km[c];
                 match l.electrical {
                     Electrical::Inductive => {
-                        set(l.qd().start + r, l.current().start + c, m * d.km[c]);
-                        set(l.qd().start + r, l.qd().start + c, -m * (d.d[c] + d.dm[c]));
+                        set(l.qd().start + r, l.current().start + c, m * km);
+                        set(l.qd().start + r, l.qd().start + c, -m * (d.d[c] + d.dm[c] + slope));
                     }
                     Electrical::QuasiStatic => {
                         let (kp, kd, _) = lin[c];
-                        set(l.qd().start + r, l.q().start + c, -m * d.km[c] * kp / d.r[c]);
-                        set(l.qd().start + r, l.qd().start + c, -m * (d.km[c] * (kd + d.ke[c]) / d.r[c] + d.d[c] + d.dm[c]));
+                        set(l.qd().start + r, l.q().start + c, -m * km * kp / d.r[c]);
+                        set(l.qd().start + r, l.qd().start + c, -m * (km * (kd + d.ke[c]) / d.r[c] + d.d[c] + d.dm[c] + slope));
                     }
                 }
             }

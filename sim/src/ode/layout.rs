@@ -22,6 +22,12 @@ pub struct Layout {
     /// of every motor follow the currents (2 nv states, before the quadratures, since R(T_w)
     /// feeds back into the currents), and the heat to the ambient `Q_a` comes last.
     pub thermal: bool,
+    /// The gears' Coulomb and efficiency loss `E_g` is present (`gear_friction`); it follows
+    /// the contacts' quadratures.
+    pub gear: bool,
+    /// The supply's four quadratures (energy delivered, regenerated, dumped, conversion loss)
+    /// are present (`supply`); they follow `E_g` (and come before `Q_a`).
+    pub supply: bool,
 }
 
 impl Layout {
@@ -38,7 +44,15 @@ impl Layout {
         2 * self.nv + self.ni() + self.nth()
     }
     pub fn dim(&self) -> usize {
-        self.head() + 2 * self.nv + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * self.contacts + usize::from(self.thermal)
+        self.head() + 2 * self.nv + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * self.contacts + usize::from(self.gear) + 4 * usize::from(self.supply) + usize::from(self.thermal)
+    }
+    /// `E_g`, when [`Layout::gear`].
+    pub fn loss_gear(&self) -> Option<usize> {
+        self.gear.then(|| self.impact_loss(self.contacts))
+    }
+    /// The first of the supply's `E_supply, E_regen, E_dump, E_sloss`, when [`Layout::supply`].
+    pub fn supply(&self) -> Option<usize> {
+        self.supply.then(|| self.impact_loss(self.contacts) + usize::from(self.gear))
     }
     pub fn q(&self) -> std::ops::Range<usize> {
         0..self.nv
@@ -133,6 +147,10 @@ impl Layout {
             "back-EMF conversion energy".into()
         } else if Some(k) == self.loss_stop() {
             "joint stop damping loss".into()
+        } else if Some(k) == self.loss_gear() {
+            "gear Coulomb and efficiency loss".into()
+        } else if let Some(s) = self.supply().filter(|&s| k >= s) {
+            ["supply energy", "supply energy regenerated", "supply energy dumped", "supply conversion loss"][(k - s).min(3)].into()
         } else {
             let first = self.impact_loss(0);
             let c = (k - first) / 3;

@@ -15,13 +15,16 @@
 //! scenes that have them (so the paper's layout is unchanged): `E_conv = ∫ Σ (K_e − K_t) k i q̇
 //! dt` when some back-EMF constant differs from the torque constant (`dynamics/motor.rs`), and
 //! `E_s = ∫ Σ c q̇² [beyond a limit] dt` when soft joint stops are configured
-//! (`joint_limits.rs`). With the motors' thermal model on (`dynamics/thermal.rs`, scene
-//! `thermal`), the winding and housing temperatures `T_w (n) | T_h (n)` follow the currents
-//! (R(T_w) feeds back into eq 11, so they are coupled states, before the quadratures) and the
-//! heat given to the ambient `Q_a` comes last; the copper loss `E_R` is then `∫ Σ R(T_w) i² dt`.
+//! (`joint_limits.rs`). After the contacts' quadratures, again only in the scenes that have
+//! them (`drive_modes.rs`): the gears' Coulomb and efficiency loss `E_g` (`gear_friction`),
+//! then the supply's `E_supply, E_regen, E_dump, E_sloss` (`supply`). With the motors' thermal
+//! model on (`dynamics/thermal.rs`, scene `thermal`), the winding and housing temperatures
+//! `T_w (n) | T_h (n)` follow the currents (R(T_w) feeds back into eq 11, so they are coupled
+//! states, before the quadratures) and the heat given to the ambient `Q_a` comes last; the
+//! copper loss `E_R` is then `∫ Σ R(T_w) i² dt`.
 //!
 //! Energy balance (SCENE.md; ideal constraints do no work):
-//! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm [+ E_conv] [+ ΔV_s + E_s]`, T including
+//! `Σ E_j = ΔT + ΔV + Δ(½ Σ L i²) + E_R + E_D + E_Dm [+ E_conv] [+ ΔV_s + E_s] [+ E_g]`, T including
 //! the rotors' `½ Σ J_m q̇²`, `V_s = Σ ½ k δ²` the stops' stored energy. The voltage that
 //! enters `E_j = ∫ i v dt` is the one the motor sees, after the drive's current window and
 //! supply saturation (the amplifier is ideal: it neither stores nor loses energy), so the
@@ -29,12 +32,16 @@
 //! chooses v: it adds no term. Its residual measures the integration error (and constraint
 //! drift, which lets f_n work).
 //!
+//! The supply's quadratures close their own identity `E_supply = Σ E_j + E_dump + E_sloss`
+//! (`dynamics/supply.rs`), reported as `SupplyOutput::residual`.
+//!
 //! Files: `layout.rs` (state indices), `workspace.rs` (the scratch), `arm.rs` (the system and
 //! its right-hand side), `outputs.rs`, `jacobian.rs` (Rosenbrock's Jacobian, IMEX's split),
 //! `projection.rs`.
 
 mod arm;
 mod describe;
+mod drive_modes;
 mod hybrid;
 mod jacobian;
 mod layout;
@@ -44,7 +51,8 @@ mod stop_slip;
 mod workspace;
 
 pub use arm::ArmSystem;
+pub use drive_modes::GearEvent;
 pub use layout::Layout;
-pub use outputs::{OutputLevel, Outputs};
+pub use outputs::{OutputLevel, Outputs, SupplyOutput};
 #[cfg(test)]
 mod hybrid_tests;

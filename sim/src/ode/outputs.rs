@@ -77,6 +77,17 @@ pub struct Outputs {
     /// The contact events since the previous sample (at times ≤ t), in time order; the run
     /// moves them here from the system's log at each sample (always empty for bilateral runs).
     pub events: Vec<crate::dynamics::contact::ContactEvent>,
+    /// `E_g = ∫ Σ (K_m i − τ_gear) q̇ dt`: the gears' Coulomb and efficiency loss, J (0 without
+    /// `gear_friction`).
+    pub loss_gear: f64,
+    /// Per joint, the gear's torque beyond the ideal train `K_m i` (sliding friction and
+    /// efficiency, or the holding torque while sticking), N m (empty without `gear_friction`;
+    /// full level only).
+    pub gear_torque: Vec<f64>,
+    /// Per joint, whether its gear sticks (empty without `gear_friction`).
+    pub gear_stuck: Vec<bool>,
+    /// The supply's powers and energies (`None` without `supply`).
+    pub supply: Option<SupplyOutput>,
     /// Per joint: the winding and housing temperatures, °C, and the winding resistance R(T_w),
     /// ohm (empty without the thermal model).
     pub winding_temperature: Vec<f64>,
@@ -90,6 +101,25 @@ pub struct Outputs {
     /// model, `E_R = heat_stored + heat_to_ambient` (`dynamics/thermal.rs`).
     pub heat_stored: f64,
     pub heat_to_ambient: f64,
+}
+
+/// The supply at one sample (`dynamics/supply.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SupplyOutput {
+    /// `P_s`, the power the supply delivers, W (NaN at the kinematic level).
+    pub power: f64,
+    /// `P_b`, the drives' DC power on the bus (or summed), W (NaN at the kinematic level).
+    pub bus_power: f64,
+    /// `E_supply = ∫ P_s dt`, J.
+    pub energy: f64,
+    /// `∫ max(−P_s, 0) dt`: taken back by the supply, J.
+    pub regenerated: f64,
+    /// Dumped in the brake resistors, J.
+    pub dumped: f64,
+    /// The supply's conversion loss, J.
+    pub loss: f64,
+    /// `E_supply − (Σ E_j + dumped + loss)`, J: an identity of the quadratures (≈ rounding).
+    pub residual: f64,
 }
 
 fn set(dst: &mut Vec<f64>, src: &[f64]) {
@@ -168,6 +198,17 @@ impl ArmSystem<'_> {
         out.loss_conversion = l.loss_conversion().map_or(0.0, |k| y[k]);
         out.loss_stop = l.loss_stop().map_or(0.0, |k| y[k]);
         out.stop_energy = s.stops.as_ref().map_or(0.0, |st| st.energy(q));
+        out.loss_gear = l.loss_gear().map_or(0.0, |k| y[k]);
+        out.gear_stuck.clear();
+        out.gear_torque.clear();
+        if let (Some(m), true) = (&self.drive_modes, l.gear) {
+            out.gear_stuck.extend(m.gear.iter().map(|&g| g == crate::dynamics::gear_friction::GearMode::Stick));
+        }
+        out.supply = l.supply().map(|k| {
+            let (energy, dumped, loss) = (y[k], y[k + 2], y[k + 3]);
+            let electric: f64 = y[l.electric()].iter().sum();
+            SupplyOutput { power: f64::NAN, bus_power: f64::NAN, energy, regenerated: y[k + 1], dumped, loss, residual: energy - (electric + dumped + loss) }
+        });
         self.thermal_outputs(y, out);
         let data = &self.ws.data;
         out.potential = potential_energy(&s.model, data);
@@ -238,6 +279,14 @@ impl ArmSystem<'_> {
         } else {
             electric - (out.kinetic + out.potential + out.magnetic - self.stored0 + out.loss_resistance + out.loss_friction)
         };
+        if l.gear {
+            out.balance_residual -= out.loss_gear;
+            set(&mut out.gear_torque, &self.drive_modes.as_ref().expect("drive modes").gear_torque);
+        }
+        if let Some(w) = self.supply_powers(y) {
+            let sup = out.supply.as_mut().expect("supply outputs");
+            (sup.power, sup.bus_power) = (w.supply, w.bus);
+        }
         if self.hybrid.is_some() {
             // the contacts' losses and the compliant contacts' stored ½ k δ² (ΔV_c: stored0 has V_c(0))
             out.balance_residual -= self.contact_losses(y) + self.contact_energy();

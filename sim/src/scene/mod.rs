@@ -12,6 +12,7 @@ pub mod schema;
 pub mod schema_key;
 pub mod spec;
 mod spec_contacts;
+mod spec_gear_supply;
 pub mod spec_drive;
 mod target;
 
@@ -97,6 +98,10 @@ pub struct Scene {
     /// The URDF's `<mesh>` references and what became of them (`urdf_xml` holds the resolved
     /// URIs).
     pub(crate) meshes: Vec<MeshInfo>,
+    /// Coulomb friction and efficiency of the gears (`gear_friction`), when the scene has them.
+    pub(crate) gear_friction: Option<crate::dynamics::gear_friction::GearFriction>,
+    /// The supply behind the drives (`supply`), when the scene has one.
+    pub(crate) supply: Option<crate::dynamics::supply::Supply>,
     /// The motors' thermal model, when the scene turns it on (`thermal`).
     pub(crate) thermal: Option<crate::dynamics::thermal::Thermal>,
     /// Per joint: what its datasheet drive is (`drives`), or `None` (the `motor` values).
@@ -132,6 +137,14 @@ impl Scene {
     /// The controller: law and gains.
     pub fn controller(&self) -> &Controller {
         &self.controller
+    }
+    /// The gears' Coulomb friction and efficiency, if configured.
+    pub fn gear_friction(&self) -> Option<&crate::dynamics::gear_friction::GearFriction> {
+        self.gear_friction.as_ref()
+    }
+    /// The supply behind the drives, if configured.
+    pub fn supply(&self) -> Option<&crate::dynamics::supply::Supply> {
+        self.supply.as_ref()
     }
     /// The soft joint stops, if configured.
     pub fn stops(&self) -> Option<&JointStops> {
@@ -578,6 +591,8 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     }
 
     let integrator = Integrator::from_spec(&spec.integrator, file, duration, 1.0 / output_rate)?;
+    let gear_friction = spec_gear_supply::gear_friction(&c, spec.gear_friction.as_ref(), nv, &drives.passive)?;
+    let supply = spec_gear_supply::supply(&c, spec.supply.as_ref(), nv)?;
     if integrator.method() == "imex" && drives.electrical == Electrical::Inductive && controller.reads_current() {
         return Err(c.err(
             "controller.current_gain",
@@ -612,6 +627,8 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
         output_rate,
         dir: dir.map(Path::to_path_buf),
         meshes,
+        gear_friction,
+        supply,
         spec,
         thermal,
         datasheets,

@@ -9,6 +9,7 @@ use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization
 
 pub use super::spec_contacts::{EventsSpec, LawKeys, TablePointSpec, TableSpec};
 use super::spec_contacts::ContactModelName;
+pub use super::spec_gear_supply::{BusSpec, GearFrictionSpec, PerJointFlag, SupplySpec};
 
 /// A per-joint setting: one number for every joint, or an array with one per joint (dof order).
 /// Its JSON Schema is written by hand (`schema.rs`), as its `Deserialize` is.
@@ -168,6 +169,14 @@ pub struct SceneSpec {
     /// each setting's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub events: Option<EventsSpec>,
+    /// Coulomb friction and direction-dependent efficiency of the gears (default: none, the
+    /// paper's ideal gear with viscous damping only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gear_friction: Option<GearFrictionSpec>,
+    /// The electric supply: regeneration per drive and a shared DC bus (default: none, ideal
+    /// regenerating supplies: the supply energy is E).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub supply: Option<SupplySpec>,
     /// Datasheet drives: a catalogue motor (and gearhead) by name, or its datasheet values, per
     /// joint; each replaces the `motor` values of its joints (default: none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use analyze::{render_comparison_fitted, render_metrics_fitted, Comparison, RunMetrics, Status};
+use analyze::{render_comparison_fitted, render_metrics_fitted, Comparison, RankBy, RunMetrics, Status};
 use anyhow::Result;
 use cli::{exit, print_out, TableFormat, Verbosity};
 
@@ -25,7 +25,8 @@ Examples:
   analyze compare out/
   analyze compare out/paper-no-elbow.mcap out/paper-two-elbow.mcap
   analyze compare out/ --baseline two-elbow -f json > comparison.json
-  analyze compare --recover out/ out/.paper-no-elbow.mcap.*.partial")]
+  analyze compare --recover out/ out/.paper-no-elbow.mcap.*.partial
+  analyze compare out/ --rank-by supply-energy    runs ranked by the energy the supply delivers")]
 pub struct CompareArgs {
     /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
     #[arg(required = true, value_name = "FILES_OR_DIRS")]
@@ -37,8 +38,32 @@ pub struct CompareArgs {
     /// Read what is intact of damaged (e.g. truncated) recordings; see `metrics --help`.
     #[arg(long)]
     pub recover: bool,
+    /// Rank the compared runs by one quantity, least first (a finding, and `ranking` in JSON):
+    /// the electric energy E = Σ ∫ i v dt, the energy the supply delivers (scenes with a
+    /// `supply`: regeneration, the DC bus and brake resistors; a run without one is ranked by
+    /// its E and marked), or the hand error's RMS.
+    #[arg(long, value_enum, value_name = "QUANTITY")]
+    pub rank_by: Option<RankByArg>,
     #[command(flatten)]
     pub format: TableFormat,
+}
+
+/// `--rank-by`'s values (clap's mirror of [`analyze::RankBy`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RankByArg {
+    ElectricEnergy,
+    SupplyEnergy,
+    HandError,
+}
+
+impl From<RankByArg> for RankBy {
+    fn from(a: RankByArg) -> Self {
+        match a {
+            RankByArg::ElectricEnergy => RankBy::ElectricEnergy,
+            RankByArg::SupplyEnergy => RankBy::SupplyEnergy,
+            RankByArg::HandError => RankBy::HandError,
+        }
+    }
 }
 
 /// Per-run metrics only (no baseline, no findings), every number of each run; for many runs as
@@ -80,7 +105,10 @@ pub struct MetricsArgs {
 
 pub fn compare(a: &CompareArgs, v: Verbosity) -> Result<u8> {
     let (runs, damaged) = crate::load::metrics(&a.inputs, a.recover, v)?;
-    let cmp = Comparison::new(&runs, a.baseline.as_deref())?;
+    let cmp = match a.rank_by {
+        Some(by) => Comparison::ranked(&runs, a.baseline.as_deref(), by.into())?,
+        None => Comparison::new(&runs, a.baseline.as_deref())?,
+    };
     print_out(&render_comparison_fitted(&cmp, a.format.format, cli::terminal_width())?)?;
     Ok(status(&runs, damaged, v))
 }

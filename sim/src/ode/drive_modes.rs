@@ -1,0 +1,607 @@
+//! The drives' discrete state as events of the hybrid driver (`integrate::events`): the gears'
+//! stick/slide and power-direction modes (`dynamics/gear_friction.rs`) and the sides of the
+//! supply's max() functions (`dynamics/supply.rs`). Present only in scenes with `gear_friction`
+//! or `supply` (the paper's runs have neither: their state, steps and bytes are unchanged).
+//!
+//! Event functions, after the contacts' `2 n_c` (all of direction −1):
+//!
+//! | function | mode | value | at its root |
+//! |---|---|---|---|
+//! | `2 j` (gear j) | slide in `s` | `s q̇_j` | stick if the holding torque is in the band, else reverse |
+//! | `2 j` | stick | `τ_s + \|1 − c_s\| \|K_m i\| − \|λ_j\|` | break away in `s = −sign λ_j` |
+//! | `2 j + 1` | slide, driving (σ = 1) or back-driving (σ = −1) | `σ s K_m i_j` | the other power direction |
+//! | `2 nv + j` (supply) | a drive without regeneration, side σ | `σ p_j` | the other side |
+//! | `3 nv` | the bus, side σ | `σ P_b` | the other side |
+//!
+//! A sticking joint is held by the torque λ_j that makes `q̈_j = 0` with the other joints in
+//! their modes: eq 21 is affine in the joint torques for fixed modes, so with `S` the sticking
+//! joints, `q̈_S(τ + E_S λ) = q̈_S(τ) + G_SS λ` where column a of G is the change of q̈ for a
+//! unit torque at joint S_a (one more solve per sticking joint, exact up to rounding), and
+//! `G_SS λ = −q̈_S(τ)` is solved by Gaussian elimination ([`ArmSystem::lock_stuck`]). When a
+//! sliding joint stops (slide → stick), the speed the root location leaves (|q̇_j| of the
+//! order of the event time tolerance times q̈) is removed and the kinetic energy it carried
+//! booked as gear loss, as the contacts' slip → stick does (`stop_slip.rs`; Pfeiffer & Glocker
+//! 1996, ch. 6). The gear loss quadrature `E_g = ∫ Σ (K_m i_j − τ_gear,j) q̇_j dt` and the
+//! supply's `E_supply`, `E_regen`, `E_dump`, `E_sloss` follow the contacts' quadratures in the
+//! state; each integrand is smooth between events, so the adaptive methods integrate them to
+//! their order.
+
+#![allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `run.rs`
+
+use crate::dynamics::gear_friction::GearMode;
+use crate::dynamics::motor::Electrical;
+use crate::error::{DynamicsError, RunError};
+use crate::integrate::HybridSystem;
+
+use super::arm::ArmSystem;
+
+/// A change of a gear's mode: at time `t` (s), joint `joint` entered `mode`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GearEvent {
+    pub t: f64,
+    pub joint: usize,
+    pub mode: GearMode,
+}
+
+/// The gear log keeps the first this many events of a run (a diagnostic; bounded memory).
+const MAX_GEAR_LOG: usize = 10_000;
+
+/// The drives' modes and the scratch of the sticking solve (sized once).
+#[derive(Clone, Debug)]
+pub(crate) struct DriveModes {
+    /// Per joint: its gear's mode (`Slide` with no torque on joints without a gear law).
+    pub(crate) gear: Vec<GearMode>,
+    /// Per joint: the gear's torque beyond the ideal train (sliding terms, or the holding λ
+    /// while sticking), N m; written by every evaluation.
+    pub(crate) gear_torque: Vec<f64>,
+    /// Per joint: the supply takes its power as ≥ 0.
+    pub(crate) pos: Vec<bool>,
+    /// The bus power is taken as ≥ 0.
+    pub(crate) bus_pos: bool,
+    /// Scratch: the sticking joints, q̈ without the holding torques, G_SS, λ, the torques saved.
+    stuck: Vec<usize>,
+    qdd0: Vec<f64>,
+    g: Vec<f64>,
+    lambda: Vec<f64>,
+    /// Scratch: the electric powers p_j (nv).
+    pub(crate) power: Vec<f64>,
+    /// The gears' mode changes (events and the start), first [`MAX_GEAR_LOG`].
+    log: Vec<GearEvent>,
+}
+
+impl DriveModes {
+    pub(crate) fn new(nv: usize) -> Self {
+        DriveModes {
+            gear: vec![GearMode::Slide { dir: 1, driving: true }; nv],
+            gear_torque: vec![0.0; nv],
+            pos: vec![true; nv],
+            bus_pos: true,
+            stuck: Vec::with_capacity(nv),
+            qdd0: vec![0.0; nv],
+            g: vec![0.0; nv * nv],
+            lambda: vec![0.0; nv],
+            power: vec![0.0; nv],
+            log: Vec::new(),
+        }
+    }
+}
+
+/// Solve `a x = b` for the n x n symmetric positive semi-definite `a` (row-major; `b`
+/// overwritten by x) by Gaussian elimination without pivoting, skipping the directions whose
+/// pivot is below `1e-12` of the largest diagonal: there the locked joints' accelerations are
+/// already tied by the constraints (two sticking joints of one closed chain), the system is
+/// consistent and the skipped unknowns are set to 0 (all of them when every locked joint is
+/// held by the constraints alone: a joint whose motion the closed chain fixes needs no holding
+/// torque from its gear). False on a non-finite entry.
+fn solve_psd(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
+    let scale = (0..n).map(|k| a[k * n + k].abs()).fold(0.0, f64::max);
+    if !scale.is_finite() {
+        return false;
+    }
+    let tol = 1e-12 * scale;
+    for k in 0..n {
+        if a[k * n + k] <= tol {
+            for c in 0..n {
+                a[k * n + c] = 0.0;
+                a[c * n + k] = 0.0;
+            }
+            b[k] = 0.0;
+            continue;
+        }
+        for r in k + 1..n {
+            let f = a[r * n + k] / a[k * n + k];
+            for c in k..n {
+                a[r * n + c] -= f * a[k * n + c];
+            }
+            b[r] -= f * b[k];
+        }
+    }
+    for k in (0..n).rev() {
+        if a[k * n + k] == 0.0 {
+            b[k] = 0.0;
+            continue;
+        }
+        let mut s = b[k];
+        for c in k + 1..n {
+            s -= a[k * n + c] * b[c];
+        }
+        b[k] = s / a[k * n + k];
+    }
+    b.iter().all(|x| x.is_finite())
+}
+
+impl ArmSystem<'_> {
+    /// Whether the run is integrated event by event: a non-bilateral contact, or drive modes.
+    pub fn is_event_driven(&self) -> bool {
+        self.hybrid.is_some() || self.drive_modes.is_some()
+    }
+
+    /// `K_m i_j` with the currents of this evaluation (after `inputs`).
+    fn km_i(&self, y: &[f64], j: usize) -> f64 {
+        let i = match self.layout.electrical {
+            Electrical::Inductive => y[self.layout.current().start + j],
+            Electrical::QuasiStatic => self.ws.current_qs[j],
+        };
+        self.scene.drives.km[j] * i
+    }
+
+    /// The gears' sliding torques into `fd.tau_joint` (after the stops' torques, which
+    /// `inputs` wrote when the scene has stops) and `gear_torque`, at y with this evaluation's
+    /// currents (0 for sticking joints: [`ArmSystem::lock_stuck`] finds theirs).
+    pub(super) fn gear_inputs(&mut self, y: &[f64]) {
+        let (Some(g), Some(m)) = (&self.scene.gear_friction, self.drive_modes.as_mut()) else { return };
+        let l = self.layout;
+        let stops = self.scene.stops.is_some();
+        for j in 0..l.nv {
+            let i = match l.electrical {
+                Electrical::Inductive => y[l.current().start + j],
+                Electrical::QuasiStatic => self.ws.current_qs[j],
+            };
+            let tau = g.sliding_torque(j, m.gear[j], self.scene.drives.km[j] * i, y[l.qd().start + j]);
+            m.gear_torque[j] = tau;
+            if stops {
+                self.ws.fd.tau_joint[j] += tau;
+            } else {
+                self.ws.fd.tau_joint[j] = tau;
+            }
+        }
+    }
+
+    /// The holding torques of the sticking joints (module docs), after a solve at (t, y) in
+    /// the current modes: `q̈_S = 0`, λ added to `fd.tau_joint` and kept in `gear_torque`.
+    pub(super) fn lock_stuck(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+        let Some(m) = self.drive_modes.as_mut() else { return Ok(()) };
+        m.stuck.clear();
+        m.stuck.extend((0..self.layout.nv).filter(|&j| m.gear[j] == GearMode::Stick));
+        let n = m.stuck.len();
+        if n == 0 {
+            return Ok(());
+        }
+        m.qdd0.copy_from_slice(self.ws.fd.qdd.as_slice());
+        for a in 0..n {
+            let j = self.drive_modes.as_ref().expect("drive modes").stuck[a];
+            let saved = self.ws.fd.tau_joint[j];
+            self.ws.fd.tau_joint[j] = saved + 1.0;
+            self.solve_eq21(t, y)?;
+            self.ws.fd.tau_joint[j] = saved;
+            let m = self.drive_modes.as_mut().expect("drive modes");
+            for b in 0..n {
+                let r = m.stuck[b];
+                m.g[b * n + a] = self.ws.fd.qdd[r] - m.qdd0[r];
+            }
+        }
+        let m = self.drive_modes.as_mut().expect("drive modes");
+        for b in 0..n {
+            m.lambda[b] = -m.qdd0[m.stuck[b]];
+        }
+        let (g, lambda) = (&mut m.g[..n * n], &mut m.lambda[..n]);
+        if !solve_psd(g, lambda, n) {
+            return Err(DynamicsError::NonFinite { t, what: "the holding torque of a sticking gear (its joint has no inertia of its own)".into() });
+        }
+        for a in 0..n {
+            let j = m.stuck[a];
+            self.ws.fd.tau_joint[j] += m.lambda[a];
+            m.gear_torque[j] = m.lambda[a];
+        }
+        self.solve_eq21(t, y)?;
+        let m = self.drive_modes.as_ref().expect("drive modes");
+        for &j in &m.stuck {
+            self.ws.fd.qdd[j] = 0.0;
+        }
+        Ok(())
+    }
+
+    /// For the structured Jacobian (`jacobian.rs`): joint j's gear efficiency factor c on K_m
+    /// and `s ∂τ_f/∂q̇` (the friction torque's slope, as a damping) while it slides; (1, 0)
+    /// otherwise.
+    pub(super) fn gear_jacobian_terms(&self, j: usize, qd: f64) -> (f64, f64) {
+        let (Some(g), Some(m)) = (&self.scene.gear_friction, &self.drive_modes) else { return (1.0, 0.0) };
+        match m.gear[j] {
+            GearMode::Slide { dir, driving } => (g.factor(j, driving), g.sliding_friction_slope(j, qd) * f64::from(dir)),
+            GearMode::Stick => (1.0, 0.0),
+        }
+    }
+
+    /// The electric powers `p_j = i_j v_j` of this evaluation into the scratch.
+    fn powers_into_scratch(&mut self, y: &[f64]) {
+        let l = self.layout;
+        let Some(m) = self.drive_modes.as_mut() else { return };
+        for j in 0..l.nv {
+            let i = match l.electrical {
+                Electrical::Inductive => y[l.current().start + j],
+                Electrical::QuasiStatic => self.ws.current_qs[j],
+            };
+            m.power[j] = i * self.ws.voltage[j];
+        }
+    }
+
+    /// The rates of the gear loss and the supply quadratures after an evaluation.
+    pub(super) fn drive_loss_rates(&mut self, y: &[f64], dydt: &mut [f64]) {
+        let l = self.layout;
+        if let Some(k) = l.loss_gear() {
+            let m = self.drive_modes.as_ref().expect("drive modes");
+            let qd = &y[l.qd()];
+            dydt[k] = -(0..l.nv).map(|j| if m.gear[j] == GearMode::Stick { 0.0 } else { m.gear_torque[j] * qd[j] }).sum::<f64>();
+        }
+        if let Some(k) = l.supply() {
+            self.powers_into_scratch(y);
+            let s = self.scene.supply.as_ref().expect("supply");
+            let m = self.drive_modes.as_ref().expect("drive modes");
+            let w = s.powers(&m.power, &m.pos, m.bus_pos);
+            dydt[k] = w.supply;
+            dydt[k + 1] = w.regenerated;
+            dydt[k + 2] = w.dumped;
+            dydt[k + 3] = w.loss;
+        }
+    }
+
+    /// The supply's powers at the last evaluation (for the outputs).
+    pub(super) fn supply_powers(&mut self, y: &[f64]) -> Option<crate::dynamics::supply::SupplyPowers> {
+        self.scene.supply.as_ref()?;
+        self.powers_into_scratch(y);
+        let s = self.scene.supply.as_ref().expect("supply");
+        let m = self.drive_modes.as_ref().expect("drive modes");
+        Some(s.powers(&m.power, &m.pos, m.bus_pos))
+    }
+
+    /// Number of the drives' event functions: `2 nv` with a gear law, `nv + 1` with a supply.
+    pub(super) fn n_drive_events(&self) -> usize {
+        if self.drive_modes.is_none() {
+            return 0;
+        }
+        let nv = self.layout.nv;
+        2 * nv + nv + 1
+    }
+
+    /// The drives' event functions at (t, y) after an evaluation there (module docs).
+    pub(super) fn drive_events(&mut self, y: &[f64], out: &mut [f64]) {
+        let l = self.layout;
+        let nv = l.nv;
+        out.fill(1.0);
+        if let Some(g) = &self.scene.gear_friction {
+            let m = self.drive_modes.as_ref().expect("drive modes");
+            for j in 0..nv {
+                if !g.active(j) {
+                    continue;
+                }
+                let km_i = self.km_i(y, j);
+                match m.gear[j] {
+                    GearMode::Stick => out[2 * j] = g.stick_margin(j, km_i, m.gear_torque[j]),
+                    GearMode::Slide { dir, driving } => {
+                        let s = f64::from(dir);
+                        out[2 * j] = s * y[l.qd().start + j];
+                        out[2 * j + 1] = if driving { 1.0 } else { -1.0 } * s * km_i;
+                    }
+                }
+            }
+        }
+        if let Some(s) = &self.scene.supply {
+            self.powers_into_scratch(y);
+            let m = self.drive_modes.as_ref().expect("drive modes");
+            for j in 0..nv {
+                if s.clips(j) {
+                    out[2 * nv + j] = if m.pos[j] { 1.0 } else { -1.0 } * m.power[j];
+                }
+            }
+            // the bus (or the summed supplies): P_s has the sign of P_b, and the energy
+            // regenerated switches there
+            let w = s.powers(&m.power, &m.pos, m.bus_pos);
+            out[3 * nv] = if m.bus_pos { 1.0 } else { -1.0 } * w.bus;
+        }
+    }
+
+    /// Every drive function is watched from its start value when it starts on its firing side
+    /// (`integrate::events`): a mode is chosen at a point where its function is 0 (a joint
+    /// breaking away from rest, a power that starts at 0), and the function may leave 0 to
+    /// either side; how far it must move: a sticking margin 1e-9 N m, a speed 1e-12 rad/s, a
+    /// torque `K_m i` 1e-10 N m, a power 1e-10 W (far below anything that matters, far above
+    /// the rounding of the solve).
+    pub(super) fn drive_event_tolerance(&self, i: usize) -> Option<f64> {
+        let m = self.drive_modes.as_ref()?;
+        let nv = self.layout.nv;
+        Some(if i < 2 * nv {
+            match (m.gear[i / 2], i % 2) {
+                (GearMode::Stick, 0) => 1e-9,
+                (_, 0) => 1e-12,
+                _ => 1e-10,
+            }
+        } else {
+            1e-10
+        })
+    }
+
+    /// The gears' mode changes so far, in time order (empty without `gear_friction`).
+    pub fn gear_events(&self) -> &[GearEvent] {
+        self.drive_modes.as_ref().map_or(&[], |m| &m.log[..])
+    }
+
+    fn log_gear(&mut self, t: f64, joint: usize, mode: GearMode) {
+        let m = self.drive_modes.as_mut().expect("drive modes");
+        if m.log.len() < MAX_GEAR_LOG {
+            m.log.push(GearEvent { t, joint, mode });
+        }
+    }
+
+    /// Set joint j's speed to 0 (it stops): the M_J-weighted velocity projection that keeps the
+    /// bilateral constraints' velocity rows and the sticking joints at rest (as the contacts'
+    /// slip → stick, `stop_slip.rs`; in a closed chain other joints move with j), its
+    /// kinetic-energy change booked as gear loss, the rotors' share into W_j as at impacts.
+    /// Uses M and J_c of the evaluation at y. Allocates (an event, not the step loop).
+    fn stop_joint(&mut self, y: &mut [f64], j: usize) {
+        use nalgebra::{DMatrix, DVector};
+        let l = self.layout;
+        let nv = l.nv;
+        let d = &self.scene.drives;
+        let m = &self.ws.data.m;
+        let modes = self.drive_modes.as_ref().expect("drive modes");
+        let qd = DVector::from_column_slice(&y[l.qd()]);
+        let mut m_j = m.clone();
+        for k in 0..nv {
+            m_j[(k, k)] += d.jm[k];
+        }
+        // rows: the bilateral constraints (a hybrid run's contact rows are the contacts' own
+        // and are left to their handler), the sticking joints, and j
+        let nc = if self.hybrid.is_some() { 0 } else { self.contacts.len() };
+        let held: Vec<usize> = (0..nv).filter(|&k| k == j || modes.gear[k] == GearMode::Stick).collect();
+        let rows = nc + held.len();
+        let mut a = DMatrix::zeros(rows, nv);
+        let mut b = DVector::zeros(rows);
+        for r in 0..nc {
+            for c in 0..nv {
+                a[(r, c)] = self.ws.fd.jac[(r, c)];
+            }
+        }
+        for (r, &k) in held.iter().enumerate() {
+            a[(nc + r, k)] = 1.0;
+            b[nc + r] = -qd[k];
+        }
+        let Some(chol) = m_j.clone().cholesky() else { return };
+        let minv_at = chol.solve(&a.transpose());
+        let s = &a * &minv_at;
+        let mu = match s.svd(true, true).solve(&b, 1e-12) {
+            Ok(mu) => mu,
+            Err(_) => return,
+        };
+        let dq = &minv_at * mu;
+        let d_t = qd.dot(&(&m_j * &dq)) + 0.5 * dq.dot(&(&m_j * &dq));
+        for k in 0..nv {
+            let (before, after) = (qd[k], qd[k] + dq[k]);
+            y[l.work().start + k] += -d.jm[k] * (after * after - before * before) / 2.0;
+            y[l.qd().start + k] = after;
+        }
+        y[l.qd().start + j] = 0.0;
+        if let Some(k) = l.loss_gear() {
+            y[k] -= d_t;
+        }
+    }
+
+    /// Set the gear modes of the joints `which` from (t, y): a joint at rest (or stopping:
+    /// `stopping`) sticks when its holding torque is in the band, else slides the way the
+    /// torque pushes; a moving joint slides in its direction. Returns whether y moved.
+    fn settle_gears(&mut self, t: f64, y: &mut [f64], which: &[usize], stopping: bool) -> Result<bool, RunError> {
+        let Some(g) = self.scene.gear_friction.clone() else { return Ok(false) };
+        let l = self.layout;
+        let mut moved = false;
+        for &j in which {
+            if !g.active(j) {
+                continue;
+            }
+            let qd = y[l.qd().start + j];
+            if qd != 0.0 && !stopping {
+                self.inputs(t, y)?;
+                let km_i = self.km_i(y, j);
+                self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::slide(qd, km_i);
+                self.log_gear(t, j, GearMode::slide(qd, km_i));
+                continue;
+            }
+            // the joint stops: the speed the root location leaves (|q̇| of the order of the
+            // dense output's error at the root) is removed, its kinetic energy booked as gear
+            // loss; then it sticks if the holding torque is in the band, else it slides from
+            // rest the way that torque pushes
+            if qd != 0.0 {
+                self.evaluate(t, y)?;
+                self.stop_joint(y, j);
+                moved = true;
+            }
+            self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::Stick;
+            self.evaluate(t, y)?;
+            let km_i = self.km_i(y, j);
+            let lambda = self.drive_modes.as_ref().expect("drive modes").gear_torque[j];
+            if g.stick_margin(j, km_i, lambda) >= 0.0 {
+                self.log_gear(t, j, GearMode::Stick);
+            } else {
+                let dir = if lambda > 0.0 { -1.0 } else { 1.0 };
+                self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::slide(dir, km_i);
+                self.log_gear(t, j, GearMode::slide(dir, km_i));
+            }
+        }
+        Ok(moved)
+    }
+
+    /// The supply's sides at the true signs at (t, y).
+    fn settle_supply(&mut self, t: f64, y: &[f64]) -> Result<(), RunError> {
+        if self.scene.supply.is_none() {
+            return Ok(());
+        }
+        self.evaluate(t, y)?;
+        self.powers_into_scratch(y);
+        let s = self.scene.supply.as_ref().expect("supply");
+        let m = self.drive_modes.as_mut().expect("drive modes");
+        m.bus_pos = s.sides(&m.power, &mut m.pos);
+        Ok(())
+    }
+
+    /// The drives' modes at the start.
+    pub(super) fn init_drive_modes(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
+        if self.drive_modes.is_none() {
+            return Ok(false);
+        }
+        let nv = self.layout.nv;
+        let all: Vec<usize> = (0..nv).collect();
+        let moved = self.settle_gears(t, y, &all, false)?;
+        self.settle_supply(t, y)?;
+        Ok(moved)
+    }
+
+    /// The drives' events `fired` (their own indices) at (t, y).
+    pub(super) fn handle_drive_events(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> Result<bool, RunError> {
+        if self.drive_modes.is_none() {
+            return Ok(false);
+        }
+        let nv = self.layout.nv;
+        let mut moved = false;
+        for j in 0..nv.min(fired.len() / 2) {
+            if fired[2 * j] {
+                let stuck = self.drive_modes.as_ref().expect("drive modes").gear[j] == GearMode::Stick;
+                if stuck {
+                    // break away the way the holding torque pushed
+                    self.evaluate(t, y)?;
+                    let km_i = self.km_i(y, j);
+                    let lambda = self.drive_modes.as_ref().expect("drive modes").gear_torque[j];
+                    let dir = if lambda > 0.0 { -1.0 } else { 1.0 };
+                    self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::slide(dir, km_i);
+                    self.log_gear(t, j, GearMode::slide(dir, km_i));
+                } else {
+                    moved |= self.settle_gears(t, y, &[j], true)?;
+                }
+            } else if fired[2 * j + 1] {
+                if let GearMode::Slide { dir, driving } = self.drive_modes.as_ref().expect("drive modes").gear[j] {
+                    self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::Slide { dir, driving: !driving };
+                    self.log_gear(t, j, GearMode::Slide { dir, driving: !driving });
+                }
+            }
+        }
+        if fired.get(2 * nv..).is_some_and(|f| f.iter().any(|&x| x)) {
+            let m = self.drive_modes.as_mut().expect("drive modes");
+            for j in 0..nv {
+                if fired[2 * nv + j] {
+                    m.pos[j] = !m.pos[j];
+                }
+            }
+            if fired[3 * nv] {
+                m.bus_pos = !m.bus_pos;
+            }
+        }
+        Ok(moved)
+    }
+
+    /// The joints whose gear functions are all of `text`'s event functions (the driver's
+    /// "event functions [i, j, ...]" of a chattering error), or `None` when another function is
+    /// among them (a contact's, a supply's) or the text is not such a list.
+    pub fn chattering_gears(&self, text: &str) -> Option<Vec<String>> {
+        let list = text.strip_prefix("event functions [")?.strip_suffix(']')?;
+        let nc = self.contact_n_events();
+        let nv = self.layout.nv;
+        self.scene.gear_friction.as_ref()?;
+        let mut joints: Vec<String> = Vec::new();
+        for part in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let i = part.parse::<usize>().ok()?.checked_sub(nc)?;
+            if i >= 2 * nv {
+                return None;
+            }
+            let name = self.scene.model.bodies[i / 2].joint.clone();
+            if !joints.contains(&name) {
+                joints.push(name);
+            }
+        }
+        (!joints.is_empty()).then_some(joints)
+    }
+
+    /// "gear of <joint> (...)" or "supply (...)" for the drives' event function `i`.
+    pub(super) fn describe_drive_event(&self, i: usize) -> Option<String> {
+        let m = self.drive_modes.as_ref()?;
+        let nv = self.layout.nv;
+        let joint = |j: usize| self.scene.model.bodies[j].joint.clone();
+        Some(if i < 2 * nv {
+            let what = match (m.gear[i / 2], i % 2) {
+                (GearMode::Stick, 0) => "stick-to-slide",
+                (GearMode::Stick, _) => "sticking: constant",
+                (_, 0) => "velocity reversal",
+                _ => "power direction",
+            };
+            format!("gear of {} ({what} function)", joint(i / 2))
+        } else if i < 3 * nv {
+            format!("supply of {} (power sign function)", joint(i - 2 * nv))
+        } else if i == 3 * nv {
+            "supply bus (power sign function)".into()
+        } else {
+            return None;
+        })
+    }
+}
+
+/// The arm's events: the contacts' `2 n_c` functions (`hybrid.rs`), then the drives' (this
+/// file).
+impl HybridSystem for ArmSystem<'_> {
+    fn n_events(&self) -> usize {
+        self.contact_n_events() + self.n_drive_events()
+    }
+
+    fn event_direction(&self, i: usize) -> i8 {
+        let nc = self.contact_n_events();
+        if i < nc {
+            self.contact_event_direction(i)
+        } else {
+            -1
+        }
+    }
+
+    fn event_tolerance(&self, i: usize) -> Option<f64> {
+        let nc = self.contact_n_events();
+        if i < nc {
+            self.contact_event_tolerance(i)
+        } else {
+            self.drive_event_tolerance(i - nc)
+        }
+    }
+
+    fn events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
+        let nc = self.contact_n_events();
+        self.contact_events(t, y, &mut out[..nc])?;
+        if self.drive_modes.is_some() {
+            if self.hybrid.is_none() {
+                self.evaluate(t, y)?;
+            }
+            self.drive_events(y, &mut out[nc..]);
+        }
+        Ok(())
+    }
+
+    fn init_modes(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
+        let moved = self.contact_init_modes(t, y)?;
+        Ok(self.init_drive_modes(t, y)? || moved)
+    }
+
+    fn handle_events(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> Result<bool, RunError> {
+        let nc = self.contact_n_events();
+        let mut moved = false;
+        if fired[..nc].iter().any(|&f| f) {
+            moved = self.contact_handle_events(t, y, &fired[..nc])?;
+        }
+        Ok(self.handle_drive_events(t, y, &fired[nc..])? || moved)
+    }
+
+    fn after_step(&mut self, _t: f64, y: &[f64]) {
+        self.contact_after_step(y);
+    }
+}
