@@ -46,5 +46,6 @@ mod workspace;
 pub use arm::ArmSystem;
 pub use layout::Layout;
 pub use outputs::{OutputLevel, Outputs};
+pub use hybrid::REBOUND_START;
 #[cfg(test)]
 mod hybrid_tests;
