@@ -480,6 +480,7 @@ fn random_scene(seed: u64) -> (sim::scene::Scene, String) {
 /// early only with a typed error that names the contact and the law (Painlevé's inconsistency
 /// of the rigid problem, or modes that chatter: issue 23 items 2 and 6, not this part), and
 /// the samples before the stop must hold too. Returns the error's message when it stopped.
+#[allow(clippy::result_large_err)] // RunError carries schemas::Error, as in `sim::run::simulate`
 fn check_random(seed: u64) -> Option<String> {
     use sim::error::{DynamicsError, RunError};
     let (scene, what) = random_scene(seed);
