@@ -509,14 +509,18 @@ fn check_random(seed: u64) -> Option<String> {
     stopped
 }
 
-proptest::proptest! {
-    #![proptest_config(proptest::prelude::ProptestConfig { cases: 16, failure_persistence: None, ..Default::default() })]
-    /// 16 random unilateral scenes (`random_scene`) hold the contact audit at every sample and
-    /// close the balance; a failure names its seed (`ELBOW_CONTACT_SEED` reruns that one).
-    #[test]
-    fn random_unilateral_scenes_hold_the_audit_and_close_the_balance(seed in proptest::prelude::any::<u64>()) {
-        check_random(seed);
+/// 16 random unilateral scenes (`random_scene`), their seeds drawn from a fixed SplitMix64
+/// stream (so CI runs the same 16 every time; a failure names its seed, which
+/// `ELBOW_CONTACT_SEED` reruns alone), hold the contact audit at every sample and close the
+/// balance.
+#[test]
+fn random_unilateral_scenes_hold_the_audit_and_close_the_balance() {
+    let mut seeds = SplitMix(0x2023_1129);
+    let mut stopped = 0;
+    for _ in 0..16 {
+        stopped += usize::from(check_random(seeds.next()).is_some());
     }
+    eprintln!("16 random unilateral scenes: {} complete, {stopped} stopped with a typed error (the audit held before)", 16 - stopped);
 }
 
 /// The case of `ELBOW_CONTACT_SEED` (a failing property case's seed), when set.
