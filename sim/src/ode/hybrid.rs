@@ -6,13 +6,18 @@
 //!
 //! | mode | ev0 (direction) | ev1 (direction) |
 //! |---|---|---|
-//! | separated (unilateral) | g (−1, touch-down) | 1 |
+//! | separated (unilateral) | g − g_ref (−1, touch-down) | 1 |
 //! | sticking | f_n (−1, lift-off) | μ f_n − \|f_t\| (−1, stick→slip) |
 //! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick; 1 when μ = 0) |
 //! | compliant | g (0) | k δ + c δ̇ while δ > 0, else 1 (0) |
 //! | bilateral | 1 | 1 |
 //!
 //! `s_ref` is the slip direction at the start of the step (refreshed in `after_step`).
+//! `g_ref` is 0, except after a contact left the table with a separating speed (a rebound):
+//! then it is the restart's gap, and the function is positive at the restart itself
+//! ([`REBOUND_START`]), so the return is located as a root however short the flight. A fired
+//! touch-down with ġ > `vel_tol` (separating) closes nothing: a contact is closed only with
+//! |g| ≤ `gap_tol` and |ġ| ≤ `vel_tol`.
 //! The force-type functions need a full evaluation of eq 21 at the interpolated state.
 //! At an event ([`HybridSystem::handle_events`]): touch-downs with approach speed above
 //! `vel_tol` are impacts (`dynamics/contact/impact.rs`; below `rest_velocity` plastic: the Zeno
@@ -56,6 +61,17 @@ pub(crate) struct Hybrid {
     pub(crate) proj_dx: Vec<f64>,
     /// The run's deadline, read by the mode enumeration ([`ArmSystem::set_watch`]).
     pub(crate) watch: Watch,
+    /// A separated contact's touch-down function is `g − gap_ref` (m): `gap_ref` is 0 except
+    /// after the contact left the table with a separating speed (a rebound, or thrown off by
+    /// another contact's impulse), where it is the restart's gap `min(g₀, 0)`, and the
+    /// function's value AT the restart time `rebound_t` is [`REBOUND_START`] (the contact is
+    /// leaving: on the open side), so its return to g₀ is located as a root.
+    pub(crate) gap_ref: Vec<f64>,
+    /// The restart time of that rebound, s (NaN: none).
+    pub(crate) rebound_t: Vec<f64>,
+    /// Whether `gap_ref` is to be taken at the next evaluation of the event functions (the
+    /// restart after the event that made the contact leave).
+    pub(crate) rebound: Vec<bool>,
 }
 
 impl Hybrid {
@@ -77,6 +93,9 @@ impl Hybrid {
             proj_rows: Vec::with_capacity(3 * nc),
             proj_dx: vec![0.0; nv],
             watch: Watch::default(),
+            gap_ref: vec![0.0; nc],
+            rebound_t: vec![f64::NAN; nc],
+            rebound: vec![false; nc],
             contacts,
         }
     }
@@ -87,6 +106,17 @@ impl Hybrid {
 /// in the slip direction's rate as the slip stops, which no step-size control crosses; the
 /// last 1e-6 m/s are removed by a velocity projection (`stop_slip`).
 pub const STICK_SPEED: f64 = 1e-6;
+
+/// The value of a rebounding contact's touch-down function at its restart, m (issue 23). A
+/// contact that leaves the table with ġ > `vel_tol` restarts at a gap g₀ that is 0 up to the
+/// event's bracket (≤ |ġ| · 1e-12 s inside); its touch-down function is `g − min(g₀, 0)` after
+/// the restart and this positive value at it, so the driver sees it on the open side, watches
+/// nothing, and locates its return to g₀ like any root — even when the whole flight is
+/// shorter than one step (the end of a bounce sequence). Without it the function started at
+/// g₀ ≤ 0, was watched from there, and a flight inside the first step fired the touch-down at
+/// the restart itself, closing a contact that separates. Once a step ends with the contact
+/// above the table (g > 0) the function is `g` again (`release_rebounds`).
+pub const REBOUND_START: f64 = 1e-14;
 
 fn mu_of(c: &Contact) -> f64 {
     match c.model {
@@ -350,6 +380,49 @@ impl ArmSystem<'_> {
         Ok(())
     }
 
+    /// After the modes are chosen at an event (rows at the post-event state, from
+    /// `resolve_modes`): every separated unilateral contact at the table (|g| ≤ gap_tol) that
+    /// leaves it with ġ > vel_tol has its touch-down function re-based at the restart
+    /// ([`REBOUND_START`]); a contact that closes has it at `g` again.
+    fn mark_rebounds(&mut self) {
+        let Some(h) = &mut self.hybrid else { return };
+        let st = h.settings;
+        for (k, c) in h.contacts.iter().enumerate() {
+            if !matches!(c.model, ContactModel::Unilateral { .. }) {
+                continue;
+            }
+            if h.state.mode[k] == ContactMode::Separated {
+                if h.cd.rows.gap[k].abs() <= st.gap_tol && h.cd.rows.vel[3 * k] > st.vel_tol {
+                    h.rebound[k] = true;
+                }
+            } else {
+                h.gap_ref[k] = 0.0;
+                h.rebound_t[k] = f64::NAN;
+                h.rebound[k] = false;
+            }
+        }
+    }
+
+    /// After an accepted step: a contact that left with a separating speed and is now above the
+    /// table (g > 0) has its touch-down function back at `g` (the next step's start values are
+    /// taken after this), so its next touch-down is located at g = 0. A flight shorter than one
+    /// step returns to its restart gap g₀ (≤ |ġ| · 1e-12 s below the table).
+    fn release_rebounds(&mut self, y: &[f64]) {
+        let l = self.layout;
+        let model = &self.scene.model;
+        let Some(h) = &mut self.hybrid else { return };
+        if h.rebound_t.iter().all(|t| t.is_nan()) {
+            return;
+        }
+        forward_kinematics(model, &mut self.ws.data, &y[l.q()]);
+        for (k, c) in h.contacts.iter().enumerate() {
+            if !h.rebound_t[k].is_nan() && h.state.mode[k] == ContactMode::Separated && c.plane.position(&self.ws.data) > 0.0 {
+                h.gap_ref[k] = 0.0;
+                h.rebound_t[k] = f64::NAN;
+            }
+        }
+    }
+
     /// After an accepted step: the slip directions the next step's ev1 refers to.
     fn refresh_slip_reference(&mut self, y: &[f64]) {
         let l = self.layout;
@@ -407,9 +480,15 @@ impl ArmSystem<'_> {
             return Ok(());
         }
         self.evaluate(t, y)?;
-        let h = self.hybrid.as_ref().expect("hybrid");
+        let h = self.hybrid.as_mut().expect("hybrid");
         let r = &h.cd.rows;
         for (k, c) in h.contacts.iter().enumerate() {
+            if h.rebound[k] {
+                // the restart after the contact left with a separating speed
+                h.gap_ref[k] = r.gap[k].min(0.0);
+                h.rebound_t[k] = t;
+                h.rebound[k] = false;
+            }
             let (f_n, f_t) = (h.cd.f_n[k], h.cd.f_t[k]);
             let (e0, e1) = match (c.model, h.state.mode[k]) {
                 (ContactModel::Bilateral, _) => (1.0, 1.0),
@@ -417,7 +496,7 @@ impl ArmSystem<'_> {
                     let (delta, delta_d) = (-r.gap[k], -r.vel[3 * k]);
                     (r.gap[k], if delta > 0.0 { stiffness * delta + damping * delta_d } else { 1.0 })
                 }
-                (_, ContactMode::Separated | ContactMode::Bilateral) => (r.gap[k], 1.0),
+                (_, ContactMode::Separated | ContactMode::Bilateral) => (if t == h.rebound_t[k] { REBOUND_START } else { r.gap[k] - h.gap_ref[k] }, 1.0),
                 (_, ContactMode::Sticking) => (f_n, mu_of(c) * f_n - f_t[0].hypot(f_t[1])),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
@@ -464,6 +543,7 @@ impl ArmSystem<'_> {
             .collect();
         let before_log = self.hybrid.as_ref().map_or(0, |h| h.log.len());
         self.resolve_modes(t, y, &closed, &preferred, &[])?;
+        self.mark_rebounds();
         // the initial choice is not an event
         let h = self.hybrid.as_mut().expect("hybrid");
         let n = h.log.len();
@@ -507,6 +587,10 @@ impl ArmSystem<'_> {
                     if f0 {
                         if gd < -st.vel_tol {
                             approaching.push(k);
+                        } else if gd > st.vel_tol {
+                            // separating: the gap is not closing (a contact is closed only with
+                            // its gap rate at zero); its return is located from the restart
+                            h.rebound[k] = true;
                         } else {
                             touched.push(k);
                             preferred[k] = if mu_of(c) > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
@@ -572,10 +656,12 @@ impl ArmSystem<'_> {
             moved = true;
         }
         self.resolve_modes(t, y, &closed, &preferred, &logged)?;
+        self.mark_rebounds();
         Ok(moved)
     }
 
     pub(super) fn contact_after_step(&mut self, y: &[f64]) {
         self.refresh_slip_reference(y);
+        self.release_rebounds(y);
     }
 }

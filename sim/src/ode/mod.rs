@@ -54,5 +54,6 @@ pub use arm::ArmSystem;
 pub use drive_modes::GearEvent;
 pub use layout::Layout;
 pub use outputs::{OutputLevel, Outputs, SupplyOutput};
+pub use hybrid::REBOUND_START;
 #[cfg(test)]
 mod hybrid_tests;

@@ -190,3 +190,38 @@ pub fn bisect(mut a: f64, mut b: f64, f: impl Fn(f64) -> f64) -> f64 {
     }
     0.5 * (a + b)
 }
+
+/// The contact audit (`schemas::ContactAuditor`, the one `sim` and `analyze` run) over every
+/// sample of a collected run: the record of the run's contacts and event settings, then each
+/// sample's `/contacts` message as the recorder fills it.
+pub fn audit(scene: &Scene, run: &str, c: &Collected) -> schemas::ContactAudit {
+    let r = scene.run(run).unwrap_or_else(|| panic!("no run {run}"));
+    let contacts = scene.run_contact_models(r);
+    let record = sim::record::contacts_record(&contacts, &scene.contact_settings());
+    let mut auditor = schemas::ContactAuditor::new(&record);
+    let mut cs = schemas::messages::ContactState { name: contacts.iter().map(|k| k.name().to_string()).collect(), ..Default::default() };
+    for o in &c.samples {
+        cs.time = o.t;
+        cs.mode = o.contacts.iter().map(|k| k.mode.code()).collect();
+        cs.gap = o.contacts.iter().map(|k| k.gap).collect();
+        cs.gap_rate = o.contacts.iter().map(|k| k.gap_rate).collect();
+        cs.normal_force = o.contacts.iter().map(|k| k.normal_force).collect();
+        cs.friction_force_t1 = o.contacts.iter().map(|k| k.friction_force[0]).collect();
+        cs.friction_force_t2 = o.contacts.iter().map(|k| k.friction_force[1]).collect();
+        cs.slip_velocity_t1 = o.contacts.iter().map(|k| k.slip_velocity[0]).collect();
+        cs.slip_velocity_t2 = o.contacts.iter().map(|k| k.slip_velocity[1]).collect();
+        auditor.sample(o.t, &cs);
+    }
+    auditor.finish()
+}
+
+/// The largest |balance residual| over the samples relative to the energy scale of the run:
+/// `Σ_j |E_j(t_end)|` plus the largest kinetic and |potential| energy met (a passive run draws
+/// no electric energy), and that scale.
+pub fn balance(c: &Collected) -> (f64, f64) {
+    let e: f64 = c.samples.last().unwrap().electric_energy.iter().map(|x| x.abs()).sum();
+    let mech = c.samples.iter().map(|o| o.kinetic.abs().max(o.potential.abs())).fold(0.0, f64::max);
+    let scale = e.max(mech);
+    let worst = c.samples.iter().map(|o| o.balance_residual.abs()).fold(0.0, f64::max);
+    (worst / scale, scale)
+}
