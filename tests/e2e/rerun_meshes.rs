@@ -29,8 +29,9 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The chunks of the recording store of an `.rrd`, in file order.
-fn batches(bytes: &[u8]) -> Vec<RecordBatch> {
+/// The chunks of the recording store of an `.rrd`, in file order (RRD framing, each chunk
+/// decompressed and read with arrow's IPC reader).
+pub(crate) fn batches(bytes: &[u8]) -> Vec<RecordBatch> {
     use prost::Message;
     let mut out = Vec::new();
     let mut i = 12;

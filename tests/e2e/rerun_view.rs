@@ -263,26 +263,13 @@ fn a_urdf_whose_root_link_is_world_is_drawn() {
     assert!(!entities.contains_key("/world/world"));
 }
 
-/// The entities of an `.rrd` and their component columns, read frame by frame (RRD framing,
-/// each chunk decompressed and read with arrow's IPC reader).
+/// The entities of an `.rrd` and their component columns (the chunks of
+/// [`crate::rerun_meshes::batches`]).
 fn entities(bytes: &[u8]) -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
-    use prost::Message;
     let mut out: std::collections::BTreeMap<String, std::collections::BTreeSet<String>> = Default::default();
-    let mut i = 12;
-    while i + 16 <= bytes.len() {
-        let kind = u64::from_le_bytes(bytes[i..i + 8].try_into().unwrap());
-        let len = u64::from_le_bytes(bytes[i + 8..i + 16].try_into().unwrap()) as usize;
-        let payload = &bytes[i + 16..i + 16 + len];
-        i += 16 + len;
-        match kind {
-            analyze::view::rrd::KIND_END => break,
-            analyze::view::rrd::KIND_ARROW_MSG => {
-                let batch = analyze::view::rrd::payload_batch(&analyze::view::rrd::ArrowMsg::decode(payload).unwrap()).unwrap();
-                let e = out.entry(batch.schema().metadata()["rerun:entity_path"].clone()).or_default();
-                e.extend(batch.schema().fields().iter().map(|f| f.name().clone()));
-            }
-            _ => {}
-        }
+    for batch in crate::rerun_meshes::batches(bytes) {
+        let e = out.entry(batch.schema().metadata()["rerun:entity_path"].clone()).or_default();
+        e.extend(batch.schema().fields().iter().map(|f| f.name().clone()));
     }
     out
 }

@@ -253,16 +253,15 @@ pub const DRAWN: [&str; 7] = [
 
 /// The topics [`Run::survey`] reads: the drawn ones and `/scene` (the force scale, the tables
 /// and the scale bar Foxglove draws: one small message).
-pub const SURVEYED: [&str; 8] = [
-    schemas::topics::TF,
-    schemas::topics::HAND,
-    schemas::topics::MOTORS,
-    schemas::topics::ENERGY,
-    schemas::topics::CONSTRAINTS,
-    schemas::topics::CONTACTS,
-    schemas::topics::CONTACT_EVENTS,
-    schemas::topics::SCENE,
-];
+pub const SURVEYED: [&str; 8] = {
+    let mut topics = [schemas::topics::SCENE; 8];
+    let mut k = 0;
+    while k < DRAWN.len() {
+        topics[k] = DRAWN[k];
+        k += 1;
+    }
+    topics
+};
 
 pub fn grow(min: &mut [f64; 3], max: &mut [f64; 3], p: [f64; 3]) {
     for i in 0..3 {
