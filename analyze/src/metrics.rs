@@ -258,6 +258,12 @@ pub struct LimitsMetrics {
 }
 
 impl RunMetrics {
+    /// Why the run's contacts fail their audit ([`ContactAuditMetrics::failure`]); `None` for a
+    /// run without a non-bilateral contact or one whose contacts held every law.
+    pub fn contact_law_failure(&self) -> Option<String> {
+        self.contact_audit.as_ref().and_then(ContactAuditMetrics::failure)
+    }
+
     /// The energy the supply delivered by the end, `E_supply = ∫ P_s dt`, J (metadata
     /// `energy_terms.supply_energy`): only runs whose scene has a `supply` (issue 26); without
     /// one the supply is ideal and regenerating, and what it delivers is E = Σ ∫ i v dt.

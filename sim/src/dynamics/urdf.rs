@@ -544,8 +544,12 @@ pub fn mesh_summary(meshes: &[MeshInfo]) -> Option<String> {
         return Some(format!("all {} mesh references resolved to file:// URIs of files present when recorded", meshes.len()));
     }
     let missing: Vec<String> = meshes.iter().filter(|m| !m.exists).map(|m| format!("{} (link {}): {}", m.filename, m.link, m.note)).collect();
+    // the remedy for what is missing: a package (or the URDF's directory) the scene did not
+    // give, or files that are not where the given paths lead
+    let unplaced = meshes.iter().any(|m| !m.exists && m.uri.is_none());
+    let remedy = if unplaced { "give robot.package_paths in the scene" } else { "the package paths were given: the files named are not there" };
     Some(format!(
-        "meshes not embedded: {} of {} mesh references do not resolve to a present file (give robot.package_paths in the scene): {}",
+        "meshes not embedded: {} of {} mesh references do not resolve to a present file ({remedy}): {}",
         missing.len(),
         meshes.len(),
         missing.join("; ")

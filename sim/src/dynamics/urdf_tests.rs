@@ -12,7 +12,7 @@ use super::energy::potential_energy;
 use super::kinematics::{body_point, forward_kinematics, forward_velocities};
 use super::model::{repair_principal_moments, JointKind, Model, UrdfOptions};
 use super::rnea::{bias_forces, rnea};
-use super::urdf::resolve_meshes;
+use super::urdf::{mesh_summary, resolve_meshes};
 
 const BOX: &str = r#"<inertial><mass value="2"/><inertia ixx="0.01" iyy="0.02" izz="0.025" ixy="0" ixz="0" iyz="0"/></inertial>"#;
 
@@ -267,11 +267,16 @@ fn mesh_references_are_resolved() {
     assert_eq!((infos[1].link.as_str(), infos[1].line, infos[1].exists), ("finger_r", 9, false));
     assert!(text.contains(&format!("<mesh filename=\"{want_l}\"/>")));
     assert_eq!(text.replace(&want_l, "package://arm_description/meshes/finger.stl").replace(&format!("file://{}/", dir.path().display()), ""), ARM);
+    // the summary's remedy fits what is missing: here a file under the given paths
+    let summary = mesh_summary(&infos).unwrap();
+    assert!(summary.starts_with("meshes not embedded: 1 of 2 ") && summary.contains("the files named are not there") && !summary.contains("give robot.package_paths"), "{summary}");
     // no package path: not embedded, the text unchanged
     let (text, infos) = resolve_meshes(ARM, "arm.urdf", &BTreeMap::new(), None).unwrap();
     assert_eq!(text, ARM);
     assert!(infos.iter().all(|m| m.uri.is_none() && !m.exists));
     assert!(infos[0].note.contains("not embedded"), "{}", infos[0].note);
+    let summary = mesh_summary(&infos).unwrap();
+    assert!(summary.starts_with("meshes not embedded: 2 of 2 ") && summary.contains("(give robot.package_paths in the scene)"), "{summary}");
 }
 
 /// The identities of a mixed revolute/prismatic model hold at a locked configuration too:

@@ -162,7 +162,7 @@ fn audit_failures(r: &RunMetrics, energy_bound: f64) -> Vec<String> {
 pub fn status(runs: &[RunMetrics], damaged: bool, v: Verbosity) -> u8 {
     let failed: Vec<&RunMetrics> = runs.iter().filter(|r| r.status != Status::Complete).collect();
     let broken: Vec<(&RunMetrics, String)> =
-        runs.iter().filter_map(|r| r.contact_audit.as_ref().and_then(analyze::ContactAuditMetrics::failure).map(|why| (r, why))).collect();
+        runs.iter().filter_map(|r| r.contact_law_failure().map(|why| (r, why))).collect();
     if !v.quiet {
         for r in &failed {
             let at = r.error_time_s.map_or(String::new(), |t| format!(" at t = {t:.3} s"));

@@ -340,7 +340,7 @@ pub fn run_all_live(
                 // a run whose contacts broke their laws is not a result (exit 1), though it ran
                 // to the end: its recording says where (record `contact_audit`)
                 let error = match &metrics {
-                    Ok(m) => m.contact_audit.as_ref().and_then(analyze::ContactAuditMetrics::failure).map(|why| format!("run `{}`: the contact laws do not hold: {why}", run.name)),
+                    Ok(m) => m.contact_law_failure().map(|why| format!("run `{}`: the contact laws do not hold: {why}", run.name)),
                     Err(_) => None,
                 };
                 Done { path: Some(r.path), error, io_error: false, metrics: Some(metrics) }

@@ -171,7 +171,7 @@ pub fn run(args: &SweepArgs, v: Verbosity) -> Result<u8> {
                 let metrics = metrics.metrics(tapped).map_err(|e| format!("the metrics of {}: {e}", rep.path.display()));
                 // as `sim run`: a run whose contacts broke their laws is not a result (exit 1)
                 let error = match &metrics {
-                    Ok(m) => m.contact_audit.as_ref().and_then(analyze::ContactAuditMetrics::failure).map(|why| {
+                    Ok(m) => m.contact_law_failure().map(|why| {
                         format!("{} run `{run_name}` ({}): the contact laws do not hold: {why}", var.name, var.describe())
                     }),
                     Err(_) => None,
