@@ -341,19 +341,7 @@ mod tests {
     use super::*;
 
     fn info(name: &str, model: &str, mu: f64) -> ContactInfo {
-        ContactInfo {
-            name: name.into(),
-            model: model.into(),
-            restitution: None,
-            friction: Some(mu),
-            stiffness: None,
-            damping: None,
-            slip_velocity: None,
-            normal: [0.0, 0.0, 1.0],
-            offset: 0.0,
-            t1: [1.0, 0.0, 0.0],
-            t2: [0.0, 1.0, 0.0],
-        }
+        ContactInfo { friction: Some(mu), ..ContactInfo::on_floor(name, model) }
     }
 
     /// Contacts `rigid` (unilateral, μ = 0.5), `soft` (compliant, μ = 0.5) and `paper`

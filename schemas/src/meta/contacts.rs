@@ -38,6 +38,26 @@ pub struct ContactInfo {
     pub t2: [f64; 3],
 }
 
+impl ContactInfo {
+    /// A `model` contact on the plane z = 0 (normal +z, tangents +x and +y) with no law
+    /// parameter set: the base the synthetic recordings and the tests fill in.
+    pub fn on_floor(name: &str, model: &str) -> Self {
+        ContactInfo {
+            name: name.into(),
+            model: model.into(),
+            restitution: None,
+            friction: None,
+            stiffness: None,
+            damping: None,
+            slip_velocity: None,
+            normal: [0.0, 0.0, 1.0],
+            offset: 0.0,
+            t1: [1.0, 0.0, 0.0],
+            t2: [0.0, 1.0, 0.0],
+        }
+    }
+}
+
 /// Record `contacts`: every contact of the run (all of them, bilateral ones too, in
 /// `run.contacts` order) and the settings of the event-driven integration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -95,19 +115,7 @@ mod tests {
     use super::*;
 
     pub(crate) fn sample() -> ContactsRecord {
-        let plane = |name: &str, model: &str| ContactInfo {
-            name: name.into(),
-            model: model.into(),
-            restitution: None,
-            friction: None,
-            stiffness: None,
-            damping: None,
-            slip_velocity: None,
-            normal: [0.0, 0.0, 1.0],
-            offset: 0.0,
-            t1: [1.0, 0.0, 0.0],
-            t2: [0.0, 1.0, 0.0],
-        };
+        let plane = ContactInfo::on_floor;
         let elbow4 = ContactInfo { restitution: Some(0.5), friction: Some(0.6), ..plane("elbow4", "unilateral") };
         let pad = ContactInfo { stiffness: Some(1e5), damping: Some(300.0), friction: Some(0.6), slip_velocity: Some(1e-3), ..plane("pad", "compliant") };
         ContactsRecord {

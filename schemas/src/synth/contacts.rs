@@ -94,19 +94,7 @@ pub fn unilateral() -> (Synth, UnilateralTruth) {
         event(0.707, "rest", 0.1, 0.01, -0.05, 0.0),
         event(0.807, "slip-to-stick", 0.0, 0.0, 0.0, 0.0),
     ];
-    let info = |name: &str| ContactInfo {
-        name: name.into(),
-        model: "unilateral".into(),
-        restitution: Some(0.5),
-        friction: Some(0.6),
-        stiffness: None,
-        damping: None,
-        slip_velocity: None,
-        normal: [0.0, 0.0, 1.0],
-        offset: 0.0,
-        t1: [1.0, 0.0, 0.0],
-        t2: [0.0, 1.0, 0.0],
-    };
+    let info = |name: &str| ContactInfo { restitution: Some(0.5), friction: Some(0.6), ..ContactInfo::on_floor(name, "unilateral") };
     s.contacts_record = Some(ContactsRecord {
         contacts: vec![info("elbow4"), info("elbow7")],
         time_tolerance: 1e-12,
