@@ -40,6 +40,18 @@ pub(crate) fn central_jacobian(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f6
     jac
 }
 
+/// At (t, y): the right-hand side f, the structured Jacobian and its central differences
+/// (both row-major, dim × dim).
+pub(crate) fn jacobian_and_differences(sys: &mut ArmSystem, t: f64, y: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let dim = y.len();
+    let mut f = vec![0.0; dim];
+    sys.rhs(t, y, &mut f).unwrap();
+    let mut j = vec![0.0; dim * dim];
+    sys.jacobian(t, y, &f, &mut j).unwrap();
+    let fd = central_jacobian(sys, t, y);
+    (f, j, fd)
+}
+
 /// The structured Jacobian equals central differences on every entry it models exactly, for
 /// every constraint solver (Schur and KKT), mass-matrix method (CRBA and Walker–Orin), contact
 /// set (none, one and two elbows) and electrical model (inductive and L = 0), at a state at
@@ -71,11 +83,7 @@ fn structured_jacobian_matches_central_differences_for_every_plant() {
                 let l = sys.layout();
                 let dim = l.dim();
                 let t = 0.37;
-                let mut f = vec![0.0; dim];
-                sys.rhs(t, &y, &mut f).unwrap();
-                let mut j = vec![0.0; dim * dim];
-                sys.jacobian(t, &y, &f, &mut j).unwrap();
-                let fd = central_jacobian(&mut sys, t, &y);
+                let (f, j, fd) = jacobian_and_differences(&mut sys, t, &y);
                 let what = format!("{mm:?} {solver:?} L = {inductance} run {}", run.name);
                 // the blocks the structured Jacobian models exactly: rows of q (all columns),
                 // q'' against q' and i, the current rates against everything
@@ -371,11 +379,7 @@ fn jacobians_match_differences_with_gear_friction_and_a_supply() {
                 *v = *speed;
             }
             let t = 0.37;
-            let mut f = vec![0.0; dim];
-            sys.rhs(t, &y, &mut f).unwrap();
-            let mut j = vec![0.0; dim * dim];
-            sys.jacobian(t, &y, &f, &mut j).unwrap();
-            let fd = central_jacobian(&mut sys, t, &y);
+            let (f, j, fd) = jacobian_and_differences(&mut sys, t, &y);
             let what = format!("{} L = {} run {}", scene.spec().name, l.ni() > 0, run.name);
             let blocks: [(Range<usize>, Vec<Range<usize>>); 3] = [
                 (l.q(), vec![l.q(), l.qd(), l.current()]),

@@ -7,14 +7,13 @@ use std::ops::Range;
 use std::path::Path;
 
 use sim::dynamics::thermal::{step_response, ThermalParams};
-use sim::integrate::{OdeJacobian, OdeSystem};
 use sim::ode::ArmSystem;
 use sim::scene::spec::{AdaptiveSpec, IntegratorSpec};
 use sim::scene::spec_drive::MotorDatasheet;
 use sim::scene::Scene;
 
 use crate::convergence::slope;
-use crate::stiff_methods::central_jacobian;
+use crate::stiff_methods::jacobian_and_differences;
 
 fn paper_thermal() -> Scene {
     Scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_thermal.json"))).unwrap()
@@ -286,11 +285,7 @@ fn structured_jacobian_matches_differences_with_the_thermal_model_on() {
         }
         let dim = l.dim();
         let t = 0.37;
-        let mut f = vec![0.0; dim];
-        sys.rhs(t, &y, &mut f).unwrap();
-        let mut j = vec![0.0; dim * dim];
-        sys.jacobian(t, &y, &f, &mut j).unwrap();
-        let fd = central_jacobian(&mut sys, t, &y);
+        let (f, j, fd) = jacobian_and_differences(&mut sys, t, &y);
         let temps = l.winding_temperature().start..l.housing_temperature().end;
         let blocks: [(Range<usize>, Vec<Range<usize>>); 4] = [
             (l.qd(), vec![l.qd(), l.current(), temps.clone()]),
