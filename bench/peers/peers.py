@@ -22,6 +22,17 @@ For each scene (default: sim/scenes/peers/mechanical-hold.json and dcmotor-hold.
   5. Per accuracy level (1e-3 ... 1e-8 m): each series' time to reach it, interpolated linearly
      in log-log between the cheapest rung within the level and the next cheaper rung (never
      extrapolated); the best series of each tool; the ratio project / MuJoCo.
+A contact scene (issue 24 item 3: `--scene sim/scenes/paper_unilateral.json --run
+two-elbow-unilateral`, the paper arm tracking its circle with elbows 4 and 7 over a rigid
+table, μ = 0.5, restitution 0): MuJoCo gets the table as a plane and each contact point as a
+1e-5 m sphere on its link (the table lowered by the radius, so that it touches where the point
+reaches the plane); its ctrl follows the circle's joint targets (`peers_dump --targets`, eq 27
+as MuJoCo's position input, see main()); the ladder runs implicitfast and rk4 for each of the
+contact settings in MJ_CONTACT_VARIANTS (the pyramidal default, and the elliptic cone with the
+stiffest contact the timestep allows, with and without noslip), and the table adds a row at
+MuJoCo's best reachable error (its floor). The reference is ours, rodas5p at rtol 1e-12
+(`sim::precision::reference` for a frictional run).
+
 Then Pinocchio (the `pin` wheel, Python bindings): on the paper scene's two-elbow run, its
 constrained accelerations (KKT with the same two normal rows) against ours at a few states,
 and its timing against `rhs_profile` (ours). Pinocchio's timing through Python is an upper bound
@@ -119,11 +130,35 @@ def origin(el) -> tuple[list[float], list[float]]:
     return [float(x) for x in o.get("xyz", "0 0 0").split()], [float(x) for x in o.get("rpy", "0 0 0").split()]
 
 
-def mjcf(urdf_path: Path, dump: dict, electrical: str) -> str:
+# MuJoCo's contact settings tried on a contact scene (the best per accuracy level is reported).
+# Chosen from MuJoCo's documentation (Computation > Contact; XML reference, option and geom):
+#  - "default": what a user gets, pyramidal cone, solref (0.02, 1), solimp (0.9, 0.95, 0.001).
+#  - "elliptic": elliptic cone (closer to the exact Coulomb cone), impratio 10 (the docs'
+#    advice against slip in elliptic cones), a contact as stiff as the timestep allows: solref
+#    timeconst 1e-9 s is clamped by `refsafe` to 2 h at every rung; solimp (0.99, 0.999, 0.001)
+#    (near-rigid at any penetration).
+#  - "elliptic-noslip": as "elliptic", plus 10 noslip iterations (the post-processor that
+#    removes the slip the soft model allows while sticking).
+MJ_CONTACT_VARIANTS = {
+    "default": {"cone": "pyramidal", "impratio": 1.0, "solref": "0.02 1", "solimp": "0.9 0.95 0.001", "noslip": 0},
+    "elliptic": {"cone": "elliptic", "impratio": 10.0, "solref": "1e-9 1", "solimp": "0.99 0.999 0.001", "noslip": 0},
+    "elliptic-noslip": {"cone": "elliptic", "impratio": 10.0, "solref": "1e-9 1", "solimp": "0.99 0.999 0.001", "noslip": 10},
+}
+MJ_CONTACT_INTEGRATORS = ["implicitfast", "rk4"]
+# the contact point as a sphere of this radius on the link, its centre at the point, over a table
+# lowered by the radius: it touches where the point reaches the plane (the lever arm of the
+# friction force about the point, 1e-5 m, is the only difference from a point contact)
+MJ_CONTACT_RADIUS = 1e-5
+
+
+def mjcf(urdf_path: Path, dump: dict, electrical: str, contact: dict | None = None) -> str:
     """MJCF of the arm: one body per moving URDF link (pos/quat from the joint origin, the URDF
     inertial as `fullinertia`), hinge joints with armature J_m = I_m k^2 and damping D + D_m
     (RBDA-style reflected drive: eqs 9-10 of the paper, sim/src/dynamics/motor.rs), the hand as a
-    site, the initial state and targets as keyframe 0, no geoms and contacts off (no-elbow runs).
+    site, the initial state and targets as keyframe 0; without `contact`, no geoms and contacts off
+    (no-elbow runs); with it (a contact scene), the table as a plane and each contact point as a
+    small sphere on its link (MJ_CONTACT_RADIUS), Coulomb friction μ of the scene, condim 3, and
+    the cone, impratio, solref, solimp and noslip of the variant (MJ_CONTACT_VARIANTS).
 
     Drives (per joint j; K_m = K k, all link side), from motor.rs (eqs 11-12) and pd.rs (eq 27)
     with a constant target (q̇_d = 0):
@@ -178,6 +213,12 @@ def mjcf(urdf_path: Path, dump: dict, electrical: str) -> str:
                        f'armature="{dr["jm"][k]!r}" damping="{dr["d"][k] + dr["dm"][k]!r}"/>')
             if joint.get("name") == hand_joint:
                 out.append(f'{ind}  <site name="hand" pos="{fmt(dump["hand"]["point_in_body"])}"/>')
+            for c in dump.get("contacts", []) if contact is not None else []:
+                if c["joint"] == joint.get("name"):
+                    mu = c["law"]["friction"]
+                    out.append(f'{ind}  <geom name="{c["name"]}" type="sphere" size="{MJ_CONTACT_RADIUS!r}" pos="{fmt(c["point_in_body"])}" '
+                               f'contype="1" conaffinity="0" condim="3" friction="{mu!r} 0 0" density="0" '
+                               f'solref="{contact["solref"]}" solimp="{contact["solimp"]}"/>')
             for cj in children.get(child, []):
                 emit_body(cj, depth + 1)
             out.append(f"{ind}</body>")
@@ -199,13 +240,22 @@ def mjcf(urdf_path: Path, dump: dict, electrical: str) -> str:
             acts.append(f'    <dcmotor joint="{name}" gear="1" motorconst="{km!r} {km!r}" resistance="{r!r}" '
                         f'inductance="{dr["l"][k]!r} 0" input="pos" controller="{km * kp / r!r} 0 {km * (kd + km) / r!r} 0 0 0"/>')
     gx = dump["gravity"]
+    if contact is None:
+        option = [f'  <option timestep="0.001" gravity="{fmt(gx)}">', '    <flag contact="disable"/>', "  </option>"]
+        table = []
+    else:
+        option = [f'  <option timestep="0.001" gravity="{fmt(gx)}" cone="{contact["cone"]}" impratio="{contact["impratio"]!r}" '
+                  f'noslip_iterations="{contact["noslip"]}"/>']
+        c0 = dump["contacts"][0]
+        mu = max(c["law"]["friction"] for c in dump["contacts"])
+        table = [f'    <geom name="table" type="plane" size="0 0 1" pos="0 0 {c0["offset"] - MJ_CONTACT_RADIUS!r}" contype="0" conaffinity="1" '
+                 f'condim="3" friction="{mu!r} 0 0" solref="{contact["solref"]}" solimp="{contact["solimp"]}"/>']
     return "\n".join([
         '<mujoco model="peers">',
         '  <compiler angle="radian" balanceinertia="false" boundmass="0" boundinertia="0"/>',
-        f'  <option timestep="0.001" gravity="{fmt(gx)}">',
-        '    <flag contact="disable"/>',
-        "  </option>",
+        *option,
         "  <worldbody>",
+        *table,
         *out,
         "  </worldbody>",
         "  <actuator>",
@@ -247,30 +297,35 @@ def check_mujoco_model(xml: str, dump: dict) -> dict:
 
 
 def mujoco_ladder(exe: Path, xml_path: Path, dump: dict, reference: np.ndarray, repeats: int, quick: bool,
-                  previous: list[dict] | None = None) -> list[dict]:
-    """Every integrator over the timesteps; a later pass runs exactly the rungs of `previous`."""
+                  previous: list[dict] | None = None, ctrl: Path | None = None, integrators: list[str] = MJ_INTEGRATORS,
+                  variant: str = "") -> list[dict]:
+    """Every integrator over the timesteps; a later pass runs exactly the rungs of `previous`.
+    `ctrl`: a time-varying control table (mj_ladder's --ctrl); `variant` names the contact
+    settings in the series."""
     rows = []
     duration, sample = dump["duration"], 1.0 / dump["output_rate"]
     steps = [sample / k for k in (MJ_DIVISORS[:8] if quick else MJ_DIVISORS)]
-    for integ in MJ_INTEGRATORS:
+    extra = [] if ctrl is None else [f"--ctrl={ctrl}"]
+    for integ in integrators:
+        series = f"mujoco {integ}" + (f" {variant}" if variant else "")
         last = None
         for dt in steps:
             predicted = 0.0 if last is None else last["wall_s"] * last["dt"] / dt
             if previous is not None:
-                if not any(r["series"] == f"mujoco {integ}" and r["dt"] == dt for r in previous):
+                if not any(r["series"] == series and r["dt"] == dt for r in previous):
                     break
             elif predicted > MJ_MAX_PREDICTED_S:
                 break
             reps = repeats if predicted < MJ_ONCE_S else 1
             with tempfile.NamedTemporaryFile(suffix=".bin") as f:
-                line = run([str(exe), str(xml_path), integ, repr(duration), repr(sample), str(reps), "hand", f.name, repr(dt)], cwd=xml_path.parent)
+                line = run([str(exe), str(xml_path), integ, repr(duration), repr(sample), str(reps), "hand", f.name, *extra, repr(dt)], cwd=xml_path.parent)
                 hand = np.fromfile(f.name, dtype=np.float64).reshape(-1, 3)
             dt_, wall, n, _, finite = line.split()
             if len(hand) != len(reference):
                 raise PeerError(f"mj_ladder gave {len(hand)} samples, the reference has {len(reference)}")
             err = float(np.linalg.norm(hand - reference, axis=1).max()) if finite == "1" else float("inf")
             ok = finite == "1" and err < 1.0
-            row = {"tool": "mujoco", "series": f"mujoco {integ}", "setting": f"h {dt:.3g} s", "dt": dt, "repeats": reps,
+            row = {"tool": "mujoco", "series": series, "setting": f"h {dt:.3g} s", "dt": dt, "repeats": reps,
                    "wall_s": float(wall), "max_hand_error_m": err, "status": "ok" if ok else "diverged"}
             rows.append(row)
             last = row
@@ -551,6 +606,38 @@ def build_pin_kernels(cxx: str, work: Path) -> Path | None:
 # ---------------------------------------------------------------------------------------------
 
 
+def figure(stem: Path, title: str, rows: list[dict]) -> None:
+    """The work-precision diagram: max hand error against wall time, log-log, one line per series
+    (the project's solid, MuJoCo's dashed); diverged rungs left out."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 5.5), dpi=110)
+    series = {}
+    for r in rows:
+        if r["status"] == "ok" and r["wall_s"] and r["max_hand_error_m"] and math.isfinite(r["max_hand_error_m"]):
+            series.setdefault((r["tool"], r["series"]), []).append((r["wall_s"], r["max_hand_error_m"]))
+    for (tool, name), pts in sorted(series.items()):
+        pts.sort()
+        x, y = zip(*pts)
+        ax.plot(x, y, "-o" if tool == "project" else "--s", ms=3, lw=1.2, label=name if tool == "project" else name)
+    for lv in LEVELS:
+        ax.axhline(lv, color="0.85", lw=0.6, zorder=0)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time of the 5-s run [s] (best of the passes)")
+    ax.set_ylabel("max hand error against the reference [m]")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    fig.tight_layout()
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    for ext in ("svg", "png"):
+        fig.savefig(f"{stem}.{ext}")
+    plt.close(fig)
+
+
 def fmt_t(t):
     return "—" if t is None else (f"{t * 1e3:.1f} ms" if t >= 1e-3 else f"{t * 1e6:.0f} µs")
 
@@ -567,6 +654,7 @@ def main() -> int:
     ap.add_argument("--passes", type=int, default=2, help="alternating passes of the two ladders; each row keeps its best time")
     ap.add_argument("--no-pinocchio", action="store_true")
     ap.add_argument("--json", type=Path, help="write every row and ratio here")
+    ap.add_argument("--figure", type=Path, help="write the work-precision diagram of each scene here: PATH-<scene>.svg and .png (needs matplotlib)")
     ap.add_argument("--cc", default=os.environ.get("CC", "cc"), help="C compiler for mj_ladder.c")
     ap.add_argument("--cxx", default=os.environ.get("CXX", "c++"), help="C++ compiler for pin_kernels.cpp (Pinocchio's C++ timing)")
     a = ap.parse_args()
@@ -594,15 +682,37 @@ def main() -> int:
 
     for scene in scenes:
         # peers_dump validates the scene (a clear error for a bad file or run name) before it is read here
-        dump = json.loads(run([str(a.dump), str(scene), a.run, "--reference"]))
+        dump = json.loads(run([str(a.dump), str(scene), a.run, "--reference", "--targets"]))
         urdf = (scene.parent / json.loads(scene.read_text())["urdf"]).resolve()
         reference = np.array(dump["reference_hand"])
         electrical = "quasi-static" if all(x == 0.0 for x in dump["drives"]["l"]) else "inductive"
-        if any(abs(x - y) > 0 for x, y in zip(dump["q_des0"], dump["q_des_end"])) and max(abs(x - y) for x, y in zip(dump["q_des0"], dump["q_des_end"])) > 1e-12:
-            raise PeerError(f"{scene}: the target is not constant (MuJoCo's ctrl is held at q_d(0))")
-        xml = mjcf(urdf, dump, electrical)
-        xml_path = work / f"{scene.stem}.xml"
-        xml_path.write_text(xml)
+        ctrl = None
+        tq = np.array(dump["targets"]["q_des"])
+        # (q_d(0) = q_d(T) says nothing: a full circle ends where it starts)
+        if np.abs(tq - tq[0]).max() > 1e-12:
+            # a tracking run: MuJoCo's position input u with v = k_p (u − q) − k_d q̇ equals eq 27's
+            # v = k_p (q_d − q) + k_d (q̇_d − q̇) for u = q_d + (k_d / k_p) q̇_d (per joint)
+            tg = dump["targets"]
+            kp, kd = np.array(dump["gains"]["kp"]), np.array(dump["gains"]["kd"])
+            u = np.array(tg["q_des"]) + (kd / kp) * np.array(tg["qd_des"])
+            ctrl = work / f"{scene.stem}-{a.run}-ctrl.bin"
+            with open(ctrl, "wb") as f:
+                np.array(u.shape, dtype=np.int64).tofile(f)
+                np.array([tg["dt"]], dtype=np.float64).tofile(f)
+                np.ascontiguousarray(u, dtype=np.float64).tofile(f)
+        contacts = dump.get("contacts", [])
+        for c in contacts:
+            law = c["law"]
+            if law["model"] != "unilateral" or law["restitution"] != 0.0 or c["normal"] != [0.0, 0.0, 1.0] or c["offset"] != contacts[0]["offset"] or c["joint"] is None:
+                raise PeerError(f"{scene}: contact {c['name']}: the peers compare rigid unilateral contacts with restitution 0 "
+                                f"on links against one horizontal table (law {law}, normal {c['normal']}, offset {c['offset']})")
+        variants = [(name, v) for name, v in MJ_CONTACT_VARIANTS.items()] if contacts else [("", None)]
+        xmls = []
+        for name, v in variants:
+            xml = mjcf(urdf, dump, electrical, v)
+            xml_path = work / f"{scene.stem}{'-' + name if name else ''}.xml"
+            xml_path.write_text(xml)
+            xmls.append((name, xml_path))
         check = check_mujoco_model(xml, dump)
         print(f"\n## {scene.relative_to(ROOT) if scene.is_relative_to(ROOT) else scene} (run {a.run}, {electrical})")
         print(f"MJCF check at {len(dump['kinematics'])} q: hand {check['hand_max_abs_m']:.1e} m, M(q) {check['mass_matrix_max_rel']:.1e} rel; "
@@ -616,7 +726,11 @@ def main() -> int:
             pr = project_ladder(a.sim, scene, a.run, a.repeats)
             t_pr = time.time() - t0
             t0 = time.time()
-            mj = mujoco_ladder(exe, xml_path, dump, reference, a.repeats, a.quick, mj_rows)
+            mj = []
+            for name, xml_path in xmls:
+                integrators = MJ_CONTACT_INTEGRATORS if contacts else MJ_INTEGRATORS
+                prev = None if mj_rows is None else [r for r in mj_rows if r["series"].endswith(name)]
+                mj += mujoco_ladder(exe, xml_path, dump, reference, a.repeats, a.quick, prev, ctrl, integrators, name)
             t_mj = time.time() - t0
             mj_rows, pr_rows = merge_best(mj_rows, mj), merge_best(pr_rows, pr)
             loads.append(os.getloadavg())
@@ -625,7 +739,12 @@ def main() -> int:
         ratios = []
         print("\n| max hand error | MuJoCo best | (integrator) | project best | (series) | project / MuJoCo |")
         print("|---|---|---|---|---|---|")
-        for lv in LEVELS:
+        # MuJoCo's best reachable hand error (its floor, plus 2 %, so that the rung that reaches it
+        # is within the level): a level of its own, beside the fixed ones
+        mj_ok = [r["max_hand_error_m"] for r in mj_rows if r["status"] == "ok" and math.isfinite(r["max_hand_error_m"])]
+        floor = 1.02 * min(mj_ok) if mj_ok else None
+        levels = sorted(LEVELS + ([floor] if floor is not None and all(abs(floor / lv - 1) > 0.05 for lv in LEVELS) else []), reverse=True)
+        for lv in levels:
             tm, wm = best_at(mj_rows, lv)
             tp, wp = best_at(pr_rows, lv)
             ratio = tp / tm if tm and tp else None
@@ -638,8 +757,10 @@ def main() -> int:
                 mj_text = "not reached | " if te is None else f"not reached (~{fmt_t(te)} extrapolated) | {we}"
                 if te is not None and tp is not None:
                     rs = f"~{tp / te:.4f} (~{te / tp:.0f}x faster, against the extrapolation)"
+            entry["mujoco_floor"] = lv == floor
             ratios.append(entry)
-            print(f"| {lv:.0e} m | {mj_text} | {fmt_t(tp)} | {wp or 'not reached'} | {rs} |")
+            print(f"| {lv:.1e} m (MuJoCo's floor)" if lv == floor else f"| {lv:.0e} m", end="")
+            print(f" | {mj_text} | {fmt_t(tp)} | {wp or 'not reached'} | {rs} |")
         print("\nLadders (wall = best of %d per pass, best of %d passes; error = max |r_hand - r_ref| over the 1 ms samples):" % (a.repeats, a.passes))
         print("| tool | series | setting | wall | max hand error [m] | status |")
         print("|---|---|---|---|---|---|")
@@ -647,7 +768,10 @@ def main() -> int:
             err = r['max_hand_error_m']
             err = "-" if err is None else f"{err:.2e}"  # a failed run has no error
             print(f"| {r['tool']} | {r['series']} | {r['setting']} | {fmt_t(r['wall_s'])} | {err} | {r['status']} |")
+        if a.figure:
+            figure(a.figure.parent / f"{a.figure.name}-{scene.stem}", f"{scene.stem}, run {a.run}", mj_rows + pr_rows)
         report["scenes"].append({"scene": str(scene), "run": a.run, "electrical": electrical, "mjcf_check": check,
+                                 "mujoco_contact_variants": MJ_CONTACT_VARIANTS if contacts else None,
                                  "ratios": ratios, "mujoco": mj_rows, "project": pr_rows, "loads_after_each_pass": loads})
 
     if not a.no_pinocchio:

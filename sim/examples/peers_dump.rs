@@ -7,8 +7,11 @@
 //! interval. Used by `bench/peers/peers.py`.
 //!
 //! ```text
-//! cargo run --release -p sim --example peers_dump -- SCENE RUN [--reference] [--states N]
+//! cargo run --release -p sim --example peers_dump -- SCENE RUN [--reference] [--targets] [--states N]
 //! ```
+//!
+//! `--targets` adds the joint targets q_d(t), q̇_d(t) (eqs 28–29) on the output grid, for a
+//! peer that tracks the circle (its controller is fed them; the contact scene of the peers).
 use std::process::ExitCode;
 
 use nalgebra::DMatrix;
@@ -36,12 +39,13 @@ fn main() -> ExitCode {
 
 fn dump() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: peers_dump SCENE RUN [--reference] [--states N]";
+    let usage = "usage: peers_dump SCENE RUN [--reference] [--targets] [--states N]";
     let (path, run_name) = match (args.first(), args.get(1)) {
         (Some(p), Some(r)) if !p.starts_with("--") && !r.starts_with("--") => (p, r),
         _ => return Err(usage.into()),
     };
     let with_reference = args.iter().any(|a| a == "--reference");
+    let with_targets = args.iter().any(|a| a == "--targets");
     let n_states: usize = match args.iter().position(|a| a == "--states") {
         Some(k) => args.get(k + 1).and_then(|v| v.parse().ok()).ok_or(usage)?,
         None => 4,
@@ -108,13 +112,24 @@ fn dump() -> Result<(), String> {
     let names = model.joint_names();
     let contact_json: Vec<Value> = contacts
         .iter()
-        .map(|c| {
+        .zip(&run.contacts)
+        .map(|(c, &k)| {
             let n = c.normal_world.into_inner();
+            let law = match scene.contact_models()[k].model {
+                sim::dynamics::contact::ContactModel::Bilateral => json!({ "model": "bilateral" }),
+                sim::dynamics::contact::ContactModel::Unilateral { restitution, friction } => {
+                    json!({ "model": "unilateral", "restitution": restitution, "friction": friction })
+                }
+                sim::dynamics::contact::ContactModel::Compliant { stiffness, damping, friction, slip_velocity } => json!({
+                    "model": "compliant", "stiffness": stiffness, "damping": damping, "friction": friction, "slip_velocity": slip_velocity,
+                }),
+            };
             json!({
                 "name": c.name,
                 "joint": c.point.body.map(|b| names[b].clone()),
                 "point_in_body": [c.point.p_body.x, c.point.p_body.y, c.point.p_body.z],
                 "normal": [n.x, n.y, n.z], "offset": c.offset,
+                "law": law,
             })
         })
         .collect();
@@ -136,6 +151,18 @@ fn dump() -> Result<(), String> {
         "kinematics": kin,
         "dynamics": dynamics,
     });
+    if with_targets {
+        // on the output grid t_k = k / output_rate, k = 0 … duration · output_rate
+        let dt = 1.0 / scene.output_rate();
+        let n = (scene.duration() * scene.output_rate()).round() as usize;
+        let (mut qs, mut qds) = (Vec::with_capacity(n + 1), Vec::with_capacity(n + 1));
+        for k in 0..=n {
+            let (q, qd) = targets(k as f64 * dt)?;
+            qs.push(q);
+            qds.push(qd);
+        }
+        out["targets"] = json!({ "dt": dt, "q_des": qs, "qd_des": qds });
+    }
     if with_reference {
         let r = sim::precision::reference(&scene, &run).map_err(|e| e.to_string())?;
         out["reference_hand"] = Value::from(r.hand.iter().map(|h| vec![h.x, h.y, h.z]).collect::<Vec<_>>());
