@@ -132,7 +132,17 @@ impl BodyPoint {
     where
         R: std::ops::IndexMut<usize, Output = f64> + ?Sized,
     {
-        let p = self.position(data);
+        self.jacobian_along_at(model, data, &self.position(data), n, row);
+    }
+
+    /// `n · J` of the material point of this point's body that is at world position `p` now
+    /// (a contact point that moves over the body, `dynamics/contact/shape.rs`), written as
+    /// [`Self::jacobian_along`] does. Needs `forward_kinematics`.
+    pub fn jacobian_along_at<R>(&self, model: &Model, data: &Data, p: &Vector3<f64>, n: &Vector3<f64>, row: &mut R)
+    where
+        R: std::ops::IndexMut<usize, Output = f64> + ?Sized,
+    {
+        let p = *p;
         let mut cur = self.body;
         while let Some(j) = cur {
             let z = data.x_world_body[j].rotation * model.bodies[j].axis.into_inner();

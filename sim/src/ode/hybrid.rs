@@ -179,7 +179,7 @@ impl ArmSystem<'_> {
             .iter()
             .map(|c| match c.model {
                 ContactModel::Compliant { stiffness, .. } => {
-                    let delta = -c.plane.position(&self.ws.data);
+                    let delta = -c.gap(&self.ws.data);
                     if delta > 0.0 {
                         0.5 * stiffness * delta * delta
                     } else {
@@ -230,7 +230,7 @@ impl ArmSystem<'_> {
         let data = &self.ws.data;
         for (k, c) in h.contacts.iter().enumerate() {
             let p = &c.plane;
-            let (gap, vel) = (p.position(data), p.point.velocity(data));
+            let (gap, vel) = (c.gap(data), c.touch_velocity(data));
             let slip = [c.t1.dot(&vel), c.t2.dot(&vel)];
             let (f_n, f_t) = if forces { (h.cd.f_n[k], h.cd.f_t[k]) } else { (f64::NAN, [f64::NAN; 2]) };
             let mode = match c.model {
@@ -416,7 +416,7 @@ impl ArmSystem<'_> {
         }
         forward_kinematics(model, &mut self.ws.data, &y[l.q()]);
         for (k, c) in h.contacts.iter().enumerate() {
-            if !h.rebound_t[k].is_nan() && h.state.mode[k] == ContactMode::Separated && c.plane.position(&self.ws.data) > 0.0 {
+            if !h.rebound_t[k].is_nan() && h.state.mode[k] == ContactMode::Separated && c.gap(&self.ws.data) > 0.0 {
                 h.gap_ref[k] = 0.0;
                 h.rebound_t[k] = f64::NAN;
             }
@@ -435,7 +435,7 @@ impl ArmSystem<'_> {
         forward_velocities(model, &mut self.ws.data, &y[l.qd()]);
         for (k, c) in h.contacts.iter().enumerate() {
             if h.state.mode[k] == ContactMode::Sliding {
-                let v = c.plane.point.velocity(&self.ws.data);
+                let v = c.touch_velocity(&self.ws.data);
                 h.s_ref[k] = slip_direction([c.t1.dot(&v), c.t2.dot(&v)], h.state.slip[k]);
                 h.state.slip[k] = h.s_ref[k];
             }

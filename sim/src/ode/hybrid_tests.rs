@@ -20,7 +20,7 @@ pub(crate) fn paper_unilateral(mu: f64, e: f64, table: &[&str]) -> Scene {
             if !table.is_empty() {
                 s.table = Some(crate::scene::spec::TableSpec {
                     plane: crate::scene::spec::PlaneSpec { normal: [0.0, 0.0, 1.0], offset: 0.0 },
-                    points: table.iter().map(|j| crate::scene::spec::TablePointSpec { name: format!("t-{j}"), point: crate::scene::spec::PointSpec { joint: Some(j.to_string()), link: None, offset: [0.0; 3] } }).collect(),
+                    points: table.iter().map(|j| crate::scene::spec::TablePointSpec { name: format!("t-{j}"), point: crate::scene::spec::PointSpec { joint: Some(j.to_string()), link: None, offset: [0.0; 3] }, shape: None }).collect(),
                     model: None,
                     restitution: Some(e),
                     friction: Some(mu),

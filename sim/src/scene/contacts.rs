@@ -6,10 +6,10 @@
 use nalgebra::Unit;
 
 use super::ctx::{non_negative, positive, Ctx};
-use super::spec::{LawKeys, PlaneSpec, PointSpec, SceneSpec};
+use super::spec::{LawKeys, PlaneSpec, PointSpec, SceneSpec, ShapeSpec};
 use super::INITIAL_CONSTRAINT_TOL;
 use crate::dynamics::constraints::PointOnPlane;
-use crate::dynamics::contact::{Contact, ContactModel, ContactSettings};
+use crate::dynamics::contact::{Contact, ContactModel, ContactSettings, ContactShape};
 use crate::dynamics::{Data, Model};
 use crate::error::{short, SceneError};
 
@@ -70,11 +70,49 @@ fn plane(c: &Ctx, f: &str, name: &str, model: &Model, point: &PointSpec, plane: 
     Ok(PointOnPlane { name: name.to_string(), point, normal_world: Unit::new_normalize(n), offset })
 }
 
+/// The contacts one spec'd contact becomes, each `(name, centre on its plane, shape)`: one
+/// (a point, or a sphere centred on it), or two spheres for a capsule (`<name>/0` at the point,
+/// `<name>/1` at `to`; `capsule_ok` only for the table's points). Errors name `{f}.shape.*`.
+fn shaped(c: &Ctx, f: &str, model: &Model, p: PointOnPlane, m: ContactModel, shape: Option<&ShapeSpec>, capsule_ok: bool) -> Result<Vec<(PointOnPlane, ContactShape)>, SceneError> {
+    let Some(shape) = shape else { return Ok(vec![(p, ContactShape::Point)]) };
+    let kind = match shape {
+        ShapeSpec::Sphere { .. } => "sphere",
+        ShapeSpec::Capsule { .. } => "capsule",
+    };
+    if m == ContactModel::Bilateral {
+        return Err(c.err(
+            format!("{f}.shape.kind"),
+            kind,
+            "a bilateral contact holds its point on the plane without friction, so a shape changes nothing but the offset: give the sphere's centre as the point and move plane.offset by the radius, or make the contact unilateral or compliant",
+        ));
+    }
+    let radius = |r: f64| c.number(&format!("{f}.shape.radius"), r, |x| x > 0.0 && x <= 10.0, "must be in (0, 10] m");
+    match shape {
+        ShapeSpec::Sphere { radius: r } => Ok(vec![(p, ContactShape::Sphere { radius: radius(*r)? })]),
+        ShapeSpec::Capsule { radius: r, to } => {
+            if !capsule_ok {
+                return Err(c.err(format!("{f}.shape.kind"), kind, "a capsule is two contacts (its end spheres): give it under table.points, or write two sphere contacts"));
+            }
+            let r = radius(*r)?;
+            let end = c.point(&format!("{f}.shape.to"), model, to)?;
+            if end.body != p.point.body {
+                return Err(c.err(format!("{f}.shape.to"), to.link.as_deref().or(to.joint.as_deref()).unwrap_or(""), "must be a point of the same link as the contact's point (a capsule is rigid)"));
+            }
+            if (end.p_body - p.point.p_body).norm() < 1e-9 {
+                return Err(c.err(format!("{f}.shape.to"), format!("{:?}", to.offset), "is the contact's point itself: a capsule of zero length is a sphere (kind \"sphere\")"));
+            }
+            let a = PointOnPlane { name: format!("{}/0", p.name), ..p.clone() };
+            let b = PointOnPlane { name: format!("{}/1", p.name), point: end, ..p };
+            Ok(vec![(a, ContactShape::Sphere { radius: r }), (b, ContactShape::Sphere { radius: r })])
+        }
+    }
+}
+
 /// The initial state against a contact: bilateral ones must hold (C = 0, Ċ = 0, the paper's
 /// check); a unilateral one must not start inside the plane (g0 ≥ −gap_tol).
 fn check_initial(c: &Ctx, f: &str, contact: &Contact, data: &Data, gap_tol: f64) -> Result<(), SceneError> {
     let p = &contact.plane;
-    let (pos, vel) = (p.position(data), p.velocity(data));
+    let (pos, vel) = (contact.gap(data), p.velocity(data));
     match contact.model {
         ContactModel::Bilateral => {
             if pos.abs() > INITIAL_CONSTRAINT_TOL || vel.abs() > INITIAL_CONSTRAINT_TOL {
@@ -92,7 +130,7 @@ fn check_initial(c: &Ctx, f: &str, contact: &Contact, data: &Data, gap_tol: f64)
                 return Err(c.err(
                     f.to_string(),
                     &p.name,
-                    format!("the point starts inside the plane: gap g(q0) = {pos:.3e} m < -{gap_tol:e} m; move initial.q or the plane"),
+                    format!("the {} starts inside the plane: gap g(q0) = {pos:.3e} m < -{gap_tol:e} m; move initial.q or the plane", contact.shape.name()),
                 ));
             }
         }
@@ -135,11 +173,11 @@ pub(super) fn build_contacts(
     let mut planes: Vec<PointOnPlane> = Vec::new();
     let mut contacts: Vec<Contact> = Vec::new();
     let mut table_idx = Vec::new();
-    let mut push = |f: &str, name: &str, p: PointOnPlane, m: ContactModel| -> Result<(), SceneError> {
-        if planes.iter().any(|x| x.name == name) {
-            return Err(c.err(format!("{f}.name"), name, "is used twice"));
+    let mut push = |f: &str, p: PointOnPlane, m: ContactModel, shape: ContactShape| -> Result<(), SceneError> {
+        if planes.iter().any(|x| x.name == p.name) {
+            return Err(c.err(format!("{f}.name"), &p.name, "is used twice"));
         }
-        let contact = Contact::new(p.clone(), m);
+        let contact = Contact::new(p.clone(), m).with_shape(shape);
         check_initial(c, f, &contact, data, settings.gap_tol)?;
         planes.push(p);
         contacts.push(contact);
@@ -149,18 +187,25 @@ pub(super) fn build_contacts(
         let f = format!("contacts[{i}]");
         let m = contact_model(c, &f, cs.law(), "bilateral")?;
         let p = plane(c, &f, &cs.name, model, &cs.point, &cs.plane)?;
-        push(&f, &cs.name, p, m)?;
+        for (p, shape) in shaped(c, &f, model, p, m, cs.shape.as_ref(), false)? {
+            push(&f, p, m, shape)?;
+        }
     }
     if let Some(t) = &spec.table {
         let m = contact_model(c, "table", t.law(), "unilateral")?;
         if t.points.is_empty() {
             return Err(c.err("table.points", "[]", "needs at least one point"));
         }
+        // one contact per `contacts[i]` (a capsule is refused there)
+        let mut n_contacts = spec.contacts.len();
         for (i, tp) in t.points.iter().enumerate() {
             let f = format!("table.points[{i}]");
             let p = plane(c, &f, &tp.name, model, &tp.point, &t.plane)?;
-            push(&f, &tp.name, p, m)?;
-            table_idx.push(spec.contacts.len() + i);
+            for (p, shape) in shaped(c, &f, model, p, m, tp.shape.as_ref(), true)? {
+                push(&f, p, m, shape)?;
+                table_idx.push(n_contacts);
+                n_contacts += 1;
+            }
         }
     }
     Ok((planes, contacts, table_idx, settings))

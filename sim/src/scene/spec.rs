@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::dynamics::forward::{ConstraintSolver, MassMatrixMethod, Stabilization};
 
-pub use super::spec_contacts::{EventsSpec, LawKeys, TablePointSpec, TableSpec};
+pub use super::spec_contacts::{EventsSpec, LawKeys, ShapeSpec, TablePointSpec, TableSpec};
 use super::spec_contacts::ContactModelName;
 pub use super::spec_gear_supply::{BusSpec, GearFrictionSpec, PerJointFlag, SupplySpec};
 
@@ -708,6 +708,10 @@ pub struct ContactSpec {
     /// Regularisation speed v_s of the compliant friction, m/s (default 1e-3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub slip_velocity: Option<f64>,
+    /// What touches the plane at the point: a `sphere` of a radius centred on it (unilateral
+    /// and compliant contacts; default: the point itself).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeSpec>,
 }
 
 /// The plane `normal · x = offset`, world frame.

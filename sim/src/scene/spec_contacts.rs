@@ -46,6 +46,32 @@ pub struct TablePointSpec {
     pub name: String,
     /// The point of the arm.
     pub point: PointSpec,
+    /// What touches the table at the point (default: the point itself).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeSpec>,
+}
+
+/// `"shape"` of a contact or a table point: what of the link touches the plane, tagged by
+/// `kind` (book: explanation/contacts.md, "Contact shapes"). Absent: the point itself.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ShapeSpec {
+    /// A sphere centred on the contact's point (a pad): it touches the plane at its lowest
+    /// point, centre − radius × normal, and rolls.
+    Sphere {
+        /// The sphere's radius, m (> 0).
+        radius: f64,
+    },
+    /// A capsule (table points only): the segment from the contact's point to `to` (on the
+    /// same link) swept by a sphere of `radius`; it becomes two sphere contacts, `<name>/0` at
+    /// the point and `<name>/1` at `to`, each lifting off and touching down on its own (a
+    /// capsule on a plane touches at its lower end, or at both when it lies flat).
+    Capsule {
+        /// The capsule's radius, m (> 0).
+        radius: f64,
+        /// The other end of the capsule's segment, a point of the same link.
+        to: PointSpec,
+    },
 }
 
 /// `"events"`: settings of the event-driven integration (every key optional).

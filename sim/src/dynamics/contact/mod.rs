@@ -13,6 +13,7 @@
 use nalgebra::{Unit, Vector3};
 
 use super::constraints::PointOnPlane;
+pub use shape::{ContactShape, Touch};
 
 /// How one contact behaves.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,12 +86,19 @@ pub struct Contact {
     /// World-frame unit tangents, `t2 = n × t1` ([`tangent_basis`]).
     pub t1: Vector3<f64>,
     pub t2: Vector3<f64>,
+    /// What touches the plane: the point itself, or a sphere centred on it (`shape.rs`).
+    pub shape: ContactShape,
 }
 
 impl Contact {
     pub fn new(plane: PointOnPlane, model: ContactModel) -> Self {
         let (t1, t2) = tangent_basis(&plane.normal_world);
-        Contact { plane, model, t1, t2 }
+        Contact { plane, model, t1, t2, shape: ContactShape::Point }
+    }
+
+    /// This contact with `shape` touching the plane instead of its point.
+    pub fn with_shape(self, shape: ContactShape) -> Self {
+        Contact { shape, ..self }
     }
 
     pub fn name(&self) -> &str {
@@ -226,6 +234,7 @@ pub mod forward;
 pub mod impact;
 pub mod modes;
 pub mod rows;
+pub mod shape;
 pub mod solve;
 #[cfg(test)]
 mod tests;

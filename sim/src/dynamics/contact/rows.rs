@@ -1,4 +1,5 @@
-//! The rows of each contact: gap `g = n · p − d`, the normal row `J_n = nᵀ J_p` and the
+//! The rows of each contact: gap `g = n · p − d` (p the touching point of the contact's shape,
+//! `shape.rs`), the normal row `J_n = nᵀ J_p` and the
 //! tangential rows `J_t = [t1ᵀ J_p; t2ᵀ J_p]` (J_p the point's world linear-velocity Jacobian),
 //! their biases `J̇ q̇` along n, t1, t2, and the velocities `ġ = J_n q̇`, `v_t = J_t q̇`
 //! (Pfeiffer & Glocker, *Multibody Dynamics with Unilateral Contacts*, 1996, §4; the point
@@ -49,16 +50,14 @@ pub fn contact_rows(model: &Model, data: &Data, contacts: &[Contact], rows: &mut
     let nv = model.nv;
     rows.jac.fill(0.0);
     for (k, c) in contacts.iter().enumerate() {
-        let point = &c.plane.point;
         let n = c.plane.normal_world.into_inner();
-        rows.gap[k] = c.plane.position(data);
-        let v = point.velocity(data);
-        let a = point.bias_acceleration(data);
+        let touch = c.touch(data);
+        rows.gap[k] = touch.gap;
         for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
             let r = 3 * k + axis;
-            rows.vel[r] = dir.dot(&v);
-            rows.bias[r] = dir.dot(&a);
-            point.jacobian_along(model, data, dir, &mut rows.jac[r * nv..(r + 1) * nv]);
+            rows.vel[r] = dir.dot(&touch.velocity);
+            rows.bias[r] = dir.dot(&touch.bias);
+            c.jacobian_along(model, data, &touch.point, dir, &mut rows.jac[r * nv..(r + 1) * nv]);
         }
     }
 }
