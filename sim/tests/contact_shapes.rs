@@ -334,3 +334,279 @@ fn bad_shapes_are_refused_naming_the_field_and_the_value() {
     let e = err(&s, &rod);
     assert!(e.contains("table.points[0].shape.to.link") && e.contains("nope"), "{e}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Cylinder rims and the table's contacts from URDF <collision> shapes (`table.from_collisions`).
+//
+// A rim's lowest point sits at `c + r u`, u the in-plane direction most opposed to the normal,
+// so a cylinder tilted by θ about an axis normal to its own touches at `z_end − r cos θ` (a
+// capsule's end sphere would touch at `z_end − r`), and the point moves along the rim as the
+// link turns (`dynamics/contact/shape.rs`).
+
+/// The rod of `rod_urdf` with a `<collision>` cylinder of radius `r` along its x axis, end to
+/// end (length 2h), on a table that takes its contacts from the rod's collisions: `rod/c0/0`
+/// (the −x rim) and `rod/c0/1` (the +x rim).
+fn cylinder_rod(m: f64, h: f64, r: f64) -> String {
+    rod_urdf(m, h).replace(
+        r#"<link name="rod"><inertial>"#,
+        &format!(r#"<link name="rod"><collision><origin xyz="0 0 0" rpy="0 1.5707963267948966 0"/><geometry><cylinder radius="{r}" length="{}"/></geometry></collision><inertial>"#, 2.0 * h),
+    )
+}
+
+fn collisions_table(s: &mut Value, links: &[&str], keys: Value) {
+    let mut table = json!({"plane": {"normal": [0.0, 0.0, 1.0], "offset": 0.0}, "from_collisions": links});
+    for (k, v) in keys.as_object().unwrap() {
+        table[k] = v.clone();
+    }
+    s["table"] = table;
+}
+
+/// The time a rod (I = m h²/3) with a cylinder of radius r and half-length h, released at
+/// rest on its lower rim on a frictionless table at θ0, takes to lie flat: the centre falls
+/// straight down, `z_c = h sin θ + r cos θ` (the rim's lowest point), `ż_c = (h cos θ −
+/// r sin θ) θ̇`, and energy gives `θ̇² = 2 g (z_c(θ0) − z_c(θ)) / ((h cos θ − r sin θ)² +
+/// h²/3)`. Quadrature as [`tipping_time`].
+fn rim_tipping_time(h: f64, r: f64, theta0: f64) -> f64 {
+    let z = |th: f64| h * th.sin() + r * th.cos();
+    let f = |s: f64| {
+        let th = theta0 - s * s;
+        let w2 = 2.0 * G * (z(theta0) - z(th)) / ((h * th.cos() - r * th.sin()).powi(2) + h * h / 3.0);
+        2.0 * s / w2.sqrt()
+    };
+    let (n, b) = (4000, theta0.sqrt());
+    let dx = b / n as f64;
+    let (x3, w) = ((0.6f64).sqrt(), [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]);
+    (0..n)
+        .map(|i| {
+            let m = (i as f64 + 0.5) * dx;
+            let half = 0.5 * dx;
+            half * (w[0] * f(m - half * x3) + w[1] * f(m) + w[2] * f(m + half * x3))
+        })
+        .sum()
+}
+
+/// A cylinder (m = 1 kg, length 0.6 m, r = 0.05 m) from the URDF's `<collision>`, released at
+/// rest on its lower rim at 30° on a frictionless table, tips until it lies on its side: the
+/// lower rim stays closed with its lowest point moving along the rim (gap 0 at every sample,
+/// `z_c = h sin θ + r cos θ`, 1e-9: a capsule would give r + h sin θ, 3.3 mm higher at θ0), the
+/// centre falls straight down, θ̇ follows the energy integral, and the upper rim touches down
+/// with an impact at the closed-form time (1e-10 s), losing `m g (z_c(θ0) − r)`; then both rims
+/// rest with m g / 2 each.
+#[test]
+fn a_cylinder_tipping_on_its_rim_lies_on_its_side_at_the_closed_form_time() {
+    let (m, h, r, th0) = (1.0, 0.3, 0.05, 30f64.to_radians());
+    let z0 = h * th0.sin() + r * th0.cos();
+    let mut s = passive_scene("rod", &["x", "z", "pitch"], &[0.0, z0, -th0], &[0.0; 3], [0.0, 0.0, -G], 0.6, 1e-12);
+    collisions_table(&mut s, &["rod"], json!({"model": "unilateral"}));
+    let scene = load(&s, &cylinder_rod(m, h, r));
+    let names: Vec<String> = scene.run_contact_models(scene.run("r").unwrap()).iter().map(|c| c.name().to_string()).collect();
+    assert_eq!(names, ["rod/c0/0", "rod/c0/1"]);
+    let c = collect(&scene, "r");
+    let t_down = rim_tipping_time(h, r, th0);
+    assert!(t_down > 0.2 && t_down < 0.5, "{t_down}");
+    let kinds: Vec<_> = c.events.iter().map(|e| (e.contact, e.kind)).collect();
+    assert_eq!(kinds, [(1, ContactEventKind::Impact)], "{:?}", c.events);
+    let ev = &c.events[0];
+    eprintln!("cylinder tipping on its rim: touch-down at {} s, closed form {t_down} s, Δ = {:e} s", ev.t, ev.t - t_down);
+    assert!((ev.t - t_down).abs() <= 1e-10, "touch-down of the upper rim at {} s, closed form {t_down} s (Δ {:e} s)", ev.t, ev.t - t_down);
+    let e_lost = m * G * (z0 - r);
+    assert!((ev.energy_lost - e_lost).abs() <= 1e-9 * e_lost, "impact loss {} J, m g (z_c(θ0) − r) = {e_lost} J", ev.energy_lost);
+    for o in &c.samples {
+        let (t, lo, hi) = (o.t, &o.contacts[0], &o.contacts[1]);
+        assert!(touching(lo.mode), "t = {t}: the lower rim stays on the table: {:?}", lo.mode);
+        assert!(lo.gap.abs() <= 1e-9 && lo.gap_rate.abs() <= 1e-9, "t = {t}: lower rim gap {} m, rate {} m/s", lo.gap, lo.gap_rate);
+        assert!(lo.normal_force >= 0.0, "t = {t}: lower rim {lo:?}");
+        assert!(o.q[0].abs() <= 1e-9 && o.qd[0].abs() <= 1e-9, "t = {t}: the centre falls straight down: x = {} m, ẋ = {} m/s", o.q[0], o.qd[0]);
+        let th = -o.q[2];
+        assert!((o.q[1] - (h * th.sin() + r * th.cos())).abs() <= 1e-9, "t = {t}: z_c = {} m, h sin θ + r cos θ = {} m", o.q[1], h * th.sin() + r * th.cos());
+        if t < ev.t {
+            assert_eq!(hi.mode, ContactMode::Separated, "t = {t}");
+            assert!((hi.gap - 2.0 * h * th.sin()).abs() <= 1e-9, "t = {t}: upper rim gap {} m, 2 h sin θ = {}", hi.gap, 2.0 * h * th.sin());
+            let w2 = 2.0 * G * (z0 - o.q[1]) / ((h * th.cos() - r * th.sin()).powi(2) + h * h / 3.0);
+            assert!((o.qd[2] - w2.sqrt()).abs() <= 1e-8, "t = {t}: |θ̇| = {}, energy integral {}", o.qd[2], w2.sqrt());
+        } else {
+            assert!(touching(hi.mode), "t = {t}: {:?}", hi.mode);
+            for (end, f) in [("lower", lo), ("upper", hi)] {
+                assert!((f.normal_force - 0.5 * m * G).abs() <= 1e-9 * m * G, "t = {t}: {end} f_n = {} N, m g / 2 = {}", f.normal_force, 0.5 * m * G);
+                assert!(f.gap.abs() <= 1e-9 && f.gap_rate.abs() <= 1e-9, "t = {t}: {end}: {f:?}");
+            }
+        }
+        assert!(o.balance_residual.abs() <= 1e-9 * e_lost, "t = {t}: balance residual {} J", o.balance_residual);
+    }
+}
+
+/// A disk (m = 2 kg, r = 0.1 m, width 2 cm, I = ½ m r² about its axis, world y) from a URDF
+/// `<collision>` cylinder, standing on its rims on the table (μ = 0.5) and pushed by the
+/// force F = m g_x at its centre (g = (3, 0, −9.81) m/s²): it rolls, `a = F / (m + I/r²)` =
+/// 2/3 g_x, held by the friction `F I/r² / (m + I/r²)` = F/3 against the push. At every sample
+/// (1e-9): x = ½ a t², ẋ = a t, `v = ω r` (ẋ = r θ̇), both rims closed with gap 0 (1e-8) and no
+/// slip, the normal forces summing to m g and the friction forces to −F/3 (the two rims' rows
+/// are the same rows, so only their sums are determined), and the balance closed to 1e-8 of F x. The touching
+/// points move along the rims as the disk turns (a material point would leave the table).
+#[test]
+fn a_disk_pushed_on_its_rims_rolls_at_f_over_m_plus_i_over_r_squared() {
+    let (m, r, w, mu, gx) = (2.0, 0.1, 0.02, 0.5, 3.0);
+    let i = 0.5 * m * r * r;
+    let urdf = ball_urdf(m, r).replace(&format!(r#"iyy="{}""#, 0.4 * m * r * r), &format!(r#"iyy="{i}""#)).replace(
+        r#"<link name="ball"><inertial>"#,
+        &format!(r#"<link name="ball"><collision><origin xyz="0 0 0" rpy="1.5707963267948966 0 0"/><geometry><cylinder radius="{r}" length="{w}"/></geometry></collision><inertial>"#),
+    );
+    assert!(urdf.contains(&format!(r#"iyy="{i}""#)));
+    let mut s = passive_scene("ball", &["x", "z", "y", "pitch"], &[0.0, r, 0.0, 0.0], &[0.0; 4], [gx, 0.0, -G], 1.0, 1e-12);
+    collisions_table(&mut s, &["ball"], json!({"model": "unilateral", "friction": mu}));
+    let c = collect(&load(&s, &urdf), "r");
+    assert!(c.events.is_empty(), "no event: {:?}", c.events);
+    assert!(c.samples.len() > 900);
+    let f = m * gx;
+    let a = f / (m + i / (r * r));
+    assert!((a - 2.0 / 3.0 * gx).abs() < 1e-15);
+    for o in &c.samples {
+        let t = o.t;
+        assert!((o.q[0] - 0.5 * a * t * t).abs() <= 1e-9, "t = {t}: x = {} m, ½ a t² = {} m", o.q[0], 0.5 * a * t * t);
+        assert!((o.qd[0] - a * t).abs() <= 1e-9, "t = {t}: ẋ = {} m/s, a t = {}", o.qd[0], a * t);
+        assert!((o.qd[0] - r * o.qd[3]).abs() <= 1e-9, "t = {t}: v = ω r: ẋ = {}, r θ̇ = {}", o.qd[0], r * o.qd[3]);
+        assert!((o.q[1] - r).abs() <= 1e-9 && o.q[2].abs() <= 1e-9, "t = {t}: q = {:?}", o.q);
+        for (k, fk) in o.contacts.iter().enumerate() {
+            assert_eq!(fk.mode, ContactMode::Sticking, "t = {t}, rim {k}");
+            // 1e-8: the two rims' identical rows go through the regularised singular set, which
+            // drifts g̈ by ε f_n (see `ball_urdf`; measured |ġ| 1.0e-9 m/s at t = 0.68 s)
+            assert!(fk.gap.abs() <= 1e-8 && fk.gap_rate.abs() <= 1e-8, "t = {t}, rim {k}: gap {} m, rate {} m/s", fk.gap, fk.gap_rate);
+            assert!(fk.slip_velocity[0].abs() <= 1e-9 && fk.slip_velocity[1].abs() <= 1e-9, "t = {t}, rim {k}: slip {:?}", fk.slip_velocity);
+            in_cone("disk on its rims", t, fk, mu);
+        }
+        let fn_sum: f64 = o.contacts.iter().map(|x| x.normal_force).sum();
+        let ft_sum: f64 = o.contacts.iter().map(|x| x.friction_force[0]).sum();
+        assert!((fn_sum - m * G).abs() <= 1e-9 * m * G, "t = {t}: Σ f_n = {fn_sum} N, m g = {} N", m * G);
+        assert!((ft_sum + f / 3.0).abs() <= 1e-9 * m * G, "t = {t}: Σ f_t = {ft_sum} N, −F/3 = {} N", -f / 3.0);
+        // relative to the work of the push, F x (6 J at t = 1 s); 1e-8: the two rims' rows are
+        // the same rows, solved through the regularised singular set (measured 1.7e-9 J at
+        // t = 0.345 s)
+        assert!(o.balance_residual.abs() <= 1e-8 * (1.0 + f * o.q[0]), "t = {t}: balance residual {} J", o.balance_residual);
+    }
+}
+
+/// A box (m = 1 kg, 0.2 × 0.1 × 0.05 m) from the URDF `<collision>`, held flat 5 cm above the
+/// table and dropped: its 8 corners are point contacts; the bottom ones touch down together
+/// with plastic impacts at `√(2 h0/g)` (1e-10 s) whose impulses sum to m √(2 g h0), the four
+/// top ones stay separated with gap = the box's height; before, the fall is z = z0 − ½ g t²;
+/// after, the box rests with its four bottom corners at gap 0 and Σ f_n = m g (each 1e-9).
+/// (The corners that differ only in y have the same rows here, no roll joint: the event driver
+/// logs the impact on one of each such pair — measured: corners 0 and 1 — so the test checks
+/// the impulses' sum, not which corner of a redundant pair carries it.)
+#[test]
+fn a_box_dropped_flat_lands_on_its_four_bottom_corners_at_the_free_fall_time() {
+    let (m, size, h0) = (1.0, [0.2, 0.1, 0.05], 0.05);
+    let urdf = ball_urdf(m, 0.1).replace(
+        r#"<link name="ball"><inertial>"#,
+        &format!(r#"<link name="ball"><collision><geometry><box size="{} {} {}"/></geometry></collision><inertial>"#, size[0], size[1], size[2]),
+    );
+    let z0 = h0 + 0.5 * size[2];
+    let mut s = passive_scene("ball", &["x", "z", "y", "pitch"], &[0.0, z0, 0.0, 0.0], &[0.0; 4], [0.0, 0.0, -G], 0.3, 1e-12);
+    collisions_table(&mut s, &["ball"], json!({"model": "unilateral", "friction": 0.5}));
+    let scene = load(&s, &urdf);
+    let names: Vec<String> = scene.run_contact_models(scene.run("r").unwrap()).iter().map(|c| c.name().to_string()).collect();
+    assert_eq!(names, (0..8).map(|j| format!("ball/c0/{j}")).collect::<Vec<_>>());
+    let c = collect(&scene, "r");
+    let t_land = (2.0 * h0 / G).sqrt();
+    // corner j has z = ±size_z/2 by bit 2: the bottom ones are 0..4
+    assert!(!c.events.is_empty(), "the box lands");
+    let impulse: f64 = c.events.iter().map(|e| e.impulse).sum();
+    assert!((impulse - m * (2.0 * G * h0).sqrt()).abs() <= 1e-9, "Σ impulses {impulse} N s, m √(2 g h0) = {}", m * (2.0 * G * h0).sqrt());
+    for e in &c.events {
+        assert_eq!(e.kind, ContactEventKind::Impact, "{e:?}");
+        assert!(e.contact < 4, "only bottom corners land: {e:?}");
+        assert!((e.t - t_land).abs() <= 1e-10, "corner {} lands at {} s, √(2 h0/g) = {t_land} s", e.contact, e.t);
+    }
+    for o in &c.samples {
+        let t = o.t;
+        for (k, f) in o.contacts.iter().enumerate() {
+            if k >= 4 {
+                assert_eq!(f.mode, ContactMode::Separated, "t = {t}, corner {k}");
+                assert!((f.gap - (o.q[1] + 0.5 * size[2])).abs() <= 1e-12, "t = {t}, corner {k}: gap {}", f.gap);
+            }
+        }
+        if t < t_land {
+            assert!((o.q[1] - (z0 - 0.5 * G * t * t)).abs() <= 1e-9, "t = {t}: z = {}", o.q[1]);
+            assert!(o.contacts.iter().all(|f| f.mode == ContactMode::Separated), "t = {t}");
+        } else if t > t_land + 1e-9 {
+            assert!((o.q[1] - 0.5 * size[2]).abs() <= 1e-9 && o.qd[1].abs() <= 1e-9, "t = {t}: at rest: z = {}, ż = {}", o.q[1], o.qd[1]);
+            let fn_sum: f64 = o.contacts[..4].iter().map(|f| f.normal_force).sum();
+            assert!((fn_sum - m * G).abs() <= 1e-9 * m * G, "t = {t}: Σ f_n = {fn_sum} N");
+            for f in &o.contacts[..4] {
+                assert!(f.gap.abs() <= 1e-9 && f.normal_force >= -1e-9, "t = {t}: {f:?}");
+            }
+            assert!(o.contacts[..4].iter().filter(|f| touching(f.mode)).count() >= 2, "t = {t}: rests on its bottom corners");
+        }
+    }
+}
+
+/// `table.from_collisions`: a collision sphere becomes a sphere contact at its centre; the
+/// field and `table.cylinders` are validated once, naming the file, the field, the value and
+/// the links without shapes; a cylinder standing on its face is refused.
+#[test]
+fn collision_shapes_on_the_table_are_validated_naming_the_field_the_value_and_the_links() {
+    let err = |s: &Value, urdf: &str| try_load(s, urdf).map(|_| ()).unwrap_err().to_string();
+    let (m, h, r) = (1.0, 0.3, 0.05);
+    let urdf = cylinder_rod(m, h, r);
+    let mut ok = passive_scene("rod", &["x", "z", "pitch"], &[0.0, r, 0.0], &[0.0; 3], [0.0, 0.0, -G], 0.1, 1e-12);
+    collisions_table(&mut ok, &["rod"], json!({"model": "unilateral"}));
+    assert!(try_load(&ok, &urdf).is_ok());
+    // cylinders as a capsule: two end spheres (touching at z_c − r with the rod flat)
+    let mut s = ok.clone();
+    s["table"]["cylinders"] = json!("capsule");
+    let scene = load(&s, &urdf);
+    let names: Vec<String> = scene.run_contact_models(scene.run("r").unwrap()).iter().map(|c| c.name().to_string()).collect();
+    assert_eq!(names, ["rod/c0/0", "rod/c0/1"]);
+    let mut s = ok.clone();
+    s["table"]["cylinders"] = json!("discs");
+    let e = err(&s, &urdf);
+    assert!(e.contains("contact-test.json") && e.contains("table.cylinders") && e.contains("discs") && e.contains("rims"), "{e}");
+    let mut s = ok.clone();
+    s["table"]["from_collisions"] = json!(["rod", "cz", "cx"]);
+    let e = err(&s, &urdf);
+    assert!(e.contains("table.from_collisions") && e.contains("cz (no <collision>)") && e.contains("cx (no <collision>)") && !e.contains("rod ("), "{e}");
+    let mesh = urdf.replace(r#"<cylinder radius="0.05" length="0.6"/>"#, r#"<mesh filename="rod.stl"/>"#);
+    assert_ne!(mesh, urdf);
+    let e = err(&ok, &mesh);
+    assert!(e.contains("table.from_collisions") && e.contains("rod (1 <collision> of meshes only)"), "{e}");
+    let mut s = ok.clone();
+    s["table"]["from_collisions"] = json!(["nope"]);
+    let e = err(&s, &urdf);
+    assert!(e.contains("table.from_collisions[0]") && e.contains("nope") && e.contains("no such link"), "{e}");
+    let mut s = ok.clone();
+    s["table"]["from_collisions"] = json!(["rod", "rod"]);
+    let e = err(&s, &urdf);
+    assert!(e.contains("table.from_collisions[1]") && e.contains("twice"), "{e}");
+    let mut s = ok.clone();
+    s["table"]["model"] = json!("bilateral");
+    let e = err(&s, &urdf);
+    assert!(e.contains("table.from_collisions") && e.contains("bilateral"), "{e}");
+    // a cylinder that starts inside the table: its rims are r below the centre
+    let mut s = ok.clone();
+    s["initial"]["q"][1] = json!(0.03);
+    let e = err(&s, &urdf);
+    assert!(e.contains("table.from_collisions[0]") && e.contains("rod/c0/0") && e.contains("rim starts inside the plane"), "{e}");
+    // standing on its face (axis along the normal): refused at the start
+    let mut s = ok.clone();
+    s["initial"]["q"][1] = json!(h);
+    s["initial"]["q"][2] = json!(-std::f64::consts::FRAC_PI_2);
+    let e = err(&s, &urdf);
+    assert!(e.contains("rod/c0/0") && e.contains("stands on its face") && e.contains("0.000°"), "{e}");
+    // a bad collision in the URDF names its line
+    let bad = urdf.replace(r#"radius="0.05""#, r#"radius="-1""#);
+    let e = err(&ok, &bad);
+    assert!(e.contains("radius=\"-1\"") && e.contains("positive length"), "{e}");
+    // a collision sphere: a sphere contact at its centre (offset in the link)
+    let ball = ball_urdf(1.0, 0.1).replace(
+        r#"<link name="ball"><inertial>"#,
+        r#"<link name="ball"><collision><origin xyz="0 0 -0.02"/><geometry><sphere radius="0.08"/></geometry></collision><inertial>"#,
+    );
+    let mut s = passive_scene("ball", &["x", "z", "y", "pitch"], &[0.0, 0.1, 0.0, 0.0], &[0.0; 4], [0.0, 0.0, -G], 0.2, 1e-12);
+    collisions_table(&mut s, &["ball"], json!({"model": "unilateral"}));
+    let c = collect(&load(&s, &ball), "r");
+    assert!(c.events.is_empty(), "resting on its sphere: {:?}", c.events);
+    for o in &c.samples {
+        let f = &o.contacts[0];
+        assert!(f.gap.abs() <= 1e-9 && (o.q[1] - 0.1).abs() <= 1e-9 && (f.normal_force - G).abs() <= 1e-9 * G, "t = {}: {f:?}", o.t);
+    }
+}

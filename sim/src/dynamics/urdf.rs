@@ -3,8 +3,9 @@
 //! `file:line: <element name="...">: what is wrong; what to do`.
 //!
 //! Read: `<robot name>`; `<link name>` with `<inertial>` (`<origin xyz rpy>`, `<mass value>`,
-//! `<inertia ixx ixy ixz iyy iyz izz>`) and the `<mesh filename>` of its `<visual>` and
-//! `<collision>`; `<joint name type>` with `<origin>`, `<parent link>`, `<child link>`,
+//! `<inertia ixx ixy ixz iyy iyz izz>`), the `<mesh filename>` of its `<visual>` and
+//! `<collision>`, and each `<collision>`'s `<origin>` and `<sphere>`, `<cylinder>`, `<box>` or
+//! `<capsule>` geometry (the table's candidate contacts, `scene/contacts.rs`); `<joint name type>` with `<origin>`, `<parent link>`, `<child link>`,
 //! `<axis xyz>` (default `1 0 0`), `<limit>`, `<dynamics>` and `<mimic joint multiplier offset>`.
 //! Everything else (materials, textures, `<transmission>`, `<gazebo>`, `<ros2_control>`,
 //! `<calibration>`, `<safety_controller>`, vendor tags) is skipped without a word: it does not
@@ -114,6 +115,29 @@ pub struct UrdfMesh {
     pub span: Option<Range<usize>>,
 }
 
+/// The geometry of a `<collision>` (ROS URDF specification, `<geometry>`; `<capsule>` is not
+/// in the specification but read by Gazebo/SDF-derived tools): lengths in m, in the collision's
+/// `<origin>` frame (a cylinder's and a capsule's axis is its z axis, centred at the origin).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum UrdfGeometry {
+    Sphere { radius: f64 },
+    Cylinder { radius: f64, length: f64 },
+    Capsule { radius: f64, length: f64 },
+    /// `size`: the full edge lengths along x, y, z.
+    Box { size: [f64; 3] },
+    Mesh,
+}
+
+/// A link's `<collision>`: its `<origin>` in the link frame and its geometry (`None` when the
+/// `<geometry>` is missing or holds nothing read).
+#[derive(Clone, Debug, PartialEq)]
+pub struct UrdfCollision {
+    pub link: String,
+    pub line: usize,
+    pub origin: UrdfPose,
+    pub geometry: Option<UrdfGeometry>,
+}
+
 /// The parsed document.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UrdfDoc {
@@ -121,6 +145,8 @@ pub struct UrdfDoc {
     pub links: Vec<UrdfLink>,
     pub joints: Vec<UrdfJointElem>,
     pub meshes: Vec<UrdfMesh>,
+    /// Every `<collision>` of every link, in file order.
+    pub collisions: Vec<UrdfCollision>,
 }
 
 /// What to do with a xacro file.
@@ -243,6 +269,9 @@ enum Open {
     Link(usize),
     Inertial(usize, Option<f64>, Option<[f64; 6]>, UrdfPose, usize),
     Joint(usize),
+    /// A `<collision>` (its index in `doc.collisions`) and its `<geometry>`.
+    Collision(usize),
+    Geometry(usize),
     Other,
 }
 
@@ -255,7 +284,7 @@ pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
     }
     let mut reader = Reader::from_str(text);
     reader.config_mut().check_end_names = true;
-    let mut doc = UrdfDoc { name: String::new(), links: Vec::new(), joints: Vec::new(), meshes: Vec::new() };
+    let mut doc = UrdfDoc { name: String::new(), links: Vec::new(), joints: Vec::new(), meshes: Vec::new(), collisions: Vec::new() };
     // the names of the open elements, outermost first, and what each is
     let mut stack: Vec<(String, Open)> = Vec::new();
     let mut seen_root = false;
@@ -276,6 +305,7 @@ pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
                 Open::Link(l) => Some(element("link", Some(&doc.links[*l].name))),
                 Open::Inertial(l, ..) => Some(format!("{}<inertial>", element("link", Some(&doc.links[*l].name)))),
                 Open::Joint(j) => Some(element("joint", Some(&doc.joints[*j].name))),
+                Open::Collision(k) | Open::Geometry(k) => Some(format!("{}<collision>", element("link", Some(&doc.collisions[*k].link)))),
                 Open::Other => None,
             })
             .unwrap_or_default();
@@ -352,6 +382,42 @@ pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
             (_, _, _) => {
                 match stack.last_mut().map(|(_, o)| o) {
                     Some(Open::Link(l)) if tag == "inertial" => Open::Inertial(*l, None, None, UrdfPose::default(), line),
+                    Some(Open::Link(l)) if tag == "collision" => {
+                        doc.collisions.push(UrdfCollision { link: doc.links[*l].name.clone(), line, origin: UrdfPose::default(), geometry: None });
+                        Open::Collision(doc.collisions.len() - 1)
+                    }
+                    Some(Open::Collision(k)) if tag == "origin" => {
+                        doc.collisions[*k].origin = attrs.pose(&c)?;
+                        Open::Other
+                    }
+                    Some(Open::Collision(k)) if tag == "geometry" => Open::Geometry(*k),
+                    Some(Open::Geometry(k)) if tag != "mesh" => {
+                        let k = *k;
+                        let len = |key: &str, what: &str| -> Result<f64, ModelError> {
+                            match attrs.number(key, &c)? {
+                                Some(x) if x.is_finite() && x > 0.0 => Ok(x),
+                                Some(x) => Err(c.err(attrs.elem(), format!("{key}=\"{x}\" must be a positive length (m) for {what}"))),
+                                None => Err(c.err(attrs.elem(), format!("the attribute `{key}` (m) is missing; the URDF specification requires it for {what}"))),
+                            }
+                        };
+                        let g = match tag.as_str() {
+                            "sphere" => Some(UrdfGeometry::Sphere { radius: len("radius", "a sphere")? }),
+                            "cylinder" => Some(UrdfGeometry::Cylinder { radius: len("radius", "a cylinder")?, length: len("length", "a cylinder")? }),
+                            "capsule" => Some(UrdfGeometry::Capsule { radius: len("radius", "a capsule")?, length: len("length", "a capsule")? }),
+                            "box" => {
+                                let size = attrs.vec3("size", &c)?.ok_or_else(|| c.err(attrs.elem(), "the attribute `size` (m, three edge lengths) is missing"))?;
+                                if !size.iter().all(|x| x.is_finite() && *x > 0.0) {
+                                    return Err(c.err(attrs.elem(), format!("size=\"{} {} {}\" must be three positive lengths (m)", size[0], size[1], size[2])));
+                                }
+                                Some(UrdfGeometry::Box { size })
+                            }
+                            _ => None,
+                        };
+                        if g.is_some() {
+                            doc.collisions[k].geometry = g;
+                        }
+                        Open::Other
+                    }
                     Some(Open::Inertial(_, mass, inertia, origin, _)) => {
                         match tag.as_str() {
                             "origin" => *origin = attrs.pose(&c)?,
@@ -407,6 +473,9 @@ pub fn parse(text: &str, file: &str) -> Result<UrdfDoc, ModelError> {
                     _ => {
                         // a mesh anywhere inside a link's visual or collision geometry
                         if tag == "mesh" {
+                            if let Some(Open::Geometry(k)) = stack.last().map(|(_, o)| o) {
+                                doc.collisions[*k].geometry = Some(UrdfGeometry::Mesh);
+                            }
                             let link = stack.iter().find_map(|(_, o)| match o {
                                 Open::Link(l) => Some(*l),
                                 _ => None,

@@ -27,6 +27,8 @@ pub(crate) fn paper_unilateral(mu: f64, e: f64, table: &[&str]) -> Scene {
                     stiffness: None,
                     damping: None,
                     slip_velocity: None,
+                    from_collisions: Vec::new(),
+                    cylinders: None,
                 });
             }
         })

@@ -3,12 +3,14 @@
 //! default that belongs to every run), and the `events` settings. Errors name
 //! `contacts[i].field` (or `table.field`) and the value.
 
-use nalgebra::Unit;
+use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 
 use super::ctx::{non_negative, positive, Ctx};
-use super::spec::{LawKeys, PlaneSpec, PointSpec, SceneSpec, ShapeSpec};
+use super::spec::{LawKeys, PlaneSpec, PointSpec, SceneSpec, ShapeSpec, TableSpec};
 use super::INITIAL_CONSTRAINT_TOL;
 use crate::dynamics::constraints::PointOnPlane;
+use crate::dynamics::kinematics::BodyPoint;
+use crate::dynamics::urdf::{self, UrdfGeometry};
 use crate::dynamics::contact::{Contact, ContactModel, ContactSettings, ContactShape};
 use crate::dynamics::{Data, Model};
 use crate::error::{short, SceneError};
@@ -136,7 +138,87 @@ fn check_initial(c: &Ctx, f: &str, contact: &Contact, data: &Data, gap_tol: f64)
         }
         ContactModel::Compliant { .. } => {}
     }
+    crate::dynamics::contact::shape::check_rims(std::slice::from_ref(contact), data, 0.0).map_err(|e| c.err(f.to_string(), &p.name, format!("at the initial state: {e}")))?;
     Ok(())
+}
+
+/// The table's candidate contacts from the URDF `<collision>` shapes of the links named in
+/// `table.from_collisions` (see its doc in `spec_contacts.rs`), each `(centre on the table's
+/// plane, shape)`. Errors name `table.from_collisions[i]`, `table.cylinders` and the links that
+/// have no usable shape.
+fn collision_contacts(c: &Ctx, t: &TableSpec, model: &Model, urdf_xml: &str, m: ContactModel, normal: Unit<Vector3<f64>>, offset: f64) -> Result<Vec<(PointOnPlane, ContactShape)>, SceneError> {
+    if t.from_collisions.is_empty() {
+        if let Some(v) = &t.cylinders {
+            return Err(c.err("table.cylinders", v, "applies to the cylinders of table.from_collisions, which names no link"));
+        }
+        return Ok(Vec::new());
+    }
+    let capsules = match t.cylinders.as_deref() {
+        None | Some("rims") => false,
+        Some("capsule") => true,
+        Some(other) => return Err(c.err("table.cylinders", other, "unknown: use \"rims\" (the cylinder's two rim circles) or \"capsule\" (two end spheres of its radius)")),
+    };
+    if m == ContactModel::Bilateral {
+        return Err(c.err("table.from_collisions", t.from_collisions.join(", "), "a bilateral table holds each contact on the plane: collision shapes give several candidate contacts, of which only some touch; make the table unilateral or compliant"));
+    }
+    let doc = urdf::parse(urdf_xml, "the URDF").map_err(|e| c.err("urdf", "", e.to_string()))?;
+    let mut out = Vec::new();
+    let mut bare = Vec::new();
+    for (i, link) in t.from_collisions.iter().enumerate() {
+        let f = format!("table.from_collisions[{i}]");
+        let Some(frame) = model.frame(link) else {
+            return Err(c.err(f, link, format!("no such link in the URDF (links: {})", super::ctx::names(model.frames.iter().map(|f| &f.name)))));
+        };
+        if t.from_collisions[..i].contains(link) {
+            return Err(c.err(f, link, "is named twice"));
+        }
+        let Some(body) = frame.body else {
+            return Err(c.err(f, link, "is fixed to the base: its shapes cannot move onto the table"));
+        };
+        let cols: Vec<_> = doc.collisions.iter().filter(|k| &k.link == link).collect();
+        let mut any = false;
+        for (k, col) in cols.iter().enumerate() {
+            let (xyz, rpy) = (col.origin.xyz, col.origin.rpy);
+            // the collision frame in the body frame
+            let x = frame.x_body_frame * Isometry3::from_parts(Translation3::new(xyz[0], xyz[1], xyz[2]), UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]));
+            let at = |p: Vector3<f64>| BodyPoint { body: Some(body), p_body: (x * Point3::from(p)).coords };
+            let plane = |name: String, p: Vector3<f64>| PointOnPlane { name, point: at(p), normal_world: normal, offset };
+            let name = format!("{link}/c{k}");
+            match col.geometry {
+                Some(UrdfGeometry::Sphere { radius }) => out.push((plane(name, Vector3::zeros()), ContactShape::Sphere { radius })),
+                Some(UrdfGeometry::Box { size }) => {
+                    for j in 0..8 {
+                        let s = |b: usize, e: f64| if j >> b & 1 == 1 { 0.5 * e } else { -0.5 * e };
+                        out.push((plane(format!("{name}/{j}"), Vector3::new(s(0, size[0]), s(1, size[1]), s(2, size[2]))), ContactShape::Point));
+                    }
+                }
+                Some(UrdfGeometry::Cylinder { radius, length }) if !capsules => {
+                    let axis = x.rotation * Vector3::z();
+                    for (j, z) in [-0.5 * length, 0.5 * length].into_iter().enumerate() {
+                        out.push((plane(format!("{name}/{j}"), Vector3::new(0.0, 0.0, z)), ContactShape::Rim { radius, axis }));
+                    }
+                }
+                Some(UrdfGeometry::Cylinder { radius, length } | UrdfGeometry::Capsule { radius, length }) => {
+                    for (j, z) in [-0.5 * length, 0.5 * length].into_iter().enumerate() {
+                        out.push((plane(format!("{name}/{j}"), Vector3::new(0.0, 0.0, z)), ContactShape::Sphere { radius }));
+                    }
+                }
+                Some(UrdfGeometry::Mesh) | None => continue,
+            }
+            any = true;
+        }
+        if !any {
+            bare.push(if cols.is_empty() { format!("{link} (no <collision>)") } else { format!("{link} ({} <collision> of meshes only)", cols.len()) });
+        }
+    }
+    if !bare.is_empty() {
+        return Err(c.err(
+            "table.from_collisions",
+            t.from_collisions.join(", "),
+            format!("these links have no <collision> sphere, cylinder, capsule or box to put on the table: {}; name other links, or give their points under table.points", bare.join(", ")),
+        ));
+    }
+    Ok(out)
 }
 
 /// Every contact of the scene (the `contacts`, then the table's points) as planes and as
@@ -147,6 +229,7 @@ pub(super) fn build_contacts(
     spec: &SceneSpec,
     model: &Model,
     data: &Data,
+    urdf_xml: &str,
 ) -> Result<(Vec<PointOnPlane>, Vec<Contact>, Vec<usize>, ContactSettings), SceneError> {
     let mut settings = ContactSettings::default();
     if let Some(ev) = &spec.events {
@@ -193,8 +276,8 @@ pub(super) fn build_contacts(
     }
     if let Some(t) = &spec.table {
         let m = contact_model(c, "table", t.law(), "unilateral")?;
-        if t.points.is_empty() {
-            return Err(c.err("table.points", "[]", "needs at least one point"));
+        if t.points.is_empty() && t.from_collisions.is_empty() {
+            return Err(c.err("table.points", "[]", "needs at least one point (or links under table.from_collisions)"));
         }
         // one contact per `contacts[i]` (a capsule is refused there)
         let mut n_contacts = spec.contacts.len();
@@ -206,6 +289,17 @@ pub(super) fn build_contacts(
                 table_idx.push(n_contacts);
                 n_contacts += 1;
             }
+        }
+        let n = c.vec3("table.plane.normal", t.plane.normal)?;
+        if n.norm() < 1e-12 {
+            return Err(c.err("table.plane.normal", format!("{:?}", t.plane.normal), "must be non-zero"));
+        }
+        for (p, shape) in collision_contacts(c, t, model, urdf_xml, m, Unit::new_normalize(n), t.plane.offset)? {
+            let link = p.name.split('/').next().unwrap_or_default().to_string();
+            let i = t.from_collisions.iter().position(|l| *l == link).unwrap_or(0);
+            push(&format!("table.from_collisions[{i}]"), p, m, shape)?;
+            table_idx.push(n_contacts);
+            n_contacts += 1;
         }
     }
     Ok((planes, contacts, table_idx, settings))

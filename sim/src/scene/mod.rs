@@ -553,7 +553,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     let mut data = Data::new(&model);
     forward_kinematics(&model, &mut data, &q0);
     forward_velocities(&model, &mut data, &qd0);
-    let (contacts, contact_models, table_contacts, contact_settings) = contacts::build_contacts(&c, &spec, &model, &data)?;
+    let (contacts, contact_models, table_contacts, contact_settings) = contacts::build_contacts(&c, &spec, &model, &data, &urdf_xml)?;
     let mut runs = Vec::with_capacity(spec.runs.len());
     if spec.runs.is_empty() {
         return Err(c.err("runs", "[]", "needs at least one run"));

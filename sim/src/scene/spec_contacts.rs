@@ -14,7 +14,9 @@ use super::spec::{ContactSpec, PlaneSpec, PointSpec};
 pub struct TableSpec {
     /// The table's plane, world frame.
     pub plane: PlaneSpec,
-    /// The points of the arm over the table, each a contact of every run.
+    /// The points of the arm over the table, each a contact of every run (may be empty when
+    /// `from_collisions` names links).
+    #[serde(default)]
     pub points: Vec<TablePointSpec>,
     /// The contact model of every point: `unilateral`, `bilateral` or `compliant` (default:
     /// unilateral).
@@ -36,6 +38,32 @@ pub struct TableSpec {
     /// Regularisation speed v_s of the compliant friction, m/s (default 1e-3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub slip_velocity: Option<f64>,
+    /// Links of the URDF whose `<collision>` shapes become candidate contacts on the table
+    /// (each link needs at least one sphere, cylinder, capsule or box; meshes are skipped): a
+    /// sphere → a sphere contact `<link>/c<k>` at its centre; a box → its 8 corners as point
+    /// contacts `<link>/c<k>/0`…`/7`; a cylinder → its two rims `<link>/c<k>/0` (−z end) and
+    /// `/1` (+z end), or a capsule (see `cylinders`); a capsule → its two end spheres. k counts
+    /// the link's `<collision>` elements from 0 in file order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub from_collisions: Vec<String>,
+    /// How a collision `<cylinder>` touches the table: `rims` (default: the two rim circles, the
+    /// cylinder's true shape) or `capsule` (two end spheres of the cylinder's radius: a capsule
+    /// of the cylinder's radius and length, as many URDFs mean a cylinder with rounded ends).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(with = "Option<CylinderContacts>")]
+    pub cylinders: Option<String>,
+}
+
+/// How a collision `<cylinder>` becomes contacts (`table.cylinders`).
+// (for the schema only: the spec keeps the string, validated in `contacts.rs` with its message)
+#[derive(JsonSchema)]
+#[schemars(rename_all = "kebab-case")]
+#[allow(dead_code)]
+pub(super) enum CylinderContacts {
+    /// The two rim circles, each touching at its lowest point.
+    Rims,
+    /// Two spheres of the cylinder's radius at the ends of its axis.
+    Capsule,
 }
 
 /// One point of the table construct.

@@ -94,6 +94,7 @@ pub fn prepare(
     generalized_force_and_inertia(plant, data, fd, q, qd, current);
     forward_velocities(model, data, qd);
     contact_rows(model, data, contacts, &mut cd.rows);
+    super::shape::check_rims(contacts, data, t)?;
     // compliant forces into b
     for (k, c) in contacts.iter().enumerate() {
         cd.f_n[k] = 0.0;
