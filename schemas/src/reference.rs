@@ -63,7 +63,7 @@ fn topic_docs() -> Vec<TopicDoc> {
         doc::<ContactFriction>(
             topics::CONTACT_FRICTION,
             "runs with a unilateral or compliant contact whose friction coefficient μ > 0, every sample",
-            "per contact: slip speed |v_t|, friction use |f_t|/(μ f_n) (0 where μ f_n = 0: separated, frictionless or bilateral) and mode, for plots",
+            "per contact: slip speed ‖v_t‖, friction use ‖f_t‖/(μ f_n) (0 where μ f_n = 0: separated, frictionless or bilateral) and mode, for plots",
         ),
         doc::<SupplyState>(topics::SUPPLY, "runs whose scene has a `supply`, every sample", "the supply's power, the bus power, and the energy delivered, regenerated, dumped and lost, cumulative"),
         doc::<MotorThermalState>(
