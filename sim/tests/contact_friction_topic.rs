@@ -52,10 +52,10 @@ fn the_friction_topic_is_the_contacts_slip_speed_and_friction_use_at_every_sampl
         assert_eq!(f.name, ["floor", "lid"]);
         assert_eq!(f.mode, s.mode, "t = {}", s.time);
         assert_eq!((f.slip_speed.len(), f.friction_use.len()), (2, 2));
-        for k in 0..2 {
+        for (k, mu_k) in mus.iter().enumerate() {
             let speed = s.slip_velocity_t1[k].hypot(s.slip_velocity_t2[k]);
             assert!((f.slip_speed[k] - speed).abs() <= 1e-12 * speed.max(1e-300), "t = {} {}: |v_t| {} vs {speed}", s.time, f.name[k], f.slip_speed[k]);
-            let (f_t, cone) = (s.friction_force_t1[k].hypot(s.friction_force_t2[k]), mus[k] * s.normal_force[k]);
+            let (f_t, cone) = (s.friction_force_t1[k].hypot(s.friction_force_t2[k]), mu_k * s.normal_force[k]);
             let want = if cone > 0.0 { f_t / cone } else { 0.0 };
             assert!((f.friction_use[k] - want).abs() <= 1e-12 * want, "t = {} {}: use {} vs {want}", s.time, f.name[k], f.friction_use[k]);
         }
