@@ -13,6 +13,8 @@ mod arms_load;
 mod bad_input;
 #[path = "by_hand.rs"]
 mod by_hand;
+#[path = "contacts_converge.rs"]
+mod contacts_converge;
 #[path = "contacts_exact.rs"]
 mod contacts_exact;
 #[path = "contacts_paper.rs"]
