@@ -78,8 +78,11 @@ fn every_method_converges_at_its_order_on_the_paper_arm() {
 /// and Stribeck, forward and backward efficiencies) and a supply without regeneration on a
 /// dumping bus: the gears' and the supply's mode changes are events located on each method's
 /// dense output, so every phase is smooth and the adaptive methods keep their order, on the
-/// hand path. (rk4 with gear events: `drive_features.rs`; the joints' stick/slide modes are
-/// decided together at every event, `ode/drive_modes.rs`.)
+/// hand path. Measured and NOT yet holding (issue 26, open): rk4 (fixed step) gives h^3.1
+/// instead of h^4, and ROSENBROCK (W-method, rtol 1e-9) takes a different stick/slide
+/// decision at one stop (hand error 5e-5 m where 1e-6..1e-8 give 3e-8..3e-10); the closed
+/// chains (one- and two-elbow runs) chatter between two coupled joints' per-joint stick
+/// decisions. Those are left out here and listed in TESTING.md.
 #[test]
 #[allow(clippy::result_large_err)] // the sink returns RunError
 fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() {
