@@ -35,7 +35,7 @@ Examples:
   sim schema -o scene.schema.json       the scene files' JSON Schema, for editors
   sim replay out/paper-two-elbow.mcap   re-run a recording from its own metadata
   sim sweep sim/scenes/sweeps/paper-gains.json -j 2
-  sim optimize sim/scenes/studies/elbow-along-arm.json -j 2
+  sim optimize sim/scenes/studies/which-elbow.json -j 2
   sim precision --duration 1            speed against error of every integrator
   sim --live                            also stream each run to the Foxglove app, paced to real
                                         time (build with --features live): ws://localhost:8765";

@@ -44,7 +44,7 @@ Exit status: 0 the study finished (or stopped at --generations), 1 no feasible d
 found, 2 bad input.
 
 Examples:
-  sim optimize sim/scenes/studies/elbow-along-arm.json -j 2
+  sim optimize sim/scenes/studies/which-elbow.json -j 2
   sim optimize my-study.json --generations 3       three generations, then stop (resume later)
   sim optimize my-study.json --shard 0/3 -o /scratch/s   one shard of the pending generation")]
 pub struct OptimizeArgs {
