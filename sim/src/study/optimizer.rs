@@ -220,7 +220,7 @@ mod tests {
     #[test]
     fn finds_the_global_minimum_of_rastrigin_in_2d() {
         // Rastrigin on [-5.12, 5.12]² (many local minima 1 apart), shifted so that the global
-        // minimum 0 sits at x = (0.5, -1.2): 600 evaluations find it to 0.01
+        // minimum 0 sits at x = (0.5, -1.2): 2000 evaluations with λ = 60 find it to 0.01
         let x_of = |u: f64| -5.12 + 10.24 * u;
         let xs = [0.5, -1.2];
         let f = |_: usize, u: &[f64]| {
@@ -231,8 +231,8 @@ mod tests {
                 })
                 .sum::<f64>()
         };
-        let mut s = settings(2, 1, 600);
-        s.population = 24; // a larger population for a multimodal function (Hansen & Kern 2004)
+        let mut s = settings(2, 1, 2000);
+        s.population = 60; // a larger population for a multimodal function (Hansen & Kern 2004)
         let (p, v, _) = minimise(s, f);
         for i in 0..2 {
             assert!((x_of(p.u[i]) - xs[i]).abs() < 0.01, "x = {}, {}; f = {v}", x_of(p.u[0]), x_of(p.u[1]));
