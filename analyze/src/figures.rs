@@ -34,9 +34,11 @@ mod index;
 pub mod markup;
 mod render;
 mod scale;
+mod study;
 mod work_precision;
 
 pub use index::write_index;
+pub use study::{pareto_front, study_figure, Mark, StudySeries};
 pub use work_precision::{work_precision, WorkPrecisionSeries};
 
 /// DejaVu Sans (licence beside it in `analyze/assets`): every figure of the project uses it

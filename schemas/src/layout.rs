@@ -44,6 +44,18 @@ pub struct LayoutRun {
     pub contacts: Vec<String>,
     /// It records `/contacts` (a non-bilateral contact: modes, friction).
     pub has_contact_topic: bool,
+    /// Per entry of `contacts`, whether it has friction (μ > 0, non-bilateral); the run records
+    /// `/contact_friction` when one has. Empty: none has.
+    pub frictional: Vec<bool>,
+    /// It has at least one `/contact_events` message (the topic exists only then).
+    pub has_contact_events: bool,
+}
+
+impl LayoutRun {
+    /// It records `/contact_friction`.
+    pub fn has_friction_topic(&self) -> bool {
+        self.frictional.iter().any(|&f| f)
+    }
 }
 
 /// What [`foxglove`] lays out.
@@ -134,7 +146,25 @@ fn zero_line() -> Value {
     json!({"value": "0", "enabled": true, "timestampMethod": "receiveTime", "label": "0", "color": "#7f7f7f"})
 }
 
-/// A plot panel: its id, config and the tab it goes in.
+/// A path of a State Transitions panel (`StateTransitionPath`,
+/// `packages/suite-base/src/panels/StateTransitions/types.ts`): a band per value over time.
+fn state_path(value: String, label: String, color: &str) -> Value {
+    json!({"value": value, "enabled": true, "timestampMethod": "receiveTime", "label": label, "color": color})
+}
+
+/// A State Transitions panel (`StateTransitionConfig`): the mode of each contact as coloured
+/// bands on the plots' time axis (synced with them), each change marked by a point.
+fn state_transitions(paths: Vec<Value>) -> Value {
+    json!({
+        "paths": paths,
+        "isSynced": true,
+        "showPoints": true,
+        "foxglovePanelTitle": "Modes (0 sep. 1 stick 2 slide)",
+        "lichtblickPanelTitle": "Modes (0 sep. 1 stick 2 slide)",
+    })
+}
+
+/// A panel (plot, state transitions, table): its id, config and the tab it goes in.
 struct PlotPanel {
     id: String,
     tab: &'static str,
@@ -143,7 +173,7 @@ struct PlotPanel {
 
 /// The tabs of the plots, in order (a tab without plots is left out); the unilateral and
 /// compliant contacts' forces get their own tab when bilateral ones share the layout.
-const TABS: [&str; 6] = ["motors", "contacts", "contacts (unilateral)", "slip / stick", "energy", "balance"];
+const TABS: [&str; 7] = ["motors", "contacts", "contacts (unilateral)", "slip / stick", "events", "energy", "balance"];
 
 /// The plot panels, in layout order: only series the runs record (a contact index that no run
 /// has is not plotted; a scene's layout, [`foxglove`], is for runs with the same topics).
@@ -171,7 +201,7 @@ fn plots(input: &LayoutInput) -> Vec<PlotPanel> {
     let nu = contact_count(input, true);
     if nu > 0 {
         let t = topics::CONTACTS;
-        let (mut normal, mut friction, mut slip, mut modes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut normal, mut friction, mut modes) = (Vec::new(), Vec::new(), Vec::new());
         for k in 0..nu {
             let name = contact_label(input, k, true);
             let c = PALETTE[k % PALETTE.len()];
@@ -179,17 +209,39 @@ fn plots(input: &LayoutInput) -> Vec<PlotPanel> {
             for (field, what) in [("friction_force_t1", "f_t1"), ("friction_force_t2", "f_t2")] {
                 friction.push(path(format!("{t}.{field}[{k}]"), format!("{name} {what} [{}]", unit(t, field)), c));
             }
-            for (field, what) in [("slip_velocity_t1", "v_t1"), ("slip_velocity_t2", "v_t2")] {
-                slip.push(path(format!("{t}.{field}[{k}]"), format!("{name} {what} [{}]", unit(t, field)), c));
-            }
-            modes.push(path(format!("{t}.mode[{k}]"), format!("{name} mode"), c));
+            modes.push(state_path(format!("{t}.mode[{k}]"), format!("{name} mode"), c));
         }
         normal.push(zero_line());
         let tab = if nb > 0 { "contacts (unilateral)" } else { "contacts" };
         add("Plot!contact_forces", tab, plot("Normal forces", "force [N]", normal));
         add("Plot!friction_forces", tab, plot("Friction forces", "force [N]", friction));
-        add("Plot!slip", "slip / stick", plot("Slip velocity", "velocity [m/s]", slip));
-        add("Plot!contact_modes", "slip / stick", plot("Mode (0 sep., 1 stick, 2 slide)", "mode code", modes));
+        // slip / stick: what Foxglove cannot combine from /contacts, from /contact_friction
+        // (the frictional contacts only), the mode bands and the events on one time axis
+        let nf = input.runs.iter().filter(|r| r.has_contact_topic).map(|r| r.frictional.iter().rposition(|&f| f).map_or(0, |k| k + 1)).max().unwrap_or(0);
+        let frictional = |k: usize| input.runs.iter().any(|r| r.has_contact_topic && r.frictional.get(k) == Some(&true));
+        let f = topics::CONTACT_FRICTION;
+        let (mut speed, mut used) = (Vec::new(), Vec::new());
+        for k in (0..nf).filter(|&k| frictional(k)) {
+            let name = contact_label(input, k, true);
+            let c = PALETTE[k % PALETTE.len()];
+            speed.push(path(format!("{f}.slip_speed[{k}]"), format!("{name} |v_t| [{}]", unit(f, "slip_speed")), c));
+            used.push(path(format!("{f}.friction_use[{k}]"), format!("{name} |f_t|/(μ f_n)"), c));
+        }
+        if !speed.is_empty() {
+            used.push(json!({"value": "1", "enabled": true, "timestampMethod": "receiveTime", "label": "1 (sliding)", "color": "#7f7f7f"}));
+            add("Plot!slip_speed", "slip / stick", plot("Slip speed", "|v_t| [m/s]", speed));
+            add("Plot!friction_use", "slip / stick", plot("Friction use (1: sliding)", "|f_t|/(μ f_n)", used));
+        }
+        let events = input.runs.iter().any(|r| r.has_contact_topic && r.has_contact_events);
+        if events {
+            let e = topics::CONTACT_EVENTS;
+            modes.push(state_path(format!("{e}.kind"), "event (last kind)".into(), "#7f7f7f"));
+            modes.push(state_path(format!("{e}.contact"), "event (contact)".into(), "#7f7f7f"));
+        }
+        add("StateTransitions!modes", "slip / stick", state_transitions(modes));
+        if events {
+            add("Table!events", "events", json!({"topicPath": topics::CONTACT_EVENTS, "foxglovePanelTitle": "Last contact event", "lichtblickPanelTitle": "Last contact event"}));
+        }
     }
     add("Plot!energy_per_joint", "energy", plot("Electric energy per joint", "energy [J]", per_joint(input, topics::ENERGY, "electric_energy", "E")));
     let e = topics::ENERGY;
@@ -379,11 +431,28 @@ impl LayoutInput {
         Ok(LayoutInput {
             title: run.scene.clone(),
             joint_names: run.joint_names.clone(),
-            runs: vec![LayoutRun { run: run.run.clone(), contacts: run.contacts.clone(), has_contact_topic: rec.channel(topics::CONTACTS).is_some() }],
+            runs: vec![LayoutRun {
+                run: run.run.clone(),
+                contacts: run.contacts.clone(),
+                has_contact_topic: rec.channel(topics::CONTACTS).is_some(),
+                frictional: frictional(rec, &run.contacts)?,
+                has_contact_events: rec.channel(topics::CONTACT_EVENTS).is_some(),
+            }],
             focus,
             camera_distance_m,
         })
     }
+}
+
+/// Per contact of `names`, whether it is on `rec`'s `/contact_friction` (μ > 0 in the record
+/// `contacts`); empty when the recording has no `/contact_friction`.
+fn frictional(rec: &crate::Recording, names: &[String]) -> Result<Vec<bool>, crate::Error> {
+    if rec.channel(topics::CONTACT_FRICTION).is_none() {
+        return Ok(Vec::new());
+    }
+    let record = rec.record_opt::<crate::ContactsRecord>()?;
+    let mu = |n: &String| record.as_ref().and_then(|r| r.contacts.iter().find(|c| &c.name == n)).and_then(|c| c.friction).unwrap_or(0.0);
+    Ok(names.iter().map(|n| mu(n) > 0.0).collect())
 }
 
 /// The layout's file name for `name`: a recording's file stem (`sim` writes one beside each
@@ -400,6 +469,9 @@ pub fn topics_named(layout: &Value) -> Vec<String> {
         for c in configs.values() {
             if let Some(t) = c.get("topics").and_then(Value::as_object) {
                 out.extend(t.keys().cloned());
+            }
+            if let Some(t) = c.get("topicPath").and_then(Value::as_str) {
+                out.push(t.to_string());
             }
             for p in c.get("paths").and_then(Value::as_array).into_iter().flatten() {
                 let v = p.get("value").and_then(Value::as_str).unwrap_or("");
@@ -423,10 +495,16 @@ mod tests {
             title: "paper".into(),
             joint_names: (1..=3).map(|k| format!("joint{k}")).collect(),
             runs: vec![
-                LayoutRun { run: "two".into(), contacts: vec!["elbow4".into(), "elbow7".into()], has_contact_topic: false },
-                LayoutRun { run: "one".into(), contacts: vec!["elbow4".into()], has_contact_topic: false },
-                LayoutRun { run: "uni".into(), contacts: vec!["joint3".into(), "elbow4".into()], has_contact_topic: true },
-                LayoutRun { run: "uni2".into(), contacts: vec!["elbow4".into()], has_contact_topic: true },
+                LayoutRun { run: "two".into(), contacts: vec!["elbow4".into(), "elbow7".into()], ..Default::default() },
+                LayoutRun { run: "one".into(), contacts: vec!["elbow4".into()], ..Default::default() },
+                LayoutRun {
+                    run: "uni".into(),
+                    contacts: vec!["joint3".into(), "elbow4".into()],
+                    has_contact_topic: true,
+                    frictional: vec![false, true],
+                    has_contact_events: true,
+                },
+                LayoutRun { run: "uni2".into(), contacts: vec!["elbow4".into()], has_contact_topic: true, ..Default::default() },
             ],
             focus: [0.5, 0.0, 0.2],
             camera_distance_m: 3.0,
@@ -467,7 +545,7 @@ mod tests {
         let configs = l["configById"].as_object().unwrap();
         let tabs = configs["Tab!plots"]["tabs"].as_array().unwrap();
         let titles: Vec<&str> = tabs.iter().map(|t| t["title"].as_str().unwrap()).collect();
-        assert_eq!(titles, ["motors", "contacts", "contacts (unilateral)", "slip / stick", "energy", "balance"]);
+        assert_eq!(titles, ["motors", "contacts", "contacts (unilateral)", "slip / stick", "events", "energy", "balance"]);
         let mut in_tabs = 0;
         for t in tabs {
             let mut ids = Vec::new();
@@ -482,8 +560,9 @@ mod tests {
                 }
             }
             leaves(&t["layout"], &mut ids);
-            assert!((1..=2).contains(&ids.len()), "{}: {ids:?}", t["title"]);
-            in_tabs += ids.len();
+            let plots = ids.iter().filter(|i| i.starts_with("Plot!")).count();
+            assert!(plots <= 2 && (1..=3).contains(&ids.len()), "{}: {ids:?}", t["title"]);
+            in_tabs += plots;
         }
         let plots: Vec<(&String, &Value)> = configs.iter().filter(|(k, _)| k.starts_with("Plot!")).collect();
         assert_eq!(in_tabs, plots.len());
@@ -496,11 +575,55 @@ mod tests {
         assert_eq!(l["layout"]["second"], "Tab!plots");
     }
 
+    /// The slip/stick tab (issue 27 item 4): slip speed and friction use of the frictional
+    /// contacts only (entry 1 of run `uni`: its joint3 has no friction), from
+    /// `/contact_friction`; the mode of every contact of `/contacts` and the events as bands;
+    /// the events table in a tab of its own. Without friction or events, none of theirs.
+    #[test]
+    fn the_slip_stick_tab_has_the_frictional_contacts_modes_and_events() {
+        let l = foxglove(&input());
+        let configs = l["configById"].as_object().unwrap();
+        let values = |id: &str| -> Vec<String> { configs[id]["paths"].as_array().unwrap().iter().map(|p| p["value"].as_str().unwrap().to_string()).collect() };
+        assert_eq!(values("Plot!slip_speed"), ["/contact_friction.slip_speed[1]"]);
+        assert_eq!(values("Plot!friction_use"), ["/contact_friction.friction_use[1]", "1"]);
+        assert_eq!(configs["Plot!friction_use"]["paths"][0]["label"], "elbow4 |f_t|/(μ f_n)");
+        assert_eq!(values("StateTransitions!modes"), ["/contacts.mode[0]", "/contacts.mode[1]", "/contact_events.kind", "/contact_events.contact"]);
+        assert_eq!(configs["StateTransitions!modes"]["isSynced"], true);
+        assert_eq!(configs["Table!events"]["topicPath"], "/contact_events");
+        let tabs = configs["Tab!plots"]["tabs"].as_array().unwrap();
+        let slip = tabs.iter().find(|t| t["title"] == "slip / stick").unwrap();
+        let mut ids = Vec::new();
+        fn leaves(v: &Value, out: &mut Vec<String>) {
+            match v {
+                Value::String(s) => out.push(s.clone()),
+                v => {
+                    leaves(&v["first"], out);
+                    leaves(&v["second"], out);
+                }
+            }
+        }
+        leaves(&slip["layout"], &mut ids);
+        assert_eq!(ids, ["Plot!slip_speed", "Plot!friction_use", "StateTransitions!modes"]);
+        assert!(topics_named(&l).contains(&"/contact_friction".to_string()) && topics_named(&l).contains(&"/contact_events".to_string()));
+
+        let mut i = input();
+        for r in &mut i.runs {
+            r.frictional.clear();
+            r.has_contact_events = false;
+        }
+        let l = foxglove(&i);
+        let configs = l["configById"].as_object().unwrap();
+        assert!(!configs.contains_key("Plot!slip_speed") && !configs.contains_key("Plot!friction_use") && !configs.contains_key("Table!events"));
+        assert_eq!(configs["StateTransitions!modes"]["paths"].as_array().unwrap().len(), 2);
+        let named = topics_named(&l);
+        assert!(!named.contains(&"/contact_friction".to_string()) && !named.contains(&"/contact_events".to_string()), "{named:?}");
+    }
+
     /// A scene without contacts has neither contact plot.
     #[test]
     fn no_contacts_no_contact_plots() {
         let mut i = input();
-        i.runs = vec![LayoutRun { run: "free".into(), contacts: vec![], has_contact_topic: false }];
+        i.runs = vec![LayoutRun { run: "free".into(), ..Default::default() }];
         let l = foxglove(&i);
         let configs = l["configById"].as_object().unwrap();
         assert!(!configs.contains_key("Plot!constraint_forces") && !configs.contains_key("Plot!contact_forces"));

@@ -45,7 +45,7 @@ pub mod writer;
 pub use error::Error;
 pub use messages::{
     frame_transform, hand_points, set_hand_points, timestamp, HAND_ACTUAL_RGBA, HAND_DESIRED_RGBA, ConstraintState, EnergyState, HandState, JointState,
-    Message, MotorState, MotorThermalState, Quat, RosString, TopicMessage, TransformEntry, Transforms, Vec3, contact_event_kind, contact_mode, ContactEventMsg, ContactState, SupplyState, CONTACT_EVENT_KINDS,
+    Message, MotorState, MotorThermalState, Quat, RosString, TopicMessage, TransformEntry, Transforms, Vec3, contact_event_kind, contact_mode, ContactEventMsg, ContactFriction, ContactState, SupplyState, CONTACT_EVENT_KINDS,
 };
 pub use meta::{
     AuditBounds, ContactAudit, ContactAuditRecord, ContactAuditor, ContactLaws, Worst, ContactInfo, ContactsRecord, EnergyTermsRecord, IntegratorInfo, LimitEventInfo, LimitsRecord, MetadataRecord, ModelInfo, RecordingInfo,

@@ -195,6 +195,49 @@ pub struct ContactState {
     pub damping_loss: Vec<f64>,
 }
 
+/// What Foxglove cannot combine from [`ContactState`] (topic
+/// [`crate::topics::CONTACT_FRICTION`]; only in runs with a frictional unilateral or compliant
+/// contact): per contact, in the order of `name` (= `/contacts`' and metadata `run.contacts`),
+/// the slip speed, the friction use and the mode, at the same log times as `/contacts`.
+/// Computed from the `/contacts` sample by [`ContactFriction::set`].
+#[derive(Debug, Clone, PartialEq, Default, foxglove::Encode, Deserialize)]
+pub struct ContactFriction {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Contact names, in array order (= `/contacts`' `name`).
+    pub name: Vec<String>,
+    /// Mode code, as `/contacts`' `mode`: 0 separated, 1 sticking, 2 sliding, 3 bilateral.
+    pub mode: Vec<u32>,
+    /// Slip speed |v_t| = √(v_t1² + v_t2²) of the point relative to the plane, m/s.
+    pub slip_speed: Vec<f64>,
+    /// Friction use |f_t| / (μ f_n), 1: how much of the Coulomb cone the friction force takes
+    /// (≤ 1 sticking, 1 sliding for a rigid contact; below 1 in a compliant contact's regularised
+    /// slip). 0 where μ f_n ≤ 0: a separated contact (f_n = 0, no friction force; its mode says
+    /// separated), a frictionless one (μ = 0) or a bilateral one (no friction law).
+    pub friction_use: Vec<f64>,
+}
+
+impl ContactFriction {
+    /// This message from the `/contacts` sample `s` and each contact's friction coefficient
+    /// `mu` (in `s`'s order; 0 for a frictionless or bilateral contact). The names are copied
+    /// only when they differ, the arrays reused: no allocation once they have their size.
+    pub fn set(&mut self, s: &ContactState, mu: &[f64]) {
+        self.time = s.time;
+        if self.name != s.name {
+            self.name.clone_from(&s.name);
+        }
+        self.mode.clone_from(&s.mode);
+        self.slip_speed.clear();
+        self.slip_speed.extend(s.slip_velocity_t1.iter().zip(&s.slip_velocity_t2).map(|(a, b)| a.hypot(*b)));
+        self.friction_use.clear();
+        for k in 0..s.normal_force.len() {
+            let cone = mu.get(k).copied().unwrap_or(0.0) * s.normal_force[k];
+            let f_t = s.friction_force_t1.get(k).copied().unwrap_or(0.0).hypot(s.friction_force_t2.get(k).copied().unwrap_or(0.0));
+            self.friction_use.push(if cone > 0.0 { f_t / cone } else { 0.0 });
+        }
+    }
+}
+
 /// The electric supply behind the drives (topic [`crate::topics::SUPPLY`]; only runs whose
 /// scene has a `supply`, absent from every other recording). Powers at the sample, energies
 /// cumulative from t = 0; `energy = Σ E_j + dumped + loss` (E_j = ∫ i v dt of `/energy`).
@@ -294,6 +337,9 @@ impl TopicMessage for MotorThermalState {
 }
 impl TopicMessage for ContactState {
     const TOPIC: &'static str = topics::CONTACTS;
+}
+impl TopicMessage for ContactFriction {
+    const TOPIC: &'static str = topics::CONTACT_FRICTION;
 }
 impl TopicMessage for SupplyState {
     const TOPIC: &'static str = topics::SUPPLY;
@@ -430,7 +476,7 @@ macro_rules! protobuf_message {
     )*};
 }
 
-protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg, MotorThermalState, SupplyState);
+protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg, MotorThermalState, SupplyState, ContactFriction);
 
 // every Foxglove well-known schema, so `sim` can record any of them without touching this crate
 use foxglove::messages as fm;

@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use foxglove::messages as fm;
 use prost_reflect::{Cardinality, DescriptorPool, Kind};
 
-use crate::messages::{ConstraintState, ContactEventMsg, ContactState, EnergyState, HandState, JointState, Message, MotorState, MotorThermalState, RosString, SupplyState};
+use crate::messages::{ConstraintState, ContactEventMsg, ContactFriction, ContactState, EnergyState, HandState, JointState, Message, MotorState, MotorThermalState, RosString, SupplyState};
 use crate::topics::{self, ArrayIndex};
 use crate::units;
 
@@ -60,6 +60,11 @@ fn topic_docs() -> Vec<TopicDoc> {
         doc::<fm::PointCloud>(topics::HAND_POINTS, EVERY, "the actual and desired hand as two coloured points (Foxglove's rgba fields)"),
         doc::<ContactState>(topics::CONTACTS, CONTACTS_EVERY, "per contact: mode, gap, gap rate, normal and friction force, slip velocity, cumulative losses"),
         doc::<ContactEventMsg>(topics::CONTACT_EVENTS, CONTACTS, "one message per contact event (lift-off, touch-down, impact, rest, stick ↔ slip), at its time"),
+        doc::<ContactFriction>(
+            topics::CONTACT_FRICTION,
+            "runs with a unilateral or compliant contact whose friction coefficient μ > 0, every sample",
+            "per contact: slip speed ‖v_t‖, friction use ‖f_t‖/(μ f_n) (0 where μ f_n = 0: separated, frictionless or bilateral) and mode, for plots",
+        ),
         doc::<SupplyState>(topics::SUPPLY, "runs whose scene has a `supply`, every sample", "the supply's power, the bus power, and the energy delivered, regenerated, dumped and lost, cumulative"),
         doc::<MotorThermalState>(
             topics::MOTOR_TEMPERATURES,
@@ -232,7 +237,7 @@ mod tests {
     #[test]
     fn every_topic_and_every_unit_is_on_the_page() {
         let page = topics_markdown();
-        for t in topics::ALL.iter().chain(&topics::CONTACT_TOPICS).chain(&topics::VIEWER_TOPICS).chain(&topics::THERMAL_TOPICS).chain(&topics::SUPPLY_TOPICS) {
+        for t in topics::ALL.iter().chain(&topics::CONTACT_TOPICS).chain(&topics::VIEWER_TOPICS).chain(&topics::THERMAL_TOPICS).chain(&topics::SUPPLY_TOPICS).chain(&topics::FRICTION_TOPICS) {
             assert!(page.contains(&format!("\n## {t}\n")), "{t} has no section");
         }
         // every unit of the units table appears on its topic's section

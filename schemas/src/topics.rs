@@ -31,6 +31,16 @@ pub const CONTACTS: &str = "/contacts";
 /// with a non-bilateral contact; not in [`ALL`].
 pub const CONTACT_EVENTS: &str = "/contact_events";
 
+/// [`crate::ContactFriction`]: per contact (the entries of `/contacts`) the slip speed |v_t|, the
+/// friction use |f_t|/(μ f_n) and the mode, every sample: what Foxglove's plots cannot combine
+/// from `/contacts` (a plot series is one field). Only in runs with a unilateral or compliant
+/// contact whose friction coefficient μ is above 0 ([`FRICTION_TOPICS`]); not in [`ALL`], so a
+/// run without friction (the paper's bilateral ones) writes nothing new.
+pub const CONTACT_FRICTION: &str = "/contact_friction";
+/// The topics only runs with a frictional non-bilateral contact have, registered after
+/// [`CONTACT_TOPICS`].
+pub const FRICTION_TOPICS: [&str; 1] = [CONTACT_FRICTION];
+
 /// [`crate::SupplyState`]: the supply's power and energies (delivered, regenerated, dumped,
 /// lost). Only in runs whose scene has a `supply` ([`SUPPLY_TOPICS`]); not in [`ALL`].
 pub const SUPPLY: &str = "/supply";
@@ -105,6 +115,7 @@ pub fn array_required(topic: &str, field: &str) -> bool {
         (topic, field),
         (MOTORS, "current") | (ENERGY, "link_work" | "electric_energy") | (CONSTRAINTS, "normal_force" | "position" | "velocity")
             | (CONTACTS, "name" | "mode" | "gap" | "gap_rate" | "normal_force")
+            | (CONTACT_FRICTION, "name" | "mode" | "slip_speed" | "friction_use")
     )
 }
 
@@ -130,6 +141,7 @@ pub fn array_index(topic: &str, field: &str) -> Option<ArrayIndex> {
             "name" | "mode" | "gap" | "gap_rate" | "normal_force" | "friction_force_t1" | "friction_force_t2" | "slip_velocity_t1"
             | "slip_velocity_t2" | "impact_loss" | "friction_work" | "damping_loss",
         ) => Some(ArrayIndex::Contact),
+        (CONTACT_FRICTION, "name" | "mode" | "slip_speed" | "friction_use") => Some(ArrayIndex::Contact),
         (JOINT_STATES, "position" | "velocity" | "effort") => Some(ArrayIndex::Joint),
         (MOTOR_TEMPERATURES, "winding_temperature" | "housing_temperature" | "resistance" | "copper_loss" | "name") => Some(ArrayIndex::Joint),
         _ => None,

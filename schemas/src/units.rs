@@ -64,6 +64,7 @@ pub fn fields(topic: &str) -> &'static [(&'static str, &'static str)] {
             ("friction_work", "J"),
             ("damping_loss", "J"),
         ],
+        topics::CONTACT_FRICTION => &[("time", "s"), ("slip_speed", "m/s"), ("friction_use", "1")],
         topics::CONTACT_EVENTS => &[
             ("time", "s"),
             ("impulse", "N·s"),
@@ -143,6 +144,7 @@ mod tests {
         check::<crate::EnergyState>(topics::ENERGY);
         check::<crate::ContactState>(topics::CONTACTS);
         check::<crate::ContactEventMsg>(topics::CONTACT_EVENTS);
+        check::<crate::ContactFriction>(topics::CONTACT_FRICTION);
         check::<crate::MotorThermalState>(topics::MOTOR_TEMPERATURES);
     }
 

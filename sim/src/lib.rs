@@ -27,3 +27,4 @@ pub mod precision;
 pub mod ode;
 pub mod replay;
 pub mod sweep;
+pub mod study;

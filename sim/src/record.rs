@@ -19,13 +19,15 @@
 //! `/contacts` (mode, gap, forces, slip, cumulative contact losses per contact, every sample),
 //! `/contact_events` (one message per event at the event time, written before the sample that
 //! follows it), the metadata record `contacts` (models, parameters, planes, tangent bases, event
-//! settings) and the contact totals in `energy_terms`. Purely bilateral runs (the paper's) write
+//! settings) and the contact totals in `energy_terms`; those with a frictional one (μ > 0) also
+//! `/contact_friction` (slip speed, friction use |f_t|/(μ f_n), mode per contact, from the
+//! `/contacts` sample: the slip/stick tab of their Foxglove layout plots it). Purely bilateral runs (the paper's) write
 //! none of these: their recordings are byte for byte what they were.
 
 use std::path::{Path, PathBuf};
 
 use schemas::{
-    frame_transform, hand_points, set_hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactInfo, ContactState,
+    frame_transform, hand_points, set_hand_points, timestamp, to_log_time, topics, ConstraintState, ContactEventMsg, ContactFriction, ContactInfo, ContactState,
     ContactsRecord, EnergyState, EnergyTermsRecord, FrameTransforms, HandState, LimitEventInfo, LimitsRecord,
     JointState, Mirror, ModelInfo, MotorState, MotorThermalState, RecordingInfo, RecordingWriter, RosString, RunInfo, RunResult,
     SceneRecord, Setup, Tap, Tapped, UrdfRecord, Vec3, WriterOptions,
@@ -144,6 +146,9 @@ pub fn layout_input(scene: &Scene) -> schemas::layout::LayoutInput {
                 run: r.name.clone(),
                 contacts: run_contacts(scene, r).iter().map(|c| c.name().to_string()).collect(),
                 has_contact_topic: scene.run_is_hybrid(r),
+                frictional: friction_coefficients(&run_contacts(scene, r)).map(|mu| mu.iter().map(|&m| m > 0.0).collect()).unwrap_or_default(),
+                // whether the run has events is known after it: `sim` sets it then
+                has_contact_events: false,
             })
             .collect(),
         focus,
@@ -197,6 +202,20 @@ pub fn contacts_record(contacts: &[Contact], settings: &ContactSettings) -> Cont
     }
 }
 
+/// Each contact's Coulomb friction coefficient μ, in the order of `contacts` (0 for a bilateral
+/// contact: no friction law), when a non-bilateral one has μ > 0 (the run gets
+/// `/contact_friction`); `None` otherwise (nothing new is written).
+fn friction_coefficients(contacts: &[Contact]) -> Option<Vec<f64>> {
+    let mu: Vec<f64> = contacts
+        .iter()
+        .map(|c| match c.model {
+            ContactModel::Bilateral => 0.0,
+            ContactModel::Unilateral { friction, .. } | ContactModel::Compliant { friction, .. } => friction,
+        })
+        .collect();
+    mu.iter().any(|&m| m > 0.0).then_some(mu)
+}
+
 /// Writes one run. Create, `record` every sample, then `finish` (or `fail`).
 pub struct Recorder<'a> {
     scene: &'a Scene,
@@ -233,6 +252,9 @@ pub struct Recorder<'a> {
     /// The last sample's gear loss and supply energy, regenerated, dumped, loss (record
     /// `energy_terms`, scenes with `gear_friction` or `supply`).
     drive_terms: [f64; 5],
+    /// `/contact_friction` and each contact's friction coefficient μ (0 for a frictionless or
+    /// bilateral one), in the run's order: `Some` when a non-bilateral contact has μ > 0.
+    friction: Option<(ContactFriction, Vec<f64>)>,
     /// The contact audit (hybrid runs): every `/contacts` sample checked against its model's
     /// laws; record `contact_audit` and the count in `result` at the end.
     audit: Option<schemas::ContactAuditor>,
@@ -390,6 +412,7 @@ impl<'a> Recorder<'a> {
             supply: scene.supply.is_some().then(schemas::SupplyState::default),
             drive_terms: [0.0; 5],
             audit,
+            friction: friction_coefficients(contacts).map(|mu| (ContactFriction::default(), mu)),
             thermal: scene.thermal.as_ref().map(|_| MotorThermalState { name: scene.model.joint_names(), ..Default::default() }),
             heat: [0.0; 2],
         })
@@ -517,6 +540,10 @@ impl<'a> Recorder<'a> {
                 audit.sample(o.t, cs);
             }
             self.writer.write(topics::CONTACTS, t_ns, &self.contact_state).map_err(&err)?;
+            if let Some((msg, mu)) = self.friction.as_mut() {
+                msg.set(&self.contact_state, mu);
+                self.writer.write(topics::CONTACT_FRICTION, t_ns, &*msg).map_err(&err)?;
+            }
         }
         self.drive_terms[0] = o.loss_gear;
         if let (Some(st), Some(sup)) = (self.supply.as_mut(), o.supply) {

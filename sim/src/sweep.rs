@@ -163,6 +163,33 @@ pub fn set_path(doc: &mut Value, path: &str, value: Value) -> Result<(), String>
     unreachable!("the loop returns at the last segment")
 }
 
+/// Why a replacement does not make a well-formed scene JSON ([`check_replacement`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum BadReplacement {
+    /// The dot path itself: not in the scene, or not a place a value can go.
+    Field(String),
+    /// The value, at that path.
+    Value(String),
+}
+
+/// Whether replacing the node at `field` of the scene JSON `base` by `value` gives a
+/// well-formed scene (the keys and types; the numbers are the scene validation's to check).
+/// The one check of a sweep's axes and a study's variables.
+pub fn check_replacement(base: &Value, field: &str, value: &Value) -> Result<(), BadReplacement> {
+    let mut doc = base.clone();
+    set_path(&mut doc, field, value.clone()).map_err(BadReplacement::Field)?;
+    if let Err(e) = serde_path_to_error::deserialize::<_, SceneSpec>(doc) {
+        let at = e.path().to_string().replace('[', ".").replace(']', "");
+        let why = e.inner().to_string();
+        return Err(if at == field && why.starts_with("unknown field") {
+            BadReplacement::Field(format!("no such field in the scene: {why}"))
+        } else {
+            BadReplacement::Value(format!("not valid at `{at}` of the scene: {why}"))
+        });
+    }
+    Ok(())
+}
+
 /// Compact text of a JSON value (for tables and messages).
 pub fn compact(v: &Value) -> String {
     serde_json::to_string(v).unwrap_or_default()
@@ -178,7 +205,7 @@ pub enum SweepError {
     Variant { file: String, variant: String, replacements: String, source: Box<SceneError> },
 }
 
-fn valid_name(s: &str) -> bool {
+pub(crate) fn valid_name(s: &str) -> bool {
     !s.is_empty() && s.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch))
 }
 
@@ -232,7 +259,14 @@ impl Sweep {
     pub fn load(path: &Path) -> Result<Sweep, SweepError> {
         let file = path.display().to_string();
         let text = read_text(path, MAX_INPUT_BYTES).map_err(|e| SceneError::new(&file, "(file)", "", e.to_string()))?;
-        let spec = parse_spec(&text, &file)?;
+        let spec: SweepSpec = parse_spec(&text, &file)?;
+        Self::from_spec_at(spec, path)
+    }
+
+    /// A sweep from its parsed `spec`, read from `path` (its `scene` is relative to the file's
+    /// directory): the study (`crate::study`) loads its base scene through this.
+    pub fn from_spec_at(spec: SweepSpec, path: &Path) -> Result<Sweep, SweepError> {
+        let file = path.display().to_string();
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let (scene_source, scene_text, urdf) = match &spec.scene {
             None => ("built-in paper scene".to_string(), PAPER_SCENE_JSON.to_string(), UrdfSource::BuiltIn),
@@ -248,7 +282,7 @@ impl Sweep {
 
     /// A sweep of the built-in paper scene from sweep JSON text (`scene` must be absent).
     pub fn from_json_paper(text: &str, file: &str) -> Result<Sweep, SweepError> {
-        let spec = parse_spec(text, file)?;
+        let spec: SweepSpec = parse_spec(text, file)?;
         if let Some(s) = &spec.scene {
             return Err(SceneError::new(file, "scene", s, "not available here (only the built-in paper scene)").into());
         }
@@ -307,18 +341,10 @@ impl Sweep {
             // every value of the axis must make a well-formed scene JSON, checked here (before
             // anything runs); the numbers are validated per variant
             for (j, v) in axis.values.iter().enumerate() {
-                let mut doc = base.clone();
-                set_path(&mut doc, &axis.field, v.clone()).map_err(|why| err(&f, &axis.field, why))?;
-                if let Err(e) = serde_path_to_error::deserialize::<_, SceneSpec>(doc) {
-                    let at = e.path().to_string().replace('[', ".").replace(']', "");
-                    let why = e.inner().to_string();
-                    return Err(if at == axis.field && why.starts_with("unknown field") {
-                        err(&f, &axis.field, format!("no such field in the scene: {why}"))
-                    } else {
-                        err(&format!("axes[{a}].values[{j}]"), &compact(v), format!("not valid at `{at}` of the scene: {why}"))
-                    }
-                    .into());
-                }
+                check_replacement(&base, &axis.field, v).map_err(|bad| match bad {
+                    BadReplacement::Field(why) => err(&f, &axis.field, why),
+                    BadReplacement::Value(why) => err(&format!("axes[{a}].values[{j}]"), &compact(v), why),
+                })?;
             }
             lens.push(axis.values.len());
         }
@@ -361,11 +387,7 @@ impl Sweep {
     pub fn scene(&self, v: &Variant) -> Result<Scene, SweepError> {
         let text = serde_json::to_string(&self.variant_json(v)).expect("JSON values serialise");
         let source = format!("{} (sweep variant {})", self.scene_source, v.name);
-        let read_urdf = |name: &str| match &self.urdf {
-            UrdfSource::BuiltIn if name == "paper_arm.urdf" => Ok(PAPER_URDF.to_string()),
-            UrdfSource::BuiltIn => Err(format!("the built-in scene has no file `{name}`")),
-            UrdfSource::Dir(dir) => crate::scene::read_urdf_file(dir, name),
-        };
+        let read_urdf = |name: &str| self.read_urdf(name);
         // the scene's directory: robot.package_paths are relative to it
         let dir = match &self.urdf {
             UrdfSource::Dir(dir) => Some(dir.as_path()),
@@ -390,13 +412,22 @@ impl Sweep {
         Ok(scene)
     }
 
+    /// The text of the base scene's URDF file `name` (as the scene names it).
+    pub fn read_urdf(&self, name: &str) -> Result<String, String> {
+        match &self.urdf {
+            UrdfSource::BuiltIn if name == "paper_arm.urdf" => Ok(PAPER_URDF.to_string()),
+            UrdfSource::BuiltIn => Err(format!("the built-in scene has no file `{name}`")),
+            UrdfSource::Dir(dir) => crate::scene::read_urdf_file(dir, name),
+        }
+    }
+
     /// The recording file name of `run` of variant `v` (what `sim run` would write).
     pub fn file_name(v: &Variant, run: &str) -> String {
         format!("{}-{run}.mcap", v.name)
     }
 }
 
-fn parse_spec(text: &str, file: &str) -> Result<SweepSpec, SceneError> {
+pub(crate) fn parse_spec<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, SceneError> {
     let de = &mut serde_json::Deserializer::from_str(text);
     // a top-level "$schema" (for editors) is dropped
     serde_path_to_error::deserialize(SkipSchemaKey(de)).map_err(|e| {

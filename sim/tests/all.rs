@@ -13,8 +13,12 @@ mod arms_load;
 mod bad_input;
 #[path = "by_hand.rs"]
 mod by_hand;
+#[path = "contact_friction_topic.rs"]
+mod contact_friction_topic;
 #[path = "contact_shapes.rs"]
 mod contact_shapes;
+#[path = "contacts_converge.rs"]
+mod contacts_converge;
 #[path = "contacts_exact.rs"]
 mod contacts_exact;
 #[path = "contacts_paper.rs"]

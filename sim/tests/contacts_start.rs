@@ -1,8 +1,9 @@
 //! Contacts whose event functions start on their firing side (the review of issue 11, F1 and
 //! F4): the event driver watches such a function from its start value
 //! (`sim/src/integrate/events.rs`), so a contact closed with f_n = 0 whose force then turns
-//! negative lifts off at once instead of pulling, and a slip that starts slower than the stick
-//! speed (1e-6 m/s) stops at once instead of reversing under a frozen friction direction.
+//! negative lifts off at once instead of pulling, and a slip that starts very slow (below the
+//! 1e-6 m/s under which the friction direction is frozen) stops at its located zero instead of
+//! reversing under a frozen friction direction.
 
 use crate::contacts_support::*;
 use serde_json::json;
@@ -33,25 +34,28 @@ fn a_ball_resting_with_zero_force_lifts_off_at_once_when_pulled() {
     }
 }
 
-/// A block sliding at 5e-7 m/s, below the stick speed 1e-6 m/s at which a slip ends (README,
-/// "Slip → stick"): its slip-to-stick function starts on its firing side, and as friction slows
-/// the block it fires at t0: the slip stops at once (the remaining 5e-7 m/s removed by the
-/// velocity projection, its ½ m v² booked as friction work). Before the fix the friction
-/// direction stayed frozen and pushed the block backwards (it ended 7.6e-14 m behind its start).
-/// Checked: one slip-to-stick at t = 0, then sticking with x ≥ 0 and |ẋ| ≤ 1e-12 m/s, and the
-/// friction work ½ m v₀² to 1e-9 relative, never decreasing.
+/// A block sliding at 5e-7 m/s (below the 1e-6 m/s under which the friction direction is frozen,
+/// `dynamics/contact/forward.rs`): friction μ m g slows it and the slip stops at its located
+/// zero, `t_s = v₀/(μ g)` = 1.02e-7 s (issue 23 item 2; the old rule stopped it at t0 by a stick
+/// speed), never reversing (before the review's fix the frozen direction pushed it backwards to
+/// 7.6e-14 m behind its start). Checked: one slip-to-stick at t_s to 1e-12 s, then sticking with
+/// x = v₀²/(2 μ g) (1e-9 relative) and |ẋ| ≤ 1e-12 m/s, and the friction work ½ m v₀² to 1e-9
+/// relative, never decreasing.
 #[test]
-fn a_slip_slower_than_the_stick_speed_stops_at_once() {
-    let v0 = 5e-7;
+fn a_very_slow_slip_stops_at_its_located_zero_without_reversing() {
+    let (v0, mu) = (5e-7, 0.5);
     let mut s = passive_scene("ball", &["x", "y", "z"], &[0.0; 3], &[v0, 0.0, 0.0], [0.0, 0.0, -G], 0.01, 1e-12);
-    add_table_contact(&mut s, "floor", json!({"link": "ball"}), json!({"model": "unilateral", "friction": 0.5}));
+    add_table_contact(&mut s, "floor", json!({"link": "ball"}), json!({"model": "unilateral", "friction": mu}));
     let c = collect(&load(&s, &point_urdf(1.0)), "r");
-    let kinds: Vec<(f64, ContactEventKind)> = c.events.iter().map(|e| (e.t, e.kind)).collect();
-    assert_eq!(kinds, vec![(0.0, ContactEventKind::SlipToStick)]);
+    let kinds: Vec<ContactEventKind> = c.events.iter().map(|e| e.kind).collect();
+    assert_eq!(kinds, vec![ContactEventKind::SlipToStick]);
+    let t_s = v0 / (mu * G);
+    assert!((c.events[0].t - t_s).abs() <= 1e-12, "stops at {} s, v₀/(μ g) = {t_s} s", c.events[0].t);
+    let d = v0 * v0 / (2.0 * mu * G);
     let mut w_prev = 0.0;
     for o in &c.samples[1..] {
         assert_eq!(o.contacts[0].mode, ContactMode::Sticking, "t = {}", o.t);
-        assert!(o.q[0] >= 0.0 && o.qd[0].abs() <= 1e-12, "t = {}: x = {}, x' = {}", o.t, o.q[0], o.qd[0]);
+        assert!((o.q[0] - d).abs() <= 1e-9 * d && o.qd[0].abs() <= 1e-12, "t = {}: x = {}, x' = {}, want x = {d}", o.t, o.q[0], o.qd[0]);
         let w = o.contacts[0].friction_work;
         assert!(w >= w_prev, "friction work decreased at t = {}: {w} < {w_prev}", o.t);
         w_prev = w;
@@ -61,8 +65,8 @@ fn a_slip_slower_than_the_stick_speed_stops_at_once() {
 }
 
 /// Two point masses (1 kg and 3 kg, on joints of their own: M is block-diagonal) resting on the
-/// table, each sliding slower than the stick speed in its own direction (5e-7 m/s along x,
-/// 3e-7 m/s along −y): both slips stop at t0 in one projection, and each contact's friction work
+/// table, each sliding slowly in its own direction (5e-7 m/s along x, 3e-7 m/s along −y): each
+/// slip stops at its own located zero |v|/(μ g) (1e-12 s), and each contact's friction work
 /// must be ITS ball's ½ m v², to 1e-9 relative. The total alone is the projection's
 /// kinetic-energy loss by construction (`sim/src/ode/stop_slip.rs` books it so); the split
 /// between the contacts is what this checks: booking the loss on one contact, or splitting it
@@ -89,8 +93,12 @@ fn two_slips_stopping_at_once_each_book_their_own_kinetic_energy() {
     add_table_contact(&mut s, "floor1", json!({"link": "ball1"}), json!({"model": "unilateral", "friction": 0.5}));
     add_table_contact(&mut s, "floor2", json!({"link": "ball2"}), json!({"model": "unilateral", "friction": 0.5}));
     let c = collect(&load(&s, &urdf), "r");
-    let stops: Vec<f64> = c.events.iter().filter(|e| e.kind == ContactEventKind::SlipToStick).map(|e| e.t).collect();
-    assert_eq!(stops, vec![0.0, 0.0], "both slips stop at t0: {:?}", c.events);
+    let stops: Vec<(usize, f64)> = c.events.iter().filter(|e| e.kind == ContactEventKind::SlipToStick).map(|e| (e.contact, e.t)).collect();
+    assert_eq!(stops.len(), 2, "both slips stop: {:?}", c.events);
+    for (k, t) in stops {
+        let v = [v1, v2][k];
+        assert!((t - v.abs() / (0.5 * G)).abs() <= 1e-12, "contact {k} stops at {t} s, |v|/(μ g) = {} s", v.abs() / (0.5 * G));
+    }
     let last = c.samples.last().expect("samples");
     for (k, (m, v)) in [(m1, v1), (m2, v2)].into_iter().enumerate() {
         assert_eq!(last.contacts[k].mode, ContactMode::Sticking, "contact {k}");

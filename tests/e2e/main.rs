@@ -23,6 +23,7 @@ mod sampled_energy;
 mod scene_schema;
 mod sim_bad_input;
 mod sim_list;
+mod sim_optimize;
 mod sim_output;
 mod sim_sweep;
 mod sim_table;

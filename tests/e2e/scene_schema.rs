@@ -98,6 +98,7 @@ fn repository_json() -> (Vec<(PathBuf, FileKind)>, Vec<PathBuf>) {
         match named.as_deref() {
             Some("scene.schema.json") => files.push((path, FileKind::Scene)),
             Some("sweep.schema.json") => files.push((path, FileKind::Sweep)),
+            Some("study.schema.json") => files.push((path, FileKind::Study)),
             _ => others.push(path),
         }
     }
@@ -124,7 +125,8 @@ fn every_scene_and_sweep_file_validates_against_its_schema_with_ajv() {
     assert!(scenes.len() >= 26 && sweeps.len() >= 3, "{scenes:?} {sweeps:?}");
     assert!(scenes.iter().any(|p| p.ends_with("recordings/paper-archive.json")));
     let Some(node) = ajv_or_skip("scene_schema::every_scene_and_sweep_file_validates_against_its_schema_with_ajv") else { return };
-    for (kind, list) in [(FileKind::Scene, &scenes), (FileKind::Sweep, &sweeps)] {
+    let studies: Vec<PathBuf> = files.iter().filter(|f| f.1 == FileKind::Study).map(|f| f.0.clone()).collect();
+    for (kind, list) in [(FileKind::Scene, &scenes), (FileKind::Sweep, &sweeps), (FileKind::Study, &studies)] {
         for (p, (valid, errors)) in list.iter().zip(ajv(&node, &committed_schema(kind), list)) {
             assert!(valid, "{}: not valid against sim/scenes/{}: {errors:?}", p.display(), kind.schema_file());
         }

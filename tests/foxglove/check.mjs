@@ -5,10 +5,12 @@
 // (a) the layout validates against layout.schema.json (derived from the open-source Foxglove
 //     Studio / Lichtblick types; the file says which) with ajv, and its mosaic tree names exactly
 //     the panels it configures;
-// (b) every topic the layout names exists in every recording, and every plot path resolves, in
-//     the protobuf schema embedded in the recording (FileDescriptorSet, decoded with protobufjs
-//     as Foxglove does: packages/mcap-support/src/parseProtobufSchema.ts), to a numeric field,
-//     and gives a finite number in at least one message of the recordings;
+// (b) every topic the layout names (3D topics, plot and band paths, Table panels) exists in every
+//     recording with at least one message, and every plot path resolves, in the protobuf schema
+//     embedded in the recording (FileDescriptorSet, decoded with protobufjs as Foxglove does:
+//     packages/mcap-support/src/parseProtobufSchema.ts), to a numeric field (a State
+//     Transitions band: a number or a string), and gives a finite number (a band: a number or a
+//     non-empty string) in at least one message of the recordings;
 // (c) every /scene and /contact_markers message decodes (protobufjs on the embedded descriptor,
 //     whose foxglove.* message fields are compared with @foxglove/schemas' definitions by the
 //     .proto text @foxglove/schemas generates), with the entity counts, the mode colours, the
@@ -54,6 +56,7 @@ const MODE_BY_CODE = ["separated", "sticking", "sliding"];
 const HAND_ACTUAL = [0x94, 0x67, 0xbd, 255];
 const HAND_DESIRED = [0xff, 0x7f, 0x0e, 255];
 
+const NUMERIC_OR_STRING = new Set(["string", "bool", "double", "float", "int32", "uint32", "sint32", "fixed32", "sfixed32", "int64", "uint64", "sint64", "fixed64", "sfixed64"]);
 const NUMERIC = new Set(["double", "float", "int32", "uint32", "sint32", "fixed32", "sfixed32", "int64", "uint64", "sint64", "fixed64", "sfixed64"]);
 
 async function readMcap(path, decompressHandlers) {
@@ -134,7 +137,9 @@ function checkLayout(layout) {
       const inTab = [];
       const w = (n) => (typeof n === "string" ? inTab.push(n) : n && (w(n.first), w(n.second)));
       w(t.layout);
-      if (inTab.length > 2) fail(`layout: ${id}: tab ${t.title} has ${inTab.length} plots (at most 2)`);
+      const plots = inTab.filter((p) => p.startsWith("Plot!")).length;
+      if (plots > 2) fail(`layout: ${id}: tab ${t.title} has ${plots} plots (at most 2)`);
+      if (inTab.length > 3) fail(`layout: ${id}: tab ${t.title} has ${inTab.length} panels (at most 2 plots and a band or table panel)`);
     }
   }
   const series = Object.values(layout.configById ?? {}).flatMap((c) => (c.paths ?? []).filter((p) => p.value.startsWith("/")));
@@ -155,14 +160,14 @@ function parsePath(value) {
 }
 
 // Resolve the steps in a protobufjs type: the leaf must be numeric, indices only on repeated.
-function resolveInSchema(type, steps, value) {
+function resolveInSchema(type, steps, value, leafTypes = NUMERIC) {
   let t = type;
   for (const [k, s] of steps.entries()) {
     const f = t.fields[s.field];
     if (!f) return `${value}: no field ${s.field} in ${t.fullName}`;
     f.resolve();
     if ((s.index !== undefined) !== f.repeated) return `${value}: ${s.field} is ${f.repeated ? "repeated (needs an index)" : "not repeated"}`;
-    if (k === steps.length - 1) return NUMERIC.has(f.type) ? undefined : `${value}: ${s.field} is ${f.type}, not numeric`;
+    if (k === steps.length - 1) return leafTypes.has(f.type) ? undefined : `${value}: ${s.field} is ${f.type}, not ${leafTypes === NUMERIC ? "numeric" : "a number or a string"}`;
     if (!f.resolvedType || !(f.resolvedType instanceof protobuf.Type)) return `${value}: ${s.field} is not a message`;
     t = f.resolvedType;
   }
@@ -183,11 +188,15 @@ function layoutTopics(layout) {
   const paths = [];
   for (const cfg of Object.values(layout.configById)) {
     for (const t of Object.keys(cfg.topics ?? {})) topics.add(t);
+    // a Table panel shows the latest message of its topic
+    if (typeof cfg.topicPath === "string") topics.add(cfg.topicPath);
+    // a State Transitions panel's bands take numbers and strings (mode codes, event kinds)
+    const state = Object.entries(layout.configById).some(([id, c]) => c === cfg && id.startsWith("StateTransitions!"));
     for (const p of cfg.paths ?? []) {
       const parsed = parsePath(p.value);
       if (parsed) {
         topics.add(parsed.topic);
-        paths.push({ value: p.value, ...parsed });
+        paths.push({ value: p.value, state, ...parsed });
       }
     }
   }
@@ -198,7 +207,10 @@ function layoutTopics(layout) {
 function checkPaths(layout, recs) {
   const { topics, paths } = layoutTopics(layout);
   for (const rec of recs) {
-    for (const t of topics) if (!rec.messages.has(t)) fail(`${rec.path}: the layout names ${t}, the recording has no such topic`);
+    for (const t of topics) {
+      if (!rec.messages.has(t)) fail(`${rec.path}: the layout names ${t}, the recording has no such topic`);
+      else if (rec.messages.get(t).length === 0) fail(`${rec.path}: the layout names ${t}, the recording has no message on it`);
+    }
   }
   let resolved = 0;
   for (const p of paths) {
@@ -206,14 +218,14 @@ function checkPaths(layout, recs) {
     for (const rec of recs) {
       const type = rec.types.get(p.topic)?.type;
       if (!type) continue;
-      const err = resolveInSchema(type, p.steps, p.value);
+      const err = resolveInSchema(type, p.steps, p.value, p.state ? NUMERIC_OR_STRING : NUMERIC);
       if (err) {
         fail(`${rec.path}: ${err}`);
         continue;
       }
       for (const { msg } of decodeAll(rec, p.topic)) {
         const v = valueAt(msg, p.steps);
-        if (typeof v === "number" && Number.isFinite(v)) numbers++;
+        if ((typeof v === "number" && Number.isFinite(v)) || (p.state && typeof v === "string" && v !== "")) numbers++;
       }
     }
     if (numbers === 0) fail(`plot path ${p.value}: no recording gives it a finite number`);

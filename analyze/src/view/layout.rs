@@ -50,7 +50,9 @@ fn side_direction(b: &Bounds) -> [f64; 3] {
 /// of everything it sweeps.
 pub fn side_eye(b: &Bounds) -> Eye {
     let c = center(b.arm_min, b.arm_max);
-    let d = 1.05 * extent(b.arm_min, b.arm_max) + 0.2;
+    // far enough that the whole arm, base to hand, fits a 3D view about as wide as high (the
+    // arm tab at 1440×900: 1.05 cut the base and the hand off)
+    let d = 1.5 * extent(b.arm_min, b.arm_max) + 0.2;
     let s = side_direction(b);
     Eye { position: [c[0] + d * s[0], c[1] + d * s[1], c[2] + 0.15 * d], look_target: c, up: [0.0, 0.0, 1.0] }
 }

@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | separated (unilateral) | g − g_ref (−1, touch-down) | 1 |
 //! | sticking | f_n (−1, lift-off) | μ f_n − \|f_t\| (−1, stick→slip) |
-//! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick; 1 when μ = 0) |
+//! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick at its zero, [`stops_here`]; 1 when μ = 0) |
 //! | compliant | g (0) | k δ + c δ̇ while δ > 0, else 1 (0) |
 //! | bilateral | 1 | 1 |
 //!
@@ -27,7 +27,7 @@
 //! impulsive torque work `−J_m (q̇⁺² − q̇⁻²)/2` to the link works W_j. Allocation happens at
 //! events only (the mode enumeration, the impact), not in the step loop.
 
-use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState};
+use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState, SLIP_DIRECTION_SPEED};
 use crate::dynamics::contact::impact::solve_impact;
 use crate::dynamics::contact::modes::choose_modes_within;
 use crate::dynamics::contact::{Contact, ContactEvent, ContactEventKind, ContactMode, ContactModel, ContactOutput, ContactSettings};
@@ -101,11 +101,24 @@ impl Hybrid {
     }
 }
 
-/// A sliding contact sticks when its slip speed falls to this, m/s (ev1 of a sliding contact
-/// is `v_t · s_ref − STICK_SPEED`): the sliding right-hand side has a `1/|v_t|` singularity
-/// in the slip direction's rate as the slip stops, which no step-size control crosses; the
-/// last 1e-6 m/s are removed by a velocity projection (`stop_slip`).
-pub const STICK_SPEED: f64 = 1e-6;
+/// The slip→stick rule (issue 23, item 2). A sliding contact's ev1 is `v_t · s_ref` (m/s),
+/// `s_ref` the slip direction at the start of the step: no threshold, its zero is located like
+/// a lift-off or a touch-down (the sliding right-hand side continues the friction's direction
+/// through the zero, `slip_direction`, so the integrator steps across it smoothly). In 1-D the
+/// zero of `v_t · s_ref` is the zero of the slip; in 2-D it is where the slip velocity turns
+/// perpendicular to `s_ref`, which is the stop when `|v_t|` there is at most this bound, and
+/// otherwise a turn of the slip direction by 90° within one step (no stop: `s_ref` is refreshed
+/// and the contact slides on). The bound is the larger of the contact settings' `vel_tol`
+/// (`velocity_tolerance`, 1e-9 m/s) and [`SLIP_DIRECTION_SPEED`] (1e-6 m/s), below which the
+/// friction's direction is frozen: there the slip's part across `s_ref` is not braked, so a 2-D
+/// slip that ends inside that speed turns across `s_ref` instead of reaching zero along it, and
+/// without the second bound each such turn restarted the slip at a smaller speed, 90° further,
+/// 33 times at one instant (one-elbow-unilateral at rtol 1e-4). A slip that stops cleanly (1-D,
+/// or 2-D coming to rest along a direction) reaches the zero with `|v_t|` ~1e-12 m/s (the root's
+/// 1e-12 s bracket). What is left is removed by the velocity projection `stop_slip`.
+fn stops_here(v_t: [f64; 2], vel_tol: f64) -> bool {
+    v_t[0].hypot(v_t[1]) <= vel_tol.max(SLIP_DIRECTION_SPEED)
+}
 
 /// The value of a rebounding contact's touch-down function at its restart, m (issue 23). A
 /// contact that leaves the table with ġ > `vel_tol` restarts at a gap g₀ that is 0 up to the
@@ -500,7 +513,7 @@ impl ArmSystem<'_> {
                 (_, ContactMode::Sticking) => (f_n, mu_of(c) * f_n - f_t[0].hypot(f_t[1])),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
-                    (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] - STICK_SPEED } else { 1.0 })
+                    (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
                 }
             };
             out[2 * k] = e0;
@@ -607,12 +620,9 @@ impl ArmSystem<'_> {
                         if m > 0.0 {
                             h.state.slip[k] = [-f[0] / m, -f[1] / m];
                         }
-                    } else if f1 {
+                    } else if f1 && stops_here(h.cd.rows.slip(k), st.vel_tol) {
                         preferred[k] = ContactMode::Sticking;
-                        let v = h.cd.rows.slip(k);
-                        if v[0].hypot(v[1]) <= 2.0 * STICK_SPEED {
-                            stopping.push(k);
-                        }
+                        stopping.push(k);
                     }
                 }
             }

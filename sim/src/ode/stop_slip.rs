@@ -1,7 +1,7 @@
-//! Slip→stick of sliding contacts whose slip speed is below `2 STICK_SPEED` at the event: an
-//! M_J-weighted velocity projection (Pfeiffer & Glocker 1996, ch. 6: the impulsive limit of
-//! Coulomb friction over the last ~1e-6 m/s; Acary & Brogliato 2008, ch. 7), its kinetic-energy
-//! loss booked per contact as friction work. Split from `hybrid.rs` (file size).
+//! Slip→stick of sliding contacts at the located zero of their slip (`hybrid.rs`, `stops_here`:
+//! `|v_t| ≤ vel_tol` there): an M_J-weighted velocity projection of the slip left at the root
+//! (≤ 1e-9 m/s; Pfeiffer & Glocker 1996, ch. 6: the impulsive limit of Coulomb friction;
+//! Acary & Brogliato 2008, ch. 7), its kinetic-energy loss booked per contact as friction work. Split from `hybrid.rs` (file size).
 
 use crate::dynamics::contact::ContactMode;
 use crate::error::{DynamicsError, RunError};
@@ -9,11 +9,11 @@ use crate::error::{DynamicsError, RunError};
 use super::arm::ArmSystem;
 
 impl ArmSystem<'_> {
-    /// Slip→stick at `|v_t| ≤ 2 STICK_SPEED`: the remaining slip velocity of the `stopping`
+    /// Slip→stick at the slip's zero (`|v_t| ≤ vel_tol`): the remaining slip velocity of the `stopping`
     /// contacts is removed by the M_J-weighted velocity projection that keeps the other active
     /// velocity rows (normal rows of the contacts in touch, tangential rows of the sticking
-    /// ones) — the impulse friction would deliver over the last ~1e-6 m/s — and its kinetic
-    /// energy loss (≤ ½ m (2e-6 m/s)²) is booked as friction work (the rotors' share of the
+    /// ones) — the impulse friction would deliver over the root's bracket — and its kinetic
+    /// energy loss (≤ ½ m vel_tol²) is booked as friction work (the rotors' share of the
     /// jump into W_j, as at impacts), so the balance stays closed.
     pub(super) fn stop_slip(&mut self, t: f64, y: &mut [f64], stopping: &[usize]) -> Result<(), RunError> {
         use crate::dynamics::contact::solve::{solve_active, ActiveRow, RowForce};

@@ -141,7 +141,7 @@ fn a_bilateral_run_writes_no_contact_channels() {
     }
     rec.finish(Ok(&crate::integrate::Stats::default())).unwrap();
     let r = read_recording(&path).unwrap();
-    for topic in topics::CONTACT_TOPICS {
+    for topic in topics::CONTACT_TOPICS.iter().chain(&topics::FRICTION_TOPICS) {
         assert!(r.channel(topic).is_none(), "{topic}");
     }
     assert!(r.record_opt::<ContactsRecord>().unwrap().is_none());

@@ -111,16 +111,20 @@ mod tests {
 
     /// The datasheets' own identities, which a mistyped value breaks: k_n k_M = 30000/π
     /// (rpm/V × mNm/A; 2 %: the sheets round to three digits), the no-load speed
-    /// ω_0 = (U_N − R I_0) / k_M (1 %), and the thermal data complete.
+    /// ω_0 = (U_N − R I_0) / k_M (1 %) where the sheet's no-load pair is given, and the thermal
+    /// data complete.
     #[test]
     fn the_motor_entries_satisfy_the_datasheet_identities() {
         for (e, d) in &catalogue().motors {
             let kn = d.speed_constant_rpm_per_v.expect("speed constant");
             let prod = kn * d.torque_constant_mnm_per_a;
             assert!((prod / (30000.0 / std::f64::consts::PI) - 1.0).abs() < 0.02, "{}: k_n k_M = {prod}", e.name);
-            let w0 = (d.nominal_voltage_v - d.terminal_resistance_ohm * d.no_load_current_ma.unwrap() * 1e-3) / (d.torque_constant_mnm_per_a * 1e-3);
-            let rpm = w0 * 60.0 / (2.0 * std::f64::consts::PI);
-            assert!((rpm / d.no_load_speed_rpm.unwrap() - 1.0).abs() < 0.01, "{}: {rpm} rpm", e.name);
+            // the no-load pair is optional (an entry leaves it out when it breaks this identity)
+            if let (Some(i0), Some(n0)) = (d.no_load_current_ma, d.no_load_speed_rpm) {
+                let w0 = (d.nominal_voltage_v - d.terminal_resistance_ohm * i0 * 1e-3) / (d.torque_constant_mnm_per_a * 1e-3);
+                let rpm = w0 * 60.0 / (2.0 * std::f64::consts::PI);
+                assert!((rpm / n0 - 1.0).abs() < 0.01, "{}: {rpm} rpm", e.name);
+            }
             assert!(d.thermal_resistance_housing_ambient_k_per_w.is_some() && d.thermal_time_constant_motor_s.is_some() && d.max_winding_temperature_c.is_some(), "{}", e.name);
         }
     }

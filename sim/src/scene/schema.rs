@@ -36,17 +36,20 @@ pub enum FileKind {
     Scene,
     /// A sweep file (`sim sweep`).
     Sweep,
+    /// A study file (`sim optimize`).
+    Study,
 }
 
 impl FileKind {
-    /// Both, scene first.
-    pub const ALL: [FileKind; 2] = [FileKind::Scene, FileKind::Sweep];
+    /// Every kind, scene first.
+    pub const ALL: [FileKind; 3] = [FileKind::Scene, FileKind::Sweep, FileKind::Study];
 
     /// `scene` or `sweep`.
     pub fn name(self) -> &'static str {
         match self {
             FileKind::Scene => "scene",
             FileKind::Sweep => "sweep",
+            FileKind::Study => "study",
         }
     }
 
@@ -56,6 +59,7 @@ impl FileKind {
         match self {
             FileKind::Scene => "scene.schema.json",
             FileKind::Sweep => "sweep.schema.json",
+            FileKind::Study => "study.schema.json",
         }
     }
 
@@ -64,6 +68,7 @@ impl FileKind {
         match self {
             FileKind::Scene => "scene-fields.md",
             FileKind::Sweep => "sweep-fields.md",
+            FileKind::Study => "study-fields.md",
         }
     }
 }
@@ -74,6 +79,7 @@ pub fn schema(kind: FileKind) -> Value {
     let (root, title) = match kind {
         FileKind::Scene => (generator.into_root_schema_for::<SceneSpec>(), "elbow-sim scene"),
         FileKind::Sweep => (generator.into_root_schema_for::<SweepSpec>(), "elbow-sim sweep"),
+        FileKind::Study => (generator.into_root_schema_for::<crate::study::StudySpec>(), "elbow-sim study"),
     };
     let mut v = root.to_value();
     let obj = v.as_object_mut().expect("a struct's schema is an object");

@@ -7,6 +7,7 @@ mod check;
 mod export_scene;
 mod list;
 mod live;
+mod optimize;
 mod precision;
 mod replay;
 mod run;
@@ -34,6 +35,7 @@ Examples:
   sim schema -o scene.schema.json       the scene files' JSON Schema, for editors
   sim replay out/paper-two-elbow.mcap   re-run a recording from its own metadata
   sim sweep sim/scenes/sweeps/paper-gains.json -j 2
+  sim optimize sim/scenes/studies/which-elbow.json -j 2
   sim precision --duration 1            speed against error of every integrator
   sim --live                            also stream each run to the Foxglove app, paced to real
                                         time (build with --features live): ws://localhost:8765";
@@ -67,6 +69,7 @@ enum Command {
     Check(check::CheckArgs),
     Replay(replay::ReplayArgs),
     Sweep(sweep::SweepArgs),
+    Optimize(optimize::OptimizeArgs),
     Precision(precision::PrecisionArgs),
     ExportScene(export_scene::ExportSceneArgs),
     List(list::ListArgs),
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Some(Command::Check(a)) => check::run(&a),
         Some(Command::Replay(a)) => replay::run(&a, v),
         Some(Command::Sweep(a)) => sweep::run(&a, v),
+        Some(Command::Optimize(a)) => optimize::run(&a, v),
         Some(Command::Precision(a)) => precision::run(&a, v),
         Some(Command::ExportScene(a)) => export_scene::run(&a, v),
         Some(Command::List(a)) => list::run(&a),

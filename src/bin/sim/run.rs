@@ -180,13 +180,28 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
 pub fn write_layouts(scene: &Scene, done: &[Done], v: Verbosity) -> Vec<Result<Option<PathBuf>, String>> {
     let input = sim::record::layout_input(scene);
     let mut out = Vec::new();
-    for recording in done.iter().filter_map(|d| d.path.as_ref()) {
+    for (d, recording) in done.iter().filter_map(|d| Some((d, d.path.as_ref()?))) {
         let stem = recording.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let mut one = input.clone();
         one.runs.retain(|r| format!("{}-{}", scene.spec().name, r.run) == stem);
+        for r in one.runs.iter_mut().filter(|r| r.has_contact_topic) {
+            r.has_contact_events = has_contact_events(d, recording);
+        }
         out.push(write_layout(&one, &recording.with_file_name(schemas::layout::file_name(&stem)), v));
     }
     out
+}
+
+/// Whether the run `d` wrote a `/contact_events` message: from its metrics (a complete run),
+/// else from the channels of its recording at `path` (read without decoding a message).
+fn has_contact_events(d: &Done, path: &Path) -> bool {
+    match &d.metrics {
+        Some(Ok(m)) => m.contact_states.iter().any(|c| {
+            let e = &c.events;
+            e.lift_offs + e.touch_downs + e.impacts + e.rests + e.stick_to_slip + e.slip_to_stick > 0
+        }),
+        _ => schemas::read_recording_topics(path, Some(&[])).is_ok_and(|r| r.channel(schemas::topics::CONTACT_EVENTS).is_some()),
+    }
 }
 
 /// Write the layout of `input` to `path` ([`write_layouts`]).

@@ -23,7 +23,7 @@ Examples:
   sim schema -f markdown > scene-fields.md      the scene keys as a reference page
   sim schema scene -o my-arm/scene.schema.json  next to a scene that names it")]
 pub struct SchemaArgs {
-    /// Which files: scene (`sim run`, `sim check`) or sweep (`sim sweep`).
+    /// Which files: scene (`sim run`, `sim check`), sweep (`sim sweep`) or study (`sim optimize`).
     #[arg(value_name = "FILES", value_enum, default_value = "scene")]
     pub kind: Kind,
     /// json: the JSON Schema; markdown: its keys as a reference page.
@@ -39,6 +39,7 @@ pub struct SchemaArgs {
 pub enum Kind {
     Scene,
     Sweep,
+    Study,
 }
 
 /// How `sim schema` prints.
@@ -52,6 +53,7 @@ pub fn run(a: &SchemaArgs, v: Verbosity) -> Result<u8> {
     let kind = match a.kind {
         Kind::Scene => FileKind::Scene,
         Kind::Sweep => FileKind::Sweep,
+        Kind::Study => FileKind::Study,
     };
     let text = match a.format {
         SchemaFormat::Json => schema::schema_text(kind),

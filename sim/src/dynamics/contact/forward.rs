@@ -60,16 +60,27 @@ impl ContactData {
 }
 
 /// Slip speeds below this use the stored slip direction (m/s): the direction `v_t/|v_t|` of
-/// Coulomb friction turns at a rate `|a_t⊥|/|v_t|`, unbounded as a slip starts or stops; below
-/// 1e-6 m/s the direction is frozen (the stored one, refreshed after each step above it).
+/// Coulomb friction turns at a rate `|a_t⊥|/|v_t|`, unbounded as a slip starts or stops, and
+/// below ~1e-12 m/s it is the solver's rounding; below 1e-6 m/s the direction is frozen (the
+/// stored one: the consistent direction `a_t ∥ s` of a slip from rest, or the slip direction at
+/// the start of the step). This is a regularisation of the direction only, not a stick rule:
+/// a slip stops where `v_t · s_ref` reaches 0 (a located event, `ode/hybrid.rs`). Its effect on
+/// the motion is bounded by the time spent below it, `SLIP_DIRECTION_SPEED / |a_t|` ≈ 2e-7 s at
+/// 5 m/s², over which the position moves ≤ `SLIP_DIRECTION_SPEED² / |a_t|` ≈ 2e-13 m; in 1-D
+/// (a slip along a fixed line) the frozen direction is exact.
 pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 
-/// The slip direction of a sliding contact: `v_t/|v_t|` when `|v_t|` > [`SLIP_DIRECTION_SPEED`],
-/// else the stored one.
+/// The slip direction of a sliding contact, continued through the stop: `±v_t/|v_t|` when
+/// `|v_t|` > [`SLIP_DIRECTION_SPEED`], with the sign that keeps it on the side of `stored` (the
+/// direction at the start of the step), else `stored`. While the slip runs along `stored` this is
+/// `v_t/|v_t|`; past the slip's zero (`v_t · stored < 0`, where an integrator's trial stages
+/// may go before the slip→stick event is located) the friction keeps its direction instead of
+/// flipping, so the right-hand side is smooth across the zero and the zero is located as a root.
 pub fn slip_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
     let s = v_t[0].hypot(v_t[1]);
     if s > SLIP_DIRECTION_SPEED {
-        [v_t[0] / s, v_t[1] / s]
+        let sign = if v_t[0] * stored[0] + v_t[1] * stored[1] < 0.0 { -1.0 } else { 1.0 };
+        [sign * v_t[0] / s, sign * v_t[1] / s]
     } else {
         stored
     }

@@ -58,7 +58,13 @@ fn shipped_files() -> Vec<(PathBuf, FileKind)> {
     files.push(repo().join("recordings/paper-archive.json"));
     files.sort();
     files.into_iter().map(|p| {
-        let kind = if p.parent().is_some_and(|d| d.ends_with("sweeps")) { FileKind::Sweep } else { FileKind::Scene };
+        let kind = if p.parent().is_some_and(|d| d.ends_with("sweeps")) {
+            FileKind::Sweep
+        } else if p.parent().is_some_and(|d| d.ends_with("studies")) {
+            FileKind::Study
+        } else {
+            FileKind::Scene
+        };
         (p, kind)
     }).collect()
 }
@@ -85,6 +91,7 @@ fn every_shipped_file_names_its_schema_first_and_parses() {
         let read = match kind {
             FileKind::Scene => SceneSpec::deserialize(SkipSchemaKey(de)).map(drop),
             FileKind::Sweep => SweepSpec::deserialize(SkipSchemaKey(de)).map(drop),
+            FileKind::Study => crate::study::StudySpec::deserialize(SkipSchemaKey(de)).map(drop),
         };
         read.unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     }

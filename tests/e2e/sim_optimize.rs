@@ -1,0 +1,165 @@
+//! `sim optimize`: on the small arm's study (`sim/scenes/studies/small-kd.json`, 0.2-s runs),
+//! the optimum lies within one spacing of a dense grid's best (the grid run by `sim sweep`),
+//! within the study's budget of 40 evaluations; the same seed gives byte-identical outputs; three
+//! shards of a generation merge to the unsharded generation; a study stopped (by
+//! `--generations` and by a kill) and resumed gives the uninterrupted study's outputs.
+
+use crate::run_sim;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn study_file() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/studies/small-kd.json")
+}
+
+/// The study's text outputs (no figures: plotters' SVG text is checked by its own tests), by name.
+fn outputs(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    ["study-state.json", "best.csv", "evaluations.csv", "pareto.csv", "optimum.json", "report.md", "map.svg", "convergence.svg"]
+        .iter()
+        .map(|n| (n.to_string(), std::fs::read(dir.join(n)).unwrap_or_else(|e| panic!("{n}: {e}"))))
+        .collect()
+}
+
+fn optimize(dir: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["optimize".to_string(), study_file().display().to_string(), "-o".into(), dir.display().to_string(), "-j".into(), "2".into()];
+    args.extend(extra.iter().map(|s| s.to_string()));
+    let out = run_sim(&args);
+    assert_eq!(out.status.code(), Some(0), "sim {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+fn state(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("study-state.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn the_optimum_is_the_dense_grids_best_within_one_spacing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("study");
+    optimize(&out, &[]);
+    let st = state(&out);
+    let evals = st["evaluations"].as_array().unwrap();
+    assert!(evals.len() <= 40, "{} evaluations: the budget is 40", evals.len());
+    // the optimum: the best evaluation
+    let best = evals.iter().filter(|e| e["objective"].is_f64()).min_by(|a, b| a["objective"].as_f64().unwrap().total_cmp(&b["objective"].as_f64().unwrap())).unwrap();
+    let kd_opt = best["values"][0][1].as_f64().unwrap();
+    let e_opt = best["objective"].as_f64().unwrap();
+    // the dense grid: kd = 2, 2.25, ..., 20 (73 points) at the evaluations' tolerance (rtol 1e-4)
+    let spacing = 0.25;
+    let values: Vec<f64> = (0..=72).map(|k| 2.0 + spacing * k as f64).collect();
+    let sweep = serde_json::json!({
+        "name": "grid", "scene": Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/small/small.json"),
+        "runs": ["elbow"], "duration": 0.2,
+        "axes": [{"field": "controller.kd", "values": values}, {"field": "integrator.rtol", "values": [1e-4]}, {"field": "integrator.atol", "values": [1e-6]}]
+    });
+    let sweep_file = tmp.path().join("grid.json");
+    std::fs::write(&sweep_file, sweep.to_string()).unwrap();
+    let g = run_sim(&["sweep", sweep_file.to_str().unwrap(), "-o", tmp.path().join("grid").to_str().unwrap(), "-j", "2", "-q", "-f", "json"]);
+    assert_eq!(g.status.code(), Some(0), "{}", String::from_utf8_lossy(&g.stderr));
+    let rows: Vec<serde_json::Value> = serde_json::from_slice(&g.stdout).unwrap();
+    let (kd_grid, e_grid) = rows
+        .iter()
+        .map(|r| (r["values"]["controller.kd"].as_f64().unwrap(), r["E_total_j"].as_f64().unwrap()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap();
+    // an interior minimum (not at a bound): the grid has a best point to find
+    assert!(kd_grid > 2.0 + spacing && kd_grid < 20.0 - spacing, "grid best at kd = {kd_grid}");
+    assert!((kd_opt - kd_grid).abs() <= spacing, "optimum kd = {kd_opt}, grid best kd = {kd_grid} (spacing {spacing})");
+    // and at least as good as the grid's best, up to the evaluations' error (the report's error
+    // bar, below 1e-5 J here)
+    assert!(e_opt <= e_grid + 1e-5, "optimum {e_opt} J, grid best {e_grid} J");
+    // the report states the error bar and the optimum's scene runs
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("Error bar:"), "{report}");
+    let r = run_sim(&["run", out.join("optimum.json").to_str().unwrap(), "-o", tmp.path().join("rerun").to_str().unwrap(), "-q"]);
+    assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
+    for f in ["small-kd-optimum-elbow.mcap", "small-kd-baseline-elbow.mcap", "map.png", "pareto.svg", "convergence.png"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    // the candidates' recordings are not kept
+    assert_eq!(std::fs::read_dir(out.join("candidates")).unwrap().count(), 0);
+}
+
+#[test]
+fn the_same_seed_gives_byte_identical_outputs_and_a_resumed_study_the_same() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b, c) = (tmp.path().join("a"), tmp.path().join("b"), tmp.path().join("c"));
+    optimize(&a, &[]);
+    optimize(&b, &[]);
+    assert_eq!(outputs(&a), outputs(&b), "two runs of one study");
+    // stopped after 3 generations (as a kill between two generations), then resumed
+    let stop = optimize(&c, &["--generations", "3"]);
+    assert!(!c.join("report.md").exists(), "a stopped study has no report yet");
+    assert!(String::from_utf8_lossy(&stop.stderr).contains("run again to go on"));
+    assert_eq!(state(&c)["optimizer"]["generation"], 3);
+    optimize(&c, &[]);
+    assert_eq!(outputs(&a), outputs(&c), "stopped and resumed");
+}
+
+#[test]
+fn a_killed_study_resumes_to_the_same_result() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, k) = (tmp.path().join("a"), tmp.path().join("k"));
+    optimize(&a, &[]);
+    // a real kill: as soon as the first state is written, SIGKILL (the study may be between
+    // generations or inside one; the state file is whole either way: written under a temporary
+    // name, then renamed)
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sim"))
+        .args(["optimize", study_file().to_str().unwrap(), "-o", k.to_str().unwrap(), "-j", "2", "-q"])
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while !k.join("study-state.json").exists() && t0.elapsed().as_secs() < 120 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let st = state(&k);
+    assert!(st["evaluations"].as_array().unwrap().len() < state(&a)["evaluations"].as_array().unwrap().len() || k.join("report.md").exists());
+    optimize(&k, &[]);
+    assert_eq!(outputs(&a), outputs(&k), "killed and resumed");
+}
+
+#[test]
+fn three_shards_of_a_generation_merge_to_the_unsharded_generation() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (u, s) = (tmp.path().join("u"), tmp.path().join("s"));
+    for g in 1..=2 {
+        optimize(&u, &["--generations", "1"]);
+        for i in 0..3 {
+            let out = optimize(&s, &["--shard", &format!("{i}/3")]);
+            assert!(s.join(format!("gen-{:04}.shard-{i}-of-3.json", g - 1)).is_file(), "{}", String::from_utf8_lossy(&out.stderr));
+        }
+        // the merge: every candidate from the shards, none evaluated again
+        let m = optimize(&s, &["--generations", "1"]);
+        assert!(!String::from_utf8_lossy(&m.stderr).contains("evaluation(s) in"), "the merge evaluated: {}", String::from_utf8_lossy(&m.stderr));
+        assert_eq!(std::fs::read(u.join("study-state.json")).unwrap(), std::fs::read(s.join("study-state.json")).unwrap(), "generation {g}");
+    }
+    // and the rest of the study, unsharded, ends where the unsharded study ends
+    optimize(&u, &[]);
+    optimize(&s, &[]);
+    assert_eq!(outputs(&u), outputs(&s));
+}
+
+#[test]
+fn bad_study_files_exit_2_naming_the_file_the_field_and_the_value() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/small/small.json");
+    let cases = [
+        (serde_json::json!([{"kind": "continuous", "field": "controller.kq", "min": 1, "max": 2}]), "variables[0].field", "controller.kq"),
+        (serde_json::json!([{"kind": "continuous", "field": "controller.kd", "min": 3, "max": 2}]), "variables[0].max", "2"),
+        (serde_json::json!([{"kind": "categorical", "field": "controller.kd", "values": ["x"]}]), "variables[0].values[0]", "\"x\""),
+        (serde_json::json!([{"kind": "continuous", "field": "controller.kd", "min": -5, "max": 2}]), "controller.kd", "-5"),
+    ];
+    for (k, (vars, field, value)) in cases.iter().enumerate() {
+        let f = tmp.path().join(format!("bad{k}.json"));
+        let doc = serde_json::json!({"name": "bad", "scene": scene, "duration": 0.1, "variables": vars});
+        std::fs::write(&f, doc.to_string()).unwrap();
+        let out = run_sim(&["optimize", f.to_str().unwrap(), "-o", tmp.path().join("o").to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "case {k}: {err}");
+        for s in [f.to_str().unwrap(), field, value] {
+            assert!(err.contains(s), "case {k}: `{s}` not in: {err}");
+        }
+    }
+}
