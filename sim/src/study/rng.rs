@@ -2,7 +2,8 @@
 //! pseudorandom number generators", OOPSLA 2014; the constants of Java's `SplittableRandom`)
 //! and normal deviates by the Box–Muller transform (Box & Muller, Ann. Math. Stat. 29, 1958).
 //! Written here rather than taken from `rand`: the state is one `u64` that the study's state
-//! file carries exactly, and the sequence is fixed by this file, not by a crate version, so that
+//! file carries exactly, and the sequence is fixed by this crate (the generator of
+//! `dynamics::samples`), not by a dependency's version, so that
 //! a seed gives the same study on every build.
 
 use serde::{Deserialize, Serialize};
@@ -12,12 +13,13 @@ use serde::{Deserialize, Serialize};
 pub struct Rng(pub u64);
 
 impl Rng {
+    /// The next output of the benches' generator (`dynamics::samples::SplitMix64`), whose state
+    /// this struct keeps in a form that serialises with the study.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        let mut g = crate::dynamics::samples::SplitMix64(self.0);
+        let z = g.next_u64();
+        self.0 = g.0;
+        z
     }
 
     /// Uniform in (0, 1): 53 random bits, never 0.
