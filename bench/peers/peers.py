@@ -382,8 +382,10 @@ def time_to_reach(points: list[tuple[float, float]], level: float) -> float | No
 
 def extrapolated(rows: list[dict], level: float) -> tuple[float | None, str | None]:
     """For a level no rung reached: per series, the log-log line through its two most accurate ok
-    rungs, followed to the level (only if that line's error falls with time, and for at most one
-    decade of error); the cheapest. An estimate, printed as such, never used as a measurement."""
+    rungs, followed to the level (only if that line's error falls with time, by at least a factor
+    2 between the two rungs: closer errors are a floor, not an order, as MuJoCo's soft contacts
+    give; and for at most one decade of error); the cheapest. An estimate, printed as such, never
+    used as a measurement."""
     series: dict[str, list] = {}
     for r in rows:
         if r["status"] == "ok" and r["max_hand_error_m"] > 0:
@@ -393,7 +395,7 @@ def extrapolated(rows: list[dict], level: float) -> tuple[float | None, str | No
         if len(pts) < 2:
             continue
         (e1, w1), (e0, w0) = sorted(pts)[:2]
-        if not (e1 < e0 and w1 > w0) or level < e1 / 10:
+        if not (2 * e1 <= e0 and w1 > w0) or level < e1 / 10:
             continue
         slope = (math.log(w1) - math.log(w0)) / (math.log(e1) - math.log(e0))
         t = math.exp(math.log(w1) + slope * (math.log(level) - math.log(e1)))
@@ -608,7 +610,8 @@ def build_pin_kernels(cxx: str, work: Path) -> Path | None:
 
 def figure(stem: Path, title: str, rows: list[dict]) -> None:
     """The work-precision diagram: max hand error against wall time, log-log, one line per series
-    (the project's solid, MuJoCo's dashed); diverged rungs left out."""
+    through its rungs in ladder order (the project's solid, MuJoCo's dashed); failed or diverged
+    rungs left out."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -620,8 +623,7 @@ def figure(stem: Path, title: str, rows: list[dict]) -> None:
         if r["status"] == "ok" and r["wall_s"] and r["max_hand_error_m"] and math.isfinite(r["max_hand_error_m"]):
             series.setdefault((r["tool"], r["series"]), []).append((r["wall_s"], r["max_hand_error_m"]))
     for (tool, name), pts in sorted(series.items()):
-        pts.sort()
-        x, y = zip(*pts)
+        x, y = zip(*pts)  # in ladder order (tolerance or step), as a work-precision line is read
         ax.plot(x, y, "-o" if tool == "project" else "--s", ms=3, lw=1.2, label=name if tool == "project" else name)
     for lv in LEVELS:
         ax.axhline(lv, color="0.85", lw=0.6, zorder=0)

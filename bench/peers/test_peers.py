@@ -55,6 +55,14 @@ class Interpolation(unittest.TestCase):
         pts = [(0.01, 1e-7), (0.02, 1e-3), (0.04, 1e-9)]
         self.assertEqual(peers.time_to_reach(pts, 1e-6), 0.01)
 
+    def test_a_floor_is_not_extrapolated(self):
+        """Two most accurate rungs within a factor 2 of each other (a soft-contact floor): no
+        estimate, where the line through them would promise any accuracy at some cost."""
+        rows = [{"series": "a", "wall_s": w, "max_hand_error_m": e, "status": "ok"} for w, e in ((1.0, 4.6e-4), (2.0, 4.5e-4), (0.5, 2e-3))]
+        self.assertEqual(peers.extrapolated(rows, 1e-4), (None, None))
+        rows[1]["max_hand_error_m"] = 2.3e-4  # a factor 2: an order, followed for a decade
+        self.assertIsNotNone(peers.extrapolated(rows, 1e-4)[0])
+
     def test_best_series_and_diverged_rows_skipped(self):
         rows = [
             {"series": "a", "wall_s": 0.01, "max_hand_error_m": 1e-7, "status": "diverged"},
