@@ -168,11 +168,13 @@ fn a_ball_that_slides_then_rolls_stops_slipping_at_two_sevenths_v0_over_mu_g() {
 /// release), by 3-point Gauss–Legendre on 4000 panels (converged to round-off: halving the
 /// panels moves it by < 1e-15 s).
 fn tipping_time(h: f64, theta0: f64) -> f64 {
-    let f = |s: f64| {
-        let th = theta0 - s * s;
-        let w2 = 2.0 * G * (theta0.sin() - th.sin()) / (h * (th.cos().powi(2) + 1.0 / 3.0));
-        2.0 * s / w2.sqrt()
-    };
+    time_to_lie_flat(theta0, |th| 2.0 * G * (theta0.sin() - th.sin()) / (h * (th.cos().powi(2) + 1.0 / 3.0)))
+}
+
+/// `T = ∫_0^θ0 dθ/|θ̇|` for a rod released at rest at θ0, given `θ̇²(θ)`: with θ = θ0 − s²
+/// (which takes out the 1/√ at the release), by 3-point Gauss–Legendre on 4000 panels.
+fn time_to_lie_flat(theta0: f64, theta_dot_sq: impl Fn(f64) -> f64) -> f64 {
+    let f = |s: f64| 2.0 * s / theta_dot_sq(theta0 - s * s).sqrt();
     let (n, b) = (4000, theta0.sqrt());
     let dx = b / n as f64;
     let (x3, w) = ((0.6f64).sqrt(), [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]);
@@ -369,21 +371,7 @@ fn collisions_table(s: &mut Value, links: &[&str], keys: Value) {
 /// h²/3)`. Quadrature as [`tipping_time`].
 fn rim_tipping_time(h: f64, r: f64, theta0: f64) -> f64 {
     let z = |th: f64| h * th.sin() + r * th.cos();
-    let f = |s: f64| {
-        let th = theta0 - s * s;
-        let w2 = 2.0 * G * (z(theta0) - z(th)) / ((h * th.cos() - r * th.sin()).powi(2) + h * h / 3.0);
-        2.0 * s / w2.sqrt()
-    };
-    let (n, b) = (4000, theta0.sqrt());
-    let dx = b / n as f64;
-    let (x3, w) = ((0.6f64).sqrt(), [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]);
-    (0..n)
-        .map(|i| {
-            let m = (i as f64 + 0.5) * dx;
-            let half = 0.5 * dx;
-            half * (w[0] * f(m - half * x3) + w[1] * f(m) + w[2] * f(m + half * x3))
-        })
-        .sum()
+    time_to_lie_flat(theta0, |th| 2.0 * G * (z(theta0) - z(th)) / ((h * th.cos() - r * th.sin()).powi(2) + h * h / 3.0))
 }
 
 /// A cylinder (m = 1 kg, length 0.6 m, r = 0.05 m) from the URDF's `<collision>`, released at
