@@ -45,6 +45,8 @@ mod drives;
 mod fuzz_scenes;
 #[path = "gear_supply.rs"]
 mod gear_supply;
+#[path = "hand_load.rs"]
+mod hand_load;
 #[path = "hard_cases.rs"]
 mod hard_cases;
 #[path = "paper.rs"]

@@ -7,6 +7,7 @@ pub mod catalogue;
 mod contacts;
 mod ctx;
 pub mod drive;
+pub mod hand_load;
 mod robot;
 pub mod schema;
 pub mod schema_key;
@@ -383,6 +384,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
     }
     let gravity = c.vec3("gravity", spec.gravity)?;
     let (model, urdf_xml, meshes) = load_robot(&c, &spec, urdf_xml, gravity, dir)?;
+    let model = hand_load::with_hand_load(&c, spec.hand_load.as_ref(), &spec.hand, model)?;
     let nv = model.nv;
     let duration = c.number("duration", spec.duration, positive, "must be > 0 s")?;
     let output_rate = c.number("output_rate", spec.output_rate, positive, "must be > 0 Hz")?;

@@ -143,6 +143,10 @@ pub struct SceneSpec {
     pub joint_limits: Option<JointLimitsSpec>,
     /// The hand point whose path is tracked: a joint's origin, or a point of a link.
     pub hand: PointSpec,
+    /// A payload held at the hand: mass, centre of mass and inertia in the hand link's frame,
+    /// merged into the hand's body (default: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hand_load: Option<super::hand_load::HandLoadSpec>,
     /// What the arm is asked to do: the paper's circle and IK, or a target tagged by `kind`.
     pub target: TargetSpec,
     /// The state at t = 0: joint angles, speeds and motor currents.
