@@ -66,7 +66,7 @@ where
         .draw()
         .map_err(e)?;
     for (k, s) in series.iter().enumerate() {
-        let color = if s.mark == Mark::Crosses { RED } else { COLORS[k % COLORS.len()] };
+        let color = if s.mark == Mark::Crosses { BLACK } else { COLORS[k % COLORS.len()] };
         let pts: Vec<(f64, f64)> = s.points.iter().filter(finite).copied().collect();
         if pts.is_empty() {
             continue;

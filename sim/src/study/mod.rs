@@ -16,6 +16,7 @@
 pub mod cmaes;
 pub mod compass;
 pub mod optimizer;
+pub mod place;
 pub mod rng;
 pub mod state;
 
@@ -30,6 +31,7 @@ use crate::limits::{read_text, MAX_INPUT_BYTES};
 use crate::scene::Scene;
 use crate::sweep::{check_replacement, compact, parse_spec, valid_name, BadReplacement, Sweep, SweepError, SweepSpec, Variant};
 use optimizer::{Point, Settings};
+use place::Placement;
 
 /// Most discrete combinations a study enumerates.
 pub const MAX_COMBINATIONS: usize = 64;
@@ -107,12 +109,39 @@ pub enum VariableSpec {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         labels: Option<Vec<String>>,
     },
+    /// Where a contact sits on the arm: a position along a chain of links (link k of `links`
+    /// for t in [k, k + 1]) and an angle around the link, on the link's collision cylinder or
+    /// capsule when it has one, else on the segment between its joint origins (the book:
+    /// "Find where to brace"). Sets `contacts.<k>.point` and, with `support`, the plane's
+    /// offset.
+    OnLink {
+        /// The contact's name in the scene's `contacts` (a point contact, no `shape`).
+        contact: String,
+        /// The links, in order along the arm (URDF names; at least one).
+        links: Vec<String>,
+        /// The range of the position t along the chain, in links: [min, max] within
+        /// [0, number of links] (default: the whole chain).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        along: Option<[f64; 2]>,
+        /// The range of the angle around the link's axis, rad, from the collision frame's x
+        /// axis towards its y axis (default: none, the side that faces the plane at the
+        /// initial state).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        around: Option<[f64; 2]>,
+        /// Move the contact's plane through the point at the initial state: a brace under the
+        /// point (default: true; false keeps the plane, and a point off it rests only if the
+        /// motion brings it down).
+        #[serde(default = "yes")]
+        support: bool,
+    },
 }
 
 impl VariableSpec {
+    /// The variable's name in tables: its dot path (an `on-link` variable: `<contact>@links`).
     pub fn field(&self) -> &str {
         match self {
             VariableSpec::Continuous { field, .. } | VariableSpec::Integer { field, .. } | VariableSpec::Categorical { field, .. } => field,
+            VariableSpec::OnLink { contact, .. } => contact,
         }
     }
 }
@@ -220,9 +249,29 @@ pub struct Study {
     pub base: Sweep,
     /// The discrete variables' indices in `spec.variables`, in order, and their counts.
     pub discrete: Vec<(usize, usize)>,
-    /// The continuous variables' indices in `spec.variables`, in order.
-    pub continuous: Vec<usize>,
+    /// The continuous dimensions, in the variables' order (a continuous variable is one, an
+    /// `on-link` variable one or two).
+    pub continuous: Vec<Dim>,
+    /// Per variable: the geometry of an `on-link` variable, read from the base scene.
+    pub placements: Vec<Option<Placement>>,
     pub settings: Settings,
+}
+
+/// One continuous dimension of the design space: `x = lo + u (hi − lo)` for `u ∈ [0, 1]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dim {
+    /// The variable's index in `spec.variables`.
+    pub var: usize,
+    /// Its name in tables and figures (a dot path, or `<contact>.along` / `<contact>.around`).
+    pub name: String,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl Dim {
+    pub fn at(&self, u: f64) -> f64 {
+        self.lo + u * (self.hi - self.lo)
+    }
 }
 
 impl Study {
@@ -252,7 +301,19 @@ impl Study {
             return Err(err("variables", &"[]", "needs at least one design variable".into()));
         }
         let (mut discrete, mut continuous) = (Vec::new(), Vec::new());
+        let mut placements: Vec<Option<Placement>> = vec![None; spec.variables.len()];
+        let mut base_scene: Option<Scene> = None;
         for (i, v) in spec.variables.iter().enumerate() {
+            if let VariableSpec::OnLink { contact, links, along, around, support } = v {
+                let scene = match &base_scene {
+                    Some(s) => s,
+                    None => base_scene.insert(base.scene(&Variant { index: 0, name: format!("{}-base", spec.name), replacements: Vec::new() })?),
+                };
+                let (placement, dims) = on_link(&err, i, &base.base, scene, contact, links, *along, *around, *support)?;
+                continuous.extend(dims);
+                placements[i] = Some(placement);
+                continue;
+            }
             let f = format!("variables[{i}].field");
             if v.field() == "name" {
                 return Err(err(&f, &v.field(), "the study names its candidates; it cannot be a variable".into()));
@@ -270,7 +331,7 @@ impl Study {
                     if max <= min {
                         return Err(err(&format!("variables[{i}].max"), max, format!("must be above min ({min})")));
                     }
-                    continuous.push(i);
+                    continuous.push(Dim { var: i, name: v.field().to_string(), lo: *min, hi: *max });
                     vec![(format!("variables[{i}].min"), Value::from(*min)), (format!("variables[{i}].max"), Value::from(*max))]
                 }
                 VariableSpec::Integer { min, max, .. } => {
@@ -293,6 +354,7 @@ impl Study {
                     discrete.push((i, values.len()));
                     values.iter().enumerate().map(|(j, x)| (format!("variables[{i}].values[{j}]"), x.clone())).collect()
                 }
+                VariableSpec::OnLink { .. } => unreachable!("on-link variables are checked above"),
             };
             for (at, x) in samples {
                 check_replacement(&base.base, v.field(), &x).map_err(|bad| match bad {
@@ -372,7 +434,7 @@ impl Study {
             min_step: m.resolution,
         };
         settings.check().map_err(|why| err("method.evaluations", &m.evaluations, why))?;
-        let study = Study { spec, file: file.clone(), base, discrete, continuous, settings };
+        let study = Study { spec, file: file.clone(), base, discrete, continuous, placements, settings };
         // the corners of the design space validate as scenes (numbers too), before anything runs
         let corners = [0.0, 1.0].map(|u| Point { combo: 0, u: vec![u; dims] });
         for p in corners.iter().chain([&Point { combo: combos - 1, u: vec![0.5; dims] }]) {
@@ -381,48 +443,99 @@ impl Study {
         Ok(study)
     }
 
-    /// The replacements of candidate `p`: every variable's value, in the study's order.
-    pub fn values(&self, p: &Point) -> Vec<(String, Value)> {
+    /// The digit of every discrete variable in combination `combo` (in `discrete`'s order).
+    fn digits(&self, combo: usize) -> Vec<usize> {
         let mut digits = vec![0usize; self.discrete.len()];
-        let mut k = p.combo;
+        let mut k = combo;
         for (d, &(_, n)) in self.discrete.iter().enumerate().rev() {
             digits[d] = k % n;
             k /= n;
         }
-        self.spec
-            .variables
-            .iter()
-            .enumerate()
-            .map(|(i, v)| {
-                let x = match v {
-                    VariableSpec::Continuous { min, max, .. } => {
-                        let c = self.continuous.iter().position(|&j| j == i).expect("a continuous variable");
-                        Value::from(min + p.u[c] * (max - min))
-                    }
-                    VariableSpec::Integer { min, .. } => {
-                        let d = self.discrete.iter().position(|&(j, _)| j == i).expect("a discrete variable");
-                        Value::from(min + digits[d] as i64)
-                    }
-                    VariableSpec::Categorical { values, .. } => {
-                        let d = self.discrete.iter().position(|&(j, _)| j == i).expect("a discrete variable");
-                        values[digits[d]].clone()
-                    }
-                };
-                (v.field().to_string(), x)
-            })
-            .collect()
+        digits
     }
 
-    /// A variable's value as a table shows it (a categorical variable by its label).
-    pub fn label(&self, i: usize, x: &Value) -> String {
-        match &self.spec.variables[i] {
-            VariableSpec::Categorical { values, labels: Some(l), .. } => values.iter().position(|v| v == x).map_or_else(|| compact(x), |j| l[j].clone()),
-            _ => match x {
-                Value::Number(n) if n.is_f64() => format!("{:.4}", n.as_f64().unwrap_or(f64::NAN)),
-                Value::String(s) => s.clone(),
-                other => compact(other),
-            },
+    /// The continuous coordinates of candidate `p`, one per dimension of `continuous`.
+    pub fn coordinates(&self, p: &Point) -> Vec<f64> {
+        self.continuous.iter().zip(&p.u).map(|(d, &u)| d.at(u)).collect()
+    }
+
+    /// The replacements of candidate `p`: every variable's, in the study's order (an `on-link`
+    /// variable gives the contact's point and, with `support`, its plane's offset).
+    pub fn values(&self, p: &Point) -> Vec<(String, Value)> {
+        let digits = self.digits(p.combo);
+        let x = self.coordinates(p);
+        let mut out = Vec::with_capacity(self.spec.variables.len() + 1);
+        for (i, v) in self.spec.variables.iter().enumerate() {
+            let dims: Vec<f64> = self.continuous.iter().zip(&x).filter(|(d, _)| d.var == i).map(|(_, &x)| x).collect();
+            let digit = || digits[self.discrete.iter().position(|&(j, _)| j == i).expect("a discrete variable")];
+            match v {
+                VariableSpec::Continuous { field, .. } => out.push((field.clone(), Value::from(dims[0]))),
+                VariableSpec::Integer { field, min, .. } => out.push((field.clone(), Value::from(min + digit() as i64))),
+                VariableSpec::Categorical { field, values, .. } => out.push((field.clone(), values[digit()].clone())),
+                VariableSpec::OnLink { .. } => {
+                    let placement = self.placements[i].as_ref().expect("an on-link variable has its placement");
+                    out.extend(placement.replacements(dims[0], dims.get(1).copied()));
+                }
+            }
         }
+        out
+    }
+
+    /// The design's columns in tables: one per discrete variable and per continuous dimension,
+    /// in the variables' order (an `on-link` variable adds `<contact>.link`, the link and the
+    /// fraction s along it).
+    pub fn columns(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (i, v) in self.spec.variables.iter().enumerate() {
+            match v {
+                VariableSpec::OnLink { contact, .. } => {
+                    out.extend(self.continuous.iter().filter(|d| d.var == i).map(|d| d.name.clone()));
+                    out.push(format!("{contact}.link"));
+                }
+                _ => out.push(v.field().to_string()),
+            }
+        }
+        out
+    }
+
+    /// The design of candidate `p` as table cells, in [`Study::columns`]' order (a categorical
+    /// variable by its label).
+    pub fn cells(&self, p: &Point) -> Vec<String> {
+        let digits = self.digits(p.combo);
+        let x = self.coordinates(p);
+        let mut out = Vec::new();
+        for (i, v) in self.spec.variables.iter().enumerate() {
+            let dims: Vec<f64> = self.continuous.iter().zip(&x).filter(|(d, _)| d.var == i).map(|(_, &x)| x).collect();
+            let digit = || digits[self.discrete.iter().position(|&(j, _)| j == i).expect("a discrete variable")];
+            match v {
+                VariableSpec::Continuous { .. } => out.push(format!("{:.4}", dims[0])),
+                VariableSpec::Integer { min, .. } => out.push((min + digit() as i64).to_string()),
+                VariableSpec::Categorical { values, labels, .. } => {
+                    let j = digit();
+                    out.push(labels.as_ref().map_or_else(|| match &values[j] {
+                        Value::String(s) => s.clone(),
+                        other => compact(other),
+                    }, |l| l[j].clone()));
+                }
+                VariableSpec::OnLink { .. } => {
+                    out.extend(dims.iter().map(|x| format!("{x:.4}")));
+                    let placement = self.placements[i].as_ref().expect("an on-link variable has its placement");
+                    let t = dims[0].clamp(0.0, placement.links.len() as f64);
+                    let k = (t.floor() as usize).min(placement.links.len() - 1);
+                    out.push(format!("{} s={:.3}", placement.links[k].link, t - k as f64));
+                }
+            }
+        }
+        out
+    }
+
+    /// The labels of the discrete variables in combination `combo`, joined.
+    pub fn combo_label(&self, combo: usize) -> String {
+        let p = Point { combo, u: vec![0.5; self.continuous.len()] };
+        let cells = self.cells(&p);
+        let cols = self.columns();
+        // the discrete variables' cells, found by their columns (their fields)
+        self.discrete.iter().filter_map(|&(i, _)| cols.iter().position(|c| c == self.spec.variables[i].field()).map(|k| cells[k].clone())).collect::<Vec<_>>().join(", ")
     }
 
     /// Candidate `index` at `p`: a sweep variant named `<study>-<index>`.
@@ -447,4 +560,61 @@ impl Study {
         }
         v
     }
+}
+
+/// An `on-link` variable (`variables[i]`), checked: its placement (the geometry, from the
+/// base scene) and its continuous dimensions (along, and around when it has a range).
+#[allow(clippy::too_many_arguments)]
+fn on_link(
+    err: &dyn Fn(&str, &dyn std::fmt::Display, String) -> SweepError,
+    i: usize,
+    base: &Value,
+    scene: &Scene,
+    contact: &str,
+    links: &[String],
+    along: Option<[f64; 2]>,
+    around: Option<[f64; 2]>,
+    support: bool,
+) -> Result<(Placement, Vec<Dim>), SweepError> {
+    let contacts = base.get("contacts").and_then(Value::as_array).map(Vec::as_slice).unwrap_or_default();
+    let names = || contacts.iter().filter_map(|c| c.get("name").and_then(Value::as_str)).collect::<Vec<_>>().join(", ");
+    let Some(k) = contacts.iter().position(|c| c.get("name").and_then(Value::as_str) == Some(contact)) else {
+        return Err(err(&format!("variables[{i}].contact"), &contact, format!("no contact of that name in the scene's `contacts` (contacts: {})", names())));
+    };
+    if let Some(shape) = contacts[k].get("shape") {
+        return Err(err(&format!("variables[{i}].contact"), &contact, format!("has a shape ({}): an on-link variable places a point contact; the point is already on the link's surface", compact(shape))));
+    }
+    let normal: [f64; 3] = contacts[k].pointer("/plane/normal").and_then(|n| serde_json::from_value(n.clone()).ok()).unwrap_or([0.0, 0.0, 1.0]);
+    if links.is_empty() {
+        return Err(err(&format!("variables[{i}].links"), &"[]", "needs at least one link".into()));
+    }
+    for (j, l) in links.iter().enumerate() {
+        if links[..j].contains(l) {
+            return Err(err(&format!("variables[{i}].links[{j}]"), l, "is listed twice".into()));
+        }
+    }
+    let placement = Placement::new(scene, k, normal, links, support).map_err(|(j, why)| err(&format!("variables[{i}].links[{j}]"), &links[j], why))?;
+    let n = links.len() as f64;
+    let [lo, hi] = along.unwrap_or([0.0, n]);
+    for (key, x) in [("along[0]", lo), ("along[1]", hi)] {
+        if !(x.is_finite() && (0.0..=n).contains(&x)) {
+            return Err(err(&format!("variables[{i}].{key}"), &x, format!("must be in [0, {n}]: the position along the {n} link(s), in links")));
+        }
+    }
+    if hi <= lo {
+        return Err(err(&format!("variables[{i}].along[1]"), &hi, format!("must be above along[0] ({lo})")));
+    }
+    let mut dims = vec![Dim { var: i, name: format!("{contact}.along"), lo, hi }];
+    if let Some([a, b]) = around {
+        for (key, x) in [("around[0]", a), ("around[1]", b)] {
+            if !(x.is_finite() && x.abs() <= 4.0 * std::f64::consts::PI) {
+                return Err(err(&format!("variables[{i}].{key}"), &x, "must be an angle in [-4π, 4π] rad".into()));
+            }
+        }
+        if b <= a {
+            return Err(err(&format!("variables[{i}].around[1]"), &b, format!("must be above around[0] ({a})")));
+        }
+        dims.push(Dim { var: i, name: format!("{contact}.around"), lo: a, hi: b });
+    }
+    Ok((placement, dims))
 }

@@ -370,8 +370,8 @@ fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity
     }
     write_json(&out.join("optimum.json"), &doc)?;
     writeln!(report, "## Optimum\n")?;
-    for (i, (f, x)) in best.values.iter().enumerate() {
-        writeln!(report, "- `{f}` = {}", study.label(i, x))?;
+    for (c, x) in study.columns().iter().zip(study.cells(&best.point)) {
+        writeln!(report, "- `{c}` = {x}")?;
     }
     let loose = best.objective.unwrap_or(f64::NAN);
     writeln!(report, "\n| | objective [J] | energy [J] | hand error RMS [mm] | hand error max [mm] | peak current [A] |")?;
@@ -398,6 +398,14 @@ fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity
                 study.spec.tolerance.as_ref().map_or(f64::NAN, |t| t.loose),
                 c.ladder.iter().map(|(r, j)| format!("rtol {r:e}: {j:.6} J")).collect::<Vec<_>>().join("; ")
             )?;
+            // the calibration's error bar (the baseline's loose − tight) holds for the optimum?
+            writeln!(
+                report,
+                "\nThe optimum's value as evaluated {} its tight re-run within the calibration's error bar ({err:.2e} J {} {:.2e} J).",
+                if err <= c.error_j { "matches" } else { "does NOT match" },
+                if err <= c.error_j { "<=" } else { ">" },
+                c.error_j
+            )?;
             // is the optimum resolved? the runner-up design against the error bar
             let second = state.evaluations.iter().filter(|e| e.objective.is_some() && e.values != best.values).map(Evaluation::told).min_by(f64::total_cmp);
             if let Some(s) = second {
@@ -410,6 +418,9 @@ fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity
     }
     if let (Some(b), Some(o)) = (base_o.objective, opt_o.objective) {
         writeln!(report, "\nAgainst the baseline (the scene as is): {:+.5} J ({:+.2} %).", o - b, 100.0 * (o - b) / b)?;
+    }
+    if study.settings.combos > 1 {
+        per_combination(study, state, &mut report)?;
     }
     writeln!(report, "\nRecordings: {} and {}.", study.base.runs.iter().map(|r| format!("{name}-optimum-{r}.mcap")).collect::<Vec<_>>().join(", "), study.base.runs.iter().map(|r| format!("{name}-baseline-{r}.mcap")).collect::<Vec<_>>().join(", "))?;
     write_tables(study, state, out)?;
@@ -425,13 +436,13 @@ fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity
 fn csv_rows(study: &Study, evals: &[&Evaluation]) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut head = vec!["index".to_string(), "generation".into()];
-    head.extend(study.spec.variables.iter().map(|x| x.field().to_string()));
+    head.extend(study.columns());
     head.extend(["objective_j", "E_total_j", "err_norm_rms_m", "err_norm_max_m", "peak_current_a", "fn_min_n", "infeasible"].map(String::from));
     w.write_record(&head)?;
     let num = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:e}"));
     for e in evals {
         let mut c = vec![e.index.to_string(), e.generation.to_string()];
-        c.extend(e.values.iter().enumerate().map(|(i, (_, x))| study.label(i, x)));
+        c.extend(study.cells(&e.point));
         c.extend([num(e.objective), num(e.energy_j), num(e.hand_error_rms_m), num(e.hand_error_max_m), num(e.peak_current_a), num(e.min_normal_force_n), e.infeasible.clone().unwrap_or_default()]);
         w.write_record(&c)?;
     }
@@ -476,13 +487,13 @@ fn figures(study: &Study, state: &State, out: &Path) -> Result<()> {
     study_figure(&s, [&format!("{name}: convergence"), "evaluations", "objective [J]"], &out.join("convergence")).map_err(anyhow::Error::msg)?;
     // the map over the first continuous variable (the discrete combinations as series),
     // infeasible designs as crosses at the top
-    if let Some(&i) = study.continuous.first() {
-        let field = study.spec.variables[i].field();
-        let x_of = |e: &Evaluation| e.values[i].1.as_f64().unwrap_or(f64::NAN);
+    if let Some(dim) = study.continuous.first() {
+        let field = dim.name.as_str();
+        let x_of = |e: &Evaluation| e.point.u.first().map_or(f64::NAN, |&u| dim.at(u));
         let top = ev.iter().filter(feasible).map(Evaluation::told).fold(f64::NEG_INFINITY, f64::max);
         let mut s: Vec<StudySeries> = (0..study.settings.combos)
             .map(|k| StudySeries {
-                name: if study.settings.combos == 1 { "feasible".into() } else { format!("combination {k}: {}", combo_label(study, ev.iter().find(|e| e.point.combo == k))) },
+                name: if study.settings.combos == 1 { "feasible".into() } else { format!("combination {k}: {}", study.combo_label(k)) },
                 points: ev.iter().filter(|e| e.objective.is_some() && e.point.combo == k).map(|e| (x_of(e), e.told())).collect(),
                 mark: Mark::Dots,
             })
@@ -501,7 +512,22 @@ fn figures(study: &Study, state: &State, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn combo_label(study: &Study, e: Option<&Evaluation>) -> String {
-    let Some(e) = e else { return String::new() };
-    study.discrete.iter().map(|&(i, _)| study.label(i, &e.values[i].1)).collect::<Vec<_>>().join(", ")
+/// The best design of every discrete combination (at the evaluations' tolerance): what the
+/// study says for each choice, e.g. each load in the hand.
+fn per_combination(study: &Study, state: &State, report: &mut String) -> Result<()> {
+    let cols = study.columns();
+    writeln!(report, "\n## Best design per combination (evaluations' tolerance)\n")?;
+    writeln!(report, "| combination | {} | objective [J] | evaluations | infeasible |", cols.join(" | "))?;
+    writeln!(report, "|---|{}---|---|---|", "---|".repeat(cols.len()))?;
+    for k in 0..study.settings.combos {
+        let of_k: Vec<&Evaluation> = state.evaluations.iter().filter(|e| e.point.combo == k).collect();
+        let bad = of_k.iter().filter(|e| e.objective.is_none()).count();
+        let best = of_k.iter().filter(|e| e.objective.is_some()).min_by(|a, b| a.told().total_cmp(&b.told()).then(a.index.cmp(&b.index)));
+        let (cells, j) = match best {
+            Some(e) => (study.cells(&e.point), format!("{:.4}", e.told())),
+            None => (vec!["-".to_string(); cols.len()], "none feasible".to_string()),
+        };
+        writeln!(report, "| {k}: {} | {} | {j} | {} | {bad} |", study.combo_label(k), cells.join(" | "), of_k.len())?;
+    }
+    Ok(())
 }
