@@ -110,12 +110,22 @@ fn a_killed_study_resumes_to_the_same_result() {
         .unwrap();
     let t0 = std::time::Instant::now();
     while !k.join("study-state.json").exists() && t0.elapsed().as_secs() < 120 {
+        assert!(child.try_wait().unwrap().is_none(), "the study ended before its first state was written");
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    // the kill must interrupt the study: it is still running when killed, dies of the signal,
+    // and leaves a state with fewer evaluations than the whole study and no report (a kill that
+    // lands after the study finished would test nothing)
+    assert!(child.try_wait().unwrap().is_none(), "the study finished before the kill");
     child.kill().unwrap();
-    child.wait().unwrap();
-    let st = state(&k);
-    assert!(st["evaluations"].as_array().unwrap().len() < state(&a)["evaluations"].as_array().unwrap().len() || k.join("report.md").exists());
+    let status = child.wait().unwrap();
+    {
+        use std::os::unix::process::ExitStatusExt;
+        assert_eq!(status.signal(), Some(9), "the study was not killed by SIGKILL: {status}");
+    }
+    let (killed_at, whole) = (state(&k)["evaluations"].as_array().unwrap().len(), state(&a)["evaluations"].as_array().unwrap().len());
+    assert!(killed_at < whole, "the kill left {killed_at} of the study's {whole} evaluations: it did not interrupt the study");
+    assert!(!k.join("report.md").exists() && !k.join("optimum.json").exists(), "the killed study wrote its outputs");
     optimize(&k, &[]);
     assert_eq!(outputs(&a), outputs(&k), "killed and resumed");
 }
@@ -150,6 +160,14 @@ fn bad_study_files_exit_2_naming_the_file_the_field_and_the_value() {
         (serde_json::json!([{"kind": "continuous", "field": "controller.kd", "min": 3, "max": 2}]), "variables[0].max", "2"),
         (serde_json::json!([{"kind": "categorical", "field": "controller.kd", "values": ["x"]}]), "variables[0].values[0]", "\"x\""),
         (serde_json::json!([{"kind": "continuous", "field": "controller.kd", "min": -5, "max": 2}]), "controller.kd", "-5"),
+        // on-link variables: the contact, the links and the ranges, each named
+        (serde_json::json!([{"kind": "on-link", "contact": "elbow9", "links": ["link2"]}]), "variables[0].contact", "elbow9"),
+        (serde_json::json!([{"kind": "on-link", "contact": "elbow3", "links": ["link2", "link9"]}]), "variables[0].links[1]", "link9"),
+        (serde_json::json!([{"kind": "on-link", "contact": "elbow3", "links": ["hand"]}]), "variables[0].links[0]", "hand"),
+        (serde_json::json!([{"kind": "on-link", "contact": "elbow3", "links": ["link2"], "along": [0, 2]}]), "variables[0].along[1]", "2"),
+        (serde_json::json!([{"kind": "on-link", "contact": "elbow3", "links": ["link2"], "around": [1, -1]}]), "variables[0].around[1]", "-1"),
+        // the hand load: its validation names the field and the value
+        (serde_json::json!([{"kind": "categorical", "field": "hand_load.mass", "values": [0.5, -1.0]}]), "hand_load.mass", "-1"),
     ];
     for (k, (vars, field, value)) in cases.iter().enumerate() {
         let f = tmp.path().join(format!("bad{k}.json"));
@@ -162,4 +180,59 @@ fn bad_study_files_exit_2_naming_the_file_the_field_and_the_value() {
             assert!(err.contains(s), "case {k}: `{s}` not in: {err}");
         }
     }
+}
+
+/// An `on-link` variable on the small arm whose links 2 and 3 have collision cylinders (radius
+/// 2 cm, along the link from 0 to 0.3 m), with the hand load as a second variable: every
+/// candidate's contact point lies on the cylinder's surface at its position along the chain
+/// and its angle around (to 1e-12 m, 1e-9 rad), the brace under it holds the bilateral
+/// contact at q0 (no candidate is infeasible), and the optimum's scene runs.
+#[test]
+fn on_link_points_lie_on_the_collision_cylinder_and_the_brace_holds_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let small = Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/small");
+    let cyl = r#"<collision><origin xyz="0 0 0.15" rpy="0 0 0"/><geometry><cylinder radius="0.02" length="0.3"/></geometry></collision>"#;
+    let urdf = std::fs::read_to_string(small.join("small_arm.urdf")).unwrap();
+    let urdf = urdf.replace("<link name=\"link2\">", &format!("<link name=\"link2\">{cyl}")).replace("<link name=\"link3\">", &format!("<link name=\"link3\">{cyl}"));
+    assert_eq!(urdf.matches("<collision>").count(), 2);
+    std::fs::write(tmp.path().join("small_arm.urdf"), urdf).unwrap();
+    std::fs::copy(small.join("small.json"), tmp.path().join("small.json")).unwrap();
+    let study = serde_json::json!({
+        "name": "on-cyl", "scene": "small.json", "runs": ["elbow"], "duration": 0.1,
+        "variables": [
+            {"kind": "categorical", "field": "hand_load.mass", "values": [0.0, 0.2]},
+            {"kind": "on-link", "contact": "elbow3", "links": ["link2", "link3"], "along": [0.2, 1.8], "around": [-3.0, 3.0]}
+        ],
+        "method": {"seed": 4, "evaluations": 24, "local_fraction": 0.0}
+    });
+    let f = tmp.path().join("on-cyl.json");
+    std::fs::write(&f, study.to_string()).unwrap();
+    let out = tmp.path().join("o");
+    let r = run_sim(&["optimize", f.to_str().unwrap(), "-o", out.to_str().unwrap(), "-j", "2", "-q"]);
+    assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
+    let st = state(&out);
+    let evals = st["evaluations"].as_array().unwrap();
+    assert_eq!(evals.len(), 24);
+    for e in evals {
+        assert!(e["objective"].is_f64(), "infeasible: {}", e["infeasible"]);
+        let u: Vec<f64> = e["point"]["u"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let (t, theta) = (0.2 + 1.6 * u[0], -3.0 + 6.0 * u[1]);
+        let values = e["values"].as_array().unwrap();
+        let point = values.iter().find(|v| v[0] == "contacts.0.point").unwrap_or_else(|| panic!("no point in {values:?}"))[1].clone();
+        assert!(values.iter().any(|v| v[0] == "contacts.0.plane.offset"), "no brace in {values:?}");
+        let link = if t < 1.0 { "link2" } else { "link3" };
+        assert_eq!(point["link"], link, "t = {t}");
+        let p: Vec<f64> = point["offset"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let s = t - t.floor();
+        assert!((p[2] - 0.3 * s).abs() < 1e-12, "t = {t}: z = {}", p[2]);
+        assert!((p[0].hypot(p[1]) - 0.02).abs() < 1e-12, "off the surface: {p:?}");
+        let d = (p[1].atan2(p[0]) - theta).rem_euclid(std::f64::consts::TAU);
+        assert!(d.min(std::f64::consts::TAU - d) < 1e-9, "θ = {theta}: {p:?}");
+    }
+    // both loads were searched, and the load is in the optimum's scene when it is the best
+    assert!(evals.iter().any(|e| e["point"]["combo"] == 1) && evals.iter().any(|e| e["point"]["combo"] == 0));
+    let opt: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("optimum.json")).unwrap()).unwrap();
+    assert!(opt["hand_load"]["mass"].is_f64(), "{}", opt["hand_load"]);
+    let r = run_sim(&["run", out.join("optimum.json").to_str().unwrap(), "-o", tmp.path().join("rerun").to_str().unwrap(), "-q"]);
+    assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
 }
