@@ -239,7 +239,9 @@ pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
 /// first probe `t_p` where every fired function is off its firing side, `fired` is cleared and
 /// the bracket to locate returned: `[t_p, t_hi]` with the probe's values as `g_lo`, or
 /// `[t_lo, t_p]` with them as `g_hi` when some function changes sign before `t_p` (the earlier
-/// root). `None`: they moved straight to their firing side; they fire at the step's start.
+/// root). Off the firing side means by more than the function's tolerance
+/// ([`HybridSystem::event_tolerance`]), as past it towards the firing side does for firing.
+/// `None`: they moved straight to their firing side; they fire at the step's start.
 /// `y` is scratch (length dim).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn departed_inside<S: HybridSystem, St: Stepper<S> + ?Sized>(
@@ -266,9 +268,11 @@ pub(super) fn departed_inside<S: HybridSystem, St: Stepper<S> + ?Sized>(
         stepper.interpolate(t_p, y);
         sys.events(t_p, y, &mut br.g_mid).map_err(IntegrateError::Rhs)?;
         shift(&mut br.g_mid, &br.base, &br.watched);
+        // off the firing side by more than the function's tolerance, as firing needs past it
+        // (a force of −c t³ computed as +1e-20 at a tiny probe is no departure)
         let departed = (0..n).filter(|&i| br.fired[i]).all(|i| match br.dir[i] {
-            d if d < 0 => br.g_mid[i] > 0.0,
-            d if d > 0 => br.g_mid[i] < 0.0,
+            d if d < 0 => br.g_mid[i] > br.tolerance[i],
+            d if d > 0 => br.g_mid[i] < -br.tolerance[i],
             _ => false,
         });
         if departed {
