@@ -132,9 +132,10 @@ fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() 
         eprintln!("{method}: error ~ steps^-{p:.3}, last pair steps^-{p_last:.3} ({runs:?})");
         // at least the method's order over the ladder; steeper there, since each rung's steps
         // are also cut at the located mode changes (each restart begins with small steps), a
-        // share of the work that shrinks as rtol tightens (imex measured 5.02 over the ladder,
-        // its pairs 5.5, 5.2, 4.9, 4.6); so the order itself is read from the last pair, where
-        // that share is least; error ∝ rtol below is the sharp check
+        // share of the work that shrinks as rtol tightens: up to one more over the ladder, or
+        // the order ± 0.75 over its last pair, where that share is least (measured dopri45
+        // 5.94, imex 4.87 over the ladder; imex 3.98 over its last pair); error ∝ rtol below
+        // is the sharp check
         assert!(p >= order - 0.5 && (p <= order + 1.0 || (p_last - order).abs() <= 0.75), "{method}: error ~ steps^-{p:.2}, last pair ^-{p_last:.2}, order {order} ({runs:?})");
         let q = slope(tols, &e);
         assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");

@@ -71,7 +71,7 @@ fn dopri(rtol: f64) -> IntegratorSpec {
 /// decided together, `ode/drive_modes.rs`). Taken one joint at a time, as before, a state
 /// error of 1e-9 chose another sequence and every method ended 6.04e-5 m from its reference at
 /// every rtol (a plateau, error ∝ rtol^0); now each method takes the reference's sequence and
-/// the error falls with rtol over the whole 0.3 s (measured slopes 0.88, 0.99, 0.97).
+/// the error falls with rtol over the whole 0.3 s (measured slopes 0.92, 0.99, 0.93).
 ///
 /// rk4 with the Stribeck term (v_s = 0.05 rad/s): slope 4 ± 0.3 over h = 5e-5, 2.5e-5, 1.25e-5 s
 /// and the first 20 ms (measured 4.05: 1.87e-9, 5.62e-11, 6.77e-12 m). At the harness's h = 2e-4,
