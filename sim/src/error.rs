@@ -108,15 +108,27 @@ pub enum RunError {
     /// `window` s of each other.
     #[error("the run stopped at t = {t:.9} s: {count} contact events in a row at the same instant (within {window:e} s), more than events.max_events_at_one_time = {limit}: the contact modes chatter; {events}. Remedies: raise events.max_events_at_one_time in the scene if the events do settle (a cascade through many contacts); make the contacts compliant (model \"compliant\", no instantaneous mode switches); lower the contacts' friction (a high coefficient can make the rigid contact problem inconsistent, Painleve's paradox); or check the initial state and the target near that time")]
     Chattering { t: f64, count: u32, window: f64, limit: u32, events: String },
-    /// [`RunError::Chattering`] where every event is a gear's (`gear_friction`, issue 26): the
-    /// joints' stick/slide decisions are taken one joint at a time, which coupled joints can
-    /// contradict without end.
-    #[error("the run stopped at t = {t:.9} s: the gears of {joints} switched between stick and slide {count} times in a row at the same instant (within {window:e} s, events.max_events_at_one_time = {limit}): the motions of these joints are coupled (a closed chain through the table, or their shared mass matrix) and their gears' stick decisions, taken one joint at a time, contradict each other. Remedies: leave the Coulomb/static friction off all but one of these joints (gear_friction values per joint: coulomb and breakaway 0; their efficiencies can stay), or run the elbow-free run; solving the joints' stick/slip modes together is not implemented")]
+    /// The gears' stick/slide modes (`gear_friction`, issue 26) found no consistent
+    /// combination: either the joints' joint decision at an event found none among every
+    /// combination of the joints at rest (`count` combinations tried, `window` 0), or the gears'
+    /// events chattered at one instant ([`RunError::Chattering`] where every event is a gear's:
+    /// `count` events within `window` s, more than `limit`).
+    #[error("the run stopped at t = {t:.9} s: the gears of {joints} have no consistent stick/slide modes there ({count} {what}): the motions of these joints are coupled (a closed chain through the table, or their shared mass matrix) and every combination of their stick and slide modes contradicts itself, or they switch without end. Remedies: leave the Coulomb/static friction off all but one of these joints (gear_friction values per joint: coulomb and breakaway 0; their efficiencies can stay), lower their breakaway torques, or run the elbow-free run", what = gears_what(.window, .limit))]
     GearsChatter { t: f64, count: u32, window: f64, limit: u32, joints: String },
     /// The recording could not be written (I/O error, full disk, another writer of the same
     /// path): `source` names the path and the OS reason.
     #[error("writing the recording: {source}")]
     Recording { path: PathBuf, source: schemas::Error },
+}
+
+/// [`RunError::GearsChatter`]'s count, said: combinations tried (a joint decision, `window` 0)
+/// or switches at one instant.
+fn gears_what(window: &f64, limit: &u32) -> String {
+    if *window == 0.0 {
+        "combinations of stick, slide + and slide - tried".to_string()
+    } else {
+        format!("switches in a row within {window:e} s, events.max_events_at_one_time = {limit}")
+    }
 }
 
 /// What makes a run with `method` slow where its budget ran out (`during`), and what to do.

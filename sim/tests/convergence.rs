@@ -78,11 +78,8 @@ fn every_method_converges_at_its_order_on_the_paper_arm() {
 /// and Stribeck, forward and backward efficiencies) and a supply without regeneration on a
 /// dumping bus: the gears' and the supply's mode changes are events located on each method's
 /// dense output, so every phase is smooth and the adaptive methods keep their order, on the
-/// hand path. Measured and NOT yet holding (issue 26, open): rk4 (fixed step) gives h^3.1
-/// instead of h^4, and ROSENBROCK (W-method, rtol 1e-9) takes a different stick/slide
-/// decision at one stop (hand error 5e-5 m where 1e-6..1e-8 give 3e-8..3e-10); the closed
-/// chains (one- and two-elbow runs) chatter between two coupled joints' per-joint stick
-/// decisions. Those are left out here and listed in TESTING.md.
+/// hand path. (rk4 with gear events: `drive_features.rs`; the joints' stick/slide modes are
+/// decided together at every event, `ode/drive_modes.rs`.)
 #[test]
 #[allow(clippy::result_large_err)] // the sink returns RunError
 fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() {
@@ -118,7 +115,9 @@ fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() 
     };
     let (reference, _) = run_of(&with(IntegratorSpec::Dopri45(AdaptiveSpec { rtol: 1e-13, atol: 1e-15, h_max: Some(1e-4), max_steps: None })));
     let err = |h: &[Vector3<f64>]| h.iter().zip(&reference).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-    for (method, order, tols) in [("dopri45", 5.0, &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10][..]), ("imex", 4.0, &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10][..])] {
+    // (dopri45 to rtol 1e-9: at 1e-10 its hand error, 2e-13 m, is at the floor of the events'
+    // location, a 1e-12 s bracket at hand speeds of ~0.1 m/s)
+    for (method, order, tols) in [("dopri45", 5.0, &[1e-6, 1e-7, 1e-8, 1e-9][..]), ("imex", 4.0, &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10][..])] {
         let runs: Vec<(f64, f64)> = tols
             .iter()
             .map(|&tol| {
@@ -128,11 +127,16 @@ fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() 
             .collect();
         let (e, n): (Vec<f64>, Vec<f64>) = runs.iter().copied().unzip();
         let p = -slope(&n, &e);
-        // at least the method's order; steeper is allowed up to one more (each rung's steps
-        // are also cut at the located mode changes, a share that shrinks as rtol tightens:
-        // imex measured 4.83 by steps at the merge of issues 23, 24 and 26), while error ∝ rtol
-        // below is the sharp check
-        assert!(p >= order - 0.5 && p <= order + 1.0, "{method}: error ~ steps^-{p:.2}, order {order} ({runs:?})");
+        let k = n.len() - 2;
+        let p_last = -slope(&n[k..], &e[k..]);
+        eprintln!("{method}: error ~ steps^-{p:.3}, last pair steps^-{p_last:.3} ({runs:?})");
+        // at least the method's order over the ladder; steeper there, since each rung's steps
+        // are also cut at the located mode changes (each restart begins with small steps), a
+        // share of the work that shrinks as rtol tightens: up to one more over the ladder, or
+        // the order ± 0.75 over its last pair, where that share is least (measured dopri45
+        // 5.94, imex 4.87 over the ladder; imex 3.98 over its last pair); error ∝ rtol below
+        // is the sharp check
+        assert!(p >= order - 0.5 && (p <= order + 1.0 || (p_last - order).abs() <= 0.75), "{method}: error ~ steps^-{p:.2}, last pair ^-{p_last:.2}, order {order} ({runs:?})");
         let q = slope(tols, &e);
         assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");
     }

@@ -25,8 +25,13 @@
 //!   [`HybridSystem::event_tolerance`], within a step that starts at `g₀` fires at that step's
 //!   start (for the first step: at the restart itself). So a contact closed with `f_n = 0` whose
 //!   force then turns negative opens at once instead of pulling unseen, while a function that
-//!   only jitters at its start value fires nothing. Other functions exactly 0 at a start are
-//!   disarmed for that step;
+//!   only jitters at its start value fires nothing. Unless it went the other way first: the
+//!   dense output is probed at `t_lo + h 2^−k` (k = 1, 2, … down to `time_tol`), and a
+//!   function found off its firing side there left and came back inside the step (a gear that
+//!   starts sliding from rest, turns and stops within one step), so its return is located like
+//!   any other root instead of firing at the start, where the handler would restart it into
+//!   the same mode without end (`locate::departed_inside`). Other functions exactly 0 at a
+//!   start are disarmed for that step;
 //! - the bracket `[t_lo, t_hi]` is narrowed by the Illinois secant on the function with the
 //!   largest `|g(t_hi)| / |g(t_hi) − g(t_lo)|` (all functions are evaluated at each trial point;
 //!   a sign change of any function in `[t_lo, t_mid]` keeps that half), to a width
@@ -62,7 +67,7 @@ mod tests;
 #[cfg(test)]
 mod toys;
 
-use self::locate::{crosses, locate_root, Bracket, Side};
+use self::locate::{crosses, departed_inside, locate_root, Bracket, Side};
 use super::sampled::{OutputGrid, Pace};
 use super::{Deadline, IntegrateError, OdeSystem, Stats, Stepper, Watch};
 
@@ -243,14 +248,22 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
         }
         sys.events(t_after, stepper.y(), &mut br.g_hi).map_err(rhs)?;
         br.shift(Side::Hi);
-        let at_start = br.left_at_start();
+        let tol = time_tolerance(settings.time_tol, t_after);
+        let mut at_start = br.left_at_start();
+        let (mut t_lo, mut t_hi) = (t_before, t_after);
+        if at_start {
+            // or a departure and a return inside the step: a root to locate
+            if let Some(bracket) = departed_inside(stepper, sys, &mut br, t_before, t_after, tol, watch, &mut buf)? {
+                (t_lo, t_hi) = bracket;
+                at_start = false;
+            }
+        }
         if !at_start && !(0..n_ev).any(|i| crosses(br.dir[i], br.g_lo[i], br.g_hi[i])) {
             continue;
         }
 
-        // an event in [t_before, t_after]: its time, then the samples before it
-        let tol = time_tolerance(settings.time_tol, t_after);
-        let t_star = if at_start { t_before } else { locate_root(stepper, sys, &mut br, t_before, t_after, tol, watch, &mut buf)? };
+        // an event in [t_lo, t_hi]: its time, then the samples before it
+        let t_star = if at_start { t_before } else { locate_root(stepper, sys, &mut br, t_lo, t_hi, tol, watch, &mut buf)? };
         while k <= n_out && grid.time(k) < t_star {
             let t_k = grid.time(k);
             stepper.interpolate(t_k, &mut buf);

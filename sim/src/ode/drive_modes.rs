@@ -43,6 +43,15 @@ pub struct GearEvent {
     pub mode: GearMode,
 }
 
+/// A preferred mode as a candidate: a sliding mode's power direction from `km_i` (the joint is
+/// at rest, its speed gives none).
+fn normalise(mode: GearMode, km_i: f64) -> GearMode {
+    match mode {
+        GearMode::Stick => GearMode::Stick,
+        GearMode::Slide { dir, .. } => GearMode::slide(f64::from(dir), km_i),
+    }
+}
+
 /// The gear log keeps the first this many events of a run (a diagnostic; bounded memory).
 const MAX_GEAR_LOG: usize = 10_000;
 
@@ -389,51 +398,153 @@ impl ArmSystem<'_> {
             y[l.work().start + k] += -d.jm[k] * (after * after - before * before) / 2.0;
             y[l.qd().start + k] = after;
         }
-        y[l.qd().start + j] = 0.0;
+        // the held joints exactly at rest (the projection leaves them there to rounding)
+        for &k in &held {
+            y[l.qd().start + k] = 0.0;
+        }
         if let Some(k) = l.loss_gear() {
             y[k] -= d_t;
         }
     }
 
-    /// Set the gear modes of the joints `which` from (t, y): a joint at rest (or stopping:
-    /// `stopping`) sticks when its holding torque is in the band, else slides the way the
-    /// torque pushes; a moving joint slides in its direction. Returns whether y moved.
-    fn settle_gears(&mut self, t: f64, y: &mut [f64], which: &[usize], stopping: bool) -> Result<bool, RunError> {
-        let Some(g) = self.scene.gear_friction.clone() else { return Ok(false) };
+    /// The gear modes of the joints at rest, decided together at (t, y) (module docs, "The
+    /// joints' modes together"): every combination of stick, slide + and slide − over the
+    /// joints at rest is a candidate, tried in the order of how many joints leave their
+    /// `preferred` mode (0 first), then stick before slide; the first consistent one is taken.
+    /// Moving joints keep their sliding modes. No consistent combination: the gears chatter
+    /// ([`RunError::GearsChatter`], naming the joints at rest). Allocates (an event).
+    fn decide_gears(&mut self, t: f64, y: &[f64], preferred: &[GearMode], fired: &[bool], log_all: bool) -> Result<(), RunError> {
+        let scene = self.scene;
+        let Some(g) = &scene.gear_friction else { return Ok(()) };
+        let l = self.layout;
+        let nv = l.nv;
+        let modes = &self.drive_modes.as_ref().expect("drive modes").gear;
+        let rest: Vec<usize> = (0..nv).filter(|&j| g.active(j) && (y[l.qd().start + j] == 0.0 || modes[j] == GearMode::Stick || fired.get(j).copied().unwrap_or(false))).collect();
+        if rest.is_empty() {
+            return Ok(());
+        }
+        self.inputs(t, y)?;
+        let km_i: Vec<f64> = (0..nv).map(|j| self.km_i(y, j)).collect();
+        let before = self.drive_modes.as_ref().expect("drive modes").gear.clone();
+        let n = rest.len();
+        // per joint at rest: its preferred mode first, then the others (stick, slide +, slide −)
+        let options: Vec<[GearMode; 3]> = rest
+            .iter()
+            .map(|&j| {
+                // a sliding mode keeps the power direction its events have tracked (at the root
+                // of `K_m i s` the sign of K_m i says nothing); a new one takes it from K_m i
+                let as_now = |mode: GearMode| match (mode, before[j]) {
+                    (GearMode::Slide { dir, .. }, GearMode::Slide { dir: d0, driving }) if dir == d0 => GearMode::Slide { dir, driving },
+                    _ => normalise(mode, km_i[j]),
+                };
+                let p = as_now(preferred[j]);
+                let mut o = [p; 3];
+                let mut k = 1;
+                for c in [GearMode::Stick, as_now(GearMode::slide(1.0, km_i[j])), as_now(GearMode::slide(-1.0, km_i[j]))] {
+                    if c != p && k < 3 {
+                        o[k] = c;
+                        k += 1;
+                    }
+                }
+                o
+            })
+            .collect();
+        let mut choice = vec![0u8; n];
+        let mut tried = 0u64;
+        for d in 0..=n {
+            // every set of d joints off their preferred mode (bit masks of popcount d), each with
+            // its two other modes (2^d)
+            for mask in 0u64..(1u64 << n) {
+                if mask.count_ones() as usize != d {
+                    continue;
+                }
+                for alt in 0u64..(1u64 << d) {
+                    let mut b = 0;
+                    for (a, c) in choice.iter_mut().enumerate() {
+                        *c = if mask >> a & 1 == 1 {
+                            b += 1;
+                            1 + (alt >> (b - 1) & 1) as u8
+                        } else {
+                            0
+                        };
+                    }
+                    tried += 1;
+                    if self.gears_consistent(t, y, g, &rest, &options, &choice, &km_i, fired)? {
+                        let m = self.drive_modes.as_ref().expect("drive modes");
+                        let changed: Vec<(usize, GearMode)> = rest.iter().map(|&j| (j, m.gear[j])).filter(|&(j, mode)| log_all || mode != before[j]).collect();
+                        for (j, mode) in changed {
+                            self.log_gear(t, j, mode);
+                        }
+                        return Ok(());
+                    }
+                }
+            }
+        }
+        let m = self.drive_modes.as_mut().expect("drive modes");
+        m.gear.copy_from_slice(&before);
+        let joints: Vec<String> = rest.iter().map(|&j| scene.model.bodies[j].joint.clone()).collect();
+        Err(RunError::GearsChatter { t, count: tried as u32, window: 0.0, limit: 0, joints: joints.join(", ") })
+    }
+
+    /// Whether the joints at rest in the modes `options[a][choice[a]]` are consistent at (t, y):
+    /// a sticking joint's holding torque inside its static band (margin ≥ −tol_f,
+    /// `tol_f = 1e-8 (1 N m + max |λ|)`), a joint sliding from rest accelerating its way
+    /// (`s q̈ ≥ −tol_a`, `tol_a = 1e-8 (1 + max |q̈|)`), the tolerances of the contacts' mode
+    /// problem (`dynamics/contact/modes.rs`). A joint whose own event `fired` sits on the boundary
+    /// the event located, to the location's accuracy rather than to rounding: its preferred mode
+    /// (the one the event implies, `choice` 0) holds within 100 times the tolerance, another mode
+    /// only from clearly inside (margin or `s q̈` ≥ +tol), which only another joint's change can
+    /// bring about.
+    #[allow(clippy::too_many_arguments)]
+    fn gears_consistent(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        g: &crate::dynamics::gear_friction::GearFriction,
+        rest: &[usize],
+        options: &[[GearMode; 3]],
+        choice: &[u8],
+        km_i: &[f64],
+        fired: &[bool],
+    ) -> Result<bool, RunError> {
+        {
+            let m = self.drive_modes.as_mut().expect("drive modes");
+            for (a, &j) in rest.iter().enumerate() {
+                m.gear[j] = options[a][choice[a] as usize];
+            }
+        }
+        self.evaluate(t, y)?;
+        let m = self.drive_modes.as_ref().expect("drive modes");
+        let qdd = self.ws.fd.qdd.as_slice();
+        let tol_f = 1e-8 * (1.0 + rest.iter().map(|&j| m.gear_torque[j].abs()).fold(0.0, f64::max));
+        let tol_a = 1e-8 * (1.0 + qdd.iter().map(|x| x.abs()).fold(0.0, f64::max));
+        Ok(rest.iter().enumerate().all(|(a, &j)| {
+            let value = match m.gear[j] {
+                GearMode::Stick => g.stick_margin(j, km_i[j], m.gear_torque[j]),
+                GearMode::Slide { dir, .. } => f64::from(dir) * qdd[j],
+            };
+            let tol = if m.gear[j] == GearMode::Stick { tol_f } else { tol_a };
+            match (fired.get(j).copied().unwrap_or(false), choice[a] == 0) {
+                (true, true) => value >= -100.0 * tol,
+                (true, false) => value >= tol,
+                (false, _) => value >= -tol,
+            }
+        }))
+    }
+
+    /// Stop the sliding joints `which` (their speed the root location leaves, |q̇| of the order
+    /// of the dense output's error at the root, removed and its kinetic energy booked as gear
+    /// loss; each held at rest while the next stops). Returns whether y moved.
+    fn stop_joints(&mut self, t: f64, y: &mut [f64], which: &[usize]) -> Result<bool, RunError> {
         let l = self.layout;
         let mut moved = false;
         for &j in which {
-            if !g.active(j) {
-                continue;
-            }
-            let qd = y[l.qd().start + j];
-            if qd != 0.0 && !stopping {
-                self.inputs(t, y)?;
-                let km_i = self.km_i(y, j);
-                self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::slide(qd, km_i);
-                self.log_gear(t, j, GearMode::slide(qd, km_i));
-                continue;
-            }
-            // the joint stops: the speed the root location leaves (|q̇| of the order of the
-            // dense output's error at the root) is removed, its kinetic energy booked as gear
-            // loss; then it sticks if the holding torque is in the band, else it slides from
-            // rest the way that torque pushes
-            if qd != 0.0 {
+            if y[l.qd().start + j] != 0.0 {
                 self.evaluate(t, y)?;
                 self.stop_joint(y, j);
                 moved = true;
             }
             self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::Stick;
-            self.evaluate(t, y)?;
-            let km_i = self.km_i(y, j);
-            let lambda = self.drive_modes.as_ref().expect("drive modes").gear_torque[j];
-            if g.stick_margin(j, km_i, lambda) >= 0.0 {
-                self.log_gear(t, j, GearMode::Stick);
-            } else {
-                let dir = if lambda > 0.0 { -1.0 } else { 1.0 };
-                self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::slide(dir, km_i);
-                self.log_gear(t, j, GearMode::slide(dir, km_i));
-            }
         }
         Ok(moved)
     }
@@ -451,16 +562,51 @@ impl ArmSystem<'_> {
         Ok(())
     }
 
-    /// The drives' modes at the start.
+    /// The drives' modes at the start: a moving joint slides its way; the joints at rest are
+    /// decided together, preferring for each what it would do alone (stick when its holding
+    /// torque with every joint at rest sticking is in its band, else slide the way it pushes).
     pub(super) fn init_drive_modes(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
         if self.drive_modes.is_none() {
             return Ok(false);
         }
-        let nv = self.layout.nv;
-        let all: Vec<usize> = (0..nv).collect();
-        let moved = self.settle_gears(t, y, &all, false)?;
+        let scene = self.scene;
+        if let Some(g) = &scene.gear_friction {
+            let l = self.layout;
+            let nv = l.nv;
+            self.inputs(t, y)?;
+            for j in 0..nv {
+                let (qd, km_i) = (y[l.qd().start + j], self.km_i(y, j));
+                let mode = if qd != 0.0 || !g.active(j) { GearMode::slide(qd, km_i) } else { GearMode::Stick };
+                self.drive_modes.as_mut().expect("drive modes").gear[j] = mode;
+                if qd != 0.0 && g.active(j) {
+                    self.log_gear(t, j, mode);
+                }
+            }
+            // a first guess for the joints at rest: from every one sticking, free the one
+            // whose holding torque is furthest out of its band (the way it pushes), again
+            // until every sticking joint holds (at most one pass per joint)
+            for _ in 0..nv {
+                self.evaluate(t, y)?;
+                let m = self.drive_modes.as_ref().expect("drive modes");
+                let worst = (0..nv)
+                    .filter(|&j| g.active(j) && m.gear[j] == GearMode::Stick)
+                    .map(|j| (j, g.stick_margin(j, self.km_i(y, j), m.gear_torque[j])))
+                    .filter(|&(_, margin)| margin < 0.0)
+                    .min_by(|a, b| a.1.total_cmp(&b.1));
+                let Some((j, _)) = worst else { break };
+                let (km_i, lambda) = (self.km_i(y, j), m.gear_torque[j]);
+                self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::slide(if lambda > 0.0 { -1.0 } else { 1.0 }, km_i);
+            }
+            let preferred = self.drive_modes.as_ref().expect("drive modes").gear.clone();
+            for j in 0..nv {
+                if g.active(j) && y[l.qd().start + j] == 0.0 {
+                    self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::Stick;
+                }
+            }
+            self.decide_gears(t, y, &preferred, &[], true)?;
+        }
         self.settle_supply(t, y)?;
-        Ok(moved)
+        Ok(false)
     }
 
     /// The drives' events `fired` (their own indices) at (t, y).
@@ -470,26 +616,50 @@ impl ArmSystem<'_> {
         }
         let nv = self.layout.nv;
         let mut moved = false;
+        // the power directions of sliding joints: a flip each
         for j in 0..nv.min(fired.len() / 2) {
-            if fired[2 * j] {
-                let stuck = self.drive_modes.as_ref().expect("drive modes").gear[j] == GearMode::Stick;
-                if stuck {
-                    // break away the way the holding torque pushed
-                    self.evaluate(t, y)?;
-                    let km_i = self.km_i(y, j);
-                    let lambda = self.drive_modes.as_ref().expect("drive modes").gear_torque[j];
-                    let dir = if lambda > 0.0 { -1.0 } else { 1.0 };
-                    self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::slide(dir, km_i);
-                    self.log_gear(t, j, GearMode::slide(dir, km_i));
-                } else {
-                    moved |= self.settle_gears(t, y, &[j], true)?;
-                }
-            } else if fired[2 * j + 1] {
+            if !fired[2 * j] && fired[2 * j + 1] {
                 if let GearMode::Slide { dir, driving } = self.drive_modes.as_ref().expect("drive modes").gear[j] {
                     self.drive_modes.as_mut().expect("drive modes").gear[j] = GearMode::Slide { dir, driving: !driving };
                     self.log_gear(t, j, GearMode::Slide { dir, driving: !driving });
                 }
             }
+        }
+        // stick/slip: the stopping joints stop, the breaking-away ones prefer to slide the way
+        // their holding torque pushed, then every joint at rest is decided together
+        let stick_slip: Vec<usize> = (0..nv.min(fired.len() / 2)).filter(|&j| fired[2 * j]).collect();
+        if !stick_slip.is_empty() {
+            self.evaluate(t, y)?;
+            let m = self.drive_modes.as_ref().expect("drive modes");
+            let mut preferred = m.gear.clone();
+            let mut stopping = Vec::new();
+            for &j in &stick_slip {
+                if m.gear[j] == GearMode::Stick {
+                    let lambda = m.gear_torque[j];
+                    preferred[j] = GearMode::slide(if lambda > 0.0 { -1.0 } else { 1.0 }, self.km_i(y, j));
+                } else {
+                    preferred[j] = GearMode::Stick;
+                    stopping.push(j);
+                }
+            }
+            let was = self.drive_modes.as_ref().expect("drive modes").gear.clone();
+            moved |= self.stop_joints(t, y, &stopping)?;
+            // a stopped joint prefers to stick when its holding torque (the others in their
+            // modes) is in its band, else to slide the way that torque pushes
+            if !stopping.is_empty() {
+                self.evaluate(t, y)?;
+                let g = self.scene.gear_friction.as_ref().expect("gear friction");
+                let m = self.drive_modes.as_ref().expect("drive modes");
+                for &j in &stopping {
+                    let (km_i, lambda) = (self.km_i(y, j), m.gear_torque[j]);
+                    if g.stick_margin(j, km_i, lambda) < 0.0 {
+                        preferred[j] = GearMode::slide(if lambda > 0.0 { -1.0 } else { 1.0 }, km_i);
+                    }
+                }
+            }
+            self.drive_modes.as_mut().expect("drive modes").gear.copy_from_slice(&was);
+            let fired_joint: Vec<bool> = (0..nv).map(|j| stick_slip.contains(&j)).collect();
+            self.decide_gears(t, y, &preferred, &fired_joint, false)?;
         }
         if fired.get(2 * nv..).is_some_and(|f| f.iter().any(|&x| x)) {
             let m = self.drive_modes.as_mut().expect("drive modes");

@@ -229,6 +229,67 @@ pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
     Ok(t_hi)
 }
 
+/// After [`Bracket::left_at_start`] fired watched functions (each at its start value at the
+/// step's start, past it towards its firing side at the end): whether they left towards the
+/// other side first and came back inside the step — a joint that starts sliding from rest,
+/// turns and stops within one step; a contact force that grows from 0, then falls below it.
+/// Then the root is the return, inside the step, not the step's start. The dense output is
+/// probed at `t_lo + (t_hi − t_lo) 2^−k`, k = 1, 2, … while the probe is more than `tol` past
+/// `t_lo` (the excursion starts at `t_lo`, so halving finds any longer than `tol`); at the
+/// first probe `t_p` where every fired function is off its firing side, `fired` is cleared and
+/// the bracket to locate returned: `[t_p, t_hi]` with the probe's values as `g_lo`, or
+/// `[t_lo, t_p]` with them as `g_hi` when some function changes sign before `t_p` (the earlier
+/// root). Off the firing side means by more than the function's tolerance
+/// ([`HybridSystem::event_tolerance`]), as past it towards the firing side does for firing.
+/// `None`: they moved straight to their firing side; they fire at the step's start.
+/// `y` is scratch (length dim).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn departed_inside<S: HybridSystem, St: Stepper<S> + ?Sized>(
+    stepper: &St,
+    sys: &mut S,
+    br: &mut Bracket,
+    t_lo: f64,
+    t_hi: f64,
+    tol: f64,
+    watch: Watch,
+    y: &mut [f64],
+) -> Result<Option<(f64, f64)>, IntegrateError<S::Error>> {
+    let n = br.g_lo.len();
+    let mut k = 1;
+    loop {
+        let t_p = t_lo + (t_hi - t_lo) * 0.5f64.powi(k);
+        let gap = t_p - t_lo;
+        if gap.is_nan() || gap <= tol {
+            return Ok(None);
+        }
+        if watch.out_of_time() {
+            return Err(IntegrateError::OutOfTime { t: t_lo, during: Phase::LocatingEvent { trials: k as usize } });
+        }
+        stepper.interpolate(t_p, y);
+        sys.events(t_p, y, &mut br.g_mid).map_err(IntegrateError::Rhs)?;
+        shift(&mut br.g_mid, &br.base, &br.watched);
+        // off the firing side by more than the function's tolerance, as firing needs past it
+        // (a force of −c t³ computed as +1e-20 at a tiny probe is no departure)
+        let departed = (0..n).filter(|&i| br.fired[i]).all(|i| match br.dir[i] {
+            d if d < 0 => br.g_mid[i] > br.tolerance[i],
+            d if d > 0 => br.g_mid[i] < -br.tolerance[i],
+            _ => false,
+        });
+        if departed {
+            br.fired.iter_mut().for_each(|f| *f = false);
+            let earlier = (0..n).any(|i| crosses(br.dir[i], br.g_lo[i], br.g_mid[i]));
+            return Ok(Some(if earlier {
+                br.g_hi.copy_from_slice(&br.g_mid);
+                (t_lo, t_p)
+            } else {
+                br.g_lo.copy_from_slice(&br.g_mid);
+                (t_p, t_hi)
+            }));
+        }
+        k += 1;
+    }
+}
+
 /// `v[i] -= base[i]` for the watched functions.
 fn shift(v: &mut [f64], base: &[f64], watched: &[bool]) {
     for ((x, b), w) in v.iter_mut().zip(base).zip(watched) {

@@ -1,7 +1,7 @@
 //! The event driver on abstract hybrid problems with closed-form event times, for every
 //! method (`toys.rs`).
 
-use super::toys::{methods, Ball, LiftOff, Law, MovedStart, Thresholds, Toy};
+use super::toys::{methods, Ball, Blip, LiftOff, Law, MovedStart, Thresholds, Toy};
 use super::*;
 use crate::integrate::test_problems::{HarmonicOscillator, Kepler, RhsFailure, StiffLinear};
 use crate::integrate::{integrate_sampled, ArkImex, DormandPrince45, Rk4, Rodas, Rosenbrock, StepControl};
@@ -190,6 +190,29 @@ fn a_contact_force_that_starts_at_zero_and_turns_negative_lifts_off_at_once() {
         assert_eq!(t, vec![0.0], "{name}: one lift-off, at t0");
         for (t, y) in &samples {
             let x = a * t.powi(3) / (6.0 * m);
+            assert!((y[0] - x).abs() <= 1e-9, "{name}: x({t}) = {}, closed form {x}", y[0]);
+        }
+    }
+}
+
+/// A watched function that leaves its start value the other way and comes back past it within
+/// one step has its root inside the step, not at the step's start: the contact force
+/// `f_n = m b t (t_off − t)` starts at 0, is positive until `t_off` = 3e-3 s (inside rk4's
+/// first step of 1e-2 s, and inside the adaptive methods' first step of a constant state),
+/// then negative; the mass lifts off at `t_off` (to 1e-12 s), then x(t) = a (t − t_off)² / 2
+/// (1e-9 m), for every method. Taken as moving straight to its firing side, it lifted off at
+/// t0 (the arm's gear that starts sliding from rest and stops within one step, issue 26).
+#[test]
+fn a_function_that_departs_and_returns_within_a_step_fires_at_its_return() {
+    let (t_off, a) = (3e-3, 2.0);
+    for (name, mut st) in methods::<Blip>(1e-2, 1e-10, 1e-12, 0.05) {
+        let mut toy = Toy::new(Blip { m: 2.0, b: 50.0, t_off, acc_free: a, in_contact: true });
+        let (samples, _) = run(st.as_mut(), &mut toy, [0.0, 0.0], 0.1, 0.01, EventSettings::default()).expect(name);
+        let t = toy.times();
+        assert_eq!(t.len(), 1, "{name}: one lift-off, {t:?}");
+        assert!((t[0] - t_off).abs() <= 1e-12, "{name}: lift-off at {}, closed form {t_off}", t[0]);
+        for (t, y) in &samples {
+            let x = if *t > t_off { a * (t - t_off).powi(2) / 2.0 } else { 0.0 };
             assert!((y[0] - x).abs() <= 1e-9, "{name}: x({t}) = {}, closed form {x}", y[0]);
         }
     }

@@ -210,6 +210,43 @@ impl Law for LiftOff {
     }
 }
 
+/// A mass resting on a table (`x = 0`, `v = 0`) whose contact force starts at 0, grows and
+/// falls back: `f_n = m b t (t_off − t)` (an event downwards, watched: it starts at 0), so
+/// it lifts off at `t_off`; free, it is pushed up at `acc_free` (event `x`, downwards).
+pub(super) struct Blip {
+    pub(super) m: f64,
+    pub(super) b: f64,
+    pub(super) t_off: f64,
+    pub(super) acc_free: f64,
+    pub(super) in_contact: bool,
+}
+
+impl Law for Blip {
+    fn n(&self) -> usize {
+        1
+    }
+    fn dir(&self, _i: usize) -> i8 {
+        -1
+    }
+    fn acc(&self, _t: f64, _y: &[f64]) -> f64 {
+        if self.in_contact {
+            0.0
+        } else {
+            self.acc_free
+        }
+    }
+    fn events(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        out[0] = if self.in_contact { self.m * self.b * t * (self.t_off - t) } else { y[0] };
+    }
+    fn handle(&mut self, _t: f64, _y: &mut [f64], _fired: &[bool]) -> bool {
+        self.in_contact = !self.in_contact;
+        false
+    }
+    fn watch(&self) -> Option<f64> {
+        Some(0.0)
+    }
+}
+
 /// `x(t) = x0 + t` (`v = 1`) and thresholds: function `i` is `x − c_i` (direction
 /// `dirs[i]`); at each event the handler moves the threshold of every fired function to
 /// `x + shift` (no move for `shift = None`).
