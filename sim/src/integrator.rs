@@ -102,6 +102,25 @@ impl Integrator {
         })
     }
 
+    /// Why this method cannot run a scene run with a frictional rigid contact, said before it
+    /// starts (issue 23 item 3), or `None`. The explicit methods (dopri45, rk4, and imex, whose
+    /// mechanics are explicit) cannot integrate a slow slip: below
+    /// [`crate::dynamics::contact::forward::SLIP_DIRECTION_SPEED`] (1e-6 m/s) the friction's
+    /// direction turns at a rate of about `μ f_n / (m_eff v_s)` (~1e7 /s for the paper arm's
+    /// elbow), so their stability bound asks for steps of ~1e-7 s there: dopri45 stops at the
+    /// first slip from rest with "the problem is stiff" (the paper's two- and one-elbow runs at
+    /// 0.245 s and 0.716 s, at any tolerance). rodas5p (or rodas4) steps through it.
+    pub fn frictional_limit(&self, friction: impl IntoIterator<Item = f64>) -> Option<String> {
+        let explicit = matches!(self, Integrator::Rk4 { .. } | Integrator::Dopri45(_) | Integrator::Imex(_));
+        let mu = friction.into_iter().fold(0.0, f64::max);
+        (explicit && mu > 0.0).then(|| {
+            format!(
+                "{} cannot integrate a slow frictional slip (a rigid contact with friction {mu}): below 1e-6 m/s the friction's direction turns at ~mu f_n / (m v_s), about 1e7 /s, so an explicit method needs steps of ~1e-7 s there and stops at the first slip from rest (\"the problem is stiff\"); use rodas5p",
+                self.method()
+            )
+        })
+    }
+
     /// The method's name in scenes.
     pub fn method(&self) -> &'static str {
         match self {

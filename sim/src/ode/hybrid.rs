@@ -110,10 +110,11 @@ impl Hybrid {
 /// otherwise a turn of the slip direction by 90° within one step (no stop: `s_ref` is refreshed
 /// and the contact slides on). The bound is the larger of the contact settings' `vel_tol`
 /// (`velocity_tolerance`, 1e-9 m/s) and [`SLIP_DIRECTION_SPEED`] (1e-6 m/s), below which the
-/// friction's direction is frozen: there the slip's part across `s_ref` is not braked, so a 2-D
-/// slip that ends inside that speed turns across `s_ref` instead of reaching zero along it, and
-/// without the second bound each such turn restarted the slip at a smaller speed, 90° further,
-/// 33 times at one instant (one-elbow-unilateral at rtol 1e-4). A slip that stops cleanly (1-D,
+/// friction's direction blends towards the stored one (`friction_direction`): there the slip's
+/// part across `s_ref` is braked less, so a 2-D slip that ends inside that speed may turn across
+/// `s_ref` instead of reaching zero along it, and without the second bound each such turn
+/// restarted the slip at a smaller speed, 90° further, 33 times at one instant
+/// (one-elbow-unilateral at rtol 1e-4, with the direction frozen below that speed). A slip that stops cleanly (1-D,
 /// or 2-D coming to rest along a direction) reaches the zero with `|v_t|` ~1e-12 m/s (the root's
 /// 1e-12 s bracket). What is left is removed by the velocity projection `stop_slip`.
 fn stops_here(v_t: [f64; 2], vel_tol: f64) -> bool {

@@ -94,7 +94,7 @@ impl ArmSystem<'_> {
     /// contacts in touch (and the bilateral ones), then velocities onto ġ = 0 for those and
     /// v_t = 0 for the sticking ones; minimum-norm corrections `−Wᵀ (W Wᵀ)⁻¹ r`.
     pub fn project_onto_active_rows(&mut self, t: f64, y: &mut [f64]) -> Result<bool, DynamicsError> {
-        use crate::dynamics::contact::rows::contact_rows;
+        use crate::dynamics::contact::rows::contact_rows_where;
         use crate::dynamics::contact::solve::{solve_active, ActiveRow, RowForce};
         use crate::dynamics::contact::ContactMode;
         let l = self.layout;
@@ -115,7 +115,9 @@ impl ArmSystem<'_> {
             let q = &y[l.q()];
             forward_kinematics(model, data, q);
             forward_velocities(model, data, &y[l.qd()]);
-            contact_rows(model, data, &h.contacts, &mut h.cd.rows);
+            // the rows of the contacts in touch only (a separated candidate is no row here)
+            let mode = &h.state.mode;
+            contact_rows_where(model, data, &h.contacts, &mut h.cd.rows, |k| held(mode[k]));
             let r = &h.cd.rows;
             h.proj_rows.clear();
             let mut worst = 0.0f64;

@@ -114,6 +114,7 @@ pub fn run(scene: Option<&Path>, a: &RunArgs, v: Verbosity) -> Result<u8> {
     cli::create_dir(&a.out)?;
     let names = runs.iter().map(|r| r.name.clone()).collect();
     let live = live::Session::start(&a.live, &live::about(&[(&scene, names)], &a.out), v.quiet)?;
+    warn_method_limits(&scene, &runs, v);
     let budget = a.live.budget(a.wall_time.budget(), scene.duration());
     let done = run_all_live(&scene, &runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
     let layouts = write_layouts(&scene, &done, v);
@@ -157,6 +158,7 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
     let mut done = Vec::new();
     let mut layouts = Vec::new();
     for (scene, runs) in scenes.iter().zip(&picked).filter(|(_, r)| !r.is_empty()) {
+        warn_method_limits(scene, runs, v);
         let budget = a.live.budget(a.wall_time.budget(), scene.duration());
         let scene_done = run_all_live(scene, runs, |run| a.out.join(format!("{}-{}.mcap", scene.spec().name, run.name)), &a.jobs, budget, v, live.as_ref());
         layouts.extend(write_layouts(scene, &scene_done, v));
@@ -167,6 +169,21 @@ pub fn run_default(a: &RunArgs, v: Verbosity) -> Result<u8> {
     report_layouts(&layouts, v);
     let dropped = live.is_some_and(live::Session::close);
     code.map(|c| if dropped { c.max(exit::FAILED) } else { c })
+}
+
+/// Before the runs start: a run whose method cannot integrate its frictional rigid contacts
+/// (`Integrator::frictional_limit`) says so on stderr, with the reason (issue 23 item 3).
+fn warn_method_limits(scene: &Scene, runs: &[sim::scene::Run], v: Verbosity) {
+    use sim::dynamics::contact::ContactModel;
+    for run in runs {
+        let friction = scene.run_contact_models(run).into_iter().filter_map(|c| match c.model {
+            ContactModel::Unilateral { friction, .. } => Some(friction),
+            _ => None,
+        });
+        if let (Some(why), false) = (scene.integrator().frictional_limit(friction), v.quiet) {
+            eprintln!("sim: warning: run `{}`: {why}", run.name);
+        }
+    }
 }
 
 /// Write the Foxglove layout of each recording of `scene` beside it,

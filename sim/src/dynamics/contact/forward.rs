@@ -8,7 +8,7 @@
 //! *Numerical Methods for Nonsmooth Dynamical Systems*, 2008, §2.2): `f_n = max(0, k δ + c δ̇)`
 //! for `δ = −g > 0`, friction `f_t = −μ f_n v_t / sqrt(|v_t|² + v_s²)`.
 
-use super::rows::{contact_rows, ContactRows};
+use super::rows::{contact_rows, contact_rows_where, ContactRows};
 use super::solve::{solve_active, ActiveRow, ActiveScratch, RowForce, Singular};
 use super::{Contact, ContactMode, ContactModel};
 use crate::dynamics::cholesky;
@@ -59,28 +59,58 @@ impl ContactData {
     }
 }
 
-/// Slip speeds below this use the stored slip direction (m/s): the direction `v_t/|v_t|` of
-/// Coulomb friction turns at a rate `|a_t⊥|/|v_t|`, unbounded as a slip starts or stops, and
-/// below ~1e-12 m/s it is the solver's rounding; below 1e-6 m/s the direction is frozen (the
-/// stored one: the consistent direction `a_t ∥ s` of a slip from rest, or the slip direction at
-/// the start of the step). This is a regularisation of the direction only, not a stick rule:
-/// a slip stops where `v_t · s_ref` reaches 0 (a located event, `ode/hybrid.rs`). Its effect on
-/// the motion is bounded by the time spent below it, `SLIP_DIRECTION_SPEED / |a_t|` ≈ 2e-7 s at
-/// 5 m/s², over which the position moves ≤ `SLIP_DIRECTION_SPEED² / |a_t|` ≈ 2e-13 m; in 1-D
-/// (a slip along a fixed line) the frozen direction is exact.
+/// Slip speeds below this blend the friction's direction towards the stored slip direction
+/// (m/s): the direction `v_t/|v_t|` of Coulomb friction turns at a rate `|a_t⊥|/|v_t|`,
+/// unbounded as a slip starts or stops, and below ~1e-12 m/s it is the solver's rounding. Below
+/// this speed the friction acts along [`friction_direction`], which turns smoothly from the
+/// stored direction (at rest: the direction `−f_t/|f_t|` of the sticking force that left the
+/// cone, or the slip direction at the start of the step) to `v_t/|v_t|` (reached at this speed,
+/// with its first derivative). This is a regularisation of the direction only, not a stick
+/// rule: a slip stops where `v_t · s_ref` reaches 0 (a located event, `ode/hybrid.rs`). Its
+/// effect on the motion is bounded by the time spent below it, `SLIP_DIRECTION_SPEED / |a_t|`
+/// ≈ 2e-7 s at 5 m/s², over which the position moves ≤ `SLIP_DIRECTION_SPEED² / |a_t|` ≈
+/// 2e-13 m; in 1-D (a slip along a fixed line) the direction is exact.
 pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 
 /// The slip direction of a sliding contact, continued through the stop: `±v_t/|v_t|` when
 /// `|v_t|` > [`SLIP_DIRECTION_SPEED`], with the sign that keeps it on the side of `stored` (the
 /// direction at the start of the step), else `stored`. While the slip runs along `stored` this is
 /// `v_t/|v_t|`; past the slip's zero (`v_t · stored < 0`, where an integrator's trial stages
-/// may go before the slip→stick event is located) the friction keeps its direction instead of
-/// flipping, so the right-hand side is smooth across the zero and the zero is located as a root.
+/// may go before the slip→stick event is located) it keeps its side instead of flipping. The
+/// reference of the slip→stick function (`s_ref`, `ode/hybrid.rs`); the friction itself acts
+/// along [`friction_direction`].
 pub fn slip_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
     let s = v_t[0].hypot(v_t[1]);
     if s > SLIP_DIRECTION_SPEED {
         let sign = if v_t[0] * stored[0] + v_t[1] * stored[1] < 0.0 { -1.0 } else { 1.0 };
         [sign * v_t[0] / s, sign * v_t[1] / s]
+    } else {
+        stored
+    }
+}
+
+/// The direction a sliding contact's friction opposes (unit, tangent basis): `w/|w|` with
+/// `w = σ v_t + v_s ψ(|v_t|/v_s) stored`, `v_s` = [`SLIP_DIRECTION_SPEED`], `σ = ±1` the sign
+/// of `v_t · stored` (+1 at 0: the side of `stored`, as [`slip_direction`]) and
+/// `ψ(r) = (1 − r²)²` for `r < 1`, else 0. So it is `σ v_t/|v_t|` (Coulomb's law) from `v_s` on,
+/// `stored` at rest, and in between turns with a bounded rate (`|w| ≥ 0.3 v_s`): continuous with
+/// its first derivative in `v_t` everywhere except across `v_t · stored = 0` (the located
+/// slip→stick event). A switch from `stored` to `v_t/|v_t|` at `v_s` instead (the frozen
+/// direction) is a jump of the friction's direction by the angle between them: a slip from rest
+/// whose velocity grows across `stored` (the inverse tangential inertia turns it) then
+/// chattered on `|v_t| = v_s`, the integrator taking 1e-10-s steps (one-elbow-unilateral at
+/// 0.7168 s: 15 000 rejected steps at rtol 1e-8, a collapse at 1e-12). `w` never vanishes: its
+/// part along `stored` is `|v_t · stored| + v_s ψ ≥ 0`, and 0 only where `ψ = 0`, `|v_t| ≥ v_s`.
+pub fn friction_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
+    let vs = SLIP_DIRECTION_SPEED;
+    let speed = v_t[0].hypot(v_t[1]);
+    let sign = if v_t[0] * stored[0] + v_t[1] * stored[1] < 0.0 { -1.0 } else { 1.0 };
+    let r2 = (speed / vs).powi(2);
+    let blend = if r2 < 1.0 { vs * (1.0 - r2) * (1.0 - r2) } else { 0.0 };
+    let w = [sign * v_t[0] + blend * stored[0], sign * v_t[1] + blend * stored[1]];
+    let n = w[0].hypot(w[1]);
+    if n > 0.0 {
+        [w[0] / n, w[1] / n]
     } else {
         stored
     }
@@ -100,11 +130,34 @@ pub fn prepare(
     qd: &[f64],
     current: &[f64],
 ) -> Result<(), DynamicsError> {
+    prepare_in_modes(plant, contacts, None, data, fd, cd, t, q, qd, current)
+}
+
+/// [`prepare`] for a solve in the modes `modes` (`None`: every contact's rows, as at an event):
+/// a `Separated` unilateral contact gets its gap and velocities but no rows
+/// ([`contact_rows_where`]), since no row of it enters the solve (a compliant contact, whose
+/// force goes into b through its rows whatever its mode, gets them).
+#[allow(clippy::too_many_arguments)]
+pub fn prepare_in_modes(
+    plant: &Plant,
+    contacts: &[Contact],
+    modes: Option<&[ContactMode]>,
+    data: &mut Data,
+    fd: &mut ForwardData,
+    cd: &mut ContactData,
+    t: f64,
+    q: &[f64],
+    qd: &[f64],
+    current: &[f64],
+) -> Result<(), DynamicsError> {
     let model = plant.model;
     let nv = model.nv;
     generalized_force_and_inertia(plant, data, fd, q, qd, current);
     forward_velocities(model, data, qd);
-    contact_rows(model, data, contacts, &mut cd.rows);
+    match modes {
+        None => contact_rows(model, data, contacts, &mut cd.rows),
+        Some(m) => contact_rows_where(model, data, contacts, &mut cd.rows, |k| m[k] != ContactMode::Separated || matches!(contacts[k].model, ContactModel::Compliant { .. })),
+    }
     super::shape::check_rims(contacts, data, t)?;
     // compliant forces into b
     for (k, c) in contacts.iter().enumerate() {
@@ -157,7 +210,7 @@ pub fn active_rows(contacts: &[Contact], state: &ContactState, stabilization: St
                 }
             }
             ContactMode::Sticking | ContactMode::Sliding => {
-                let s = slip_direction(r.slip(k), state.slip[k]);
+                let s = friction_direction(r.slip(k), state.slip[k]);
                 cd.active.push(normal(if mu > 0.0 { RowForce::Sliding { mu, s } } else { RowForce::Same }));
             }
         }
@@ -207,7 +260,7 @@ pub fn forward_dynamics_contacts(
     current: &[f64],
     voltage: &[f64],
 ) -> Result<(), DynamicsError> {
-    prepare(plant, contacts, data, fd, cd, t, q, qd, current)?;
+    prepare_in_modes(plant, contacts, Some(&state.mode), data, fd, cd, t, q, qd, current)?;
     if solve_modes(contacts, state, plant.stabilization, fd, cd).is_err() {
         let names: Vec<&str> = cd.active.iter().map(|a| contacts[a.row / 3].name()).collect();
         return Err(DynamicsError::SingularConstraints { t, constraints: names.join(", ") });
@@ -226,4 +279,60 @@ pub fn finish(plant: &Plant, fd: &mut ForwardData, t: f64, qd: &[f64], current: 
         return Err(DynamicsError::NonFinite { t, what: format!("the acceleration of {}", model.bodies[j].joint) });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod friction_direction_tests {
+    use super::{friction_direction, slip_direction, SLIP_DIRECTION_SPEED as VS};
+
+    fn unit(a: f64) -> [f64; 2] {
+        [a.cos(), a.sin()]
+    }
+
+    fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+        (a[0] - b[0]).hypot(a[1] - b[1])
+    }
+
+    /// Coulomb's direction `σ v_t/|v_t|` from `SLIP_DIRECTION_SPEED` on (to 1e-15), the stored
+    /// direction at rest and along it (1-D: exact at every speed), a unit vector everywhere, and
+    /// continuous across `|v_t| = SLIP_DIRECTION_SPEED` with a bounded slope: on every ray at
+    /// an angle to `stored` (on its side), the direction moves by at most `2 |Δv| / (0.3 v_s)`
+    /// between neighbouring speeds 1e-3 v_s apart, and by at most 1e-6 across `v_s ± 1e-12 v_s`.
+    /// The frozen direction it replaces (`slip_direction`) jumps there by the angle between
+    /// `stored` and `v_t` (checked: > 0.5 for the rays at more than 30°).
+    #[test]
+    fn turns_smoothly_from_the_stored_direction_to_coulombs() {
+        for &stored_angle in &[0.0, 0.7, -2.1] {
+            let stored = unit(stored_angle);
+            assert!(dist(friction_direction([0.0, 0.0], stored), stored) <= 1e-15, "at rest");
+            for &speed in &[1e-12, 1e-8, 0.5 * VS, VS, 3.0 * VS, 1.0] {
+                let d = friction_direction([speed * stored[0], speed * stored[1]], stored);
+                assert!(dist(d, stored) <= 1e-15, "along stored at {speed:e}: {d:?}");
+            }
+            for k in 0..24 {
+                // rays within 89° of stored (on its side; σ flips across 90°: the located stop)
+                let off = -1.55 + 3.1 * f64::from(k) / 23.0;
+                let ray = unit(stored_angle + off);
+                for &speed in &[VS, 1.5 * VS, 1e-3, 2.0] {
+                    let d = friction_direction([speed * ray[0], speed * ray[1]], stored);
+                    assert!(dist(d, ray) <= 1e-15, "Coulomb's direction at {speed:e}, ray {off}: {d:?} vs {ray:?}");
+                }
+                let mut prev = friction_direction([0.0, 0.0], stored);
+                for i in 1..=2000 {
+                    let speed = VS * f64::from(i) * 1e-3;
+                    let d = friction_direction([speed * ray[0], speed * ray[1]], stored);
+                    assert!((d[0].hypot(d[1]) - 1.0).abs() <= 1e-15, "not a unit vector: {d:?}");
+                    assert!(dist(d, prev) <= 2.0 * 1e-3 / 0.3, "ray {off}: the direction jumps by {} at {speed:e} m/s", dist(d, prev));
+                    prev = d;
+                }
+                let (below, above) = (VS * (1.0 - 1e-12), VS * (1.0 + 1e-12));
+                let jump = dist(friction_direction([below * ray[0], below * ray[1]], stored), friction_direction([above * ray[0], above * ray[1]], stored));
+                assert!(jump <= 1e-6, "ray {off}: a jump of {jump:e} across v_s");
+                if off.abs() > 0.53 {
+                    let frozen = dist(slip_direction([below * ray[0], below * ray[1]], stored), slip_direction([above * ray[0], above * ray[1]], stored));
+                    assert!(frozen > 0.5, "the frozen direction's jump {frozen} at ray {off}");
+                }
+            }
+        }
+    }
 }

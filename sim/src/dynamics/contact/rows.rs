@@ -47,17 +47,31 @@ impl ContactRows {
 /// Fill `rows` at the state of `data` (needs `forward_kinematics` and `forward_velocities`).
 /// The normal row's formulas are those of `constraints::constraint_rows` (same operations).
 pub fn contact_rows(model: &Model, data: &Data, contacts: &[Contact], rows: &mut ContactRows) {
+    contact_rows_where(model, data, contacts, rows, |_| true);
+}
+
+/// [`contact_rows`] with the rows (`J`, `J̇ q̇`) of contact k only where `rows_of(k)`; the
+/// others get their gap and velocities (`g`, `ġ`, `v_t`: what their event functions and the
+/// recorded outputs read) and zero rows and biases. For the right-hand side of a hybrid run,
+/// where a separated contact adds no force (issue 24 item 2: a candidate that does not touch
+/// costs its touching point, not three Jacobian rows).
+pub fn contact_rows_where(model: &Model, data: &Data, contacts: &[Contact], rows: &mut ContactRows, rows_of: impl Fn(usize) -> bool) {
     let nv = model.nv;
     rows.jac.fill(0.0);
     for (k, c) in contacts.iter().enumerate() {
         let n = c.plane.normal_world.into_inner();
         let touch = c.touch(data);
         rows.gap[k] = touch.gap;
+        let full = rows_of(k);
         for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
             let r = 3 * k + axis;
             rows.vel[r] = dir.dot(&touch.velocity);
-            rows.bias[r] = dir.dot(&touch.bias);
-            c.jacobian_along(model, data, &touch.point, dir, &mut rows.jac[r * nv..(r + 1) * nv]);
+            if full {
+                rows.bias[r] = dir.dot(&touch.bias);
+                c.jacobian_along(model, data, &touch.point, dir, &mut rows.jac[r * nv..(r + 1) * nv]);
+            } else {
+                rows.bias[r] = 0.0;
+            }
         }
     }
 }
