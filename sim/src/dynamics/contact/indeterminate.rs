@@ -34,7 +34,7 @@ pub fn null_direction(b: &[[f64; 3]; 3]) -> Option<[f64; 3]> {
     let cross = |u: &[f64; 3], v: &[f64; 3]| [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
     let norm = |u: &[f64; 3]| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
     let scale = b[0][0].abs().max(b[1][1].abs()).max(b[2][2].abs());
-    if !(scale > 0.0) {
+    if scale.is_nan() || scale <= 0.0 {
         return None;
     }
     let mut z = [0.0; 3];
@@ -47,7 +47,7 @@ pub fn null_direction(b: &[[f64; 3]; 3]) -> Option<[f64; 3]> {
             z = [c[0] / n, c[1] / n, c[2] / n];
         }
     }
-    if !(best > 0.0) {
+    if best.is_nan() || best <= 0.0 {
         return None;
     }
     let r = [0, 1, 2].map(|i| b[i][0] * z[0] + b[i][1] * z[1] + b[i][2] * z[2]);
