@@ -29,6 +29,8 @@ mod contacts_pendulum;
 mod contacts_point;
 #[path = "contacts_recording.rs"]
 mod contacts_recording;
+#[path = "contacts_real_arms.rs"]
+mod contacts_real_arms;
 #[path = "contacts_rod.rs"]
 mod contacts_rod;
 #[path = "contacts_scene.rs"]

@@ -523,6 +523,41 @@ fn random_unilateral_scenes_hold_the_audit_and_close_the_balance() {
     eprintln!("16 random unilateral scenes: {} complete, {stopped} stopped with a typed error (the audit held before)", 16 - stopped);
 }
 
+/// The long sweep (issue 23 item 6), run by hand: `ELBOW_CONTACT_SWEEP=N` random scenes
+/// (`random_scene`) whose seeds come from a SplitMix64 stream started at
+/// `ELBOW_CONTACT_SWEEP_START` (hex; default the clock's nanoseconds, printed), each checked as
+/// the 16 fixed ones; every failure is listed with its seed (`ELBOW_CONTACT_SEED` reruns it),
+/// then the test fails if any did. `cargo test … contacts_exact::random_unilateral_sweep --
+/// --ignored --nocapture`.
+#[test]
+#[ignore]
+fn random_unilateral_sweep() {
+    let n: usize = std::env::var("ELBOW_CONTACT_SWEEP").ok().and_then(|s| s.parse().ok()).unwrap_or(200);
+    let start = std::env::var("ELBOW_CONTACT_SWEEP_START")
+        .ok()
+        .and_then(|s| u64::from_str_radix(s.trim_start_matches("0x"), 16).ok())
+        .unwrap_or_else(|| std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(1, |d| d.as_nanos() as u64));
+    eprintln!("sweep of {n} random unilateral scenes, ELBOW_CONTACT_SWEEP_START={start:#x}");
+    let mut seeds = SplitMix(start);
+    let (mut failed, mut stopped) = (Vec::new(), Vec::new());
+    for _ in 0..n {
+        let seed = seeds.next();
+        match std::panic::catch_unwind(|| check_random(seed)) {
+            Ok(None) => {}
+            Ok(Some(why)) => stopped.push(format!("{seed:#x}: {why}")),
+            Err(e) => failed.push(format!("{seed:#x}: {}", e.downcast_ref::<String>().cloned().unwrap_or_default())),
+        }
+    }
+    eprintln!("{n} scenes: {} complete, {} stopped with a typed error, {} failed", n - stopped.len() - failed.len(), stopped.len(), failed.len());
+    for s in &stopped {
+        eprintln!("stopped {s}");
+    }
+    for f in &failed {
+        eprintln!("FAILED {f}");
+    }
+    assert!(failed.is_empty(), "{} of {n} random scenes failed", failed.len());
+}
+
 /// The case of `ELBOW_CONTACT_SEED` (a failing property case's seed), when set.
 #[test]
 fn random_unilateral_scene_of_a_given_seed() {

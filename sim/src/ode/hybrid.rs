@@ -7,7 +7,7 @@
 //! | mode | ev0 (direction) | ev1 (direction) |
 //! |---|---|---|
 //! | separated (unilateral) | g − g_ref (−1, touch-down) | 1 |
-//! | sticking | f_n (−1, lift-off) | μ f_n − \|f_t\| (−1, stick→slip) |
+//! | sticking | f_n (−1, lift-off) | μ f_n − \|f_t\| (−1, stick→slip; a statically indeterminate contact's largest, `contact/indeterminate.rs`) |
 //! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick at its zero, [`stops_here`]; 1 when μ = 0) |
 //! | compliant | g (0) | k δ + c δ̇ while δ > 0, else 1 (0) |
 //! | bilateral | 1 | 1 |
@@ -503,7 +503,7 @@ impl ArmSystem<'_> {
                 h.rebound_t[k] = t;
                 h.rebound[k] = false;
             }
-            let (f_n, f_t) = (h.cd.f_n[k], h.cd.f_t[k]);
+            let f_n = h.cd.f_n[k];
             let (e0, e1) = match (c.model, h.state.mode[k]) {
                 (ContactModel::Bilateral, _) => (1.0, 1.0),
                 (ContactModel::Compliant { stiffness, damping, .. }, _) => {
@@ -511,7 +511,8 @@ impl ArmSystem<'_> {
                     (r.gap[k], if delta > 0.0 { stiffness * delta + damping * delta_d } else { 1.0 })
                 }
                 (_, ContactMode::Separated | ContactMode::Bilateral) => (if t == h.rebound_t[k] { REBOUND_START } else { r.gap[k] - h.gap_ref[k] }, 1.0),
-                (_, ContactMode::Sticking) => (f_n, mu_of(c) * f_n - f_t[0].hypot(f_t[1])),
+                // the stick margin (a statically indeterminate contact's largest; jammed: no slip)
+                (_, ContactMode::Sticking) => (f_n, if h.cd.margin[k].is_finite() { h.cd.margin[k] } else { 1.0 }),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
                     (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })

@@ -45,6 +45,10 @@ pub struct ContactData {
     /// Per contact: normal force f_n (N) and friction force `[t1, t2]` (N) of the last solve.
     pub f_n: Vec<f64>,
     pub f_t: Vec<[f64; 2]>,
+    /// Per contact: the stick margin `μ f_n − |f_t|` of the last solve (N) while sticking, the
+    /// largest over the forces a statically indeterminate contact admits
+    /// (`indeterminate.rs`; `+∞` when jammed); 0 in the other modes.
+    pub margin: Vec<f64>,
 }
 
 impl ContactData {
@@ -55,6 +59,7 @@ impl ContactData {
             scratch: ActiveScratch::new(nv, nc),
             f_n: vec![0.0; nc],
             f_t: vec![[0.0; 2]; nc],
+            margin: vec![0.0; nc],
         }
     }
 }
@@ -241,7 +246,31 @@ pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: St
             (a, _) => cd.f_t[k][a - 1] = lam,
         }
     }
+    stick_margins(contacts, state, cd);
     Ok(())
+}
+
+/// The stick margins of the sticking contacts after [`solve_modes`]; a contact whose three rows
+/// are dependent gets the force of the largest margin among those it admits
+/// ([`super::indeterminate`]; the accelerations do not change).
+fn stick_margins(contacts: &[Contact], state: &ContactState, cd: &mut ContactData) {
+    for (k, c) in contacts.iter().enumerate() {
+        cd.margin[k] = 0.0;
+        let ContactModel::Unilateral { friction: mu, .. } = c.model else { continue };
+        if state.mode[k] != ContactMode::Sticking || mu <= 0.0 {
+            continue;
+        }
+        let (f_n, f_t) = (cd.f_n[k], cd.f_t[k]);
+        cd.margin[k] = mu * f_n - f_t[0].hypot(f_t[1]);
+        let Some(i) = cd.active.iter().position(|a| a.row == 3 * k) else { continue };
+        let b: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|s| cd.scratch.gram(&cd.rows, &cd.active, i + r, i + s)));
+        if let Some(z) = super::indeterminate::null_direction(&b) {
+            let (alpha, margin) = super::indeterminate::most_admissible(mu, f_n, f_t, z);
+            cd.f_n[k] = f_n + alpha * z[0];
+            cd.f_t[k] = [f_t[0] + alpha * z[1], f_t[1] + alpha * z[2]];
+            cd.margin[k] = margin;
+        }
+    }
 }
 
 /// Eq 21 with contacts of any model in the modes of `state` (the bilateral path's outputs in

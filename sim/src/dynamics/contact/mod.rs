@@ -232,6 +232,7 @@ pub const MAX_CLOSED_CONTACTS: usize = 8;
 
 pub mod forward;
 pub mod impact;
+pub mod indeterminate;
 pub mod modes;
 pub mod rows;
 pub mod shape;

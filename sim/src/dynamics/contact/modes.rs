@@ -44,6 +44,10 @@ struct Feasible {
     slip: Vec<[f64; 2]>,
     qdd: Vec<f64>,
     score: usize,
+    /// At a boundary of its modes within the tolerances (a stick with its margin at 0, a
+    /// slide from rest not accelerating, a separation not accelerating away, a closed contact
+    /// with no force): the limit of the neighbouring combination, not a second solution.
+    marginal: bool,
 }
 
 /// Choose the modes of the `closed` contacts (indices) after [`super::forward::prepare`] at the
@@ -251,6 +255,17 @@ pub fn choose_modes_within(
             let fmax = closed.iter().fold(0.0f64, |m, &k| m.max(cd.f_n[k].abs()).max(cd.f_t[k][0].hypot(cd.f_t[k][1])));
             let (tol_f, tol_a) = (1e-8 * (1.0 + fmax), 1e-8 * (1.0 + qmax));
             let mut feasible_here = true;
+            let mut marginal = false;
+            for (i, &k) in closed.iter().enumerate() {
+                let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
+                marginal |= match cands[i][idx[i]] {
+                    Cand::Sep => accel(0) <= tol_a,
+                    Cand::Stick => cd.margin[k] <= tol_f || cd.f_n[k] <= tol_f,
+                    Cand::Slide { moving } => {
+                        cd.f_n[k] <= tol_f || (!moving && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= tol_a)
+                    }
+                };
+            }
             for (i, &k) in closed.iter().enumerate() {
                 let (f_n, f_t) = (cd.f_n[k], cd.f_t[k]);
                 let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
@@ -264,7 +279,7 @@ pub fn choose_modes_within(
             }
             if feasible_here {
                 let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();
-                feasible.push(Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), qdd: qdd.to_vec(), score });
+                feasible.push(Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), qdd: qdd.to_vec(), score, marginal });
             }
         }
         // next combination
@@ -293,7 +308,7 @@ pub fn choose_modes_within(
         });
     };
     let qmax = best.qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    for f in &feasible {
+    for f in feasible.iter().filter(|f| !f.marginal && !best.marginal) {
         let d = f.qdd.iter().zip(&best.qdd).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         if d > 1e-6 * (1.0 + qmax) {
             return Err(DynamicsError::InconsistentContact {

@@ -64,6 +64,15 @@ impl ActiveScratch {
     }
 }
 
+impl ActiveScratch {
+    /// `W_i · M_J⁻¹ Ŵ_jᵀ` of active rows `i` and `j` of the last [`solve_active`] (for rows with
+    /// their own force column, the Gram matrix `W M_J⁻¹ Wᵀ`), N⁻¹ kg⁻¹ in SI.
+    pub fn gram(&self, rows: &ContactRows, active: &[ActiveRow], i: usize, j: usize) -> f64 {
+        let nv = rows.nv;
+        rows.dot(active[i].row, &self.x[j * nv..(j + 1) * nv])
+    }
+}
+
 /// The active rows' system is singular (redundant rows, or a sliding combination with no
 /// solution).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
