@@ -8,7 +8,7 @@
 # points (`--window-size ... --screenshot-to`) into docs/src/images/rerun-*.png (Rerun draws
 # them at twice the logical size), quantised with pngquant to keep the book small (about
 # 100-150 KB each). CI does not run it.
-# Needs: the `sim` and `analyze` binaries (built here with `cargo build --profile test --bins`,
+# Needs: the `sim` and `analyze` binaries (built here with `cargo build --workspace --all-features --profile test --bins`,
 # CARGO_TARGET_DIR honoured), Rerun 0.41 or later, Xvfb (`xvfb-run`) and a Vulkan driver (Mesa's
 # software one, lavapipe, will do: `apt-get install xvfb mesa-vulkan-drivers`) and `pngquant`.
 set -euo pipefail
@@ -23,7 +23,7 @@ need xvfb-run "apt-get install xvfb"
 need pngquant "apt-get install pngquant"
 lvp=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 [ -e "$lvp" ] || { echo "screenshots.sh: needs a Vulkan driver (apt-get install mesa-vulkan-drivers)" >&2; exit 2; }
-[ -x "$sim" ] && [ -x "$analyze" ] || cargo build --profile test --bins --quiet
+[ -x "$sim" ] && [ -x "$analyze" ] || cargo build --workspace --all-features --profile test --bins --quiet
 
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
