@@ -47,7 +47,7 @@ mod encode;
 #[cfg(all(test, feature = "rerun"))]
 mod tests;
 #[cfg(feature = "rerun")]
-pub use encode::{encode, encode_to, fnv1a, labels, read_input, Input};
+pub use encode::{encode, encode_on_tab, encode_to, fnv1a, labels, read_input, Input};
 
 use std::path::{Path, PathBuf};
 
@@ -71,8 +71,10 @@ pub struct Converted {
 /// Converts the recordings `inputs` into one `.rrd` at `out` (written atomically, its directory
 /// created if needed), application
 /// id = `out`'s file stem; `progress` is called after each input is read. Returns the bytes
-/// written and the runs' results. Without the feature `rerun`, an error that says how to get it.
-pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<Converted, Error> {
+/// written and the runs' results. The viewer opens on the blueprint's tab named `tab` (the
+/// first, "arm", when `None`; an error naming the tabs when there is no such tab). Without the
+/// feature `rerun`, an error that says how to get it.
+pub fn convert(inputs: &[PathBuf], out: &Path, tab: Option<&str>, progress: &dyn Fn()) -> Result<Converted, Error> {
     #[cfg(feature = "rerun")]
     {
         let mut read = Vec::with_capacity(inputs.len());
@@ -89,7 +91,7 @@ pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<Co
         let mut bytes = 0;
         let mut drawn = Vec::new();
         schemas::atomic::write_with(out, |f| -> Result<(), Error> {
-            let (_, n, d) = encode_to(&read, &app_id, std::io::BufWriter::with_capacity(1 << 20, f), &label, window::WINDOW_ROWS)?;
+            let (_, n, d) = encode_on_tab(&read, &app_id, tab, std::io::BufWriter::with_capacity(1 << 20, f), &label, window::WINDOW_ROWS)?;
             (bytes, drawn) = (n, d);
             Ok(())
         })?;
@@ -105,7 +107,7 @@ pub fn convert(inputs: &[PathBuf], out: &Path, progress: &dyn Fn()) -> Result<Co
     }
     #[cfg(not(feature = "rerun"))]
     {
-        let _ = (inputs, out, progress);
+        let _ = (inputs, out, tab, progress);
         Err(Error::ViewUnavailable)
     }
 }

@@ -48,7 +48,7 @@ pub use messages::{
     Message, MotorState, MotorThermalState, Quat, RosString, TopicMessage, TransformEntry, Transforms, Vec3, contact_event_kind, contact_mode, ContactEventMsg, ContactFriction, ContactState, SupplyState, CONTACT_EVENT_KINDS,
 };
 pub use meta::{
-    AuditBounds, ContactAudit, ContactAuditRecord, ContactAuditor, ContactLaws, Worst, ContactInfo, ContactsRecord, EnergyTermsRecord, IntegratorInfo, LimitEventInfo, LimitsRecord, MetadataRecord, ModelInfo, RecordingInfo,
+    AuditBounds, ContactAudit, ContactAuditRecord, ContactAuditor, ContactLaws, Worst, ContactInfo, ContactShapeInfo, ContactsRecord, EnergyTermsRecord, IntegratorInfo, LimitEventInfo, LimitsRecord, MetadataRecord, ModelInfo, RecordingInfo,
     RunDescription, RunInfo, RunNames, RunResult, RunStatus, SceneRecord, Setup, UrdfRecord,
 };
 pub use reader::{

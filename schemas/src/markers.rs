@@ -42,6 +42,9 @@ use crate::messages::timestamp;
 #[cfg(doc)]
 use crate::topics;
 
+mod shapes;
+pub use shapes::{circle, shape_entities, shape_glyphs, ShapeGlyph, SHAPE_ALPHA, SHAPE_ID};
+
 /// The world frame of `/tf`, the frame of every entity (`sim` records `world -> root link`).
 pub const WORLD_FRAME: &str = "world";
 
@@ -232,6 +235,8 @@ pub mod colors {
     pub const TABLE: &str = "#8c6d46";
     /// The force scale bar.
     pub const SCALE_BAR: &str = "#404040";
+    /// A contact's shape (sphere pad, capsule, cylinder rim), fixed to its link.
+    pub const CONTACT_SHAPE: &str = "#17becf";
 
     /// `#rrggbb` as RGBA bytes with `alpha` (0 for a malformed string: the constants above are not).
     pub fn rgba8(hex: &str, alpha: u8) -> [u8; 4] {
@@ -333,6 +338,9 @@ pub struct SceneDescription<'a> {
     /// The scale of the force arrows (the scale bar `legend/force_scale`, drawn when there is
     /// a plane).
     pub force_scale: ForceScale,
+    /// The run's contact shapes ([`shape_glyphs`]; none for point contacts), each an entity
+    /// `shape/<name>` in its link's frame.
+    pub shapes: &'a [ShapeGlyph],
 }
 
 fn kv(key: &str, value: impl Into<String>) -> KeyValuePair {
@@ -393,7 +401,8 @@ pub mod ids {
 /// points, dt, units) and, when there is a plane, `legend/force_scale` (an arrow of a round
 /// force at the arrows' scale standing on the first plane, with its text; metadata: the
 /// scale, its reference force, the bar's force, the shortest arrow), all at t = 0 in
-/// `frame_id`.
+/// `frame_id`; then one entity per contact shape (`shape/<name>`, in its link's frame,
+/// [`shape_entities`]).
 pub fn scene_update(d: &SceneDescription<'_>) -> SceneUpdate {
     let mut entities = Vec::with_capacity(d.planes.len() + 2);
     for (k, p) in d.planes.iter().enumerate() {
@@ -487,6 +496,7 @@ pub fn scene_update(d: &SceneDescription<'_>) -> SceneUpdate {
             ..Default::default()
         });
     }
+    entities.extend(shape_entities(d.shapes));
     SceneUpdate { deletions: Vec::new(), entities }
 }
 
@@ -940,7 +950,7 @@ mod tests {
         let planes = [TablePlane { normal: [0.0, 0.0, 1.0], offset: 0.0, contacts: vec!["elbow4".into()] }];
         let path = [[0.0, 0.0, 0.1], [0.1, 0.0, 0.1]];
         let scale = ForceScale::for_arm(1.0, 3.0, 10);
-        let s = scene_update(&SceneDescription { frame_id: "world", planes: &planes, half_size_m: 2.0, target_path: &path, target_dt_s: 0.001, force_scale: scale });
+        let s = scene_update(&SceneDescription { frame_id: "world", planes: &planes, half_size_m: 2.0, target_path: &path, target_dt_s: 0.001, force_scale: scale, shapes: &[] });
         assert_eq!(s.entities.len(), 3);
         let cube = &s.entities[0].cubes[0];
         let top = cube.pose.as_ref().unwrap().position.as_ref().unwrap().z + cube.size.as_ref().unwrap().z / 2.0;
@@ -961,7 +971,7 @@ mod tests {
     fn scene_reads_back() {
         let planes = [TablePlane { normal: [0.0, 0.6, 0.8], offset: 0.1, contacts: vec!["elbow4".into()] }];
         let scale = ForceScale { m_per_n: 0.02, reference_force_n: 4.9 };
-        let s = scene_update(&SceneDescription { frame_id: "world", planes: &planes, half_size_m: 1.5, target_path: &[], target_dt_s: 0.0, force_scale: scale });
+        let s = scene_update(&SceneDescription { frame_id: "world", planes: &planes, half_size_m: 1.5, target_path: &[], target_dt_s: 0.0, force_scale: scale, shapes: &[] });
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("scene.mcap");
         let mut w = crate::RecordingWriter::create(&path).unwrap();

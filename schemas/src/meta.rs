@@ -24,6 +24,7 @@
 //! | `energy_terms` | `impact_loss`, `friction_work`, `damping_loss` (totals over the contacts) — only runs with a non-bilateral contact | 2+ |
 //! | `energy_terms` | `gear_loss` (scenes with `gear_friction`), `supply_energy`, `supply_regenerated`, `supply_dumped`, `supply_loss` (scenes with a `supply`) | 3+ |
 //! | `contacts` | `contacts` (JSON array of [`ContactInfo`]), `time_tolerance`, `gap_tolerance`, `velocity_tolerance`, `rest_velocity`, `max_events` — only runs with a non-bilateral contact | 2+ |
+//! | `contacts` | each contact's `shape` (kind, radius, link, link-frame centre and rim axis: [`ContactShapeInfo`]; optional, issue 27) | 3+ |
 //! | `contact_audit` | `bounds` (JSON), `contacts` (JSON array of [`ContactLaws`]), `samples`, `breaches` — only runs with a non-bilateral contact ([`ContactAuditor`], issue 23) | 2+ |
 //!
 //! `2+`: added within format 2 by issue 11 (contacts), with the topics `/contacts` and
@@ -43,7 +44,7 @@ use serde::{Deserialize, Serialize};
 mod audit;
 pub use audit::{AuditBounds, ContactAudit, ContactAuditRecord, ContactAuditor, ContactLaws, Worst};
 mod contacts;
-pub use contacts::{ContactInfo, ContactsRecord};
+pub use contacts::{shape_kind, ContactInfo, ContactShapeInfo, ContactsRecord};
 mod typed;
 pub use typed::{typed_records, typed_value};
 

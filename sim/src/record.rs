@@ -175,6 +175,7 @@ pub fn contacts_record(contacts: &[Contact], settings: &ContactSettings) -> Cont
                 offset: c.plane.offset,
                 t1: xyz(&c.t1),
                 t2: xyz(&c.t2),
+                shape: None,
             };
             match c.model {
                 ContactModel::Bilateral => {}
@@ -200,6 +201,45 @@ pub fn contacts_record(contacts: &[Contact], settings: &ContactSettings) -> Cont
         rest_velocity: settings.rest_velocity,
         max_events: settings.max_events,
     }
+}
+
+/// Record `contacts` as a run writes it: [`contacts_record`] with each contact's shape on its
+/// link ([`contact_shape`]).
+pub fn contacts_record_with_shapes(model: &crate::dynamics::Model, contacts: &[Contact], settings: &ContactSettings) -> ContactsRecord {
+    let mut record = contacts_record(contacts, settings);
+    for (info, c) in record.contacts.iter_mut().zip(contacts) {
+        info.shape = Some(contact_shape(model, c));
+    }
+    record
+}
+
+/// Where contact `c` is on the arm, in a `/tf` frame: its link (the URDF link of the contact's
+/// body whose frame is the body's own, else the first link fixed to that body; the root link
+/// for a point of the base), its point (the sphere's or rim's centre) and a rim's axis in that
+/// link's frame, its kind and radius (`dynamics::contact::shape`).
+pub fn contact_shape(model: &crate::dynamics::Model, c: &Contact) -> schemas::ContactShapeInfo {
+    use crate::dynamics::contact::ContactShape;
+    let p = &c.plane.point;
+    let on_body = |f: &&crate::dynamics::model::Frame| f.body == p.body;
+    let frame = model
+        .frames
+        .iter()
+        .filter(on_body)
+        .find(|f| f.x_body_frame == nalgebra::Isometry3::identity())
+        .or_else(|| model.frames.iter().find(on_body));
+    let (link, x_frame_body) = match frame {
+        Some(f) => (f.name.clone(), f.x_body_frame.inverse()),
+        None => (model.root_link.clone(), nalgebra::Isometry3::identity()),
+    };
+    let center = x_frame_body * nalgebra::Point3::from(p.p_body);
+    let axis = match c.shape {
+        ContactShape::Rim { axis, .. } => {
+            let a = x_frame_body.rotation * axis;
+            Some([a.x, a.y, a.z])
+        }
+        _ => None,
+    };
+    schemas::ContactShapeInfo { kind: c.shape.name().into(), radius: c.shape.radius(), link, center: [center.x, center.y, center.z], axis }
 }
 
 /// Each contact's Coulomb friction coefficient μ, in the order of `contacts` (0 for a bilateral
@@ -348,7 +388,7 @@ impl<'a> Recorder<'a> {
             })
             .map_err(err)?;
         let audit = if hybrid {
-            let record = contacts_record(contacts, settings);
+            let record = contacts_record_with_shapes(&scene.model, contacts, settings);
             writer.write_record(&record).map_err(err)?;
             Some(schemas::ContactAuditor::new(&record))
         } else {
@@ -361,6 +401,10 @@ impl<'a> Recorder<'a> {
         // the table and the target path, once
         let planes = table_planes(scene, run);
         let (path_points, path_dt) = target_path(scene);
+        // the contact shapes on their links (none for point contacts: the paper's `/scene` is
+        // as it was)
+        let shape_infos: Vec<schemas::ContactShapeInfo> = contacts.iter().map(|c| contact_shape(&scene.model, c)).collect();
+        let shapes = markers::shape_glyphs(contacts.iter().zip(&shape_infos).map(|(c, s)| (c.name(), s)));
         let scene_msg = markers::scene_update(&SceneDescription {
             frame_id: WORLD_FRAME,
             planes: &planes,
@@ -368,6 +412,7 @@ impl<'a> Recorder<'a> {
             target_path: &path_points,
             target_dt_s: path_dt,
             force_scale: force_scale(scene),
+            shapes: &shapes,
         });
         writer.write(topics::SCENE, 0, &scene_msg).map_err(err)?;
         // world -> root (none when the URDF's root link is itself named `world`, as UR5's and

@@ -17,6 +17,7 @@ mod foxglove_layout;
 mod live;
 mod pipeline;
 mod recover_crash;
+mod rerun_contact_shapes;
 mod rerun_meshes;
 mod rerun_view;
 mod sampled_energy;

@@ -127,7 +127,7 @@ const ARMS: [Arm; 3] = [
 /// own size, m.
 const MARGIN_M: f64 = 0.3;
 
-fn rerun_cli(test: &str) -> Option<PathBuf> {
+pub(crate) fn rerun_cli(test: &str) -> Option<PathBuf> {
     let python = std::env::var_os("ELBOW_RERUN_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(std::env::var_os("HOME").unwrap_or_default()).join(".cache/elbow-sim/venv-check/bin/python"));

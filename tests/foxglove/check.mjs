@@ -280,6 +280,10 @@ function checkScene(rec) {
   const planeOf = new Map();
   for (const c of sceneJson.contacts ?? []) planeOf.set(c.name, c.plane);
   for (const p of sceneJson.table?.points ?? []) planeOf.set(p.name, sceneJson.table.plane);
+  // the contacts as they ran (record `contacts`, runs with a non-bilateral contact): also the
+  // capsules' ends `<name>/0`, `<name>/1` and the table's contacts from URDF collisions, which
+  // the scene does not list by name
+  for (const c of JSON.parse(rec.metadata.get("contacts")?.get("contacts") ?? "[]")) planeOf.set(c.name, { normal: c.normal, offset: c.offset });
   const distinct = new Set([...planeOf.values()].map((p) => JSON.stringify([p.normal, p.offset ?? 0])));
   const hybrid = rec.messages.has("/contacts");
   const out = { run: run.get("run"), contacts: contacts.length, hybrid };

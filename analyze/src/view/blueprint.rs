@@ -121,13 +121,54 @@ impl View {
 /// A node of the layout.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Node {
-    Container { kind: ContainerKind, name: Option<String>, shares: Vec<f32>, children: Vec<Node> },
+    /// `active`: the tab shown first (tabs only; the first when `None`).
+    Container { kind: ContainerKind, name: Option<String>, shares: Vec<f32>, children: Vec<Node>, active: Option<usize> },
     View(View),
 }
 
 impl Node {
     pub fn container(kind: ContainerKind, children: Vec<Node>) -> Node {
-        Node::Container { kind, name: None, shares: Vec::new(), children }
+        Node::Container { kind, name: None, shares: Vec::new(), children, active: None }
+    }
+
+    /// The names of the tabs of the first tab container (depth first), in order.
+    pub fn tab_names(&self) -> Vec<String> {
+        match self {
+            Node::View(_) => Vec::new(),
+            Node::Container { kind: ContainerKind::Tabs, children, .. } => children
+                .iter()
+                .map(|c| match c {
+                    Node::View(v) => v.name.clone(),
+                    Node::Container { name, .. } => name.clone().unwrap_or_default(),
+                })
+                .collect(),
+            Node::Container { children, .. } => children.iter().map(Node::tab_names).find(|t| !t.is_empty()).unwrap_or_default(),
+        }
+    }
+
+    /// The same tree opening on the tab named `tab` of its first tab container; `Err` with the
+    /// tab names when there is none of that name.
+    pub fn open_on(mut self, tab: &str) -> Result<Node, Vec<String>> {
+        fn set(n: &mut Node, tab: &str) -> bool {
+            match n {
+                Node::View(_) => false,
+                Node::Container { kind: ContainerKind::Tabs, children, active, .. } => {
+                    let k = children.iter().position(|c| match c {
+                        Node::View(v) => v.name == tab,
+                        Node::Container { name, .. } => name.as_deref() == Some(tab),
+                    });
+                    *active = k;
+                    k.is_some()
+                }
+                Node::Container { children, .. } => children.iter_mut().any(|c| !c.tab_names().is_empty() && set(c, tab)),
+            }
+        }
+        let names = self.tab_names();
+        if set(&mut self, tab) {
+            Ok(self)
+        } else {
+            Err(names)
+        }
     }
 
     /// Column (horizontal) or row (vertical) shares of the children.
@@ -264,7 +305,7 @@ fn emit(node: &Node, ids: &mut Ids, out: &mut Vec<Chunk>) -> String {
             }
             format!("view/{id}")
         }
-        Node::Container { kind, name, shares, children } => {
+        Node::Container { kind, name, shares, children, active } => {
             let contents: Vec<String> = children.iter().map(|c| emit(c, ids, out)).collect();
             let mut chunk = Chunk::new(format!("/container/{id}"), Index::Blueprint)
                 .with(CONTAINER, "container_kind", "rerun.blueprint.components.ContainerKind", u8_lists(&[vec![*kind as u8]]))
@@ -280,8 +321,8 @@ fn emit(node: &Node, ids: &mut Ids, out: &mut Vec<Chunk>) -> String {
                 chunk = chunk.with(CONTAINER, field, ty, f32_lists(&[shares.clone()]));
             }
             if *kind == ContainerKind::Tabs {
-                if let Some(first) = contents.first() {
-                    chunk = chunk.with(CONTAINER, "active_tab", "rerun.blueprint.components.ActiveTab", one_str(first));
+                if let Some(tab) = contents.get(active.unwrap_or(0)) {
+                    chunk = chunk.with(CONTAINER, "active_tab", "rerun.blueprint.components.ActiveTab", one_str(tab));
                 }
             }
             out.push(chunk);

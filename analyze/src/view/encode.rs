@@ -98,6 +98,12 @@ pub fn encode(inputs: &[Input], app_id: &str) -> Result<Vec<u8>, Error> {
 /// ([`mesh::draw`]). Returns the writer, the bytes written and what was drawn of each run's
 /// meshes.
 pub fn encode_to<W: Write>(inputs: &[Input], app_id: &str, out: W, label: &str, window_rows: usize) -> Result<(W, u64, Vec<Drawn>), Error> {
+    encode_on_tab(inputs, app_id, None, out, label, window_rows)
+}
+
+/// [`encode_to`], the blueprint opening on the tab named `tab` (the first when `None`; an
+/// error naming the tabs when the blueprint has none of that name).
+pub fn encode_on_tab<W: Write>(inputs: &[Input], app_id: &str, tab: Option<&str>, out: W, label: &str, window_rows: usize) -> Result<(W, u64, Vec<Drawn>), Error> {
     let hash = inputs.iter().fold(fnv1a(app_id.as_bytes()), |h, i| h.rotate_left(5) ^ i.hash);
     let recording = StoreId::new(StoreKind::Recording, app_id, &format!("{app_id}-{hash:016x}"));
     let blueprint_id = StoreId::new(StoreKind::Blueprint, app_id, &format!("{app_id}-{hash:016x}-blueprint"));
@@ -125,6 +131,13 @@ pub fn encode_to<W: Write>(inputs: &[Input], app_id: &str, out: W, label: &str, 
     } else {
         let refs: Vec<_> = inputs.iter().zip(&placed).map(|(i, (p, b))| (&i.run, p, b)).collect();
         layout::comparison(&refs)
+    };
+    let root = match tab {
+        Some(t) => root.open_on(t).map_err(|tabs| Error::View {
+            file: label.to_string(),
+            detail: format!("--tab {t:?}: no such tab in its view (its tabs: {})", tabs.iter().map(|n| format!("{n:?}")).collect::<Vec<_>>().join(", ")),
+        })?,
+        None => root,
     };
 
     // the blueprint first (as the SDK does), made the default of the application id

@@ -34,6 +34,7 @@ const POINTS: &str = "rerun.archetypes.Points3D";
 const ARROWS: &str = "rerun.archetypes.Arrows3D";
 const STRIPS: &str = "rerun.archetypes.LineStrips3D";
 const BOXES: &str = "rerun.archetypes.Boxes3D";
+const CAPSULES: &str = "rerun.archetypes.Capsules3D";
 const TRANSFORM: &str = "rerun.archetypes.Transform3D";
 const SCALARS: &str = "rerun.archetypes.Scalars";
 const SERIES: &str = "rerun.archetypes.SeriesLines";
@@ -220,6 +221,15 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
+    // the contact shapes, static on their links (`schemas::markers::shape_glyphs`: what
+    // Foxglove's `/scene` draws)
+    let infos: Vec<(&str, &schemas::ContactShapeInfo)> = run.contacts.iter().filter_map(|c| c.shape.as_ref().map(|s| (c.name.as_str(), s))).collect();
+    for g in schemas::markers::shape_glyphs(infos) {
+        if run.frames.iter().any(|(n, _)| n == g.link()) || g.link() == run.root_frame {
+            out.extend(shape_chunks(&format!("{}/contact_shape/{}", run.frame_path(g.link(), &world), escape(g.name())), &g));
+        }
+    }
+
     // the bounds are the whole run's (`Run::survey`); the contact points those of the window
     let w = &run.whole;
     let bounds = Bounds { arm_min: w.arm_min, arm_max: w.arm_max, hand_min: w.hand_min, hand_max: w.hand_max, base: w.base };
@@ -228,7 +238,7 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         let poses = run.world_poses(k);
         for (c, pts) in run.contacts.iter().zip(contact_points.iter_mut()) {
             if let Some(link) = &c.link {
-                pts.push(poses.get(link.as_str()).map_or([0.0; 3], |p: &Pose| p.apply(c.offset_m)));
+                pts.push(poses.get(link.as_str()).map_or([0.0; 3], |p: &Pose| touch_point(c, p)));
             }
         }
     }
@@ -263,9 +273,9 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![hand_actual()]]))
                 .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![0.0015]])),
         );
-        for (name, pts, color, label, r) in
-            [("actual", &actual, hand_actual(), "hand (actual)", r_point), ("desired", &desired, hand_desired(), "target (desired)", 0.75 * r_point)]
-        {
+        // no text labels: on its target the two labels overlapped; the views' titles name the
+        // colours
+        for (name, pts, color, r) in [("actual", &actual, hand_actual(), r_point), ("desired", &desired, hand_desired(), 0.75 * r_point)] {
             out.push(
                 Chunk::new(format!("{world}/hand/{name}"), Index::SimTime(hand_times.clone()))
                     .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&pts.iter().map(|p| vec![f3(*p)]).collect::<Vec<_>>())),
@@ -273,7 +283,6 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             out.push(
                 Chunk::new(format!("{world}/hand/{name}"), Index::Static)
                     .with(POINTS, "colors", "rerun.components.Color", u32_lists(&[vec![color]]))
-                    .with(POINTS, "labels", "rerun.components.Text", str_lists(&[vec![label.to_string()]]))
                     .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![r as f32]])),
             );
         }
@@ -314,7 +323,6 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 .with(BOXES, "colors", "rerun.components.Color", u32_lists(&[vec![rgba(r, g, bl, alpha)]]))
                 .with(BOXES, "fill_mode", "rerun.components.FillMode", u8_lists(&[vec![4]]))
                 .with(BOXES, "half_sizes", "rerun.components.HalfSize3D", vec3_lists(&[vec![f3(b.size.map(|x| 0.5 * x))]]))
-                .with(BOXES, "labels", "rerun.components.Text", str_lists(&[vec!["table".to_string()]]))
                 .with(BOXES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(b.rotation)]])),
         );
     }
@@ -335,7 +343,9 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
             out.push(
                 Chunk::new(format!("{world}/force_scale"), Index::Static)
                     .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&[vec![shared(schemas::markers::colors::SCALE_BAR)]]))
-                    .with(ARROWS, "labels", "rerun.components.Text", str_lists(&[vec![format!("{} ({})", bar.text, scale_words(&scale))]]))
+                    // short, so that it is not cut at the view's edge (the scale in words is
+                    // in the side view's title)
+                    .with(ARROWS, "labels", "rerun.components.Text", str_lists(&[vec![bar.text.clone()]]))
                     .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&[vec![f3(bar.tail)]]))
                     .with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::ARROW_SHAFT_DIAMETER_M) as f32]]))
                     .with(ARROWS, "vectors", "rerun.components.Vector3D", vec3_lists(&[vec![f3(bar.vector)]])),
@@ -366,9 +376,10 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
                 .with(POINTS, "colors", "rerun.components.Color", u32_lists(&translucent))
                 .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&d.points.iter().map(|p| vec![f3(*p)]).collect::<Vec<_>>())),
         );
+        // the marker has no label of its own: the force's label names the contact (two labels
+        // at one contact overlapped)
         out.push(
             Chunk::new(&base, Index::Static)
-                .with(POINTS, "labels", "rerun.components.Text", str_lists(&[vec![c.name.clone()]]))
                 .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![schemas::markers::CONTACT_MARKER_RADIUS_M as f32]])),
         );
         let rings: Vec<Vec<Vec<[f32; 3]>>> = d.glyphs.iter().map(|g| vec![ring(g.tail, d.normal)]).collect();
@@ -515,6 +526,87 @@ pub fn contact_drawing(
     d
 }
 
+/// Where contact `c` touches (or would touch) its plane, world frame, m, with its link at `link`
+/// (world frame): its point, or its shape's lowest point (`schemas::ContactShapeInfo`, the
+/// point `sim` draws its Foxglove marker at).
+pub fn touch_point(c: &super::run::ContactPoint, link: &Pose) -> [f64; 3] {
+    let center = link.apply(c.offset_m);
+    match (&c.shape, c.plane) {
+        (Some(s), Some(plane)) => {
+            let n = plane.normal;
+            let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
+            let axis = s.axis.map_or([0.0; 3], |a| super::pose::rotate(link.rotation, a));
+            s.lowest_point(center, axis, n.map(|x| x / norm))
+        }
+        _ => center,
+    }
+}
+
+/// The static chunks of a contact shape at `path` (below its link's entity, so in the link's
+/// frame): a sphere pad as an ellipsoid, a capsule as `Capsules3D` (from its first end along
+/// +z, as Rerun defines it), a cylinder as `Cylinders3D` between its rims, and each rim as a
+/// closed line strip; translucent cyan (`schemas::markers::colors::CONTACT_SHAPE`).
+fn shape_chunks(path: &str, g: &schemas::markers::ShapeGlyph) -> Vec<Chunk> {
+    use schemas::markers::ShapeGlyph;
+    let [r, gr, b, _] = schemas::markers::colors::rgba8(schemas::markers::colors::CONTACT_SHAPE, 255);
+    let fill = rgba(r, gr, b, (schemas::markers::SHAPE_ALPHA * 255.0).round() as u8);
+    let line = rgba(r, gr, b, 255);
+    let mut out = Vec::new();
+    let segment = |ends: &[[f64; 3]; 2]| {
+        let d = [0, 1, 2].map(|i| ends[1][i] - ends[0][i]);
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        (quat_z_to(d.map(|x| x / len.max(1e-300))), len)
+    };
+    match g {
+        ShapeGlyph::Sphere { center, radius, .. } => out.push(super::mesh::shape_chunk(
+            path,
+            &Pose { translation: *center, rotation: [0.0, 0.0, 0.0, 1.0] },
+            Shape::Sphere { radius_m: *radius },
+            fill,
+        )),
+        ShapeGlyph::Capsule { ends, radius, .. } => {
+            let (q, len) = segment(ends);
+            out.push(
+                Chunk::new(path, Index::Static)
+                    .with(CAPSULES, "colors", "rerun.components.Color", u32_lists(&[vec![fill]]))
+                    .with(CAPSULES, "lengths", "rerun.components.Length", f32_lists(&[vec![len as f32]]))
+                    .with(CAPSULES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(q)]]))
+                    .with(CAPSULES, "radii", "rerun.components.Radius", f32_lists(&[vec![*radius as f32]]))
+                    .with(CAPSULES, "translations", "rerun.components.Translation3D", vec3_lists(&[vec![f3(ends[0])]])),
+            );
+        }
+        ShapeGlyph::Cylinder { ends, radius, .. } => {
+            let (q, len) = segment(ends);
+            let mid = [0, 1, 2].map(|i| 0.5 * (ends[0][i] + ends[1][i]));
+            out.push(super::mesh::shape_chunk(
+                path,
+                &Pose { translation: mid, rotation: q },
+                Shape::Cylinder { radius_m: *radius, length_m: len },
+                rgba(r, gr, b, 64),
+            ));
+        }
+        ShapeGlyph::Rim { .. } => {}
+    }
+    let rims: Vec<Vec<[f32; 3]>> = g
+        .rims()
+        .into_iter()
+        .map(|(c, a)| {
+            let mut pts: Vec<[f32; 3]> = schemas::markers::circle(c, a, g.radius()).into_iter().map(f3).collect();
+            pts.push(pts[0]);
+            pts
+        })
+        .collect();
+    if !rims.is_empty() {
+        out.push(
+            Chunk::new(format!("{path}/rims"), Index::Static)
+                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![line]]))
+                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::RING_LINE_WIDTH_M) as f32]]))
+                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[rims])),
+        );
+    }
+    out
+}
+
 /// The ring around a contact's point on the table: a closed strip of
 /// [`schemas::markers::CONTACT_RING_POINTS`] points about `center` in the plane of `normal`.
 fn ring(center: [f64; 3], normal: [f64; 3]) -> Vec<[f32; 3]> {
@@ -531,7 +623,7 @@ fn ring(center: [f64; 3], normal: [f64; 3]) -> Vec<[f32; 3]> {
 }
 
 /// "10 mm per N" (the scale in words).
-fn scale_words(s: &schemas::markers::ForceScale) -> String {
+pub fn scale_words(s: &schemas::markers::ForceScale) -> String {
     let mm = s.m_per_n * 1e3;
     if mm >= 0.01 {
         format!("{} mm per N", (mm * 1e4).round() / 1e4)
@@ -633,7 +725,8 @@ fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], m
                 format!("{}/{cp}", paths.signal(CONTACT_MODE)),
                 &force_t,
                 v,
-                &format!("{} mode (0 separated, 1 sticking, 2 sliding)", contact.name),
+                // short: the plot's title gives the codes (the long name made a legend that covered the data)
+                &format!("{} mode", contact.name),
                 color,
                 width,
             ));

@@ -57,6 +57,30 @@ pub fn side_eye(b: &Bounds) -> Eye {
     Eye { position: [c[0] + d * s[0], c[1] + d * s[1], c[2] + 0.15 * d], look_target: c, up: [0.0, 0.0, 1.0] }
 }
 
+/// Whether the arm sweeps a flat band (its height less than half its width, as the paper's arm
+/// lying over its table): then the side view is drawn wide and short, across the whole tab.
+pub fn is_flat(b: &Bounds) -> bool {
+    let w = (b.arm_max[0] - b.arm_min[0]).max(b.arm_max[1] - b.arm_min[1]);
+    b.arm_max[2] - b.arm_min[2] < 0.5 * w
+}
+
+/// The side view of a flat arm in a wide, short view (about 3:1 at 1440×900 and 3.5:1 at
+/// 1920×1080; Rerun's vertical field of view is 55°, so the view's width is about 3 × 2 tan
+/// 27.5° ≈ 3.1 × the distance): near enough that the arm's width fills about three quarters
+/// of it and its height at most 60 % of the view's, from the same side and height as [`side_eye`]
+/// (the 1.05 × extent side view of a square view left its upper half empty).
+pub fn wide_side_eye(b: &Bounds) -> Eye {
+    let c = center(b.arm_min, b.arm_max);
+    let s = side_direction(b);
+    // the bounds' extents across the view and along it (the camera stands in front of the
+    // nearest part, not of the middle)
+    let (dx, dy) = (b.arm_max[0] - b.arm_min[0], b.arm_max[1] - b.arm_min[1]);
+    let (across, depth) = (s[1].abs() * dx + s[0].abs() * dy, s[0].abs() * dx + s[1].abs() * dy);
+    let h = b.arm_max[2] - b.arm_min[2];
+    let d = (0.45 * across).max(1.6 * h) + 0.5 * depth + 0.2;
+    Eye { position: [c[0] + d * s[0], c[1] + d * s[1], c[2] + 0.15 * d], look_target: c, up: [0.0, 0.0, 1.0] }
+}
+
 /// A close-up of the hand path, from the same side and a little above.
 pub fn hand_eye(b: &Bounds) -> Eye {
     let c = center(b.hand_min, b.hand_max);
@@ -185,14 +209,22 @@ fn row(children: Vec<Node>) -> Node {
 /// The blueprint of one run (entities as [`super::entities::run_chunks`] made them).
 pub fn single(run: &Run, paths: &Paths, bounds: &Bounds) -> Node {
     let world = paths.world();
-    let arm = View::new(ViewClass::Spatial3D, "arm, side view", &world).eye(side_eye(bounds));
+    // the colours in the title (no labels on the hand points: on the target they overlapped)
+    let title = "arm (hand purple, target orange)";
+    let flat = is_flat(bounds);
+    let arm = View::new(ViewClass::Spatial3D, title, &world).eye(if flat { wide_side_eye(bounds) } else { side_eye(bounds) });
     let hand = View::new(ViewClass::Spatial3D, "hand (purple) and target (orange)", &world).eye(hand_eye(bounds));
     let mut all = plots(run, paths);
     let mut take = |key: &str| all.iter().position(|p| p.key == key).map(|k| all.remove(k)).map(|p| p.node(&p.title));
     let mut tabs = Vec::new();
     let mut side = vec![Node::View(hand)];
     side.extend(take(signal::NORMAL_FORCE));
-    tabs.push(row(vec![Node::View(arm), column(side)]).shares(&[3.0, 2.0]).named("arm"));
+    tabs.push(if flat {
+        // a flat arm: wide and short across the tab, the hand and the forces below it
+        column(vec![Node::View(arm), row(side)]).shares(&[3.0, 2.0]).named("arm")
+    } else {
+        row(vec![Node::View(arm), column(side)]).shares(&[3.0, 2.0]).named("arm")
+    });
     let motors: Vec<Node> = [signal::CURRENT, signal::VOLTAGE].iter().filter_map(|k| take(k)).collect();
     tabs.push(column(motors).named("motors"));
     let slip: Vec<Node> = [signal::SLIP_SPEED, signal::FRICTION_RATIO, signal::CONTACT_MODE].iter().filter_map(|k| take(k)).collect();
@@ -334,6 +366,34 @@ mod tests {
         let r = run.energy.iter().map(|(_, e)| e.balance_residual.abs()).fold(0.0, f64::max);
         assert_eq!(res.y_range, Some(residual_range(r)));
         assert!(views.iter().all(|v| v.name.chars().count() <= 36), "{:?}", views.iter().map(|v| &v.name).collect::<Vec<_>>());
+    }
+
+    /// `--tab`: the blueprint opens on the tab named (its `active_tab` is that child), an
+    /// unknown name is refused with the tab names, and without it the first tab is active.
+    #[test]
+    fn the_blueprint_opens_on_the_tab_asked_for() {
+        use super::super::blueprint::chunks;
+        use arrow_array::Array;
+        let (s, _) = schemas::synth::unilateral();
+        let (_, _, root) = laid_out(&s);
+        let active = |root: &Node| -> (String, Vec<String>) {
+            let cs = chunks(root, 7);
+            let tabs = cs.iter().find(|c| c.columns.iter().any(|col| col.field == "active_tab")).expect("a tab container");
+            let get = |field: &str| -> Vec<String> {
+                let col = tabs.columns.iter().find(|col| col.field == field).unwrap();
+                let list = col.values.as_any().downcast_ref::<arrow_array::ListArray>().unwrap().value(0);
+                let strs = list.as_any().downcast_ref::<arrow_array::StringArray>().unwrap();
+                (0..strs.len()).map(|k| strs.value(k).to_string()).collect()
+            };
+            (get("active_tab")[0].clone(), get("contents"))
+        };
+        let (first, contents) = active(&root);
+        assert_eq!(first, contents[0]);
+        let names = root.tab_names();
+        let k = names.iter().position(|n| n == "slip / stick").expect("a slip / stick tab");
+        let (slip, contents) = active(&root.clone().open_on("slip / stick").unwrap());
+        assert_eq!(slip, contents[k]);
+        assert_eq!(root.open_on("nope").unwrap_err(), names);
     }
 
     /// The time series views of `root` whose origin has no sample in `chunks` (no temporal

@@ -48,6 +48,9 @@ pub struct ContactPoint {
     pub tangents: Option<([f64; 3], [f64; 3])>,
     /// Friction coefficient μ, from the `contacts` record (unilateral and compliant contacts).
     pub friction: Option<f64>,
+    /// Its shape on its link, from the `contacts` record (recordings since issue 27): where
+    /// it touches (`ContactShapeInfo::lowest_point`) and what is drawn on the link.
+    pub shape: Option<schemas::ContactShapeInfo>,
 }
 
 /// A frame of the `/tf` tree and its poses.
@@ -710,7 +713,14 @@ impl Run {
                 (None, None) => None,
             };
             let offset_m = point.and_then(|p| p.get("offset")).and_then(vec3).unwrap_or([0.0; 3]);
-            contacts.push(ContactPoint { name: cname.clone(), link, offset_m, plane, tangents: info.map(|i| (i.t1, i.t2)), friction: info.and_then(|i| i.friction) });
+            let shape = info.and_then(|i| i.shape.clone());
+            // the record's link and point win (a capsule's ends and the table's contacts from
+            // URDF collisions are no entry of the scene's `contacts`)
+            let (link, offset_m) = match &shape {
+                Some(s) => (Some(s.link.clone()), s.center),
+                None => (link, offset_m),
+            };
+            contacts.push(ContactPoint { name: cname.clone(), link, offset_m, plane, tangents: info.map(|i| (i.t1, i.t2)), friction: info.and_then(|i| i.friction), shape });
         }
         let mut other_planes = Vec::new();
         for c in &scene_contacts {

@@ -36,6 +36,64 @@ pub struct ContactInfo {
     /// The tangent basis of `/contacts`' `*_t1`, `*_t2` fields, world frame.
     pub t1: [f64; 3],
     pub t2: [f64; 3],
+    /// Where the contact is on the arm and its shape there (issue 27; absent in recordings
+    /// made before it, whose readers take the point from the scene).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ContactShapeInfo>,
+}
+
+/// A contact's shape on its link, in that link's frame (a `/tf` frame), as it ran
+/// (`sim::dynamics::contact::shape`): a `point` of the link, a `sphere` of `radius` centred on
+/// `center` (a pad, or one end sphere of a capsule: a capsule is the two contacts
+/// `<name>/0` and `<name>/1`), or the `rim` of a cylinder's end face, the circle of `radius`
+/// about `center` normal to `axis`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ContactShapeInfo {
+    /// `point`, `sphere` or `rim`.
+    pub kind: String,
+    /// m (0 for a point).
+    pub radius: f64,
+    /// The link (a frame of `/tf`) the geometry is fixed to.
+    pub link: String,
+    /// The contact's point (the sphere's or rim's centre), link frame, m.
+    pub center: [f64; 3],
+    /// A rim's unit axis, link frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[f64; 3]>,
+}
+
+/// The kinds of [`ContactShapeInfo::kind`].
+pub mod shape_kind {
+    pub const POINT: &str = "point";
+    pub const SPHERE: &str = "sphere";
+    pub const RIM: &str = "rim";
+}
+
+impl ContactShapeInfo {
+    /// The point of the shape farthest along `−normal` (unit, world frame), world frame, m,
+    /// given its centre `center_w` and (a rim) its axis `axis_w` in the world frame: the point
+    /// itself; `c − r n` for a sphere; `c + r u`, `u = −m/|m|`, `m = n − (n·a) a`, for a rim
+    /// (Ericson, *Real-Time Collision Detection*, 2005, §3.9; the formulas of
+    /// `sim::dynamics::contact::shape`, which the simulation touches the plane with). A rim
+    /// standing on its face (|m| = 0, refused by the run near the plane) gives its centre.
+    pub fn lowest_point(&self, center_w: [f64; 3], axis_w: [f64; 3], normal: [f64; 3]) -> [f64; 3] {
+        let n = normal;
+        match self.kind.as_str() {
+            shape_kind::SPHERE => [0, 1, 2].map(|i| center_w[i] - self.radius * n[i]),
+            shape_kind::RIM => {
+                let a = axis_w;
+                let na = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+                let m = [0, 1, 2].map(|i| n[i] - na * a[i]);
+                let s = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+                if s > 0.0 {
+                    [0, 1, 2].map(|i| center_w[i] - self.radius * m[i] / s)
+                } else {
+                    center_w
+                }
+            }
+            _ => center_w,
+        }
+    }
 }
 
 impl ContactInfo {
@@ -54,6 +112,7 @@ impl ContactInfo {
             offset: 0.0,
             t1: [1.0, 0.0, 0.0],
             t2: [0.0, 1.0, 0.0],
+            shape: None,
         }
     }
 }

@@ -43,8 +43,9 @@ pub struct Outputs {
     pub normal_force: Vec<f64>,
     pub constraint_position: Vec<f64>,
     pub constraint_velocity: Vec<f64>,
-    /// World position of each contact point of the run, in its order, m (forward kinematics at
-    /// q; for the viewers' contact markers).
+    /// World position of each contact of the run where it touches (or would touch) its plane,
+    /// in its order, m (forward kinematics at q; for the viewers' contact markers): the
+    /// contact's point, or a sphere's or rim's lowest point (`Contact::touch_point`).
     pub contact_point: Vec<Vector3<f64>>,
     pub hand: Vector3<f64>,
     pub hand_desired: Vector3<f64>,
@@ -219,7 +220,10 @@ impl ArmSystem<'_> {
         out.constraint_velocity.clear();
         out.constraint_velocity.extend(self.contacts.iter().map(|c| c.velocity(data)));
         out.contact_point.clear();
-        out.contact_point.extend(self.contacts.iter().map(|c| c.point.position(data)));
+        match &self.hybrid {
+            Some(h) => out.contact_point.extend(h.contacts.iter().map(|c| c.touch_point(data))),
+            None => out.contact_point.extend(self.contacts.iter().map(|c| c.point.position(data))),
+        }
         if level == OutputLevel::Kinematic {
             for v in [&mut out.qdd, &mut out.voltage, &mut out.electric_power, &mut out.tau_motor, &mut out.normal_force, &mut out.voltage_command] {
                 v.clear();

@@ -111,7 +111,9 @@ fn contact_states_events_and_records_read_back_equal() {
     // order per topic, so check through the joint states' and events' log times
     assert!(events.windows(2).all(|w| w[0].0 <= w[1].0));
     let got = r.record::<ContactsRecord>().unwrap();
-    assert_eq!(got, contacts_record(&contacts, &settings));
+    assert_eq!(got, contacts_record_with_shapes(&scene.model, &contacts, &settings));
+    // the paper's elbows are points of their links
+    assert!(got.contacts.iter().all(|c| c.shape.as_ref().is_some_and(|s| s.kind == "point" && s.radius == 0.0)), "{:?}", got.contacts);
     let e4 = got.contact("elbow4").unwrap();
     assert_eq!((e4.model.as_str(), e4.restitution, e4.friction, e4.stiffness), ("unilateral", Some(0.5), Some(0.6), None));
     let e7 = got.contact("elbow7").unwrap();

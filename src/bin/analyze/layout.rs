@@ -118,7 +118,7 @@ pub fn run(a: &LayoutArgs, v: Verbosity) -> Result<u8> {
                 let path = dir.join(layout::file_name(&input.title));
                 schemas::atomic::write_file(&path, json(input)?).with_context(|| format!("cannot write {}", path.display()))?;
                 if !v.quiet {
-                    eprintln!("analyze: wrote {} ({} runs); in Foxglove: Layouts -> Import from file", path.display(), input.runs.len());
+                    eprintln!("analyze: wrote {} ({} run{}); in Foxglove: Layouts -> Import from file", path.display(), input.runs.len(), if input.runs.len() == 1 { "" } else { "s" });
                 }
             }
         }

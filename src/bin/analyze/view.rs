@@ -21,6 +21,7 @@ Examples:
   analyze view out/paper-two-elbow.mcap            -> out/paper-two-elbow.rrd
   analyze view out/paper-two-elbow.mcap --spawn    and open it in the Rerun viewer
   analyze view out/ -o out/paper.rrd               every out/*.mcap side by side in one file
+  analyze view out/run.mcap --tab \"slip / stick\"   open on the slip / stick tab
   rerun out/paper-two-elbow.rrd                    open a converted file (Rerun 0.41)")]
 pub struct ViewArgs {
     /// Recordings (.mcap), or directories: every *.mcap directly in them, sorted by name.
@@ -33,6 +34,10 @@ pub struct ViewArgs {
     /// Open the result in the Rerun viewer (`rerun` must be on PATH).
     #[arg(long)]
     pub spawn: bool,
+    /// The tab the viewer opens on, by its name ("slip / stick", "energy", ...) [default: the
+    /// first, "arm"].
+    #[arg(long, value_name = "NAME")]
+    pub tab: Option<String>,
 }
 
 fn stem(p: &Path) -> String {
@@ -64,7 +69,7 @@ pub fn run(a: &ViewArgs, v: Verbosity) -> Result<u8> {
     if a.spawn {
         which_rerun()?;
     }
-    let (written, failed) = convert(&jobs, v)?;
+    let (written, failed) = convert(&jobs, a.tab.as_deref(), v)?;
     if a.spawn {
         let status = std::process::Command::new("rerun").args(&written).status();
         match status {
@@ -89,7 +94,7 @@ fn which_rerun() -> Result<()> {
 
 /// Converts each job (an output and its inputs); a job that fails is reported and the others go
 /// on. The outputs written and the number of jobs that failed.
-fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<(Vec<PathBuf>, usize)> {
+fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], tab: Option<&str>, v: Verbosity) -> Result<(Vec<PathBuf>, usize)> {
     use anyhow::Context;
     let total: usize = jobs.iter().map(|(_, i)| i.len()).sum();
     let bar = cli::progress::count(total, "reading", "recordings", v.quiet || total < 2);
@@ -99,7 +104,7 @@ fn convert(jobs: &[(PathBuf, Vec<PathBuf>)], v: Verbosity) -> Result<(Vec<PathBu
         let inputs = &jobs.iter().find(|(o, _)| o == out).expect("a job per output").1;
         let started = std::time::Instant::now();
         let names = inputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-        let converted = analyze::view::convert(inputs, out, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
+        let converted = analyze::view::convert(inputs, out, tab, &|| bar.inc(1)).with_context(|| format!("converting {names}"))?;
         let size = converted.bytes;
         // the URDF geometry that could not be drawn as written: once per output, per link
         for note in &converted.notes {
