@@ -71,6 +71,24 @@ fn the_optimum_is_the_dense_grids_best_within_one_spacing() {
     // the report states the error bar and the optimum's scene runs
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("Error bar:"), "{report}");
+    // the error bar is measured at the baseline, the centre and both ends of kd's range (each at
+    // the loose and the tight rtol), and stated as 2 × the largest difference; the optimum's
+    // own loose − tight lies within it
+    let cal = &st["calibration"];
+    let designs = cal["designs"].as_array().expect("the calibration designs");
+    assert_eq!(designs.len(), 4, "{cal}");
+    let largest = designs.iter().map(|d| (d["loose"].as_f64().unwrap() - d["tight"].as_f64().unwrap()).abs()).fold(0.0, f64::max);
+    assert!(largest > 0.0, "{cal}");
+    assert_eq!(cal["error_j"].as_f64().unwrap(), 2.0 * largest, "{cal}");
+    let tight_opt: f64 = report
+        .lines()
+        .find_map(|l| l.strip_prefix("| optimum (tight) | "))
+        .and_then(|l| l.split(" | ").next())
+        .and_then(|x| x.parse().ok())
+        .unwrap_or_else(|| panic!("no tight optimum in {report}"));
+    // the report prints 5 decimals: the optimum's loose − tight within the bar, up to that rounding
+    assert!((e_opt - tight_opt).abs() <= 2.0 * largest + 5e-6, "loose {e_opt} J, tight {tight_opt} J, error bar {} J", 2.0 * largest);
+    assert!(report.contains("matches its tight re-run within the stated error bar"), "{report}");
     let r = run_sim(&["run", out.join("optimum.json").to_str().unwrap(), "-o", tmp.path().join("rerun").to_str().unwrap(), "-q"]);
     assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
     for f in ["small-kd-optimum-elbow.mcap", "small-kd-baseline-elbow.mcap", "map.png", "pareto.svg", "convergence.png"] {

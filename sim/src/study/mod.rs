@@ -35,6 +35,8 @@ use place::Placement;
 
 /// Most discrete combinations a study enumerates.
 pub const MAX_COMBINATIONS: usize = 64;
+/// Most designs (besides the baseline) the evaluations' error bar is measured at.
+pub const MAX_CALIBRATION_DESIGNS: usize = 24;
 /// Most evaluations of one study.
 pub const MAX_EVALUATIONS: usize = 100_000;
 
@@ -536,6 +538,27 @@ impl Study {
         let cols = self.columns();
         // the discrete variables' cells, found by their columns (their fields)
         self.discrete.iter().filter_map(|&(i, _)| cols.iter().position(|c| c == self.spec.variables[i].field()).map(|k| cells[k].clone())).collect::<Vec<_>>().join(", ")
+    }
+
+    /// The designs (besides the baseline) at which the evaluations' error bar is measured: in
+    /// every discrete combination, the centre of the continuous box and, for each continuous
+    /// variable, its two ends (the others at the centre); the centres of all combinations come
+    /// first, then the ends, and at most [`MAX_CALIBRATION_DESIGNS`] are taken.
+    pub fn calibration_points(&self) -> Vec<Point> {
+        let n = self.continuous.len();
+        let combos = self.settings.combos.max(1);
+        let mut pts: Vec<Point> = (0..combos).map(|combo| Point { combo, u: vec![0.5; n] }).collect();
+        for combo in 0..combos {
+            for i in 0..n {
+                for end in [0.0, 1.0] {
+                    let mut u = vec![0.5; n];
+                    u[i] = end;
+                    pts.push(Point { combo, u });
+                }
+            }
+        }
+        pts.truncate(MAX_CALIBRATION_DESIGNS);
+        pts
     }
 
     /// Candidate `index` at `p`: a sweep variant named `<study>-<index>`.

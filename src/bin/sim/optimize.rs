@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde_json::Value;
 use sim::run::{run_to_file_tapped, Budget};
 use sim::study::optimizer::{Optimizer, Point};
-use sim::study::state::{shard_file, Calibration, Evaluation, ShardResult, State, STATE_FILE};
+use sim::study::state::{shard_file, Calibration, CalibrationDesign, Evaluation, ShardResult, State, ERROR_BAR_FACTOR, STATE_FILE};
 use sim::study::Study;
 use sim::sweep::{Shard, Sweep, Variant};
 
@@ -186,10 +186,13 @@ fn baseline(study: &Study) -> Variant {
     Variant { index: 0, name: format!("{}-baseline", study.spec.name), replacements: Vec::new() }
 }
 
-/// The stated rule: starting from the study's `loose` rtol, the evaluations' rtol is the
+/// The stated rules: starting from the study's `loose` rtol, the evaluations' rtol is the
 /// loosest (in steps of 10) at which the baseline's objective is within 0.1 % of its value at
-/// `tight`.
-fn calibrate(study: &Study, dir: &Path, budget: Budget) -> Result<Option<Calibration>> {
+/// `tight`; the error bar of an evaluation is [`ERROR_BAR_FACTOR`] × the largest
+/// |loose − tight| over the baseline and the calibration designs (`Study::calibration_points`:
+/// the centre and the ends of every continuous variable in every discrete combination), run in
+/// parallel.
+fn calibrate(study: &Study, dir: &Path, budget: Budget, pool: &rayon::ThreadPool) -> Result<Option<Calibration>> {
     let Some(t) = &study.spec.tolerance else { return Ok(None) };
     let b = baseline(study);
     let at = |r: f64| -> Result<f64> {
@@ -199,15 +202,35 @@ fn calibrate(study: &Study, dir: &Path, budget: Budget) -> Result<Option<Calibra
     let tight = at(t.tight)?;
     let mut ladder = Vec::new();
     let mut r = t.loose;
-    loop {
+    let loose_j = loop {
         let j = at(r)?;
         ladder.push((r, j));
         if (j - tight).abs() <= 1e-3 * tight.abs() || r / 10.0 <= t.tight {
             ladder.push((t.tight, tight));
-            return Ok(Some(Calibration { loose: r, tight: t.tight, ladder, error_j: (j - tight).abs() }));
+            break j;
         }
         r /= 10.0;
+    };
+    let points = study.calibration_points();
+    let cols = study.columns();
+    // every design at both tolerances, in parallel (named apart from the candidates)
+    let jobs: Vec<(usize, f64)> = (0..points.len()).flat_map(|k| [(k, r), (k, t.tight)]).collect();
+    let values: Vec<Option<f64>> = pool.install(|| {
+        jobs.par_iter()
+            .map(|&(k, rtol)| {
+                let mut var = study.variant(k, &points[k]);
+                var.name = format!("{}-calibration-{k:02}-{}", study.spec.name, if rtol == t.tight { "tight" } else { "loose" });
+                evaluate(study, &var, Some(rtol), dir, false, budget).objective
+            })
+            .collect()
+    });
+    let mut designs = vec![CalibrationDesign { design: "baseline".into(), loose: Some(loose_j), tight: Some(tight) }];
+    for (k, p) in points.iter().enumerate() {
+        let label = cols.iter().zip(study.cells(p)).map(|(c, x)| format!("{c} = {x}")).collect::<Vec<_>>().join(", ");
+        designs.push(CalibrationDesign { design: label, loose: values[2 * k], tight: values[2 * k + 1] });
     }
+    let largest = designs.iter().filter_map(CalibrationDesign::error).fold(0.0, f64::max);
+    Ok(Some(Calibration { loose: r, tight: t.tight, ladder, error_j: ERROR_BAR_FACTOR * largest, designs }))
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(p: &Path) -> Result<T> {
@@ -228,6 +251,8 @@ pub fn run(args: &OptimizeArgs, v: Verbosity) -> Result<u8> {
     cli::create_dir(&evals_dir)?;
     let budget = args.wall_time.budget();
     let state_path = out.join(STATE_FILE);
+    let threads = args.jobs.threads(study.settings.population.max(study.settings.combos));
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
     let mut state: State = if state_path.is_file() {
         let s: State = read_json(&state_path)?;
         if s.spec != spec_value {
@@ -236,15 +261,20 @@ pub fn run(args: &OptimizeArgs, v: Verbosity) -> Result<u8> {
         s
     } else {
         let started = Instant::now();
-        let calibration = calibrate(&study, &evals_dir, budget)?;
+        let calibration = calibrate(&study, &evals_dir, budget, &pool)?;
         if let (Some(c), false) = (&calibration, v.quiet) {
-            eprintln!("tolerance: evaluations at rtol {:e} (baseline objective within {:.3e} J of rtol {:e}; {:.1} s)", c.loose, c.error_j, c.tight, started.elapsed().as_secs_f64());
+            eprintln!(
+                "tolerance: evaluations at rtol {:e}; error bar {:.3e} J ({ERROR_BAR_FACTOR} x the largest loose - tight of {} design(s) at rtol {:e}; {:.1} s)",
+                c.loose,
+                c.error_j,
+                c.designs.iter().filter(|d| d.error().is_some()).count(),
+                c.tight,
+                started.elapsed().as_secs_f64()
+            );
         }
         State { study: study.spec.name.clone(), spec: spec_value, calibration, optimizer: Optimizer::new(study.settings), evaluations: Vec::new() }
     };
     let rtol = state.calibration.as_ref().map(|c| c.loose);
-    let threads = args.jobs.threads(study.settings.population.max(study.settings.combos));
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
     let bar = cli::progress::count(study.settings.evaluations, &study.spec.name, "evaluations", v.quiet);
     bar.set_position(state.evaluations.len() as u64);
     let started = Instant::now();
@@ -388,20 +418,30 @@ fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity
     match (&state.calibration, opt_o.objective) {
         (Some(c), Some(t)) => {
             let err = (loose - t).abs();
+            let counted: Vec<&CalibrationDesign> = c.designs.iter().filter(|d| d.error().is_some()).collect();
             writeln!(
                 report,
-                "Error bar: the optimum's objective at rtol {:e} (evaluations) and {:e} (re-run) differ by {err:.2e} J ({:.3} %); the baseline's by {:.2e} J. Tolerance rule: the loosest rtol (from {:e}, in steps of 10) at which the baseline's objective is within 0.1 % of its tight value: {}.",
+                "Error bar: ±{:.2e} J, stated before the search: {ERROR_BAR_FACTOR} × the largest |loose − tight| of the objective over {} design(s) (the baseline, and the centre and the ends of every continuous variable in every discrete combination; {} infeasible at one tolerance not counted). The optimum's objective at rtol {:e} (evaluations) and {:e} (re-run) differ by {err:.2e} J ({:.3} %). Tolerance rule: the loosest rtol (from {:e}, in steps of 10) at which the baseline's objective is within 0.1 % of its tight value: {}.",
+                c.error_j,
+                counted.len(),
+                c.designs.len() - counted.len(),
                 c.loose,
                 c.tight,
                 100.0 * err / t.abs(),
-                c.error_j,
                 study.spec.tolerance.as_ref().map_or(f64::NAN, |t| t.loose),
                 c.ladder.iter().map(|(r, j)| format!("rtol {r:e}: {j:.6} J")).collect::<Vec<_>>().join("; ")
             )?;
-            // the calibration's error bar (the baseline's loose − tight) holds for the optimum?
+            if !c.designs.is_empty() {
+                writeln!(report, "\n| calibration design | objective, loose [J] | objective, tight [J] | loose − tight [J] |\n|---|---|---|---|")?;
+                let j = |x: Option<f64>| x.map_or("infeasible".into(), |x| format!("{x:.6}"));
+                for d in &c.designs {
+                    writeln!(report, "| {} | {} | {} | {} |", d.design, j(d.loose), j(d.tight), d.error().map_or("-".into(), |e| format!("{e:.2e}")))?;
+                }
+            }
+            // the stated error bar holds for the optimum?
             writeln!(
                 report,
-                "\nThe optimum's value as evaluated {} its tight re-run within the calibration's error bar ({err:.2e} J {} {:.2e} J).",
+                "\nThe optimum's value as evaluated {} its tight re-run within the stated error bar ({err:.2e} J {} {:.2e} J).",
                 if err <= c.error_j { "matches" } else { "does NOT match" },
                 if err <= c.error_j { "<=" } else { ">" },
                 c.error_j
@@ -410,7 +450,7 @@ fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity
             let second = state.evaluations.iter().filter(|e| e.objective.is_some() && e.values != best.values).map(Evaluation::told).min_by(f64::total_cmp);
             if let Some(s) = second {
                 let gap = s - loose;
-                writeln!(report, "\nThe best other design is {gap:.2e} J worse: {} the error bar.", if gap > err { "larger than" } else { "within" })?;
+                writeln!(report, "\nThe best other design is {gap:.2e} J worse: {} the stated error bar.", if gap > c.error_j { "larger than" } else { "within" })?;
             }
         }
         (_, None) => writeln!(report, "The optimum's re-run at the tight tolerance is infeasible: {}.", opt_o.infeasible.clone().unwrap_or_default())?,
