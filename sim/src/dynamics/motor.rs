@@ -221,8 +221,11 @@ impl Drives {
         let i_max = self.current_limit[j];
         if i_max.is_finite() {
             let emf = self.ke[j] * qd;
+            // max/min, not clamp: an integrator's trial stage far from the solution (a winding
+            // temperature so low that R(T) < 0, a speed of 1e8 rad/s) must give a number the
+            // error control rejects, not a panic on a window whose ends cross
             let w = self.r[j] * i_max;
-            v = v.clamp(emf - w, emf + w);
+            v = v.max(emf - w).min(emf + w);
         }
         let v_max = self.voltage_limit[j];
         v.clamp(-v_max, v_max)
