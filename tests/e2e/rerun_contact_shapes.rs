@@ -89,7 +89,7 @@ fn scene() -> serde_json::Value {
     let joints = ["bx", "bz", "bpitch", "rx", "rz", "rpitch", "dx", "dz", "dpitch"];
     let plane = serde_json::json!({"normal": [0.0, 0.0, 1.0], "offset": 0.0});
     serde_json::json!({
-        "name": "shapes", "urdf": "shapes.urdf", "gravity": [0.0, 0.0, -9.81], "duration": 0.5, "output_rate": 1000.0,
+        "$schema": "../../../../sim/scenes/scene.schema.json", "name": "shapes", "urdf": "shapes.urdf", "gravity": [0.0, 0.0, -9.81], "duration": 0.5, "output_rate": 1000.0,
         "joint_damping": 0.0,
         "motor": {"torque_constant": 0.5, "resistance": 1.0, "inductance": 0.0, "rotor_inertia": 1e-5, "gear_ratio": 1.0, "gear_damping": 0.0},
         "controller": {"kp": 0.0, "kd": 0.0}, "passive": joints, "hand": {"link": "ball"},

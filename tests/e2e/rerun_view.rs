@@ -99,7 +99,7 @@ fn check(python: &Path, mcap: &Path, rrd: &Path) -> Facts {
 
     // the blueprint: the arm and the hand in 3D, the plots of the experiment, laid out
     assert_eq!(f.views.iter().filter(|v| v.class == "3D" && v.origin == "/world").count(), 2, "{:?}", f.views);
-    assert!(f.views.iter().any(|v| v.class == "3D" && v.name.contains("side view")));
+    assert!(f.views.iter().any(|v| v.class == "3D" && v.name.starts_with("arm (")), "{:?}", f.views);
     assert!(f.views.iter().any(|v| v.class == "3D" && v.name.contains("hand")));
     for origin in ["/current_A", "/voltage_V", "/normal_force_N", "/electric_energy_J", "/link_work_J", "/energy_J", "/energy_residual_J"] {
         assert!(view(&f, "TimeSeries", origin), "no time series of {origin}: {:?}", f.views);
