@@ -75,3 +75,20 @@ pub fn contact_rows_where(model: &Model, data: &Data, contacts: &[Contact], rows
         }
     }
 }
+
+/// The q̇-dependent part of [`contact_rows_where`] (the same `rows_of`): the velocities
+/// `ġ, v_t` and, where `rows_of(k)`, the biases `J̇ q̇`, from the kinematics in `data` (at the
+/// same q as the rows, the q̇ given to `forward_velocities`); the gaps and `J` are left as they
+/// are. The same operations as there, so the values are bit for bit those of a full call.
+pub fn contact_velocities_where(data: &Data, contacts: &[Contact], rows: &mut ContactRows, rows_of: impl Fn(usize) -> bool) {
+    for (k, c) in contacts.iter().enumerate() {
+        let n = c.plane.normal_world.into_inner();
+        let touch = c.touch(data);
+        let full = rows_of(k);
+        for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
+            let r = 3 * k + axis;
+            rows.vel[r] = dir.dot(&touch.velocity);
+            rows.bias[r] = if full { dir.dot(&touch.bias) } else { 0.0 };
+        }
+    }
+}
