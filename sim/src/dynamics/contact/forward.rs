@@ -8,7 +8,7 @@
 //! *Numerical Methods for Nonsmooth Dynamical Systems*, 2008, §2.2): `f_n = max(0, k δ + c δ̇)`
 //! for `δ = −g > 0`, friction `f_t = −μ f_n v_t / sqrt(|v_t|² + v_s²)`.
 
-use super::rows::{contact_rows, contact_rows_where, contact_velocities_where, ContactRows};
+use super::rows::{contact_rows, contact_rows_only, contact_velocities_only, ContactRows};
 use super::solve::{solve_active, ActiveRow, ActiveScratch, RowForce, Singular};
 use super::{Contact, ContactMode, ContactModel};
 use crate::dynamics::cholesky;
@@ -138,10 +138,17 @@ pub fn prepare(
     prepare_in_modes(plant, contacts, None, data, fd, cd, t, q, qd, current)
 }
 
+/// Whether contact k has rows in a solve in the modes `m`: all but a `Separated` rigid one (a
+/// compliant contact's force goes into b through its rows whatever its mode).
+pub fn has_rows(contacts: &[Contact], m: &[ContactMode], k: usize) -> bool {
+    m[k] != ContactMode::Separated || matches!(contacts[k].model, ContactModel::Compliant { .. })
+}
+
 /// [`prepare`] for a solve in the modes `modes` (`None`: every contact's rows, as at an event):
-/// a `Separated` unilateral contact gets its gap and velocities but no rows
-/// ([`contact_rows_where`]), since no row of it enters the solve (a compliant contact, whose
-/// force goes into b through its rows whatever its mode, gets them).
+/// a `Separated` unilateral contact is not touched at all — no rows, no touching point, its gap
+/// and velocities left as they were ([`contact_rows_only`]; issue 24 item 2) — since nothing of
+/// it enters the solve; what reads its gap (the event functions, `ode/hybrid.rs`) computes it
+/// with [`super::rows::contact_gaps_where`].
 #[allow(clippy::too_many_arguments)]
 pub fn prepare_in_modes(
     plant: &Plant,
@@ -161,7 +168,7 @@ pub fn prepare_in_modes(
     forward_velocities(model, data, qd);
     match modes {
         None => contact_rows(model, data, contacts, &mut cd.rows),
-        Some(m) => contact_rows_where(model, data, contacts, &mut cd.rows, |k| m[k] != ContactMode::Separated || matches!(contacts[k].model, ContactModel::Compliant { .. })),
+        Some(m) => contact_rows_only(model, data, contacts, &mut cd.rows, |k| has_rows(contacts, m, k)),
     }
     super::shape::check_rims(contacts, data, t)?;
     compliant_forces(contacts, fd, cd);
@@ -334,7 +341,7 @@ pub fn forward_dynamics_contacts_same_q(
     generalized_force_placed(plant, data, fd, qd, current);
     forward_velocities(plant.model, data, qd);
     let m = &state.mode;
-    contact_velocities_where(data, contacts, &mut cd.rows, |k| m[k] != ContactMode::Separated || matches!(contacts[k].model, ContactModel::Compliant { .. }));
+    contact_velocities_only(data, contacts, &mut cd.rows, |k| has_rows(contacts, m, k));
     compliant_forces(contacts, fd, cd);
     solve_and_finish(plant, contacts, state, fd, cd, t, qd, current, voltage)
 }
