@@ -49,6 +49,8 @@ mod fuzz_scenes;
 mod gear_supply;
 #[path = "hand_load.rs"]
 mod hand_load;
+#[path = "hybrid_jacobian.rs"]
+mod hybrid_jacobian;
 #[path = "hard_cases.rs"]
 mod hard_cases;
 #[path = "paper.rs"]

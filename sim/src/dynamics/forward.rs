@@ -164,6 +164,25 @@ pub(crate) fn generalized_force_and_inertia(plant: &Plant, data: &mut Data, fd: 
     let (model, drives) = (plant.model, plant.drives);
     let nv = model.nv;
     forward_kinematics(model, data, q);
+    generalized_force_placed(plant, data, fd, qd, current);
+    match plant.mass_matrix {
+        // in world coordinates, from the world placements just computed (crba.rs)
+        MassMatrixMethod::Crba => crba_world(model, data),
+        MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
+    };
+    fd.m_j.copy_from(&data.m);
+    for j in 0..nv {
+        fd.m_j[(j, j)] += drives.jm[j];
+    }
+}
+
+/// The generalised force `b` of [`generalized_force_and_inertia`] into `fd.b` (and the bias
+/// forces into `data.tau`), from the placements already in `data` (at the same q): the part
+/// that depends on q̇ and the currents, for an evaluation that moves only those
+/// (`dynamics/contact/forward.rs`, `forward_dynamics_contacts_same_q`).
+pub(crate) fn generalized_force_placed(plant: &Plant, data: &mut Data, fd: &mut ForwardData, qd: &[f64], current: &[f64]) {
+    let (model, drives) = (plant.model, plant.drives);
+    let nv = model.nv;
     bias_forces_placed(model, data, qd);
     for j in 0..nv {
         fd.b[j] = drives.km[j] * current[j] - data.tau[j];
@@ -177,15 +196,6 @@ pub(crate) fn generalized_force_and_inertia(plant: &Plant, data: &mut Data, fd: 
         for j in 0..nv {
             fd.b[j] += fd.tau_joint[j];
         }
-    }
-    match plant.mass_matrix {
-        // in world coordinates, from the world placements just computed (crba.rs)
-        MassMatrixMethod::Crba => crba_world(model, data),
-        MassMatrixMethod::WalkerOrin => walker_orin::mass_matrix(model, data, q),
-    };
-    fd.m_j.copy_from(&data.m);
-    for j in 0..nv {
-        fd.m_j[(j, j)] += drives.jm[j];
     }
 }
 

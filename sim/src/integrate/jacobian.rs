@@ -1,6 +1,7 @@
 //! Finite-difference Jacobians for systems without an analytic one.
 //!
-//! Forward differences, one column per evaluation of `f` (HNW II §IV.8, "Jacobian by finite
+//! Forward differences, one column per evaluation of `f` ([`super::OdeSystem::rhs_column`],
+//! which lets a system reuse the work of the components a column does not move; HNW II §IV.8, "Jacobian by finite
 //! differences"; as in Hairer's `radau5.f`/`rodas.f`), with the increment
 //! `delta_j = sqrt(eps) max(|y_j|, 1e-5)`, signed like `y_j` (positive for `y_j = 0`), and
 //! divided by the increment actually represented (`(y_j + delta_j) - y_j`). The truncation
@@ -99,7 +100,7 @@ pub fn fd_jacobian_columns_within<S: OdeSystem>(
         let delta = sqrt_eps * yj.abs().max(floor);
         scratch_y[j] = if yj < 0.0 { yj - delta } else { yj + delta };
         let d = scratch_y[j] - yj; // the increment actually represented
-        let res = sys.rhs(t, scratch_y, scratch_f);
+        let res = sys.rhs_column(t, scratch_y, j, scratch_f);
         scratch_y[j] = yj;
         res?;
         for i in 0..n {
@@ -161,6 +162,9 @@ impl<S: OdeSystem> OdeSystem for FdJacobian<S> {
     }
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), S::Error> {
         self.sys.rhs(t, y, dydt)
+    }
+    fn rhs_column(&mut self, t: f64, y: &[f64], col: usize, dydt: &mut [f64]) -> Result<(), S::Error> {
+        self.sys.rhs_column(t, y, col, dydt)
     }
 }
 

@@ -142,6 +142,16 @@ pub trait OdeSystem {
     fn dim(&self) -> usize;
     /// Writes `f(t, y)` into `dydt` (both of length `dim`).
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), Self::Error>;
+    /// `f(t, y)` for column `col` of a difference Jacobian ([`fd_jacobian_columns`]): `y` is
+    /// the sweep's base point with component `col` moved. The columns of one sweep come in
+    /// increasing order from `col = 0`, each call right after the previous one (nothing else
+    /// evaluates the system in between), so a system may reuse what it computed in the sweep
+    /// for the components not moved since (the arm: everything that depends on q only, for the
+    /// q̇ and current columns). It must write what `rhs` would write. The default is `rhs`.
+    fn rhs_column(&mut self, t: f64, y: &[f64], col: usize, dydt: &mut [f64]) -> Result<(), Self::Error> {
+        let _ = col;
+        self.rhs(t, y, dydt)
+    }
     /// Called by [`integrate_sampled`] after every accepted step: may move `y` back onto an
     /// invariant manifold (e.g. constraints C = 0, Ċ = 0) and returns whether it changed it.
     /// The default leaves `y` alone.

@@ -2,7 +2,7 @@
 //! (eqs 27–29), the motors' currents, eq 21, and the quadratures of the energy balance.
 
 use crate::dynamics::constraints::PointOnPlane;
-use crate::dynamics::contact::forward::forward_dynamics_contacts;
+use crate::dynamics::contact::forward::{forward_dynamics_contacts, forward_dynamics_contacts_same_q};
 use crate::dynamics::energy::{link_kinetic_energy, magnetic_energy, potential_energy, rotor_kinetic_energy};
 use crate::dynamics::forward::{forward_dynamics, Plant, Stabilization};
 use crate::dynamics::kinematics::forward_kinematics;
@@ -57,6 +57,12 @@ impl<'a> ArmSystem<'a> {
             sys.stored0 += sys.contact_energy();
         }
         sys
+    }
+
+    /// How many right-hand sides of difference-Jacobian columns reused the q-only part of the
+    /// sweep's first q̇ column (`OdeSystem::rhs_column`; 0 for a run without contacts' modes).
+    pub fn same_q_evaluations(&self) -> u64 {
+        self.ws.same_q_evals
     }
 
     /// Where each part of the state is.
@@ -170,8 +176,36 @@ impl<'a> ArmSystem<'a> {
     /// the outputs and the Jacobian read, into the workspace. A hybrid run solves eq 21 with
     /// its contacts' active rows in the current modes (`dynamics/contact/forward.rs`).
     pub(super) fn evaluate(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+        self.ws.sweep_ready = false;
         self.inputs(t, y)?;
         self.solve_eq21(t, y)?;
+        if self.drive_modes.is_some() {
+            self.lock_stuck(t, y)?;
+        }
+        Ok(())
+    }
+
+    /// [`ArmSystem::evaluate`] of a hybrid run at a state whose q is the one of the q-only
+    /// part in the workspace (`sweep_q`, checked by the caller): the inputs in full, eq 21 with
+    /// that part reused (`forward_dynamics_contacts_same_q`), bit for bit a full evaluation.
+    fn evaluate_same_q(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+        self.inputs(t, y)?;
+        let l = self.layout;
+        let s = self.scene;
+        let plant = Plant {
+            model: &s.model,
+            drives: &self.ws.drives,
+            contacts: &self.contacts,
+            mass_matrix: s.mass_matrix,
+            solver: s.solver,
+            stabilization: s.stabilization,
+        };
+        let current = match l.electrical {
+            Electrical::Inductive => &y[l.current()],
+            Electrical::QuasiStatic => &self.ws.current_qs[..],
+        };
+        let h = self.hybrid.as_mut().expect("hybrid");
+        forward_dynamics_contacts_same_q(&plant, &h.contacts, &h.state, &mut self.ws.data, &mut self.ws.fd, &mut h.cd, t, &y[l.qd()], current, &self.ws.voltage)?;
         if self.drive_modes.is_some() {
             self.lock_stuck(t, y)?;
         }
@@ -212,6 +246,49 @@ impl OdeSystem for ArmSystem<'_> {
 
     fn rhs(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), RunError> {
         self.evaluate(t, y)?;
+        self.rates(y, dydt);
+        Ok(())
+    }
+
+    /// A hybrid run's q̇ and current columns after the first q̇ column reuse the q-only part
+    /// of that column's evaluation ([`ArmSystem::evaluate_same_q`]): the sweep moves one
+    /// component at a time from the same base, so their q is the base's (checked bit for bit).
+    /// The other columns, and every column of a run without contacts' modes, are full
+    /// evaluations.
+    fn rhs_column(&mut self, t: f64, y: &[f64], col: usize, dydt: &mut [f64]) -> Result<(), RunError> {
+        let l = self.layout;
+        let (q, qd) = (l.q(), l.qd());
+        let moves_qd_or_i = col >= qd.start && col < l.work().start;
+        if self.hybrid.is_some() && moves_qd_or_i && col > qd.start && self.ws.sweep_ready && self.ws.sweep_q[..] == y[q.clone()] {
+            self.evaluate_same_q(t, y)?;
+            self.ws.same_q_evals += 1;
+        } else {
+            self.evaluate(t, y)?;
+            if self.hybrid.is_some() && col == qd.start {
+                self.ws.sweep_q.copy_from_slice(&y[q]);
+                self.ws.sweep_ready = true;
+            }
+        }
+        self.rates(y, dydt);
+        Ok(())
+    }
+
+    fn project(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
+        if self.scene.stabilization == Stabilization::Projection {
+            if self.hybrid.is_some() {
+                return Ok(self.project_onto_active_rows(t, y)?);
+            }
+            Ok(self.project_onto_constraints(t, y)?)
+        } else {
+            Ok(false)
+        }
+    }
+}
+
+impl ArmSystem<'_> {
+    /// The derivative `dydt` from the evaluation in the workspace at `y` (eq 21's q̈ and
+    /// di/dt, the quadratures' rates).
+    fn rates(&mut self, y: &[f64], dydt: &mut [f64]) {
         let l = self.layout;
         let d = &self.ws.drives;
         let qd = &y[l.qd()];
@@ -260,18 +337,6 @@ impl OdeSystem for ArmSystem<'_> {
         }
         if self.drive_modes.is_some() {
             self.drive_loss_rates(y, dydt);
-        }
-        Ok(())
-    }
-
-    fn project(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
-        if self.scene.stabilization == Stabilization::Projection {
-            if self.hybrid.is_some() {
-                return Ok(self.project_onto_active_rows(t, y)?);
-            }
-            Ok(self.project_onto_constraints(t, y)?)
-        } else {
-            Ok(false)
         }
     }
 }

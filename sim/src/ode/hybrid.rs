@@ -27,7 +27,8 @@
 //! impulsive torque work `−J_m (q̇⁺² − q̇⁻²)/2` to the link works W_j. Allocation happens at
 //! events only (the mode enumeration, the impact), not in the step loop.
 
-use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState, SLIP_DIRECTION_SPEED};
+use crate::dynamics::contact::forward::{has_rows, prepare, slip_direction, ContactData, ContactState, SLIP_DIRECTION_SPEED};
+use crate::dynamics::contact::rows::contact_gaps_where;
 use crate::dynamics::contact::impact::solve_impact;
 use crate::dynamics::contact::modes::choose_modes_within;
 use crate::dynamics::contact::{Contact, ContactEvent, ContactEventKind, ContactMode, ContactModel, ContactOutput, ContactSettings};
@@ -489,11 +490,21 @@ impl ArmSystem<'_> {
         }
     }
 
+    /// After an [`ArmSystem::evaluate`] (whose solve leaves the separated rigid contacts
+    /// untouched, `contact_rows_only`): their gaps and velocities from the kinematics it left,
+    /// for the event functions and the event handler.
+    fn separated_gaps(&mut self) {
+        let Some(h) = self.hybrid.as_mut() else { return };
+        let (contacts, mode) = (&h.contacts, &h.state.mode);
+        contact_gaps_where(&self.ws.data, contacts, &mut h.cd.rows, |k| !has_rows(contacts, mode, k));
+    }
+
     pub(super) fn contact_events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
         if self.hybrid.is_none() {
             return Ok(());
         }
         self.evaluate(t, y)?;
+        self.separated_gaps();
         let h = self.hybrid.as_mut().expect("hybrid");
         let r = &h.cd.rows;
         for (k, c) in h.contacts.iter().enumerate() {
@@ -573,6 +584,7 @@ impl ArmSystem<'_> {
         }
         // forces and rows at the event in the current modes
         self.evaluate(t, y)?;
+        self.separated_gaps();
         let h = self.hybrid.as_mut().expect("hybrid");
         let st = h.settings;
         let nc = h.contacts.len();

@@ -46,6 +46,14 @@ pub(super) struct Workspace {
     /// reads (eq 11, the copper loss, the drive's current window); the controller keeps the
     /// scene's nominal drives.
     pub(super) drives: Drives,
+    /// The q (nv) whose q-only part of a hybrid evaluation (placements, `M_J`'s factor, the
+    /// contact rows and gaps) the workspace holds for the q̇ and current columns of a
+    /// difference-Jacobian sweep, when `sweep_ready`: set by `ArmSystem::rhs_column` after its
+    /// full evaluation of the first q̇ column, cleared by every `ArmSystem::evaluate`.
+    pub(super) sweep_q: Vec<f64>,
+    pub(super) sweep_ready: bool,
+    /// Evaluations that reused that part (`ArmSystem::same_q_evaluations`).
+    pub(super) same_q_evals: u64,
 }
 
 impl Workspace {
@@ -66,6 +74,9 @@ impl Workspace {
             jac: JacobianScratch::new(nv, nc, dim),
             projection: ProjectionScratch::new(nv, nc),
             drives: drives.clone(),
+            sweep_q: vec![0.0; nv],
+            sweep_ready: false,
+            same_q_evals: 0,
         }
     }
 }

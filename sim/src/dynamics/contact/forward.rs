@@ -8,12 +8,12 @@
 //! *Numerical Methods for Nonsmooth Dynamical Systems*, 2008, §2.2): `f_n = max(0, k δ + c δ̇)`
 //! for `δ = −g > 0`, friction `f_t = −μ f_n v_t / sqrt(|v_t|² + v_s²)`.
 
-use super::rows::{contact_rows, contact_rows_where, ContactRows};
+use super::rows::{contact_rows, contact_rows_only, contact_velocities_only, ContactRows};
 use super::solve::{solve_active, ActiveRow, ActiveScratch, RowForce, Singular};
 use super::{Contact, ContactMode, ContactModel};
 use crate::dynamics::cholesky;
 use crate::dynamics::data::Data;
-use crate::dynamics::forward::{generalized_force_and_inertia, ForwardData, Plant, Stabilization};
+use crate::dynamics::forward::{generalized_force_and_inertia, generalized_force_placed, ForwardData, Plant, Stabilization};
 use crate::dynamics::kinematics::forward_velocities;
 use crate::error::DynamicsError;
 
@@ -138,10 +138,17 @@ pub fn prepare(
     prepare_in_modes(plant, contacts, None, data, fd, cd, t, q, qd, current)
 }
 
+/// Whether contact k has rows in a solve in the modes `m`: all but a `Separated` rigid one (a
+/// compliant contact's force goes into b through its rows whatever its mode).
+pub fn has_rows(contacts: &[Contact], m: &[ContactMode], k: usize) -> bool {
+    m[k] != ContactMode::Separated || matches!(contacts[k].model, ContactModel::Compliant { .. })
+}
+
 /// [`prepare`] for a solve in the modes `modes` (`None`: every contact's rows, as at an event):
-/// a `Separated` unilateral contact gets its gap and velocities but no rows
-/// ([`contact_rows_where`]), since no row of it enters the solve (a compliant contact, whose
-/// force goes into b through its rows whatever its mode, gets them).
+/// a `Separated` unilateral contact is not touched at all — no rows, no touching point, its gap
+/// and velocities left as they were ([`contact_rows_only`]; issue 24 item 2) — since nothing of
+/// it enters the solve; what reads its gap (the event functions, `ode/hybrid.rs`) computes it
+/// with [`super::rows::contact_gaps_where`].
 #[allow(clippy::too_many_arguments)]
 pub fn prepare_in_modes(
     plant: &Plant,
@@ -161,10 +168,20 @@ pub fn prepare_in_modes(
     forward_velocities(model, data, qd);
     match modes {
         None => contact_rows(model, data, contacts, &mut cd.rows),
-        Some(m) => contact_rows_where(model, data, contacts, &mut cd.rows, |k| m[k] != ContactMode::Separated || matches!(contacts[k].model, ContactModel::Compliant { .. })),
+        Some(m) => contact_rows_only(model, data, contacts, &mut cd.rows, |k| has_rows(contacts, m, k)),
     }
     super::shape::check_rims(contacts, data, t)?;
-    // compliant forces into b
+    compliant_forces(contacts, fd, cd);
+    if !cholesky::factor_in_place(fd.m_j.as_mut_slice(), nv, &mut fd.l_inv_diag) {
+        return Err(DynamicsError::SingularMassMatrix { t });
+    }
+    Ok(())
+}
+
+/// The compliant contacts' forces from the rows' gaps and velocities, into b (`J_nᵀ f_n +
+/// J_tᵀ f_t`) and `cd.f_n`, `cd.f_t` (0 for the other contacts).
+fn compliant_forces(contacts: &[Contact], fd: &mut ForwardData, cd: &mut ContactData) {
+    let nv = cd.rows.nv;
     for (k, c) in contacts.iter().enumerate() {
         cd.f_n[k] = 0.0;
         cd.f_t[k] = [0.0; 2];
@@ -184,10 +201,6 @@ pub fn prepare_in_modes(
             }
         }
     }
-    if !cholesky::factor_in_place(fd.m_j.as_mut_slice(), nv, &mut fd.l_inv_diag) {
-        return Err(DynamicsError::SingularMassMatrix { t });
-    }
-    Ok(())
 }
 
 /// The active rows of `state` (with Baumgarte's terms when asked) into `cd.active`.
@@ -290,11 +303,47 @@ pub fn forward_dynamics_contacts(
     voltage: &[f64],
 ) -> Result<(), DynamicsError> {
     prepare_in_modes(plant, contacts, Some(&state.mode), data, fd, cd, t, q, qd, current)?;
+    solve_and_finish(plant, contacts, state, fd, cd, t, qd, current, voltage)
+}
+
+/// The mode solve after the preparation, its error named by the active contacts, then eq 12's
+/// electrical rows ([`finish`]).
+#[allow(clippy::too_many_arguments)]
+fn solve_and_finish(plant: &Plant, contacts: &[Contact], state: &ContactState, fd: &mut ForwardData, cd: &mut ContactData, t: f64, qd: &[f64], current: &[f64], voltage: &[f64]) -> Result<(), DynamicsError> {
     if solve_modes(contacts, state, plant.stabilization, fd, cd).is_err() {
         let names: Vec<&str> = cd.active.iter().map(|a| contacts[a.row / 3].name()).collect();
         return Err(DynamicsError::SingularConstraints { t, constraints: names.join(", ") });
     }
     finish(plant, fd, t, qd, current, voltage)
+}
+
+/// [`forward_dynamics_contacts`] at a state that differs from the one of the last full call
+/// (or the last call of this) in q̇ and the currents only, in the same modes: what depends on
+/// q alone — the placements, `M_J` and its factor, the contact Jacobians and gaps, the rims'
+/// check — is taken from `data`, `fd` and `cd` as that call left them, and the rest (the bias
+/// forces, b, the velocities, the rows' `J̇ q̇`, the compliant forces, the mode solve, eq 12's
+/// electrical rows) is computed by the same operations, so the outputs are bit for bit those
+/// of a full call (`sim/tests/hybrid_jacobian.rs`). For the q̇ and current columns of the
+/// difference Jacobian (`ode/jacobian.rs`, issue 24 item 1). The caller guarantees the q.
+#[allow(clippy::too_many_arguments)]
+pub fn forward_dynamics_contacts_same_q(
+    plant: &Plant,
+    contacts: &[Contact],
+    state: &ContactState,
+    data: &mut Data,
+    fd: &mut ForwardData,
+    cd: &mut ContactData,
+    t: f64,
+    qd: &[f64],
+    current: &[f64],
+    voltage: &[f64],
+) -> Result<(), DynamicsError> {
+    generalized_force_placed(plant, data, fd, qd, current);
+    forward_velocities(plant.model, data, qd);
+    let m = &state.mode;
+    contact_velocities_only(data, contacts, &mut cd.rows, |k| has_rows(contacts, m, k));
+    compliant_forces(contacts, fd, cd);
+    solve_and_finish(plant, contacts, state, fd, cd, t, qd, current, voltage)
 }
 
 /// The electrical rows and the motor torque of eq 12, as in the bilateral path.

@@ -56,13 +56,47 @@ pub fn contact_rows(model: &Model, data: &Data, contacts: &[Contact], rows: &mut
 /// where a separated contact adds no force (issue 24 item 2: a candidate that does not touch
 /// costs its touching point, not three Jacobian rows).
 pub fn contact_rows_where(model: &Model, data: &Data, contacts: &[Contact], rows: &mut ContactRows, rows_of: impl Fn(usize) -> bool) {
-    let nv = model.nv;
-    rows.jac.fill(0.0);
+    fill_rows(model, data, contacts, rows, rows_of, true);
+}
+
+/// [`contact_rows_where`] that does not touch the other contacts at all: zero rows and biases,
+/// their gaps and velocities left as they were (no touching point computed). For the
+/// right-hand side of a hybrid run, where a separated contact adds no force and nothing reads
+/// its gap (issue 24 item 2: a candidate that does not touch costs nothing per evaluation;
+/// its event function and the recorded outputs compute its gap themselves,
+/// [`contact_gaps_where`]).
+pub fn contact_rows_only(model: &Model, data: &Data, contacts: &[Contact], rows: &mut ContactRows, rows_of: impl Fn(usize) -> bool) {
+    fill_rows(model, data, contacts, rows, rows_of, false);
+}
+
+/// The gaps and velocities (`g`, `ġ`, `v_t`) of the contacts `which(k)`, by the operations of
+/// [`contact_rows_where`] (the same values bit for bit); rows and biases left as they are.
+pub fn contact_gaps_where(data: &Data, contacts: &[Contact], rows: &mut ContactRows, which: impl Fn(usize) -> bool) {
     for (k, c) in contacts.iter().enumerate() {
+        if !which(k) {
+            continue;
+        }
         let n = c.plane.normal_world.into_inner();
         let touch = c.touch(data);
         rows.gap[k] = touch.gap;
+        for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
+            rows.vel[3 * k + axis] = dir.dot(&touch.velocity);
+        }
+    }
+}
+
+fn fill_rows(model: &Model, data: &Data, contacts: &[Contact], rows: &mut ContactRows, rows_of: impl Fn(usize) -> bool, others: bool) {
+    let nv = model.nv;
+    rows.jac.fill(0.0);
+    for (k, c) in contacts.iter().enumerate() {
         let full = rows_of(k);
+        if !full && !others {
+            rows.bias[3 * k..3 * k + 3].fill(0.0);
+            continue;
+        }
+        let n = c.plane.normal_world.into_inner();
+        let touch = c.touch(data);
+        rows.gap[k] = touch.gap;
         for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
             let r = 3 * k + axis;
             rows.vel[r] = dir.dot(&touch.velocity);
@@ -72,6 +106,26 @@ pub fn contact_rows_where(model: &Model, data: &Data, contacts: &[Contact], rows
             } else {
                 rows.bias[r] = 0.0;
             }
+        }
+    }
+}
+
+/// The q̇-dependent part of [`contact_rows_only`] (the same `rows_of`): the velocities
+/// `ġ, v_t` and the biases `J̇ q̇` of the contacts `rows_of(k)`, from the kinematics in `data`
+/// (at the same q as the rows, the q̇ given to `forward_velocities`); the gaps, `J` and the
+/// other contacts are left as they are. The same operations as there, so the values are bit
+/// for bit those of a full call.
+pub fn contact_velocities_only(data: &Data, contacts: &[Contact], rows: &mut ContactRows, rows_of: impl Fn(usize) -> bool) {
+    for (k, c) in contacts.iter().enumerate() {
+        if !rows_of(k) {
+            continue;
+        }
+        let n = c.plane.normal_world.into_inner();
+        let touch = c.touch(data);
+        for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
+            let r = 3 * k + axis;
+            rows.vel[r] = dir.dot(&touch.velocity);
+            rows.bias[r] = dir.dot(&touch.bias);
         }
     }
 }
