@@ -495,9 +495,10 @@ mod tests {
         assert!(min_outside >= 0.02, "{min_outside}");
         // the two labels never clash (`schemas::markers::LabelBox`: a row apart or side by
         // side, at every sample; f32 positions: 1e-6 m)
-        for k in 0..run.constraints.len() {
-            let c = label_boxes[0][k].clearance_m(&label_boxes[1][k]);
-            assert!(c >= -1e-6, "sample {k}: the labels clash by {} m: {:?} {:?}", -c, label_boxes[0][k], label_boxes[1][k]);
+        assert_eq!(label_boxes[0].len(), run.constraints.len());
+        for (k, (a, b)) in label_boxes[0].iter().zip(&label_boxes[1]).enumerate() {
+            let c = a.clearance_m(b);
+            assert!(c >= -1e-6, "sample {k}: the labels clash by {} m: {a:?} {b:?}", -c);
         }
 
         // the table is /scene's (the size Foxglove draws)

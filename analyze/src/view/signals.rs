@@ -31,8 +31,11 @@ pub mod signal {
     pub const RESIDUAL: &str = "energy_residual_J";
 }
 
+/// How an energy term is read from `/energy`.
+pub type EnergyTerm = fn(&schemas::EnergyState) -> f64;
+
 /// The energy totals: entity name, series label, and how to get it from `/energy`.
-pub const ENERGY_TERMS: [(&str, &str, fn(&schemas::EnergyState) -> f64); 8] = [
+pub const ENERGY_TERMS: [(&str, &str, EnergyTerm); 8] = [
     ("electric-in", "electric energy in, Σ E_j", |e| e.electric_energy_total),
     ("link-work", "link work, Σ W_j", |e| e.link_work_total),
     ("kinetic", "kinetic T", |e| e.kinetic),
