@@ -24,6 +24,8 @@ pub mod blueprint;
 #[cfg(feature = "rerun")]
 pub mod chunk;
 #[cfg(feature = "rerun")]
+pub mod contacts;
+#[cfg(feature = "rerun")]
 pub mod entities;
 #[cfg(feature = "rerun")]
 pub mod layout;
@@ -37,6 +39,8 @@ pub mod pose;
 pub mod rrd;
 #[cfg(feature = "rerun")]
 pub mod run;
+#[cfg(feature = "rerun")]
+pub mod signals;
 #[cfg(feature = "rerun")]
 pub mod urdf;
 #[cfg(feature = "rerun")]

@@ -42,6 +42,13 @@ use crate::messages::timestamp;
 #[cfg(doc)]
 use crate::topics;
 
+mod labels;
+mod scale;
+mod scene;
+pub use scale::{round_125_down, ForceGlyph, ForceScale};
+use scale::fmt_num;
+pub use scene::{ids, recorded_arrow_scale, scene_update, ScaleBar, SceneDescription, SceneRead, TableBox, TablePlane};
+pub use labels::{default_anchor, label_capacity, place_labels, write_label, LabelBox, LABEL_CHAR_WIDTH_M, LABEL_GAP_M, LABEL_LIFT_M, LABEL_ROW_M};
 mod shapes;
 pub use shapes::{circle, shape_entities, shape_glyphs, ShapeGlyph, SHAPE_ALPHA, SHAPE_ID};
 
@@ -85,135 +92,6 @@ pub const ARROW_HEAD_DIAMETER_M: f64 = 0.015;
 pub const ARROW_HEAD_SHARE: f64 = 0.25;
 /// Font size of the labels, screen pixels (scale invariant).
 pub const LABEL_FONT_PX: f64 = 14.0;
-
-/// The largest `m × 10^k` (m in 1, 2, 5) not above `x > 0` (`x` itself when it is not a
-/// positive finite number).
-pub fn round_125_down(x: f64) -> f64 {
-    if !(x.is_finite() && x > 0.0) {
-        return x;
-    }
-    let p = 10f64.powf(x.log10().floor());
-    let m = [5.0, 2.0, 1.0].into_iter().find(|m| m * p <= x * (1.0 + 1e-12)).unwrap_or(1.0);
-    m * p
-}
-
-/// The length scale of the contact force arrows: one per scene, the same in every run and in
-/// both viewers (Foxglove's `/contact_markers`, `analyze view`'s Rerun arrows), written on
-/// [`topics::SCENE`] (entity `legend/force_scale`) and in each arrow entity's metadata.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ForceScale {
-    /// Arrow length per newton, m/N.
-    pub m_per_n: f64,
-    /// The force the scale was chosen from (the arm's weight under standard gravity), N.
-    pub reference_force_n: f64,
-}
-
-impl ForceScale {
-    /// The scale of an arm of `mass_kg` (every link) whose `links` moving links reach
-    /// `reach_m`: its weight under standard gravity is drawn a third of a mean link long,
-    /// rounded down to 1, 2 or 5 × 10^k m/N (the paper arm: 1.0 kg, ten 0.3 m links: 9.8 N
-    /// would be 0.1 m, so 10 mm per newton; its elbow forces, up to 32 N, up to 0.32 m). An arm
-    /// without mass or length gets [`LEGACY_FORCE_SCALE_M_PER_N`].
-    pub fn for_arm(mass_kg: f64, reach_m: f64, links: usize) -> Self {
-        let weight = mass_kg * STANDARD_GRAVITY_M_PER_S2;
-        let link = reach_m / links.max(1) as f64;
-        let raw = link / 3.0 / weight;
-        let m_per_n = if raw.is_finite() && raw > 0.0 { round_125_down(raw) } else { LEGACY_FORCE_SCALE_M_PER_N };
-        ForceScale { m_per_n, reference_force_n: weight }
-    }
-
-    /// The scale of a recording written before the scale came from the scene.
-    pub fn legacy() -> Self {
-        ForceScale { m_per_n: LEGACY_FORCE_SCALE_M_PER_N, reference_force_n: 0.0 }
-    }
-
-    /// Drawn length of a force of magnitude `force_n` ≥ 0, m: `|F| × scale`, at least
-    /// [`MIN_ARROW_LENGTH_M`] for a nonzero force, 0 for none.
-    pub fn length_m(&self, force_n: f64) -> f64 {
-        if force_n > 0.0 {
-            (force_n * self.m_per_n).max(MIN_ARROW_LENGTH_M)
-        } else {
-            0.0
-        }
-    }
-
-    /// A round force whose arrow is about 0.1 m long (the scale bar's), N.
-    pub fn bar_force_n(&self) -> f64 {
-        round_125_down(0.1 / self.m_per_n)
-    }
-
-    /// The legend, e.g. "force arrows: 10 N = 0.100 m (10 mm per N); shorter than 0.060 m
-    /// drawn 0.060 m, value in the label".
-    pub fn legend(&self) -> String {
-        let f = self.bar_force_n();
-        format!(
-            "force arrows: {} N = {:.3} m ({} mm per N); shorter than {:.3} m drawn {:.3} m, value in the label",
-            fmt_num(f),
-            f * self.m_per_n,
-            fmt_num(self.m_per_n * 1e3),
-            MIN_ARROW_LENGTH_M,
-            MIN_ARROW_LENGTH_M
-        )
-    }
-}
-
-/// A number without trailing zeros (`10`, `0.5`, `2.5e-5`).
-fn fmt_num(x: f64) -> String {
-    if x != 0.0 && (x.abs() < 1e-3 || x.abs() >= 1e6) {
-        format!("{x:e}")
-    } else {
-        let s = format!("{x:.6}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    }
-}
-
-/// How a contact force is drawn: an arrow from the contact point's projection on its plane
-/// (the point on the table's surface) along the force, [`ForceScale::length_m`] long.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ForceGlyph {
-    /// Where the arrow starts: the contact point projected on its plane, world frame, m.
-    pub tail: [f64; 3],
-    /// Unit direction of the force (+x when there is none), world frame.
-    pub direction: [f64; 3],
-    /// Drawn length, m (0: no force).
-    pub length_m: f64,
-    /// `|F|`, N.
-    pub magnitude_n: f64,
-}
-
-impl ForceGlyph {
-    /// The glyph of `force` (N, world frame) at contact `point` (m) on the plane `normal · x =
-    /// offset` (unit normal), drawn at `scale`.
-    pub fn new(point: [f64; 3], normal: [f64; 3], offset: f64, force: [f64; 3], scale: &ForceScale) -> Self {
-        let gap = normal[0] * point[0] + normal[1] * point[1] + normal[2] * point[2] - offset;
-        let tail = [0, 1, 2].map(|i| point[i] - gap * normal[i]);
-        let magnitude_n = (force[0] * force[0] + force[1] * force[1] + force[2] * force[2]).sqrt();
-        let direction = if magnitude_n > 0.0 { force.map(|f| f / magnitude_n) } else { [1.0, 0.0, 0.0] };
-        ForceGlyph { tail, direction, length_m: scale.length_m(magnitude_n), magnitude_n }
-    }
-
-    /// The arrow's tip, world frame, m.
-    pub fn tip(&self) -> [f64; 3] {
-        [0, 1, 2].map(|i| self.tail[i] + self.length_m * self.direction[i])
-    }
-}
-
-/// Writes the label of a contact's force into `out` (cleared first): `<name> <|F|> N <mode>`,
-/// e.g. `elbow4 1.4 N bilateral pulling`. Allocates nothing when `out` has room for
-/// [`label_capacity`]`(name)`.
-pub fn write_label(out: &mut String, name: &str, magnitude_n: f64, mode: MarkerMode) {
-    use std::fmt::Write;
-    out.clear();
-    out.push_str(name);
-    // bounded width: at most 8 characters before the unit
-    let _ = if magnitude_n.is_finite() && magnitude_n < 99_999.95 { write!(out, " {magnitude_n:.1} N ") } else { write!(out, " {magnitude_n:.2e} N ") };
-    out.push_str(mode.name());
-}
-
-/// Room a label of contact `name` needs ([`write_label`]).
-pub fn label_capacity(name: &str) -> usize {
-    name.len() + 48
-}
 
 /// The colours of the views (`#rrggbb` and RGBA in [0, 1]).
 pub mod colors {
@@ -309,40 +187,6 @@ impl MarkerMode {
     }
 }
 
-/// A contact plane `n · p = d` (world frame, unit normal), as drawn on [`topics::SCENE`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct TablePlane {
-    /// Unit normal, world frame.
-    pub normal: [f64; 3],
-    /// Offset d, m.
-    pub offset: f64,
-    /// The contacts on it (names), in this run; empty when the run has none on it (the plane
-    /// of the scene's other runs, drawn fainter).
-    pub contacts: Vec<String>,
-}
-
-/// What [`scene_update`] draws.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SceneDescription<'a> {
-    /// The frame of every entity (the world frame of `/tf`).
-    pub frame_id: &'a str,
-    /// Distinct planes, each drawn as a thin square box centred on the projection of the world
-    /// origin (the arm's base), its top face on the plane.
-    pub planes: &'a [TablePlane],
-    /// Half the side of each table box, m (the arm's reach).
-    pub half_size_m: f64,
-    /// The hand's target path, world frame, m (one point per sample taken, in time order).
-    pub target_path: &'a [[f64; 3]],
-    /// The time between two points of `target_path`, s (metadata).
-    pub target_dt_s: f64,
-    /// The scale of the force arrows (the scale bar `legend/force_scale`, drawn when there is
-    /// a plane).
-    pub force_scale: ForceScale,
-    /// The run's contact shapes ([`shape_glyphs`]; none for point contacts), each an entity
-    /// `shape/<name>` in its link's frame.
-    pub shapes: &'a [ShapeGlyph],
-}
-
 fn kv(key: &str, value: impl Into<String>) -> KeyValuePair {
     KeyValuePair { key: key.into(), value: value.into() }
 }
@@ -375,247 +219,6 @@ pub fn rotation_between(a: [f64; 3], b: [f64; 3]) -> [f64; 4] {
     let w = 1.0 + dot;
     let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + w * w).sqrt();
     [c[0] / l, c[1] / l, c[2] / l, w / l]
-}
-
-/// Where the scale bar stands on plane `p`: the projection of (0, −0.25 m, 0) (in front of
-/// the base, seen from the −y side view of both viewers), pointing along the normal.
-fn scale_bar_tail(p: &TablePlane) -> [f64; 3] {
-    let n = p.normal;
-    let q = [0.0, -0.25, 0.0];
-    let gap = n[0] * q[0] + n[1] * q[1] + n[2] * q[2] - p.offset;
-    [0, 1, 2].map(|i| q[i] - gap * n[i])
-}
-
-/// The ids of the [`topics::SCENE`] entities.
-pub mod ids {
-    /// Prefix of the table boxes (`table/<k>`).
-    pub const TABLE: &str = "table/";
-    /// The target path.
-    pub const TARGET_PATH: &str = "target_path";
-    /// The force scale bar and its legend.
-    pub const FORCE_SCALE: &str = "legend/force_scale";
-}
-
-/// The message of [`topics::SCENE`]: entity `table/<k>` per plane (a box, metadata: normal,
-/// offset, contacts, units), `target_path` (a line strip of the hand's target, metadata:
-/// points, dt, units) and, when there is a plane, `legend/force_scale` (an arrow of a round
-/// force at the arrows' scale standing on the first plane, with its text; metadata: the
-/// scale, its reference force, the bar's force, the shortest arrow), all at t = 0 in
-/// `frame_id`; then one entity per contact shape (`shape/<name>`, in its link's frame,
-/// [`shape_entities`]).
-pub fn scene_update(d: &SceneDescription<'_>) -> SceneUpdate {
-    let mut entities = Vec::with_capacity(d.planes.len() + 2);
-    for (k, p) in d.planes.iter().enumerate() {
-        let n = p.normal;
-        // centre: the base's projection on the plane, moved half a thickness below it
-        let c = [n[0] * (p.offset - TABLE_THICKNESS_M / 2.0), n[1] * (p.offset - TABLE_THICKNESS_M / 2.0), n[2] * (p.offset - TABLE_THICKNESS_M / 2.0)];
-        let in_run = !p.contacts.is_empty();
-        let side = 2.0 * d.half_size_m;
-        entities.push(SceneEntity {
-            timestamp: Some(timestamp(0)),
-            frame_id: d.frame_id.into(),
-            id: format!("{}{k}", ids::TABLE),
-            lifetime: None,
-            frame_locked: false,
-            metadata: vec![
-                kv("what", "contact plane n·p = d (the table); top face of the box"),
-                kv("normal", format!("[{}, {}, {}]", n[0], n[1], n[2])),
-                kv("offset_m", p.offset.to_string()),
-                kv("contacts", if in_run { p.contacts.join(", ") } else { "none in this run (the scene's other runs touch it)".into() }),
-                kv("size_m", format!("{side} x {side} x {TABLE_THICKNESS_M}")),
-                kv("units", "m"),
-            ],
-            cubes: vec![CubePrimitive {
-                pose: Some(pose(c, quat(rotation_between([0.0, 0.0, 1.0], n)))),
-                size: Some(Vector3 { x: side, y: side, z: TABLE_THICKNESS_M }),
-                color: Some(colors::color(colors::TABLE, if in_run { 0.35 } else { 0.15 })),
-            }],
-            ..Default::default()
-        });
-    }
-    if !d.target_path.is_empty() {
-        entities.push(SceneEntity {
-            timestamp: Some(timestamp(0)),
-            frame_id: d.frame_id.into(),
-            id: ids::TARGET_PATH.into(),
-            metadata: vec![
-                kv("what", "the hand's target path (desired position), world frame"),
-                kv("points", d.target_path.len().to_string()),
-                kv("dt_s", d.target_dt_s.to_string()),
-                kv("units", "m"),
-            ],
-            lines: vec![LinePrimitive {
-                r#type: line_primitive::Type::LineStrip as i32,
-                pose: Some(pose([0.0; 3], identity())),
-                thickness: TARGET_LINE_WIDTH_M,
-                scale_invariant: false,
-                points: d.target_path.iter().map(|p| Point3 { x: p[0], y: p[1], z: p[2] }).collect(),
-                color: Some(colors::color(colors::HAND_DESIRED, 0.8)),
-                colors: Vec::new(),
-                indices: Vec::new(),
-            }],
-            ..Default::default()
-        });
-    }
-    if let Some(plane) = d.planes.iter().find(|p| !p.contacts.is_empty()).or(d.planes.first()) {
-        let s = d.force_scale;
-        let f = s.bar_force_n();
-        let len = f * s.m_per_n;
-        let tail = scale_bar_tail(plane);
-        let n = plane.normal;
-        let legend = s.legend();
-        entities.push(SceneEntity {
-            timestamp: Some(timestamp(0)),
-            frame_id: d.frame_id.into(),
-            id: ids::FORCE_SCALE.into(),
-            metadata: vec![
-                kv("what", "the scale of the contact force arrows (the same in every run of the scene and in analyze view)"),
-                kv("scale_m_per_n", s.m_per_n.to_string()),
-                kv("reference_force_n", s.reference_force_n.to_string()),
-                kv("bar_force_n", f.to_string()),
-                kv("min_arrow_length_m", MIN_ARROW_LENGTH_M.to_string()),
-                kv("legend", legend.clone()),
-                kv("units", "m per N"),
-            ],
-            arrows: vec![ArrowPrimitive {
-                pose: Some(pose(tail, quat(rotation_between([1.0, 0.0, 0.0], n)))),
-                shaft_length: (1.0 - ARROW_HEAD_SHARE) * len,
-                shaft_diameter: ARROW_SHAFT_DIAMETER_M,
-                head_length: ARROW_HEAD_SHARE * len,
-                head_diameter: ARROW_HEAD_DIAMETER_M,
-                color: Some(colors::color(colors::SCALE_BAR, 1.0)),
-            }],
-            texts: vec![TextPrimitive {
-                pose: Some(pose([0, 1, 2].map(|i| tail[i] + (len + 0.03) * n[i]), identity())),
-                billboard: true,
-                font_size: LABEL_FONT_PX,
-                scale_invariant: true,
-                color: Some(colors::color(colors::SCALE_BAR, 1.0)),
-                text: format!("{} N = {:.3} m", fmt_num(f), len),
-            }],
-            ..Default::default()
-        });
-    }
-    entities.extend(shape_entities(d.shapes));
-    SceneUpdate { deletions: Vec::new(), entities }
-}
-
-/// A table box of [`topics::SCENE`], as read back.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TableBox {
-    /// Centre, world frame, m.
-    pub center: [f64; 3],
-    /// Orientation `[x, y, z, w]` (its z axis is the plane's normal).
-    pub rotation: [f64; 4],
-    /// Full extents, m.
-    pub size: [f64; 3],
-    /// Opacity in [0, 1] (fainter: a plane no contact of this run is on).
-    pub alpha: f64,
-}
-
-/// The scale bar of [`topics::SCENE`], as read back.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ScaleBar {
-    pub tail: [f64; 3],
-    /// The bar's vector (direction × length), world frame, m.
-    pub vector: [f64; 3],
-    /// Its text (`10 N = 0.100 m`).
-    pub text: String,
-}
-
-/// What a reader of a recording (`analyze view`) takes from [`topics::SCENE`] so that it draws
-/// what Foxglove draws: the force scale, the tables, the scale bar.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SceneRead {
-    /// [`ForceScale::legacy`] for a recording without `legend/force_scale`.
-    pub force_scale: ForceScale,
-    /// Whether the scale came from the recording (else the legacy one).
-    pub scale_recorded: bool,
-    pub tables: Vec<TableBox>,
-    pub scale_bar: Option<ScaleBar>,
-}
-
-impl Default for SceneRead {
-    fn default() -> Self {
-        SceneRead { force_scale: ForceScale::legacy(), scale_recorded: false, tables: Vec::new(), scale_bar: None }
-    }
-}
-
-impl SceneRead {
-    /// Reads a decoded [`topics::SCENE`] message (a `foxglove.SceneUpdate`); what it lacks
-    /// keeps its default (a message of another producer, or of an older version).
-    pub fn from_message(msg: &crate::Value) -> SceneRead {
-        use crate::Value;
-        let mut out = SceneRead::default();
-        let num = |v: &Value, path: &str| v.get(path).and_then(Value::as_f64).unwrap_or(0.0);
-        let xyz = |v: &Value, path: &str| [num(v, &format!("{path}.x")), num(v, &format!("{path}.y")), num(v, &format!("{path}.z"))];
-        let quat4 = |v: &Value, path: &str| {
-            let q = [num(v, &format!("{path}.x")), num(v, &format!("{path}.y")), num(v, &format!("{path}.z")), num(v, &format!("{path}.w"))];
-            if q == [0.0; 4] {
-                [0.0, 0.0, 0.0, 1.0]
-            } else {
-                q
-            }
-        };
-        let list = |v: &Value, path: &str| -> Vec<Value> {
-            match v.get(path) {
-                Some(Value::List(l)) => l.clone(),
-                _ => Vec::new(),
-            }
-        };
-        for e in list(msg, "entities") {
-            let id = e.get("id").and_then(Value::as_str).unwrap_or("");
-            let meta = |key: &str| list(&e, "metadata").into_iter().find(|kv| kv.get("key").and_then(Value::as_str) == Some(key)).and_then(|kv| kv.get("value").and_then(Value::as_str).map(str::to_string));
-            if id.starts_with(ids::TABLE) {
-                for c in list(&e, "cubes") {
-                    out.tables.push(TableBox { center: xyz(&c, "pose.position"), rotation: quat4(&c, "pose.orientation"), size: xyz(&c, "size"), alpha: num(&c, "color.a") });
-                }
-            } else if id == ids::FORCE_SCALE {
-                let scale = meta("scale_m_per_n").and_then(|s| s.parse::<f64>().ok()).filter(|s| s.is_finite() && *s > 0.0);
-                if let Some(m_per_n) = scale {
-                    let reference_force_n = meta("reference_force_n").and_then(|s| s.parse().ok()).unwrap_or(0.0);
-                    out.force_scale = ForceScale { m_per_n, reference_force_n };
-                    out.scale_recorded = true;
-                }
-                if let (Some(a), Some(t)) = (list(&e, "arrows").first(), list(&e, "texts").first()) {
-                    let q = quat4(a, "pose.orientation");
-                    let len = num(a, "shaft_length") + num(a, "head_length");
-                    let dir = rotate(q, [1.0, 0.0, 0.0]);
-                    out.scale_bar = Some(ScaleBar {
-                        tail: xyz(a, "pose.position"),
-                        vector: dir.map(|x| x * len),
-                        text: t.get("text").and_then(Value::as_str).unwrap_or("").to_string(),
-                    });
-                }
-            }
-        }
-        out
-    }
-}
-
-impl SceneRead {
-    /// What `rec`'s [`topics::SCENE`] says (its first message); the defaults when it has none
-    /// or did not decode it.
-    pub fn from_recording(rec: &crate::Recording) -> SceneRead {
-        rec.messages(crate::topics::SCENE).and_then(|m| m.first()).map(|(_, v)| SceneRead::from_message(v)).unwrap_or_default()
-    }
-
-    /// What a [`topics::SCENE`] message handed to a [`crate::Visitor`] says (a streamed read:
-    /// `analyze view`'s survey takes the first).
-    pub fn from_decoded(m: &crate::DecodedMessage<'_>) -> SceneRead {
-        SceneRead::from_message(&m.value())
-    }
-}
-
-/// The `scale_m_per_n` of the first force arrow of `rec`'s first [`topics::CONTACT_MARKERS`]
-/// message (what Foxglove draws the run's arrows at), when it has one.
-pub fn recorded_arrow_scale(rec: &crate::Recording) -> Option<f64> {
-    use crate::Value;
-    let (_, msg) = rec.messages(crate::topics::CONTACT_MARKERS)?.first()?;
-    let entities = msg.get("entities")?.as_list()?;
-    let force = entities.iter().find(|e| e.get("id").and_then(Value::as_str).is_some_and(|id| id.starts_with("force/")))?;
-    let meta = force.get("metadata")?.as_list()?;
-    meta.iter().find(|kv| kv.get("key").and_then(Value::as_str) == Some("scale_m_per_n"))?.get("value")?.as_str()?.parse().ok()
 }
 
 /// `v` turned by the unit quaternion `q = [x, y, z, w]`.
@@ -659,6 +262,8 @@ pub struct ContactMarkers {
     msg: SceneUpdate,
     contacts: Vec<MarkerContact>,
     scale: ForceScale,
+    /// The labels' boxes, one per contact, placed every sample ([`place_labels`]).
+    labels: Vec<LabelBox>,
 }
 
 /// Index of the metadata entry `mode` of a contact entity.
@@ -754,7 +359,8 @@ impl ContactMarkers {
         let mut desired = entity("hand/desired".into(), vec![kv("what", "the hand, desired position (target)"), kv("units", "m")]);
         desired.spheres.push(sphere(HAND_DESIRED_RADIUS_M, colors::color(colors::HAND_DESIRED, 0.35)));
         entities.push(desired);
-        ContactMarkers { msg: SceneUpdate { deletions: Vec::new(), entities }, contacts: contacts.to_vec(), scale }
+        let labels = vec![LabelBox::new([0.0; 3], 0); contacts.len()];
+        ContactMarkers { msg: SceneUpdate { deletions: Vec::new(), entities }, contacts: contacts.to_vec(), scale, labels }
     }
 
     /// The scale of the arrows.
@@ -770,7 +376,7 @@ impl ContactMarkers {
             e.timestamp = stamp;
         }
         let (contact_entities, hand) = self.msg.entities.split_at_mut(2 * self.contacts.len());
-        for ((pair, c), info) in contact_entities.chunks_exact_mut(2).zip(contacts).zip(&self.contacts) {
+        for (((pair, c), info), label) in contact_entities.chunks_exact_mut(2).zip(contacts).zip(&self.contacts).zip(&mut self.labels) {
             let (marker, arrow) = pair.split_at_mut(1);
             let (marker, arrow) = (&mut marker[0], &mut arrow[0]);
             let mode = &mut marker.metadata[MODE_KEY].value;
@@ -795,12 +401,17 @@ impl ContactMarkers {
                 a.color = Some(color);
             }
             if let Some(t) = arrow.texts.first_mut() {
-                // beside the tip (at the marker when there is no force)
-                let at = if glyph.length_m > 0.0 { glyph.tip() } else { c.point };
-                let n = info.normal;
-                t.pose = Some(pose([0, 1, 2].map(|i| at[i] + 0.02 * n[i]), identity()));
+                // above the tip (the marker when there is no force); placed below, with the others
                 t.color = Some(color);
                 write_label(&mut t.text, &info.name, glyph.magnitude_n, c.mode);
+                *label = LabelBox::new(default_anchor(&glyph, c.point, info.normal), t.text.chars().count());
+            }
+        }
+        // the labels apart (`labels`): the same placement as `analyze view`'s Rerun labels
+        place_labels(&mut self.labels);
+        for (pair, label) in contact_entities.chunks_exact_mut(2).zip(&self.labels) {
+            if let Some(t) = pair[1].texts.first_mut() {
+                t.pose = Some(pose(label.anchor, identity()));
             }
         }
         for (e, p) in hand.iter_mut().zip([actual, desired]) {
@@ -915,19 +526,58 @@ mod tests {
         len - (t1 - t0)
     }
 
-    /// The paper arm (1.0 kg, ten 0.3 m links) gets 10 mm per N; scales are 1-2-5 rounded
-    /// down; a massless arm gets the legacy scale; the bar is a round force about 0.1 m long.
+    /// Foxglove's labels of close contacts never clash (`LabelBox::clearance_m` ≥ −1e-9 m, the
+    /// text primitives' poses and texts as recorded): nine contacts 0.3 m apart on a line (the
+    /// whole-table run) and two at one point, over 100 samples of forces that change size, sign
+    /// and mode; at their default places (above the tips) they clash; a contact far from the
+    /// others keeps its default place exactly (the paper runs' bytes do not move).
     #[test]
-    fn the_scale_comes_from_the_arm() {
-        let s = ForceScale::for_arm(1.0, 3.0, 10);
-        assert_eq!(s.m_per_n, 0.01);
-        assert!((s.reference_force_n - 9.80665).abs() < 1e-12);
-        assert_eq!(s.bar_force_n(), 10.0);
-        assert_eq!(ForceScale::for_arm(0.0, 3.0, 10), ForceScale { m_per_n: LEGACY_FORCE_SCALE_M_PER_N, reference_force_n: 0.0 });
-        for (x, want) in [(0.0102, 0.01), (0.0099, 0.005), (0.03, 0.02), (7.0, 5.0), (1.0, 1.0), (2e-4, 2e-4)] {
-            assert!((round_125_down(x) - want).abs() < 1e-15 * want.max(1.0), "{x}: {}", round_125_down(x));
+    fn labels_of_close_contacts_never_clash() {
+        let mut contacts: Vec<MarkerContact> = (0..9).map(|i| MarkerContact { name: format!("joint{}", i + 3), normal: [0.0, 0.0, 1.0], offset: 0.0 }).collect();
+        contacts.push(MarkerContact { name: "pad/0".into(), normal: [0.0, 0.0, 1.0], offset: 0.0 });
+        contacts.push(MarkerContact { name: "pad/1".into(), normal: [0.0, 0.0, 1.0], offset: 0.0 });
+        contacts.push(MarkerContact { name: "far".into(), normal: [0.0, 0.0, 1.0], offset: 0.0 });
+        let point = |i: usize| match i {
+            0..=8 => [0.3 * i as f64, 0.0, 0.0],
+            9 | 10 => [1.0, 1.0, 0.0],
+            _ => [10.0, 10.0, 0.0],
+        };
+        let scale = ForceScale::for_arm(1.0, 3.0, 10);
+        let mut m = ContactMarkers::new("world", &contacts, scale);
+        let mut clashed_by_default = 0;
+        for k in 0..100 {
+            let samples: Vec<ContactSample> = (0..contacts.len())
+                .map(|i| {
+                    let f_n = if (k + i) % 7 == 0 { 0.0 } else { 30.0 * ((0.1 * k as f64 + i as f64).sin()) };
+                    ContactSample { point: point(i), force: [0.2 * f_n, 0.0, f_n], mode: MarkerMode::bilateral(f_n) }
+                })
+                .collect();
+            let msg = m.update(k as u64 * 1_000_000, samples.iter().copied(), [0.0; 3], [0.0; 3]).clone();
+            let boxes: Vec<LabelBox> = (0..contacts.len())
+                .map(|i| {
+                    let t = &msg.entities[2 * i + 1].texts[0];
+                    let p = t.pose.as_ref().unwrap().position.as_ref().unwrap();
+                    LabelBox::new([p.x, p.y, p.z], t.text.chars().count())
+                })
+                .collect();
+            let defaults: Vec<LabelBox> = (0..contacts.len())
+                .map(|i| {
+                    let g = ForceGlyph::new(samples[i].point, [0.0, 0.0, 1.0], 0.0, samples[i].force, &scale);
+                    LabelBox::new(default_anchor(&g, samples[i].point, [0.0, 0.0, 1.0]), boxes[i].half_width_m as usize)
+                })
+                .collect();
+            let mut clash = false;
+            for i in 0..boxes.len() {
+                for j in 0..i {
+                    let c = boxes[i].clearance_m(&boxes[j]);
+                    assert!(c >= -1e-9, "sample {k}: {} and {} clash by {} m", contacts[i].name, contacts[j].name, -c);
+                    clash |= LabelBox { half_width_m: boxes[i].half_width_m, ..defaults[i] }.clearance_m(&LabelBox { half_width_m: boxes[j].half_width_m, ..defaults[j] }) < 0.0;
+                }
+            }
+            clashed_by_default += usize::from(clash);
+            assert_eq!(boxes[11].anchor, defaults[11].anchor, "sample {k}: the far label moved");
         }
-        assert!(s.legend().starts_with("force arrows: 10 N = 0.100 m (10 mm per N)"), "{}", s.legend());
+        assert!(clashed_by_default > 25, "{clashed_by_default}");
     }
 
     /// A label never outgrows the room it was given (no allocation per sample), whatever the
@@ -942,50 +592,5 @@ mod tests {
         }
         write_label(&mut s, "elbow4", 1.44, MarkerMode::Pulling);
         assert_eq!(s, "elbow4 1.4 N bilateral pulling");
-    }
-
-    /// A table box's top face lies on its plane (within rounding) and the path keeps its points.
-    #[test]
-    fn scene_draws_planes_and_path() {
-        let planes = [TablePlane { normal: [0.0, 0.0, 1.0], offset: 0.0, contacts: vec!["elbow4".into()] }];
-        let path = [[0.0, 0.0, 0.1], [0.1, 0.0, 0.1]];
-        let scale = ForceScale::for_arm(1.0, 3.0, 10);
-        let s = scene_update(&SceneDescription { frame_id: "world", planes: &planes, half_size_m: 2.0, target_path: &path, target_dt_s: 0.001, force_scale: scale, shapes: &[] });
-        assert_eq!(s.entities.len(), 3);
-        let cube = &s.entities[0].cubes[0];
-        let top = cube.pose.as_ref().unwrap().position.as_ref().unwrap().z + cube.size.as_ref().unwrap().z / 2.0;
-        assert!(top.abs() < 1e-15);
-        assert_eq!(s.entities[1].lines[0].points.len(), 2);
-        assert_eq!(s.entities[1].id, "target_path");
-        // the scale bar: 10 N at 10 mm per N, standing on the table
-        let bar = &s.entities[2];
-        assert_eq!(bar.id, ids::FORCE_SCALE);
-        let a = &bar.arrows[0];
-        assert!((a.shaft_length + a.head_length - 0.1).abs() < 1e-15);
-        assert_eq!(bar.texts[0].text, "10 N = 0.100 m");
-    }
-
-    /// What analyze view reads back from /scene is what was written: the scale, the tables,
-    /// the bar (through the recording's own encoding and decoding).
-    #[test]
-    fn scene_reads_back() {
-        let planes = [TablePlane { normal: [0.0, 0.6, 0.8], offset: 0.1, contacts: vec!["elbow4".into()] }];
-        let scale = ForceScale { m_per_n: 0.02, reference_force_n: 4.9 };
-        let s = scene_update(&SceneDescription { frame_id: "world", planes: &planes, half_size_m: 1.5, target_path: &[], target_dt_s: 0.0, force_scale: scale, shapes: &[] });
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("scene.mcap");
-        let mut w = crate::RecordingWriter::create(&path).unwrap();
-        w.write(crate::topics::SCENE, 0, &s).unwrap();
-        w.finish().unwrap();
-        let rec = crate::read_recording(&path).unwrap();
-        let r = SceneRead::from_message(&rec.messages(crate::topics::SCENE).unwrap()[0].1);
-        assert!(r.scale_recorded);
-        assert_eq!(r.force_scale, scale);
-        assert_eq!(r.tables.len(), 1);
-        assert_eq!(r.tables[0].size, [3.0, 3.0, TABLE_THICKNESS_M]);
-        let bar = r.scale_bar.unwrap();
-        let len = (bar.vector.iter().map(|x| x * x).sum::<f64>()).sqrt();
-        assert!((len - 0.1).abs() < 1e-12 && (bar.vector[1] / len - 0.6).abs() < 1e-12, "{bar:?}");
-        assert_eq!(SceneRead::from_message(&crate::Value::Struct(Vec::new())), SceneRead::default());
     }
 }

@@ -18,7 +18,9 @@
 //     (the same in every recording given), the arrows' normal component f_n (1e-9 N), each
 //     arrow starting on the plane at the contact point's projection, every nonzero force's
 //     arrow at least 20 mm outside its marker sphere (larger than the 20 mm elbow sphere), the
-//     rings on the table, the labels (name, |F| to 0.1 N, mode), the contact spheres on their
+//     rings on the table, the labels (name, |F| to 0.1 N, mode; no two clash: their anchor boxes,
+//     12 mm per character wide and a 35 mm row high, side by side 10 mm apart or a row apart
+//     at every sample), the contact spheres on their
 //     constraint value C or gap (1e-9 m), the hand spheres on /hand (exact), and /hand_points
 //     coloured purple (actual) and orange (desired); the layout's legends never float over a
 //     plot and no tab holds more than two plots.
@@ -42,6 +44,11 @@ const here = dirname(fileURLToPath(import.meta.url));
 const failures = [];
 const fail = (msg) => failures.push(msg);
 const TOL = 1e-9;
+// a label's anchor box at the default views' scale (schemas/src/markers/labels.rs): 12 mm per
+// character wide, a 35 mm row high, 10 mm apart side by side
+const LABEL_CHAR_WIDTH_M = 0.012;
+const LABEL_ROW_M = 0.035;
+const LABEL_GAP_M = 0.01;
 
 // the lead's colours (DECISIONS.md), as Foxglove RGB in [0, 1]
 const hex = (h) => [1, 3, 5].map((k) => parseInt(h.slice(k, k + 2), 16) / 255);
@@ -326,6 +333,7 @@ function checkScene(rec) {
   const modesSeen = {};
   let arrows = 0;
   let labels = 0;
+  let minLabelClearance = Infinity;
   let nonzero = 0;
   let minOutside = Infinity;
   let maxArrowErr = 0;
@@ -351,6 +359,7 @@ function checkScene(rec) {
       fail(`${rec.path}: /contact_markers and the forces are not sample for sample at ${logTime}`);
       break;
     }
+    const labelBoxes = [];
     for (const [k, name] of contacts.entries()) {
       const marker = msg.entities[2 * k];
       const arrowEnt = msg.entities[2 * k + 1];
@@ -411,7 +420,20 @@ function checkScene(rec) {
       const m = /^(\S+) (\S+) N (.+)$/.exec(text);
       if (!m || m[1] !== name || Math.abs(Number(m[2]) - norm) > 0.05 + 1e-9 * norm) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: label ${JSON.stringify(text)} for |F| = ${norm} N`);
       else labels++;
+      const lp = arrowEnt.texts[0]?.pose?.position;
+      if (lp) labelBoxes.push({ name, x: lp.x, y: lp.y, z: lp.z, half: 0.5 * [...text].length * LABEL_CHAR_WIDTH_M });
       arrows++;
+    }
+    // no two labels clash: side by side (horizontal gap) or a row apart (schemas::markers::labels)
+    for (let a = 0; a < labelBoxes.length; a++) {
+      for (let b = 0; b < a; b++) {
+        const [p, q] = [labelBoxes[a], labelBoxes[b]];
+        const across = Math.hypot(p.x - q.x, p.y - q.y) - p.half - q.half - LABEL_GAP_M;
+        const up = Math.abs(p.z - q.z) - LABEL_ROW_M;
+        const clearance = Math.max(across, up);
+        minLabelClearance = Math.min(minLabelClearance, clearance);
+        if (clearance < -1e-9) fail(`${rec.path}: /contact_markers at ${logTime}: the labels of ${q.name} and ${p.name} overlap (${-clearance} m)`);
+      }
     }
     const [actual, desired] = msg.entities.slice(2 * contacts.length);
     const h = hand[i].msg;
@@ -425,6 +447,7 @@ function checkScene(rec) {
   out.contact_marker_messages = markers.length;
   out.arrows_checked = arrows;
   out.labels_checked = labels;
+  out.min_label_clearance_m = Number.isFinite(minLabelClearance) ? minLabelClearance : null;
   out.nonzero_forces = nonzero;
   out.min_length_outside_marker_m = nonzero ? minOutside : null;
   out.max_arrow_length_error_m = maxArrowErr;

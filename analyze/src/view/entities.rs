@@ -25,19 +25,20 @@
 
 use arrow_array::ArrayRef;
 
-use super::chunk::{f32_lists, f64_each, quat_lists, rgba, str_lists, strip_lists, u32_lists, u8_lists, vec3_lists, Chunk, Index};
+use super::chunk::{f32_lists, quat_lists, rgba, str_lists, strip_lists, u32_lists, u8_lists, vec3_lists, Chunk, Index};
 use super::pose::{quat_z_to, Pose};
 use super::run::{escape, ns, Plane, Run};
 use super::urdf::Shape;
+use super::contacts::{contact_chunks, contact_forces, shape_chunks, touch_point};
+pub use super::signals::signal;
+use super::signals::signal_chunks;
 
-const POINTS: &str = "rerun.archetypes.Points3D";
-const ARROWS: &str = "rerun.archetypes.Arrows3D";
-const STRIPS: &str = "rerun.archetypes.LineStrips3D";
+pub(super) const POINTS: &str = "rerun.archetypes.Points3D";
+pub(super) const ARROWS: &str = "rerun.archetypes.Arrows3D";
+pub(super) const STRIPS: &str = "rerun.archetypes.LineStrips3D";
 const BOXES: &str = "rerun.archetypes.Boxes3D";
-const CAPSULES: &str = "rerun.archetypes.Capsules3D";
+pub(super) const CAPSULES: &str = "rerun.archetypes.Capsules3D";
 const TRANSFORM: &str = "rerun.archetypes.Transform3D";
-const SCALARS: &str = "rerun.archetypes.Scalars";
-const SERIES: &str = "rerun.archetypes.SeriesLines";
 const TEXT_LOG: &str = "rerun.archetypes.TextLog";
 const VIEW_COORDINATES: &str = "rerun.archetypes.ViewCoordinates";
 
@@ -62,7 +63,7 @@ pub fn palette(k: usize) -> u32 {
 
 /// A colour of [`schemas::markers::colors`] (the one owner of the viewers' colours, so Rerun
 /// and Foxglove draw the same thing in the same colour) as Rerun's packed RGBA.
-fn shared(hex: &str) -> u32 {
+pub(super) fn shared(hex: &str) -> u32 {
     let [r, g, b, a] = schemas::markers::colors::rgba8(hex, 255);
     rgba(r, g, b, a)
 }
@@ -77,11 +78,11 @@ fn hand_desired() -> u32 {
 const TABLE: u32 = rgba(0x8c, 0x6d, 0x46, 70);
 const ARM: u32 = rgba(170, 180, 200, 255);
 
-fn f3(p: [f64; 3]) -> [f32; 3] {
+pub(super) fn f3(p: [f64; 3]) -> [f32; 3] {
     p.map(|x| x as f32)
 }
 
-fn q4(q: [f64; 4]) -> [f32; 4] {
+pub(super) fn q4(q: [f64; 4]) -> [f32; 4] {
     q.map(|x| x as f32)
 }
 
@@ -108,51 +109,6 @@ impl Paths {
             None => format!("/{signal}"),
         }
     }
-}
-
-/// The signal groups and their entity names (the first path part; the unit after `_`).
-pub mod signal {
-    pub const CURRENT: &str = "current_A";
-    pub const VOLTAGE: &str = "voltage_V";
-    pub const NORMAL_FORCE: &str = "normal_force_N";
-    pub const FRICTION_FORCE: &str = "friction_force_N";
-    pub const CONTACT_MODE: &str = "contact_mode";
-    /// The slip speed `|v_t|` of a unilateral or compliant contact, m/s.
-    pub const SLIP_SPEED: &str = "slip_speed_mps";
-    /// `|f_t| / (μ f_n)`: 1 on the friction cone (sliding), below it sticking (samples with
-    /// `f_n > 0` only).
-    pub const FRICTION_RATIO: &str = "friction_ratio";
-    pub const ELECTRIC_ENERGY: &str = "electric_energy_J";
-    pub const LINK_WORK: &str = "link_work_J";
-    pub const ENERGY: &str = "energy_J";
-    pub const RESIDUAL: &str = "energy_residual_J";
-}
-
-/// The energy totals: entity name, series label, and how to get it from `/energy`.
-pub const ENERGY_TERMS: [(&str, &str, fn(&schemas::EnergyState) -> f64); 8] = [
-    ("electric-in", "electric energy in, Σ E_j", |e| e.electric_energy_total),
-    ("link-work", "link work, Σ W_j", |e| e.link_work_total),
-    ("kinetic", "kinetic T", |e| e.kinetic),
-    ("potential", "potential V", |e| e.potential),
-    ("magnetic", "magnetic L i²/2", |e| e.magnetic),
-    ("resistive-loss", "resistive loss", |e| e.resistive_loss),
-    ("friction-loss", "friction loss (joints D and gears D_m)", |e| e.friction_loss),
-    ("gear-friction-loss", "gear friction loss", |e| e.gear_friction_loss),
-];
-
-/// A time series: `Scalars` per sample plus its static `SeriesLines` style (name, colour).
-fn series(path: String, times: &[i64], values: Vec<f64>, name: &str, color: u32, width: f32) -> [Chunk; 2] {
-    [
-        Chunk::new(&path, Index::SimTime(times.to_vec())).with(SCALARS, "scalars", "rerun.components.Scalar", f64_each(&values)),
-        Chunk::new(&path, Index::Static)
-            .with(SERIES, "colors", "rerun.components.Color", u32_lists(&[vec![color]]))
-            .with(SERIES, "names", "rerun.components.Name", str_lists(&[vec![name.to_string()]]))
-            .with(SERIES, "widths", "rerun.components.StrokeWidth", f32_lists(&[vec![width]])),
-    ]
-}
-
-fn repeat<T: Clone>(x: T, n: usize) -> Vec<T> {
-    vec![x; n]
 }
 
 /// What the views of a run need to know to place their cameras: bounds of the arm and the hand
@@ -353,72 +309,10 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         }
     }
 
-    // contacts: marker, ring and force arrow per sample, coloured by mode, at the scene's one
-    // scale (`/scene`), as Foxglove draws them (`schemas::markers`)
-    let (f_n, f_t, modes) = contact_forces(run);
-    let force_times: Vec<i64> = if run.contact_states.is_some() {
-        run.contact_states.iter().flatten().map(|(t, _)| ns(*t)).collect()
-    } else {
-        run.constraints.iter().map(|(t, _)| ns(*t)).collect()
-    };
-    let n_rows = force_times.len().min(times.len());
-    for (ci, c) in run.contacts.iter().enumerate() {
-        if contact_points[ci].len() < n_rows {
-            continue; // where it acts is unknown: plots only
-        }
-        let base = format!("{world}/contacts/{}", escape(&c.name));
-        let d = contact_drawing(c, &contact_points[ci][..n_rows], &f_n[ci], f_t.get(ci).map(Vec::as_slice), modes.as_ref().map(|m| m[ci].as_slice()), &scale);
-        let colors: Vec<Vec<u32>> = d.modes.iter().map(|m| vec![shared(m.hex())]).collect();
-        let translucent: Vec<Vec<u32>> = d.modes.iter().map(|m| vec![shared(m.hex()) & 0xffff_ff00 | 0x90]).collect();
-        let ft = Index::SimTime(force_times[..n_rows].to_vec());
-        out.push(
-            Chunk::new(&base, ft.clone())
-                .with(POINTS, "colors", "rerun.components.Color", u32_lists(&translucent))
-                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&d.points.iter().map(|p| vec![f3(*p)]).collect::<Vec<_>>())),
-        );
-        // the marker has no label of its own: the force's label names the contact (two labels
-        // at one contact overlapped)
-        out.push(
-            Chunk::new(&base, Index::Static)
-                .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![schemas::markers::CONTACT_MARKER_RADIUS_M as f32]])),
-        );
-        let rings: Vec<Vec<Vec<[f32; 3]>>> = d.glyphs.iter().map(|g| vec![ring(g.tail, d.normal)]).collect();
-        out.push(
-            Chunk::new(format!("{base}/ring"), ft.clone())
-                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&rings)),
-        );
-        out.push(
-            Chunk::new(format!("{base}/ring"), Index::Static)
-                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::RING_LINE_WIDTH_M) as f32]])),
-        );
-        let mut label = String::with_capacity(schemas::markers::label_capacity(&c.name));
-        let labels: Vec<Vec<String>> = d
-            .glyphs
-            .iter()
-            .zip(&d.modes)
-            .map(|(g, m)| {
-                schemas::markers::write_label(&mut label, &c.name, g.magnitude_n, *m);
-                vec![label.clone()]
-            })
-            .collect();
-        out.push(
-            Chunk::new(format!("{base}/force"), ft)
-                .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(ARROWS, "labels", "rerun.components.Text", str_lists(&labels))
-                .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.tail)]).collect::<Vec<_>>()))
-                .with(
-                    ARROWS,
-                    "vectors",
-                    "rerun.components.Vector3D",
-                    vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.direction.map(|x| x * g.length_m))]).collect::<Vec<_>>()),
-                ),
-        );
-        out.push(
-            Chunk::new(format!("{base}/force"), Index::Static)
-                .with(ARROWS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::ARROW_SHAFT_DIAMETER_M) as f32]])),
-        );
-    }
+    // contacts: marker, ring, force arrow and label per sample, coloured by mode, at the
+    // scene's one scale (`/scene`), as Foxglove draws them (`super::contacts`)
+    let forces = contact_forces(run);
+    out.extend(contact_chunks(run, &world, &contact_points, times.len(), &forces, &scale));
 
     // contact events
     if !run.events.is_empty() {
@@ -437,12 +331,12 @@ pub fn run_chunks(run: &Run, paths: &Paths) -> (Vec<Chunk>, Bounds) {
         let n = t.len();
         out.push(
             Chunk::new(format!("{}/events", paths.prefix), Index::SimTime(t))
-                .with(TEXT_LOG, "level", "rerun.components.TextLogLevel", str_lists(&repeat(vec!["INFO".to_string()], n)))
+                .with(TEXT_LOG, "level", "rerun.components.TextLogLevel", str_lists(&vec![vec!["INFO".to_string()]; n]))
                 .with(TEXT_LOG, "text", "rerun.components.Text", str_lists(&text)),
         );
     }
 
-    out.extend(signal_chunks(run, paths, &f_n, &f_t, modes.as_deref()));
+    out.extend(signal_chunks(run, paths, &forces));
     (out, bounds)
 }
 
@@ -483,279 +377,6 @@ pub fn trail_updates(times: &[i64], actual: &[[f64; 3]], window: (i64, i64)) -> 
     (ks.iter().map(|&k| times[k]).collect(), rows)
 }
 
-/// A contact's drawing, sample by sample: where its marker is, its mode, its force glyph.
-#[derive(Debug, Clone)]
-pub struct ContactDrawing {
-    /// The contact point (the marker's centre), world frame, m.
-    pub points: Vec<[f64; 3]>,
-    pub modes: Vec<schemas::markers::MarkerMode>,
-    pub glyphs: Vec<schemas::markers::ForceGlyph>,
-    /// The plane's unit normal.
-    pub normal: [f64; 3],
-}
-
-/// The drawing of contact `c` at its `points` (per sample) with normal forces `f_n`, friction
-/// components `f_t` (`(t1, t2)` interleaved, when recorded) and mode codes (when recorded), at
-/// `scale`: the geometry of `schemas::markers` (Foxglove's), so that both viewers draw the same.
-pub fn contact_drawing(
-    c: &super::run::ContactPoint,
-    points: &[[f64; 3]],
-    f_n: &[f64],
-    f_t: Option<&[f64]>,
-    modes: Option<&[u32]>,
-    scale: &schemas::markers::ForceScale,
-) -> ContactDrawing {
-    use schemas::markers::{ForceGlyph, MarkerMode};
-    let (normal, offset) = c.plane.map_or(([0.0, 0.0, 1.0], 0.0), |p| {
-        let n = p.normal;
-        let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
-        (n.map(|x| x / norm), p.offset_m / norm)
-    });
-    let mut d = ContactDrawing { points: points.to_vec(), modes: Vec::with_capacity(points.len()), glyphs: Vec::with_capacity(points.len()), normal };
-    for (k, p) in points.iter().enumerate() {
-        let fn_k = f_n.get(k).copied().unwrap_or(0.0);
-        let mode = modes.and_then(|m| m.get(k)).map_or_else(|| MarkerMode::bilateral(fn_k), |code| MarkerMode::from_code(*code, fn_k));
-        let mut f = normal.map(|x| x * fn_k);
-        if let (Some((t1, t2)), Some(ft)) = (c.tangents, f_t) {
-            let (a, b) = ft.get(2 * k).copied().zip(ft.get(2 * k + 1).copied()).unwrap_or((0.0, 0.0));
-            f = [0, 1, 2].map(|i| f[i] + a * t1[i] + b * t2[i]);
-        }
-        d.modes.push(mode);
-        d.glyphs.push(ForceGlyph::new(*p, normal, offset, f, scale));
-    }
-    d
-}
-
-/// Where contact `c` touches (or would touch) its plane, world frame, m, with its link at `link`
-/// (world frame): its point, or its shape's lowest point (`schemas::ContactShapeInfo`, the
-/// point `sim` draws its Foxglove marker at).
-pub fn touch_point(c: &super::run::ContactPoint, link: &Pose) -> [f64; 3] {
-    let center = link.apply(c.offset_m);
-    match (&c.shape, c.plane) {
-        (Some(s), Some(plane)) => {
-            let n = plane.normal;
-            let norm = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-12);
-            let axis = s.axis.map_or([0.0; 3], |a| super::pose::rotate(link.rotation, a));
-            s.lowest_point(center, axis, n.map(|x| x / norm))
-        }
-        _ => center,
-    }
-}
-
-/// The static chunks of a contact shape at `path` (below its link's entity, so in the link's
-/// frame): a sphere pad as an ellipsoid, a capsule as `Capsules3D` (from its first end along
-/// +z, as Rerun defines it), a cylinder as `Cylinders3D` between its rims, and each rim as a
-/// closed line strip; translucent cyan (`schemas::markers::colors::CONTACT_SHAPE`).
-fn shape_chunks(path: &str, g: &schemas::markers::ShapeGlyph) -> Vec<Chunk> {
-    use schemas::markers::ShapeGlyph;
-    let [r, gr, b, _] = schemas::markers::colors::rgba8(schemas::markers::colors::CONTACT_SHAPE, 255);
-    let fill = rgba(r, gr, b, (schemas::markers::SHAPE_ALPHA * 255.0).round() as u8);
-    let line = rgba(r, gr, b, 255);
-    let mut out = Vec::new();
-    let segment = |ends: &[[f64; 3]; 2]| {
-        let d = [0, 1, 2].map(|i| ends[1][i] - ends[0][i]);
-        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        (quat_z_to(d.map(|x| x / len.max(1e-300))), len)
-    };
-    match g {
-        ShapeGlyph::Sphere { center, radius, .. } => out.push(super::mesh::shape_chunk(
-            path,
-            &Pose { translation: *center, rotation: [0.0, 0.0, 0.0, 1.0] },
-            Shape::Sphere { radius_m: *radius },
-            fill,
-        )),
-        ShapeGlyph::Capsule { ends, radius, .. } => {
-            let (q, len) = segment(ends);
-            out.push(
-                Chunk::new(path, Index::Static)
-                    .with(CAPSULES, "colors", "rerun.components.Color", u32_lists(&[vec![fill]]))
-                    .with(CAPSULES, "lengths", "rerun.components.Length", f32_lists(&[vec![len as f32]]))
-                    .with(CAPSULES, "quaternions", "rerun.components.RotationQuat", quat_lists(&[vec![q4(q)]]))
-                    .with(CAPSULES, "radii", "rerun.components.Radius", f32_lists(&[vec![*radius as f32]]))
-                    .with(CAPSULES, "translations", "rerun.components.Translation3D", vec3_lists(&[vec![f3(ends[0])]])),
-            );
-        }
-        ShapeGlyph::Cylinder { ends, radius, .. } => {
-            let (q, len) = segment(ends);
-            let mid = [0, 1, 2].map(|i| 0.5 * (ends[0][i] + ends[1][i]));
-            out.push(super::mesh::shape_chunk(
-                path,
-                &Pose { translation: mid, rotation: q },
-                Shape::Cylinder { radius_m: *radius, length_m: len },
-                rgba(r, gr, b, 64),
-            ));
-        }
-        ShapeGlyph::Rim { .. } => {}
-    }
-    let rims: Vec<Vec<[f32; 3]>> = g
-        .rims()
-        .into_iter()
-        .map(|(c, a)| {
-            let mut pts: Vec<[f32; 3]> = schemas::markers::circle(c, a, g.radius()).into_iter().map(f3).collect();
-            pts.push(pts[0]);
-            pts
-        })
-        .collect();
-    if !rims.is_empty() {
-        out.push(
-            Chunk::new(format!("{path}/rims"), Index::Static)
-                .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&[vec![line]]))
-                .with(STRIPS, "radii", "rerun.components.Radius", f32_lists(&[vec![(0.5 * schemas::markers::RING_LINE_WIDTH_M) as f32]]))
-                .with(STRIPS, "strips", "rerun.components.LineStrip3D", strip_lists(&[rims])),
-        );
-    }
-    out
-}
-
-/// The ring around a contact's point on the table: a closed strip of
-/// [`schemas::markers::CONTACT_RING_POINTS`] points about `center` in the plane of `normal`.
-fn ring(center: [f64; 3], normal: [f64; 3]) -> Vec<[f32; 3]> {
-    let q = quat_z_to(normal);
-    let r = schemas::markers::CONTACT_RING_RADIUS_M;
-    let n = schemas::markers::CONTACT_RING_POINTS;
-    (0..=n)
-        .map(|k| {
-            let a = std::f64::consts::TAU * (k % n) as f64 / n as f64;
-            let v = schemas::markers::rotate(q, [r * a.cos(), r * a.sin(), 0.0]);
-            f3([0, 1, 2].map(|i| center[i] + v[i]))
-        })
-        .collect()
-}
-
-/// "10 mm per N" (the scale in words).
-pub fn scale_words(s: &schemas::markers::ForceScale) -> String {
-    let mm = s.m_per_n * 1e3;
-    if mm >= 0.01 {
-        format!("{} mm per N", (mm * 1e4).round() / 1e4)
-    } else {
-        format!("{:e} m per N", s.m_per_n)
-    }
-}
-
-/// Per contact and sample: normal force, friction components `(t1, t2)` interleaved, and mode
-/// (when `/contacts` is recorded; bilateral runs have `/constraints` only).
-#[allow(clippy::type_complexity)]
-fn contact_forces(run: &Run) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, Option<Vec<Vec<u32>>>) {
-    let nc = run.contacts.len();
-    match &run.contact_states {
-        Some(states) => {
-            let mut f_n = vec![Vec::with_capacity(states.len()); nc];
-            let mut f_t = vec![Vec::with_capacity(2 * states.len()); nc];
-            let mut modes = vec![Vec::with_capacity(states.len()); nc];
-            for (_, s) in states {
-                for c in 0..nc {
-                    f_n[c].push(s.normal_force[c]);
-                    f_t[c].push(s.friction_force_t1.get(c).copied().unwrap_or(0.0));
-                    f_t[c].push(s.friction_force_t2.get(c).copied().unwrap_or(0.0));
-                    modes[c].push(s.mode[c]);
-                }
-            }
-            (f_n, f_t, Some(modes))
-        }
-        None => {
-            let mut f_n = vec![Vec::with_capacity(run.constraints.len()); nc];
-            for (_, s) in &run.constraints {
-                for c in 0..nc {
-                    f_n[c].push(s.normal_force[c]);
-                }
-            }
-            (f_n, Vec::new(), None)
-        }
-    }
-}
-
-/// The typed scalar entities of a run ([`signal`]).
-fn signal_chunks(run: &Run, paths: &Paths, f_n: &[Vec<f64>], f_t: &[Vec<f64>], modes: Option<&[Vec<u32>]>) -> Vec<Chunk> {
-    use signal::*;
-    let mut out = Vec::new();
-    let motor_t: Vec<i64> = run.motors.iter().map(|(t, _)| ns(*t)).collect();
-    let energy_t: Vec<i64> = run.energy.iter().map(|(t, _)| ns(*t)).collect();
-    let width = 1.5;
-    for (j, joint) in run.joints.iter().enumerate() {
-        let color = palette(j);
-        let jp = escape(joint);
-        let current = run.motors.iter().map(|(_, m)| m.current[j]).collect();
-        out.extend(series(format!("{}/{jp}", paths.signal(CURRENT)), &motor_t, current, &format!("{joint} [A]"), color, width));
-        if run.whole.voltage_every_joint {
-            let v = run.motors.iter().map(|(_, m)| m.voltage[j]).collect();
-            out.extend(series(format!("{}/{jp}", paths.signal(VOLTAGE)), &motor_t, v, &format!("{joint} [V]"), color, width));
-        }
-        let e = run.energy.iter().map(|(_, e)| e.electric_energy[j]).collect();
-        out.extend(series(format!("{}/{jp}", paths.signal(ELECTRIC_ENERGY)), &energy_t, e, &format!("E {joint} [J]"), color, width));
-        let w = run.energy.iter().map(|(_, e)| e.link_work[j]).collect();
-        out.extend(series(format!("{}/{jp}", paths.signal(LINK_WORK)), &energy_t, w, &format!("W {joint} [J]"), color, width));
-    }
-    let force_t: Vec<i64> = match &run.contact_states {
-        Some(s) => s.iter().map(|(t, _)| ns(*t)).collect(),
-        None => run.constraints.iter().map(|(t, _)| ns(*t)).collect(),
-    };
-    for (c, contact) in run.contacts.iter().enumerate() {
-        // contacts after the joints in the palette's order would repeat joint colours: start at
-        // the far end
-        let color = palette(PALETTE.len() - 1 - c % PALETTE.len());
-        let cp = escape(&contact.name);
-        out.extend(series(format!("{}/{cp}", paths.signal(NORMAL_FORCE)), &force_t, f_n[c].clone(), &format!("{} f_n [N]", contact.name), color, width));
-        if let Some(ft) = f_t.get(c).filter(|v| !v.is_empty()) {
-            let mag = ft.chunks(2).map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt()).collect();
-            out.extend(series(format!("{}/{cp}", paths.signal(FRICTION_FORCE)), &force_t, mag, &format!("{} |f_t| [N]", contact.name), color, width));
-        }
-        if let (Some(states), Some(ft)) = (&run.contact_states, f_t.get(c).filter(|v| !v.is_empty())) {
-            let slip = states
-                .iter()
-                .map(|(_, s)| {
-                    let (a, b) = (s.slip_velocity_t1.get(c).copied().unwrap_or(0.0), s.slip_velocity_t2.get(c).copied().unwrap_or(0.0));
-                    (a * a + b * b).sqrt()
-                })
-                .collect();
-            out.extend(series(format!("{}/{cp}", paths.signal(SLIP_SPEED)), &force_t, slip, &format!("{} |v_t| [m/s]", contact.name), color, width));
-            if let Some(mu) = contact.friction.filter(|m| *m > 0.0) {
-                let (t, v): (Vec<i64>, Vec<f64>) = ft
-                    .chunks(2)
-                    .zip(&f_n[c])
-                    .zip(&force_t)
-                    .filter(|((_, n), _)| **n > 0.0)
-                    .map(|((p, n), t)| (*t, (p[0] * p[0] + p[1] * p[1]).sqrt() / (mu * n)))
-                    .unzip();
-                out.extend(series(format!("{}/{cp}", paths.signal(FRICTION_RATIO)), &t, v, &format!("{} |f_t|/(μ f_n)", contact.name), color, width));
-            }
-        }
-        if let Some(m) = modes {
-            let v = m[c].iter().map(|&x| f64::from(x)).collect();
-            out.extend(series(
-                format!("{}/{cp}", paths.signal(CONTACT_MODE)),
-                &force_t,
-                v,
-                // short: the plot's title gives the codes (the long name made a legend that covered the data)
-                &format!("{} mode", contact.name),
-                color,
-                width,
-            ));
-        }
-    }
-    // totals and the residual: `/energy_J/<term>[/<run>]`
-    let term_path = |term: &str| match &paths.run {
-        Some(r) => format!("/{ENERGY}/{term}/{}", escape(r)),
-        None => format!("/{ENERGY}/{term}"),
-    };
-    for (k, (term, label, get)) in ENERGY_TERMS.iter().enumerate() {
-        let v = run.energy.iter().map(|(_, e)| get(e)).collect();
-        let name = match &paths.run {
-            Some(r) => format!("{r}: {label} [J]"),
-            None => format!("{label} [J]"),
-        };
-        let color = if paths.run.is_some() { palette(paths.index) } else { palette(k) };
-        out.extend(series(term_path(term), &energy_t, v, &name, color, width));
-    }
-    let residual = run.energy.iter().map(|(_, e)| e.balance_residual).collect();
-    let name = match &paths.run {
-        Some(r) => format!("{r}: balance residual [J]"),
-        None => "balance residual E − (ΔT + ΔV + ΔL i²/2 + losses) [J]".to_string(),
-    };
-    let color = if paths.run.is_some() { palette(paths.index) } else { rgba(90, 90, 90, 255) };
-    out.extend(series(paths.signal(RESIDUAL), &energy_t, residual, &name, color, width));
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use std::path::Path;
@@ -765,7 +386,7 @@ mod tests {
     use arrow_array::Array;
 
     use super::*;
-    use schemas::markers::{CONTACT_MARKER_RADIUS_M, MIN_ARROW_LENGTH_M};
+    use schemas::markers::{LabelBox, CONTACT_MARKER_RADIUS_M, MIN_ARROW_LENGTH_M};
 
     /// The 3-vectors of column `field` of `chunk`, one row each (the first of the row).
     fn vec3_rows(chunk: &Chunk, field: &str) -> Vec<[f64; 3]> {
@@ -829,6 +450,7 @@ mod tests {
         let (chunks, _) = run_chunks(run, &paths);
         let mut nonzero = 0;
         let mut min_outside = f64::INFINITY;
+        let mut label_boxes: Vec<Vec<LabelBox>> = Vec::new();
         for (ci, c) in run.contacts.iter().enumerate() {
             let base = format!("/world/contacts/{}", c.name);
             let marker = vec3_rows(find(&chunks, &base, true), "positions");
@@ -846,7 +468,10 @@ mod tests {
                 .fold(0.0, f64::max);
             assert!(link_sphere > 0.0 && radius > link_sphere, "{}: marker {radius} m, URDF sphere {link_sphere} m", c.name);
             let arrows = find(&chunks, &format!("{base}/force"), true);
-            let (origins, vectors, labels) = (vec3_rows(arrows, "origins"), vec3_rows(arrows, "vectors"), strings(arrows, "labels"));
+            let (origins, vectors) = (vec3_rows(arrows, "origins"), vec3_rows(arrows, "vectors"));
+            let label_chunk = find(&chunks, &format!("{base}/label"), true);
+            let labels = strings(label_chunk, "labels");
+            label_boxes.push(vec3_rows(label_chunk, "positions").into_iter().zip(&labels).map(|(p, t)| LabelBox::new(p, t.chars().count())).collect::<Vec<_>>());
             assert_eq!(origins.len(), run.constraints.len());
             for (k, (_, s)) in run.constraints.iter().enumerate() {
                 let f = s.normal_force[ci].abs();
@@ -868,6 +493,13 @@ mod tests {
         }
         assert_eq!(nonzero, 2 * run.constraints.len(), "both elbows carry a force at every sample");
         assert!(min_outside >= 0.02, "{min_outside}");
+        // the two labels never clash (`schemas::markers::LabelBox`: a row apart or side by
+        // side, at every sample; f32 positions: 1e-6 m)
+        assert_eq!(label_boxes[0].len(), run.constraints.len());
+        for (k, (a, b)) in label_boxes[0].iter().zip(&label_boxes[1]).enumerate() {
+            let c = a.clearance_m(b);
+            assert!(c >= -1e-6, "sample {k}: the labels clash by {} m: {a:?} {b:?}", -c);
+        }
 
         // the table is /scene's (the size Foxglove draws)
         let table = find(&chunks, "/world/table0", false);
