@@ -43,6 +43,8 @@ mod convergence;
 mod drive_features;
 #[path = "drives.rs"]
 mod drives;
+#[path = "drives_support.rs"]
+mod drives_support;
 #[path = "fuzz_scenes.rs"]
 mod fuzz_scenes;
 #[path = "gear_supply.rs"]

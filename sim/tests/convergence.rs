@@ -14,6 +14,8 @@ use nalgebra::Vector3;
 use sim::scene::spec::{AdaptiveSpec, IntegratorSpec};
 use sim::scene::Scene;
 
+use crate::drives_support::assert_orders;
+
 fn hand(scene: &Scene) -> (Vec<Vector3<f64>>, u64) {
     let run = scene.run("two-elbow").unwrap().clone();
     let mut h = Vec::new();
@@ -66,11 +68,7 @@ fn every_method_converges_at_its_order_on_the_paper_arm() {
                 (err(&h), n as f64)
             })
             .collect();
-        let (e, n): (Vec<f64>, Vec<f64>) = runs.iter().copied().unzip();
-        let p = -slope(&n, &e);
-        assert!((p - order).abs() <= 0.5, "{method}: error ~ N^-{p:.2}, order {order} ({runs:?})");
-        let q = slope(tols, &e);
-        assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");
+        assert_orders(method, order, tols, &runs);
     }
 }
 
@@ -83,21 +81,15 @@ fn every_method_converges_at_its_order_on_the_paper_arm() {
 #[test]
 #[allow(clippy::result_large_err)] // the sink returns RunError
 fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() {
-    use sim::scene::spec::{BusSpec, GearFrictionSpec, PerJoint, PerJointFlag, SupplySpec};
+    use crate::drives_support::{dumping_bus, gears};
     let paper = Scene::paper().unwrap();
     let with = |i: IntegratorSpec| {
         paper
             .vary(|s| {
                 s.duration = 0.3;
                 s.integrator = i;
-                s.gear_friction = Some(GearFrictionSpec {
-                    coulomb: Some(PerJoint::All(0.2)),
-                    breakaway: Some(PerJoint::All(0.3)),
-                    stribeck_velocity: Some(PerJoint::All(0.05)),
-                    efficiency: Some(PerJoint::All(0.85)),
-                    back_efficiency: Some(PerJoint::All(0.7)),
-                });
-                s.supply = Some(SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: Some(BusSpec { efficiency: Some(0.9), regeneration: false }) });
+                s.gear_friction = Some(gears());
+                s.supply = Some(dumping_bus());
             })
             .unwrap()
     };
@@ -139,5 +131,16 @@ fn adaptive_methods_converge_at_their_order_with_gear_friction_and_the_supply() 
         assert!(p >= order - 0.5 && (p <= order + 1.0 || (p_last - order).abs() <= 0.75), "{method}: error ~ steps^-{p:.2}, last pair ^-{p_last:.2}, order {order} ({runs:?})");
         let q = slope(tols, &e);
         assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");
+    }
+    // RODAS5P and RODAS4, classical Rosenbrock methods whose order needs the exact Jacobian
+    // (forward differences with the arm's increment, `ArmSystem::difference_increment`): error
+    // ∝ rtol ± 0.15 over rtol 1e-6 … 1e-9 (measured 1.00 and 0.90; rtol^0.76 and ^0.67 with
+    // the earlier increment `sqrt(eps) max(|y_j|, atol / rtol)`, a plateau near 2e-12 m)
+    for method in ["rodas5p", "rodas4"] {
+        let tols = [1e-6, 1e-7, 1e-8, 1e-9];
+        let e: Vec<f64> = tols.iter().map(|&tol| err(&run_of(&with(IntegratorSpec::adaptive(method, tol, Some(0.1)).unwrap())).0)).collect();
+        let q = slope(&tols, &e);
+        eprintln!("{method}: error ~ rtol^{q:.3} ({e:?})");
+        assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({e:?})");
     }
 }

@@ -5,28 +5,12 @@
 
 #![allow(clippy::result_large_err)] // the sinks return RunError, as in convergence.rs
 
-use sim::scene::spec::{AdaptiveSpec, BusSpec, GearFrictionSpec, IntegratorSpec, PerJoint, PerJointFlag, SupplySpec};
+use sim::scene::spec::{AdaptiveSpec, GearFrictionSpec, IntegratorSpec};
 use sim::scene::Scene;
 
 use crate::convergence::slope;
+use crate::drives_support::{assert_blocks_match, assert_rodas_differences, dumping_bus, gears, lift};
 use crate::thermal::fast_thermal;
-
-/// The gear law used throughout: τ_c 0.2, τ_s 0.3 N m, Stribeck speed 0.05 rad/s, η 0.85,
-/// η_b 0.7 (a small gearbox's range, issue 26).
-fn gears() -> GearFrictionSpec {
-    GearFrictionSpec {
-        coulomb: Some(PerJoint::All(0.2)),
-        breakaway: Some(PerJoint::All(0.3)),
-        stribeck_velocity: Some(PerJoint::All(0.05)),
-        efficiency: Some(PerJoint::All(0.85)),
-        back_efficiency: Some(PerJoint::All(0.7)),
-    }
-}
-
-/// No regeneration in the drives, a bus of η_s 0.9 that dumps its surplus.
-fn supply() -> SupplySpec {
-    SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: Some(BusSpec { efficiency: Some(0.9), regeneration: false }) }
-}
 
 /// `fast_thermal` (thermal.rs: the paper's motor as a datasheet, winding time constant 0.2 s)
 /// with the gears and the supply on.
@@ -35,7 +19,7 @@ fn everything(integrator: IntegratorSpec, duration: f64) -> Scene {
         .vary(|s| {
             s.duration = duration;
             s.gear_friction = Some(gears());
-            s.supply = Some(supply());
+            s.supply = Some(dumping_bus());
         })
         .unwrap()
 }
@@ -61,7 +45,7 @@ fn dopri(rtol: f64) -> IntegratorSpec {
 }
 
 /// The convergence harness of `convergence.rs` (the same bands as `thermal.rs`: error ∝ rtol
-/// ± 0.15 for dopri45, rosenbrock and imex; rk4 below) with every feature on, over 0.3 s of
+/// ± 0.15 for dopri45, rosenbrock, imex, rodas5p and rodas4; rk4 below) with every feature on, over 0.3 s of
 /// the paper arm's open-chain run, whose first 11 ms alone hold 40 gear mode changes
 /// (breakaways, stops, power reversals on 9 of the 10 joints) and the supply's sign changes,
 /// each located on the method's dense output.
@@ -72,6 +56,14 @@ fn dopri(rtol: f64) -> IntegratorSpec {
 /// error of 1e-9 chose another sequence and every method ended 6.04e-5 m from its reference at
 /// every rtol (a plateau, error ∝ rtol^0); now each method takes the reference's sequence and
 /// the error falls with rtol over the whole 0.3 s (measured slopes 0.92, 0.99, 0.93).
+///
+/// RODAS5P and RODAS4 (classical Rosenbrock methods: their order needs the exact Jacobian,
+/// which they take by forward differences) in the same band over rtol 1e-6 … 1e-9: measured
+/// 1.08 and 1.03 (4.8e-10 … 2.6e-13 m, 3.6e-10 … 3.0e-13 m). With the increment
+/// `sqrt(eps) max(|y_j|, atol / rtol)` (1.5e-10 for an angle or a speed near 0) the
+/// differences' rounding error, up to 1e-4 of a row, gave RODAS4 rtol^0.55 (an error that
+/// stalled at 1.2e-11, 4.9e-12 m at rtol 1e-8, 1e-9); the arm now states its components'
+/// scale and its rounding noise (`ode/jacobian.rs`, `ArmSystem::difference_increment`).
 ///
 /// rk4 with the Stribeck term (v_s = 0.05 rad/s): slope 4 ± 0.3 over h = 5e-5, 2.5e-5, 1.25e-5 s
 /// and the first 20 ms (measured 4.05: 1.87e-9, 5.62e-11, 6.77e-12 m). At the harness's h = 2e-4,
@@ -97,6 +89,8 @@ fn every_method_keeps_its_order_with_every_drive_feature_on() {
         ("dopri45", &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10][..]),
         ("rosenbrock", &[1e-6, 1e-7, 1e-8, 1e-9][..]),
         ("imex", &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10][..]),
+        ("rodas5p", &[1e-6, 1e-7, 1e-8, 1e-9][..]),
+        ("rodas4", &[1e-6, 1e-7, 1e-8, 1e-9][..]),
     ] {
         let e: Vec<f64> = tols.iter().map(|&tol| err(&trace(&everything(IntegratorSpec::adaptive(method, tol, Some(0.1)).unwrap(), dur), "no-elbow").0)).collect();
         let q = slope(tols, &e);
@@ -212,26 +206,19 @@ fn coupled_gears_on_a_closed_chain_are_decided_together_and_run() {
 /// efficiency factor on K_m in `∂q̈/∂i`, the temperature rows, `−R' i / L`); (b) a lead screw
 /// on a datasheet drive lifting a slider at 0.03 m/s (no Coriolis, no gravity stiffness: every
 /// entry of its q̈ row is modelled), where the Stribeck slope enters `∂q̈/∂q̇` as well. Then
-/// RODAS's forward differences over the coupled columns against the central ones.
+/// RODAS's forward differences (the arm's increment) over the coupled columns against the
+/// central ones (`drives_support.rs`).
 #[test]
-#[allow(clippy::result_large_err)] // Scene::from_json's reader closure
 fn jacobians_match_differences_with_every_drive_feature_on() {
-    use sim::integrate::{fd_jacobian_columns, OdeJacobian as _};
     use std::ops::Range;
     let with_gears = |s: &mut sim::scene::SceneSpec| {
         s.gear_friction = Some(gears());
-        s.supply = Some(supply());
+        s.supply = Some(dumping_bus());
     };
     let paper = Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_thermal.json"))).unwrap().vary(with_gears).unwrap();
-    let lift_urdf = r#"<robot name="lift"><link name="base"/><joint name="screw" type="prismatic"><parent link="base"/><child link="slider"/><axis xyz="0 0 1"/><limit lower="-1e4" upper="1e4" effort="1e4" velocity="1e3"/></joint><link name="slider"><inertial><mass value="2"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#;
-    let json = r#"{"name":"lift","urdf":"lift.urdf","gravity":[0,0,-9.81],"duration":0.3,"output_rate":1000,"joint_damping":0.1,
-        "motor":{"torque_constant":0.05,"resistance":1.0,"inductance":0.001,"rotor_inertia":1e-6,"gear_ratio":1256.6370614359173,"gear_damping":0},
-        "drives":[{"joints":["screw"],"motor":"maxon-re40-148877","gearhead_data":{"reduction":1256.6370614359173}}],
-        "thermal":{"ambient_temperature_c":25.0},
-        "controller":{"kp":10,"kd":1},"hand":{"link":"slider"},
-        "target":{"kind":"joint-spline","waypoints":[{"t":0,"q":[0.1]},{"t":1,"q":[0.1]}]},
-        "initial":{"q":0},"integrator":{"method":"dopri45","rtol":1e-9,"atol":1e-11},"runs":[{"name":"lift","contacts":[]}]}"#;
-    let lift = Scene::from_json(json, "lift.json", |_| Ok(lift_urdf.to_string())).unwrap().vary(with_gears).unwrap();
+    let datasheet = r#""drives":[{"joints":["screw"],"motor":"maxon-re40-148877","gearhead_data":{"reduction":1256.6370614359173}}],
+        "thermal":{"ambient_temperature_c":25.0},"#;
+    let lift = lift(0.001, datasheet).vary(with_gears).unwrap();
     let mut checked = 0;
     for (scene, speed) in [(&paper, 0.0), (&lift, 0.03)] {
         for run in scene.runs() {
@@ -247,7 +234,6 @@ fn jacobians_match_differences_with_every_drive_feature_on() {
                 y[l.winding_temperature().start + j] = 25.0 + 10.0 * j as f64;
                 y[l.housing_temperature().start + j] = 25.0 + 4.0 * j as f64;
             }
-            let dim = l.dim();
             let t = 0.37;
             let (f, j, fd) = crate::stiff_methods::jacobian_and_differences(&mut sys, t, &y);
             let temps = l.winding_temperature().start..l.housing_temperature().end;
@@ -259,38 +245,9 @@ fn jacobians_match_differences_with_every_drive_feature_on() {
                 (l.housing_temperature(), vec![l.q(), l.qd(), l.current(), temps.clone()]),
             ];
             let what = format!("{} run {}", scene.spec().name, run.name);
-            for (rows, groups) in &blocks {
-                for cols in groups {
-                    let scale = rows.clone().flat_map(|r| cols.clone().map(move |c| (r, c))).map(|(r, c)| fd[r * dim + c].abs()).fold(0.0, f64::max);
-                    for r in rows.clone() {
-                        for c in cols.clone() {
-                            let (a, b) = (j[r * dim + c], fd[r * dim + c]);
-                            let h = 1e-6 * (1.0 + y[c].abs());
-                            let tol = 1e-7 * (b.abs() + scale) + 4.0 * f64::EPSILON * (f[r].abs() + 1.0) / h;
-                            assert!((a - b).abs() <= tol, "{what}: d f[{r}] / d y[{c}]: structured {a}, differences {b} (block scale {scale:e})");
-                            checked += 1;
-                        }
-                    }
-                }
-            }
-            // RODAS: forward differences over the coupled columns, the quadratures' columns 0
-            let nc = sys.coupled_dim();
-            let mut jf = vec![0.0; dim * dim];
-            let (mut sy, mut sf) = (vec![0.0; dim], vec![0.0; dim]);
-            fd_jacobian_columns(&mut sys, t, &y, &f, &mut jf, nc, 1e-2, &mut sy, &mut sf).unwrap();
-            let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for r in 0..dim {
-                let scale = (0..nc).map(|c| fd[r * dim + c].abs()).fold(0.0, f64::max);
-                for c in 0..dim {
-                    if c >= nc {
-                        assert_eq!(fd[r * dim + c], 0.0, "{what}: d f[{r}] / d y[{c}] (a quadrature column)");
-                        continue;
-                    }
-                    let delta = f64::EPSILON.sqrt() * y[c].abs().max(1e-2);
-                    let tol = 1e-6 * scale + 128.0 * f64::EPSILON * (fmax + 1.0) / delta;
-                    assert!((jf[r * dim + c] - fd[r * dim + c]).abs() <= tol, "{what}: RODAS d f[{r}] / d y[{c}]: {} vs {}", jf[r * dim + c], fd[r * dim + c]);
-                }
-            }
+            checked += assert_blocks_match(&what, &y, &f, &j, &fd, &blocks, |_, _, _| {});
+            // RODAS: its forward differences over the coupled columns, the quadratures' columns 0
+            assert_rodas_differences(&mut sys, t, &y, &f, &fd, &what);
         }
     }
     assert!(checked > 1000, "{checked} entries");

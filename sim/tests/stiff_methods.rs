@@ -9,6 +9,8 @@ use sim::scene::Scene;
 use sim::ode::ArmSystem;
 use std::ops::Range;
 
+use crate::drives_support::{assert_blocks_match, assert_rodas_differences, dumping_bus, gear_law, lift};
+
 /// The system of `run` and its initial state with every motor current set to a different
 /// non-zero value, so that the current-dependent terms are exercised.
 fn with_currents<'a>(scene: &'a Scene, run: &'a sim::scene::Run) -> (ArmSystem<'a>, Vec<f64>) {
@@ -81,7 +83,6 @@ fn structured_jacobian_matches_central_differences_for_every_plant() {
             for run in scene.runs() {
                 let (mut sys, y) = with_currents(&scene, run);
                 let l = sys.layout();
-                let dim = l.dim();
                 let t = 0.37;
                 let (f, j, fd) = jacobian_and_differences(&mut sys, t, &y);
                 let what = format!("{mm:?} {solver:?} L = {inductance} run {}", run.name);
@@ -92,25 +93,7 @@ fn structured_jacobian_matches_central_differences_for_every_plant() {
                     (l.qd(), vec![l.qd(), l.current()]),
                     (l.current(), vec![l.q(), l.qd(), l.current()]),
                 ];
-                let mut checked = 0;
-                for (rows, column_groups) in &blocks {
-                    for cols in column_groups {
-                        // the block's own scale: its largest entry
-                        let fd = &fd;
-                        let scale = rows.clone().flat_map(|r| cols.clone().map(move |c| fd[r * dim + c].abs())).fold(0.0, f64::max);
-                        for r in rows.clone() {
-                            for c in cols.clone() {
-                                let (a, b) = (j[r * dim + c], fd[r * dim + c]);
-                                // truncation O(h²) well under 1e-7 of the block; rounding
-                                // eps |f_r| / h of the differences themselves
-                                let h = 1e-6 * (1.0 + y[c].abs());
-                                let tol = 1e-7 * (b.abs() + scale) + 4.0 * f64::EPSILON * (f[r].abs() + 1.0) / h;
-                                assert!((a - b).abs() <= tol, "{what}: d f[{r}] / d y[{c}]: structured {a}, differences {b} (block scale {scale:e})");
-                                checked += 1;
-                            }
-                        }
-                    }
-                }
+                let checked = assert_blocks_match(&what, &y, &f, &j, &fd, &blocks, |_, _, _| {});
                 assert!(checked >= 2 * l.nv * l.nv, "{what}: {checked} entries");
             }
         }
@@ -119,7 +102,9 @@ fn structured_jacobian_matches_central_differences_for_every_plant() {
 
 /// The Jacobian the classical Rosenbrock methods (RODAS5P) use on the arm: forward
 /// differences over the coupled columns (q, q', i: `coupled_dim`) only, the quadrature columns
-/// zero, with the increment floor of the precision ladder (atol / rtol = 1e-2). Against central differences over every column, for every contact set, with and
+/// zero, with the arm's increment `sqrt(1e-13) max(|y_j|, 1)` (`ArmSystem::difference_increment`;
+/// the numbers below were measured with the earlier `sqrt(eps) max(|y_j|, 1e-2)`, whose
+/// rounding error cost RODAS its order with gear friction, `drive_features.rs`). Against central differences over every column, for every contact set, with and
 /// without inductance, at a moving state (q' != 0, currents != 0, where Coriolis and the
 /// other terms the structured Jacobian leaves out have derivatives): the quadrature columns of
 /// the central differences are exactly 0 (the quadratures never enter f), the coupled columns
@@ -133,7 +118,6 @@ fn structured_jacobian_matches_central_differences_for_every_plant() {
 /// order on).
 #[test]
 fn rodas_jacobian_is_exact_on_the_coupled_block() {
-    use sim::integrate::fd_jacobian_columns;
     let paper = Scene::paper().unwrap();
     for inductance in [0.0017, 0.0] {
         let scene = paper.vary(|s| s.motor.inductance = PerJoint::All(inductance)).unwrap();
@@ -151,24 +135,9 @@ fn rodas_jacobian_is_exact_on_the_coupled_block() {
             sys.rhs(t, &y, &mut f).unwrap();
             let mut probe = vec![0.0; dim * dim];
             assert!(!sys.exact_jacobian(t, &y, &f, &mut probe).unwrap(), "the arm leaves the exact Jacobian to differences");
-            let mut j = vec![0.0; dim * dim];
-            let (mut sy, mut sf) = (vec![0.0; dim], vec![0.0; dim]);
-            fd_jacobian_columns(&mut sys, t, &y, &f, &mut j, nc, 1e-2, &mut sy, &mut sf).unwrap();
             let central = central_jacobian(&mut sys, t, &y);
             let what = format!("L = {inductance} run {}", run.name);
-            let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for r in 0..dim {
-                for c in nc..dim {
-                    assert_eq!(central[r * dim + c], 0.0, "{what}: d f[{r}] / d y[{c}] (a quadrature column)");
-                }
-                let scale = (0..nc).map(|c| central[r * dim + c].abs()).fold(0.0, f64::max);
-                for c in 0..nc {
-                    let (a, b) = (j[r * dim + c], central[r * dim + c]);
-                    let delta = f64::EPSILON.sqrt() * y[c].abs().max(1e-2);
-                    let tol = 1e-6 * scale + 128.0 * f64::EPSILON * (fmax + 1.0) / delta;
-                    assert!((a - b).abs() <= tol, "{what}: d f[{r}] / d y[{c}]: forward {a}, central {b} (row scale {scale:e}, tol {tol:e})");
-                }
-            }
+            assert_rodas_differences(&mut sys, t, &y, &f, &central, &what);
             let mut approx = vec![0.0; dim * dim];
             sys.jacobian(t, &y, &f, &mut approx).unwrap();
             let rows = l.qd();
@@ -339,42 +308,23 @@ fn the_fastest_modes_are_the_ones_stated() {
 /// `∂q̈/∂q̇`; and RODAS's forward differences over the coupled columns against central ones.
 /// Without the gear terms in `jacobian.rs` (c = 1, no slope) (a) and (b) fail.
 #[test]
-#[allow(clippy::result_large_err)] // Scene::from_json's reader closure
 fn jacobians_match_differences_with_gear_friction_and_a_supply() {
-    use sim::integrate::fd_jacobian_columns;
-    use sim::scene::spec::{BusSpec, GearFrictionSpec, PerJointFlag, SupplySpec};
     let gear = |s: &mut sim::scene::SceneSpec| {
-        s.gear_friction = Some(GearFrictionSpec {
-            coulomb: Some(PerJoint::All(0.1)),
-            breakaway: Some(PerJoint::All(0.3)),
-            stribeck_velocity: Some(PerJoint::All(0.05)),
-            efficiency: Some(PerJoint::All(0.8)),
-            back_efficiency: Some(PerJoint::All(0.6)),
-        });
-        s.supply = Some(SupplySpec { regeneration: Some(PerJointFlag::All(false)), bus: Some(BusSpec { efficiency: Some(0.9), regeneration: false }) });
+        s.gear_friction = Some(gear_law(0.1, 0.3, 0.05, 0.8, 0.6));
+        s.supply = Some(dumping_bus());
     };
-    let lift_urdf = r#"<robot name="lift"><link name="base"/><joint name="screw" type="prismatic"><parent link="base"/><child link="slider"/><axis xyz="0 0 1"/><limit lower="-1e4" upper="1e4" effort="1e4" velocity="1e3"/></joint><link name="slider"><inertial><mass value="2"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#;
     let mut scenes = Vec::new();
     for inductance in [0.0017, 0.0] {
         scenes.push((Scene::paper().unwrap().vary(|s| {
             s.motor.inductance = PerJoint::All(inductance);
             gear(s);
         }).unwrap(), 0.0));
-        let json = format!(
-            r#"{{"name":"lift","urdf":"lift.urdf","gravity":[0,0,-9.81],"duration":0.3,"output_rate":1000,"joint_damping":0.1,
-            "motor":{{"torque_constant":0.05,"resistance":1.0,"inductance":{inductance},"rotor_inertia":1e-6,"gear_ratio":1256.6370614359173,"gear_damping":0}},
-            "controller":{{"kp":10,"kd":1}},"hand":{{"link":"slider"}},
-            "target":{{"kind":"joint-spline","waypoints":[{{"t":0,"q":[0.1]}},{{"t":1,"q":[0.1]}}]}},
-            "initial":{{"q":0}},"integrator":{{"method":"dopri45","rtol":1e-9,"atol":1e-11}},"runs":[{{"name":"lift","contacts":[]}}]}}"#
-        );
-        let lift = Scene::from_json(&json, "lift.json", |_| Ok(lift_urdf.to_string())).unwrap().vary(gear).unwrap();
-        scenes.push((lift, 0.03));
+        scenes.push((lift(inductance, "").vary(gear).unwrap(), 0.03));
     }
     for (scene, speed) in &scenes {
         for run in scene.runs() {
             let (mut sys, mut y) = with_currents(scene, run);
             let l = sys.layout();
-            let dim = l.dim();
             for v in y[l.qd()].iter_mut() {
                 *v = *speed;
             }
@@ -386,38 +336,9 @@ fn jacobians_match_differences_with_gear_friction_and_a_supply() {
                 (l.qd(), vec![l.qd(), l.current()]),
                 (l.current(), vec![l.q(), l.qd(), l.current()]),
             ];
-            for (rows, column_groups) in &blocks {
-                for cols in column_groups {
-                    let fd = &fd;
-                    let scale = rows.clone().flat_map(|r| cols.clone().map(move |c| fd[r * dim + c].abs())).fold(0.0, f64::max);
-                    for r in rows.clone() {
-                        for c in cols.clone() {
-                            let (a, b) = (j[r * dim + c], fd[r * dim + c]);
-                            let h = 1e-6 * (1.0 + y[c].abs());
-                            let tol = 1e-7 * (b.abs() + scale) + 4.0 * f64::EPSILON * (f[r].abs() + 1.0) / h;
-                            assert!((a - b).abs() <= tol, "{what}: d f[{r}] / d y[{c}]: structured {a}, differences {b} (block scale {scale:e})");
-                        }
-                    }
-                }
-            }
+            assert_blocks_match(&what, &y, &f, &j, &fd, &blocks, |_, _, _| {});
             // RODAS: forward differences over the coupled columns, the quadratures' columns 0
-            let nc = sys.coupled_dim();
-            let mut jf = vec![0.0; dim * dim];
-            let (mut sy, mut sf) = (vec![0.0; dim], vec![0.0; dim]);
-            fd_jacobian_columns(&mut sys, t, &y, &f, &mut jf, nc, 1e-2, &mut sy, &mut sf).unwrap();
-            let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for r in 0..dim {
-                let scale = (0..nc).map(|c| fd[r * dim + c].abs()).fold(0.0, f64::max);
-                for c in 0..dim {
-                    if c >= nc {
-                        assert_eq!(fd[r * dim + c], 0.0, "{what}: d f[{r}] / d y[{c}] (a quadrature column)");
-                        continue;
-                    }
-                    let delta = f64::EPSILON.sqrt() * y[c].abs().max(1e-2);
-                    let tol = 1e-6 * scale + 128.0 * f64::EPSILON * (fmax + 1.0) / delta;
-                    assert!((jf[r * dim + c] - fd[r * dim + c]).abs() <= tol, "{what}: RODAS d f[{r}] / d y[{c}]");
-                }
-            }
+            assert_rodas_differences(&mut sys, t, &y, &f, &fd, &what);
         }
     }
 }

@@ -13,6 +13,7 @@ use sim::scene::spec_drive::MotorDatasheet;
 use sim::scene::Scene;
 
 use crate::convergence::slope;
+use crate::drives_support::{assert_blocks_match, assert_orders};
 use crate::stiff_methods::jacobian_and_differences;
 
 fn paper_thermal() -> Scene {
@@ -253,11 +254,7 @@ fn every_method_keeps_its_order_with_the_thermal_model_on() {
             })
             .collect();
         assert!(et[et.len() - 1] < 1e-5 && et[0] > et[et.len() - 1], "{method}: temperature errors {et:?} K");
-        let (e, n): (Vec<f64>, Vec<f64>) = runs.iter().copied().unzip();
-        let p = -slope(&n, &e);
-        assert!((p - order).abs() <= 0.5, "{method}: error ~ N^-{p:.2}, order {order} ({runs:?})");
-        let q = slope(tols, &e);
-        assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({runs:?})");
+        assert_orders(method, order, tols, &runs);
     }
 }
 
@@ -283,7 +280,6 @@ fn structured_jacobian_matches_differences_with_the_thermal_model_on() {
             y[l.winding_temperature().start + j] = 25.0 + 10.0 * j as f64;
             y[l.housing_temperature().start + j] = 25.0 + 4.0 * j as f64;
         }
-        let dim = l.dim();
         let t = 0.37;
         let (f, j, fd) = jacobian_and_differences(&mut sys, t, &y);
         let temps = l.winding_temperature().start..l.housing_temperature().end;
@@ -294,22 +290,11 @@ fn structured_jacobian_matches_differences_with_the_thermal_model_on() {
             (l.housing_temperature(), vec![l.q(), l.qd(), l.current(), temps.clone()]),
         ];
         let mut nonzero = 0;
-        for (rows, groups) in &blocks {
-            for cols in groups {
-                let scale = rows.clone().flat_map(|r| cols.clone().map(move |c| (r, c))).map(|(r, c)| fd[r * dim + c].abs()).fold(0.0, f64::max);
-                for r in rows.clone() {
-                    for c in cols.clone() {
-                        let (a, b) = (j[r * dim + c], fd[r * dim + c]);
-                        let h = 1e-6 * (1.0 + y[c].abs());
-                        let tol = 1e-7 * (b.abs() + scale) + 4.0 * f64::EPSILON * (f[r].abs() + 1.0) / h;
-                        assert!((a - b).abs() <= tol, "run {}: d f[{r}] ({}) / d y[{c}] ({}): structured {a}, differences {b}", run.name, l.name(r, &scene.model().joint_names()), l.name(c, &scene.model().joint_names()));
-                        if temps.contains(&r) || temps.contains(&c) {
-                            nonzero += usize::from(b != 0.0);
-                        }
-                    }
-                }
+        assert_blocks_match(&format!("run {}", run.name), &y, &f, &j, &fd, &blocks, |r, c, b| {
+            if temps.contains(&r) || temps.contains(&c) {
+                nonzero += usize::from(b != 0.0);
             }
-        }
+        });
         // per joint: dT_w/dT_w, dT_w/dT_h, dT_w/di, dT_h/dT_w, dT_h/dT_h, di/dT_w
         // (joint5 has i = 0: its dT_w/di and di/dT_w vanish)
         assert!(nonzero >= 6 * l.nv - 2, "run {}: {nonzero} thermal entries", run.name);

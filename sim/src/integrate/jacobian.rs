@@ -11,6 +11,23 @@
 
 use super::{OdeJacobian, OdeSystem, Watch};
 
+/// The forward-difference increment of a column, `delta_j = sqrt(noise) max(|y_j|, floor)`:
+/// the size that balances the truncation error `delta |f''| / 2` against the rounding error
+/// `noise |f| / delta` when `f` is computed with relative noise `noise` (≥ eps) and the
+/// components have natural size `floor` (Gill, Murray & Wright, *Practical Optimization*,
+/// Academic Press 1981, §8.6.2, "finite-difference intervals"; Moré & Wild, "Estimating
+/// derivatives of noisy simulations", ACM TOMS 38 (2012) 19). A right-hand side that sums many
+/// rounded terms (an arm's RNEA, CRBA and Cholesky) is noisier than eps, and differencing it
+/// with `sqrt(eps)` gives a Jacobian whose rounding error, `sqrt(noise / eps)` times larger
+/// than planned, costs a classical Rosenbrock method its order ([`OdeJacobian::difference_increment`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DifferenceIncrement {
+    /// Relative rounding noise of `f` (values below eps count as eps).
+    pub noise: f64,
+    /// The size below which a component counts as 0 (its natural scale).
+    pub floor: f64,
+}
+
 /// Forward-difference Jacobian `jac[i * n + j] ≈ ∂f_i/∂y_j` of `sys` at `(t, y)`, column by
 /// column (`n = y.len()` evaluations of `rhs`), given `fy = f(t, y)`. `scratch_y`, `scratch_f`
 /// (length `n`) are overwritten. Allocates nothing.
@@ -59,10 +76,12 @@ pub fn fd_jacobian_columns<S: OdeSystem>(
     scratch_y: &mut [f64],
     scratch_f: &mut [f64],
 ) -> Result<(), S::Error> {
-    fd_jacobian_columns_within(sys, t, y, fy, jac, cols, floor, scratch_y, scratch_f, Watch::default()).map(|_| ())
+    fd_jacobian_columns_within(sys, t, y, fy, jac, cols, DifferenceIncrement { noise: f64::EPSILON, floor }, scratch_y, scratch_f, Watch::default()).map(|_| ())
 }
 
-/// [`fd_jacobian_columns`] that reads `watch`'s clock before every column after the first
+/// [`fd_jacobian_columns`] with the increment `sqrt(inc.noise) max(|y_j|, inc.floor)`
+/// ([`DifferenceIncrement`]; `fd_jacobian_columns` is `noise = eps`) that reads `watch`'s clock
+/// before every column after the first
 /// (each costs one evaluation of `rhs`, far more than the clock): `Ok(None)` when every column
 /// is done, `Ok(Some(j))` when the deadline passed before column `j` (0-based; the columns
 /// from `j` on are not computed). Allocates nothing.
@@ -80,7 +99,7 @@ pub fn fd_jacobian_columns_within<S: OdeSystem>(
     fy: &[f64],
     jac: &mut [f64],
     cols: usize,
-    floor: f64,
+    inc: DifferenceIncrement,
     scratch_y: &mut [f64],
     scratch_f: &mut [f64],
     watch: Watch,
@@ -90,14 +109,14 @@ pub fn fd_jacobian_columns_within<S: OdeSystem>(
         fy.len() == n && scratch_y.len() == n && scratch_f.len() == n && jac.len() == n * n && cols <= n,
         "fd_jacobian: slice lengths vs dim {n}, columns {cols}"
     );
-    let sqrt_eps = f64::EPSILON.sqrt();
+    let rel = inc.noise.max(f64::EPSILON).sqrt();
     scratch_y.copy_from_slice(y);
     for j in 0..cols {
         if j > 0 && watch.out_of_time() {
             return Ok(Some(j));
         }
         let yj = y[j];
-        let delta = sqrt_eps * yj.abs().max(floor);
+        let delta = rel * yj.abs().max(inc.floor);
         scratch_y[j] = if yj < 0.0 { yj - delta } else { yj + delta };
         let d = scratch_y[j] - yj; // the increment actually represented
         let res = sys.rhs_column(t, scratch_y, j, scratch_f);

@@ -124,7 +124,7 @@ pub use self::control::{SettingsError, StepControl};
 pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
 pub use self::events::{integrate_hybrid, EventSettings, HybridSystem};
 pub use self::imex::ArkImex;
-pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, fd_jacobian_columns_within, FdJacobian};
+pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, fd_jacobian_columns_within, DifferenceIncrement, FdJacobian};
 pub use self::rk4::Rk4;
 pub use self::rodas::{Rodas, RodasMethod};
 pub use self::rosenbrock::Rosenbrock;
@@ -215,6 +215,14 @@ pub trait OdeJacobian: OdeSystem {
     /// assumes nothing.
     fn coupled_dim(&self) -> usize {
         self.dim()
+    }
+
+    /// How [`Rodas`] differences `f` when [`OdeJacobian::exact_jacobian`] gives no Jacobian:
+    /// the relative noise of `f` and the components' natural size ([`DifferenceIncrement`]).
+    /// The default, `None`: `f` rounded to eps, and the stepper's own floor (`atol / rtol`
+    /// within `[1e-5, 1]`, which knows nothing of the components' units).
+    fn difference_increment(&self) -> Option<DifferenceIncrement> {
+        None
     }
 }
 

@@ -27,7 +27,8 @@
 //! - Jacobian: [`OdeJacobian::exact_jacobian`]; if the system has none, forward differences
 //!   (HNW II §IV.8, [`super::fd_jacobian_columns`], increment `sqrt(eps) max(|y_j|, floor)`
 //!   with `floor = atol / rtol` within `[1e-5, 1]`, the scale below which the error norm
-//!   treats a component as absolute) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`. `f_t`:
+//!   treats a component as absolute, unless the system states its noise and scale,
+//!   [`OdeJacobian::difference_increment`]) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`. `f_t`:
 //!   [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
 //!   [`super::Rosenbrock`]. Both are evaluated at the start of every step by default;
 //!   `with_jacobian_reuse(k)` keeps `J` for `k` accepted steps (this loses the order, which
@@ -42,7 +43,7 @@
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
 use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
-use super::jacobian::fd_jacobian_columns_within;
+use super::jacobian::{fd_jacobian_columns_within, DifferenceIncrement};
 use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::rosenbrock::{stage_argument, stage_rhs, time_derivative};
 use super::{
@@ -252,6 +253,7 @@ impl Rodas {
             .map_err(IntegrateError::Rhs)?;
         if !exact {
             self.jac.fill(0.0);
+            let inc = sys.difference_increment().unwrap_or(DifferenceIncrement { noise: f64::EPSILON, floor: fd_floor(&self.core.control) });
             let stopped = fd_jacobian_columns_within(
                 sys,
                 t,
@@ -259,7 +261,7 @@ impl Rodas {
                 &self.f0,
                 &mut self.jac,
                 nc,
-                fd_floor(&self.core.control),
+                inc,
                 &mut self.y_stage,
                 &mut self.f_stage,
                 self.watch,

@@ -28,7 +28,8 @@
 //! - For the classical Rosenbrock methods (`Rodas`), which need the exact Jacobian:
 //!   [`OdeJacobian::coupled_dim`] = the q, q̇, i block (the quadratures never feed back, so
 //!   their columns are zero), and no analytic exact Jacobian, so the stepper differences the
-//!   right-hand side over those columns.
+//!   right-hand side over those columns, with the increment the arm's units and rounding noise
+//!   call for ([`OdeJacobian::difference_increment`]).
 //! - [`SplitSystem`]: the armature circuit `L di/dt = v − R i − K_e k q̇` (K_e k = K_m unless
 //!   the scene gives `back_emf_constant`) is linear in i with a diagonal matrix, so its implicit
 //!   stage equation `z − γ f_I(z) = r` has the closed form
@@ -93,6 +94,24 @@ impl OdeJacobian for ArmSystem<'_> {
     /// right-hand side.
     fn coupled_dim(&self) -> usize {
         self.layout.work().start
+    }
+
+    /// The increment RODAS differences `f` with: `3.2e-7 max(|y_j|, 1)`. The components are in
+    /// SI units of natural size 1 (rad, rad/s, A; m for a prismatic joint; °C, larger), not
+    /// `atol / rtol` (1e-2 at the usual tolerances: an angle or a speed at 0 got an increment
+    /// of 1.5e-10); and q̈, summed from the RNEA, the CRBA, a Cholesky solve and the
+    /// constraint and gear solves, carries a rounding noise up to ~2e-14 of the largest |q̈|
+    /// (measured on the paper arm with every drive feature, the 6th differences of f along
+    /// each coupled component, Moré & Wild 2012), so `noise = 1e-13` leaves a margin of 5.
+    /// With `sqrt(eps) · max(|y_j|, 1e-2)` the difference Jacobian's rounding error, up to 1e-4
+    /// of a row, cost RODAS4 its order with gear friction on (error ∝ rtol^0.55 over
+    /// 1e-6 … 1e-9, `drive_features.rs`) and RODAS5P on the paper arm with gears (rtol^0.76).
+    /// Not in a run with contact modes (`None`: the stepper's `sqrt(eps) max(|y_j|, atol /
+    /// rtol)`): a sliding contact's friction direction blends over tangential speeds below
+    /// 1e-6 m/s (`dynamics/contact/forward.rs`), a feature of f far below the SI scale that an
+    /// increment of 3.2e-7 rad/s would straddle.
+    fn difference_increment(&self) -> Option<crate::integrate::DifferenceIncrement> {
+        self.hybrid.is_none().then_some(crate::integrate::DifferenceIncrement { noise: 1e-13, floor: 1.0 })
     }
 
     fn jacobian(&mut self, t: f64, y: &[f64], _fy: &[f64], jac: &mut [f64]) -> Result<(), RunError> {

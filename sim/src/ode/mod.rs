@@ -41,6 +41,7 @@
 
 mod arm;
 mod describe;
+mod drive_forces;
 mod drive_modes;
 mod hybrid;
 mod jacobian;
