@@ -207,7 +207,7 @@ fn sticking_is_a_three_row_weld() {
     let mut fd0 = ForwardData::new(n, 3);
     forward_dynamics(&p, &mut data, &mut fd0, 0.0, &q, &qd, &cur, &cur).expect("weld");
     let contacts = [contact];
-    let state = ContactState { mode: vec![ContactMode::Sticking], slip: vec![[1.0, 0.0]] };
+    let state = ContactState { mode: vec![ContactMode::Sticking], slip: vec![[1.0, 0.0]], onset: vec![None] };
     let (mut fd, mut cd) = (ForwardData::new(n, 1), ContactData::new(n, 1));
     forward_dynamics_contacts(&plant(&model, &drives), &contacts, &state, &mut data, &mut fd, &mut cd, 0.0, &q, &qd, &cur, &cur).expect("sticking");
     let d = (&fd.qdd - &fd0.qdd).amax() / fd0.qdd.amax().max(1.0);
@@ -346,7 +346,7 @@ fn sliding_solve_satisfies_its_equations() {
     let mut data = Data::new(&model);
     let (mut fd, mut cd) = (ForwardData::new(n, 1), ContactData::new(n, 1));
     prepare(&plant(&model, &drives), &contacts, &mut data, &mut fd, &mut cd, 0.0, &q, &qd, &cur).expect("prepare");
-    let state = ContactState { mode: vec![ContactMode::Sliding], slip: vec![[0.6, 0.8]] };
+    let state = ContactState { mode: vec![ContactMode::Sliding], slip: vec![[0.6, 0.8]], onset: vec![None] };
     solve_modes(&contacts, &state, Default::default(), &mut fd, &mut cd).expect("solvable");
     let qdd = fd.qdd.as_slice();
     let res = cd.rows.dot(0, qdd) + cd.rows.bias[0];
