@@ -300,8 +300,8 @@ fn onset_anchors(contacts: &[Contact], state: &ContactState, stabilization: Stab
     let ok = solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, fd.b.as_slice(), &cd.rows, &cd.active, &mut cd.scratch, &mut fd.qdd.as_mut_slice()[..nv]).is_ok();
     if ok {
         forces_of(contacts, &mode, cd);
-        for k in 0..contacts.len() {
-            if mode[k] == ContactMode::Sticking && state.mode[k] == ContactMode::Sliding {
+        for (k, (&now, &was)) in mode.iter().zip(&state.mode).enumerate() {
+            if now == ContactMode::Sticking && was == ContactMode::Sliding {
                 let f = cd.f_t[k];
                 let m = f[0].hypot(f[1]);
                 if let (true, Some(r)) = (m > 1e-12 * (1.0 + cd.f_n[k].abs()), state.onset[k]) {
