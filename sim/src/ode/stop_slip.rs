@@ -1,7 +1,9 @@
 //! Slip→stick of sliding contacts at the located zero of their slip (`hybrid.rs`, `stops_here`:
 //! `|v_t| ≤ vel_tol` there): an M_J-weighted velocity projection of the slip left at the root
 //! (≤ 1e-9 m/s; Pfeiffer & Glocker 1996, ch. 6: the impulsive limit of Coulomb friction;
-//! Acary & Brogliato 2008, ch. 7), its kinetic-energy loss booked per contact as friction work. Split from `hybrid.rs` (file size).
+//! Acary & Brogliato 2008, ch. 7), its kinetic-energy loss booked per contact as friction work.
+//! The same projection removes a breaking stick's drift (~1e-13 m/s) at a stick → slip onset,
+//! so the slide starts from rest exactly. Split from `hybrid.rs` (file size).
 
 use crate::dynamics::contact::ContactMode;
 use crate::error::{DynamicsError, RunError};

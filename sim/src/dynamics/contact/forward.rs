@@ -24,6 +24,13 @@ use crate::error::DynamicsError;
 pub struct ContactState {
     pub mode: Vec<ContactMode>,
     pub slip: Vec<[f64; 2]>,
+    /// Per contact: `Some(r)` for a slip that started from rest (a stick → slip onset) and has
+    /// not reached [`SLIP_DIRECTION_SPEED`] at the end of a step yet. Below that speed its
+    /// friction's blend turns towards the impending direction of the sticking force at the
+    /// current state turned by the rotation `r = (cos, sin)` ([`onset_anchors`]; `r` takes the
+    /// impending direction to the slip direction the mode problem chose at the onset), not
+    /// towards the fixed `slip`.
+    pub onset: Vec<Option<[f64; 2]>>,
 }
 
 impl ContactState {
@@ -32,6 +39,7 @@ impl ContactState {
         ContactState {
             mode: contacts.iter().map(|c| if c.model == ContactModel::Bilateral { ContactMode::Bilateral } else { ContactMode::Separated }).collect(),
             slip: vec![[1.0, 0.0]; contacts.len()],
+            onset: vec![None; contacts.len()],
         }
     }
 }
@@ -49,6 +57,12 @@ pub struct ContactData {
     /// largest over the forces a statically indeterminate contact admits
     /// (`indeterminate.rs`; `+∞` when jammed); 0 in the other modes.
     pub margin: Vec<f64>,
+    /// Per contact: the direction a sliding contact's friction blends towards below
+    /// [`SLIP_DIRECTION_SPEED`] in the last solve (unit, tangent basis): the stored slip
+    /// direction, or during an onset the impending direction ([`onset_anchors`]).
+    pub anchor: Vec<[f64; 2]>,
+    /// Scratch of [`onset_anchors`]: the modes with the onset contacts sticking.
+    stick_mode: Vec<ContactMode>,
 }
 
 impl ContactData {
@@ -60,6 +74,8 @@ impl ContactData {
             f_n: vec![0.0; nc],
             f_t: vec![[0.0; 2]; nc],
             margin: vec![0.0; nc],
+            anchor: vec![[1.0, 0.0]; nc],
+            stick_mode: vec![ContactMode::Separated; nc],
         }
     }
 }
@@ -205,6 +221,15 @@ fn compliant_forces(contacts: &[Contact], fd: &mut ForwardData, cd: &mut Contact
 
 /// The active rows of `state` (with Baumgarte's terms when asked) into `cd.active`.
 pub fn active_rows(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, cd: &mut ContactData) {
+    for k in 0..contacts.len() {
+        cd.anchor[k] = state.slip[k];
+    }
+    active_rows_of(contacts, &state.mode, stabilization, cd);
+}
+
+/// [`active_rows`] of the modes `mode`, a sliding contact's friction blending towards
+/// `cd.anchor` below [`SLIP_DIRECTION_SPEED`].
+fn active_rows_of(contacts: &[Contact], mode: &[ContactMode], stabilization: Stabilization, cd: &mut ContactData) {
     let (alpha, beta) = match stabilization {
         Stabilization::Baumgarte { alpha, beta } => (alpha, beta),
         _ => (0.0, 0.0),
@@ -218,7 +243,7 @@ pub fn active_rows(contacts: &[Contact], state: &ContactState, stabilization: St
             ContactModel::Unilateral { friction, .. } => friction,
             _ => 0.0,
         };
-        match state.mode[k] {
+        match mode[k] {
             ContactMode::Separated => {}
             ContactMode::Bilateral => cd.active.push(normal(RowForce::Same)),
             ContactMode::Sticking if mu > 0.0 => {
@@ -228,7 +253,7 @@ pub fn active_rows(contacts: &[Contact], state: &ContactState, stabilization: St
                 }
             }
             ContactMode::Sticking | ContactMode::Sliding => {
-                let s = friction_direction(r.slip(k), state.slip[k]);
+                let s = friction_direction(r.slip(k), cd.anchor[k]);
                 cd.active.push(normal(if mu > 0.0 { RowForce::Sliding { mu, s } } else { RowForce::Same }));
             }
         }
@@ -238,9 +263,73 @@ pub fn active_rows(contacts: &[Contact], state: &ContactState, stabilization: St
 /// The mode-dependent solve after [`prepare`]: q̈ into `fd.qdd`, the forces of the rigid
 /// contacts into `cd.f_n`, `cd.f_t` (compliant ones keep theirs).
 pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) -> Result<(), Singular> {
-    active_rows(contacts, state, stabilization, cd);
+    for k in 0..contacts.len() {
+        cd.anchor[k] = state.slip[k];
+    }
+    onset_anchors(contacts, state, stabilization, fd, cd);
+    active_rows_of(contacts, &state.mode, stabilization, cd);
     let nv = cd.rows.nv;
     solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, fd.b.as_slice(), &cd.rows, &cd.active, &mut cd.scratch, &mut fd.qdd.as_mut_slice()[..nv])?;
+    forces_of(contacts, &state.mode, cd);
+    Ok(())
+}
+
+/// The friction's anchor of the sliding contacts in an onset (`state.onset`) slower than
+/// [`SLIP_DIRECTION_SPEED`]: `−f_t/|f_t|` of the force that would keep them sticking at this
+/// state (the same modes with those contacts sticking; a statically indeterminate contact's
+/// largest-margin force), turned by the onset's rotation (at the event it is the direction the
+/// mode problem chose, so the anchor starts there), into `cd.anchor` (the others keep
+/// `state.slip`).
+///
+/// Why (issue 23, the stick → slip onset): at the onset the sticking force `f*` reaches the
+/// cone, and Coulomb's slide from rest has `a_t = G (f − f*)` with `G` the contact's
+/// tangential Delassus block and `f` the force of the disc nearest `f*` in G's metric
+/// (Moreau's maximal dissipation; Glocker, *Set-Valued Force Laws*, 2001, §7; Pfeiffer &
+/// Glocker 1996, §5.2): `a_t = O(δ)`, δ = |f*| − μ f_n, which is 0 at the event and grows
+/// with time. So the slip's direction over its first ~`sqrt(2 v_s / |ȧ_t|)` seconds is decided
+/// at the order of `ḟ*`, and `f*` turns while it grows. A friction held along the fixed
+/// direction of the event (`s₀`) gives `ȧ_t · s₀ = G₁₁ δ̇ + G₁₂ (the turn of f*)`, which is
+/// negative when f* turns faster than it leaves the cone: the slip ran backwards along `s₀` at
+/// 1e-10 m/s, the located slip → stick fired, the stick broke again at once, and the modes
+/// chattered (the hobby arm at μ = 1, 1.886217 s; the paper's unilateral runs at rtol 1e-4 …
+/// 1e-6). Anchored on `−f*/|f*|` (the radial projection of f* on the disc, which is the G
+/// projection up to O(δ/μ f_n)), `a_t · s = δ sᵀ G s > 0` whenever the stick is broken: the
+/// slip grows along the direction the sticking force leaves the cone, and the anchor turns
+/// with it. One more constrained solve per evaluation, only while such a slip is below v_s.
+fn onset_anchors(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) {
+    let slow = |k: usize, cd: &ContactData| {
+        let v = cd.rows.slip(k);
+        state.onset[k].is_some() && state.mode[k] == ContactMode::Sliding && v[0].hypot(v[1]) < SLIP_DIRECTION_SPEED && matches!(contacts[k].model, ContactModel::Unilateral { friction, .. } if friction > 0.0)
+    };
+    if !(0..contacts.len()).any(|k| slow(k, cd)) {
+        return;
+    }
+    for k in 0..contacts.len() {
+        cd.stick_mode[k] = if slow(k, cd) { ContactMode::Sticking } else { state.mode[k] };
+    }
+    let mode = std::mem::take(&mut cd.stick_mode);
+    active_rows_of(contacts, &mode, stabilization, cd);
+    let nv = cd.rows.nv;
+    let ok = solve_active(fd.m_j.as_slice(), &fd.l_inv_diag, fd.b.as_slice(), &cd.rows, &cd.active, &mut cd.scratch, &mut fd.qdd.as_mut_slice()[..nv]).is_ok();
+    if ok {
+        forces_of(contacts, &mode, cd);
+        for (k, (&now, &was)) in mode.iter().zip(&state.mode).enumerate() {
+            if now == ContactMode::Sticking && was == ContactMode::Sliding {
+                let f = cd.f_t[k];
+                let m = f[0].hypot(f[1]);
+                if let (true, Some(r)) = (m > 1e-12 * (1.0 + cd.f_n[k].abs()), state.onset[k]) {
+                    let i = [-f[0] / m, -f[1] / m];
+                    cd.anchor[k] = [r[0] * i[0] - r[1] * i[1], r[1] * i[0] + r[0] * i[1]];
+                }
+            }
+        }
+    }
+    cd.stick_mode = mode;
+}
+
+/// The forces of the rigid contacts of the last solve (`cd.active`, `cd.scratch.lambda`) in
+/// the modes `mode`, and the stick margins of the sticking ones.
+fn forces_of(contacts: &[Contact], mode: &[ContactMode], cd: &mut ContactData) {
     for (k, c) in contacts.iter().enumerate() {
         if !matches!(c.model, ContactModel::Compliant { .. }) {
             cd.f_n[k] = 0.0;
@@ -259,18 +348,17 @@ pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: St
             (a, _) => cd.f_t[k][a - 1] = lam,
         }
     }
-    stick_margins(contacts, state, cd);
-    Ok(())
+    stick_margins(contacts, mode, cd);
 }
 
 /// The stick margins of the sticking contacts after [`solve_modes`]; a contact whose three rows
 /// are dependent gets the force of the largest margin among those it admits
 /// ([`super::indeterminate`]; the accelerations do not change).
-fn stick_margins(contacts: &[Contact], state: &ContactState, cd: &mut ContactData) {
+fn stick_margins(contacts: &[Contact], mode: &[ContactMode], cd: &mut ContactData) {
     for (k, c) in contacts.iter().enumerate() {
         cd.margin[k] = 0.0;
         let ContactModel::Unilateral { friction: mu, .. } = c.model else { continue };
-        if state.mode[k] != ContactMode::Sticking || mu <= 0.0 {
+        if mode[k] != ContactMode::Sticking || mu <= 0.0 {
             continue;
         }
         let (f_n, f_t) = (cd.f_n[k], cd.f_t[k]);

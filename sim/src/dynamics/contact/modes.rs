@@ -11,7 +11,14 @@
 //! row alone). Feasibility, with tolerances relative to the solution's scale
 //! (`tol_f = 1e-8 (1 N + max |f|)`, `tol_a = 1e-8 (1 + max |q̈|)`): separated → `g̈ ≥ −tol_a`;
 //! sticking → `f_n ≥ −tol_f`, `|f_t| ≤ μ f_n + tol_f`; sliding → `f_n ≥ −tol_f` and from rest
-//! `a_t · s ≥ −tol_a`. No feasible combination: Painlevé inconsistency (error). Feasible
+//! `a_t · s ≥ −max(tol_a, tol_f sᵀ G s)` (G the contact's tangential Delassus block: "at the
+//! cone" is the same force tolerance for the stick and for the slide from rest, so at a
+//! stick → slip onset, where both are at the cone, the two agree; with `tol_a` alone a slide
+//! whose acceleration read −1.3e-7 m/s² — 2.6e-6 N of force, the rounding of the stick's
+//! margin — was refused while the stick at margin −4e-14 N was taken, and the stick broke
+//! again at the restart: one-elbow-unilateral at rtol 1e-5, 0.7161 s, 33 events). A slide from
+//! rest is an onset (`ContactState::onset`): its friction follows the impending direction
+//! while slower than `SLIP_DIRECTION_SPEED` (`forward::onset_anchors`). No feasible combination: Painlevé inconsistency (error). Feasible
 //! combinations with different q̈ (beyond `1e-6 (1 + max |q̈|)`): indeterminate (error). Among
 //! those with the same q̈ (f_n = 0 with g̈ = 0, or |f_t| = μ f_n), the rule: the one whose modes
 //! agree with the `preferred` ones (the event's implication: lift-off → separated, touch-down →
@@ -42,6 +49,7 @@ enum Cand {
 struct Feasible {
     mode: Vec<ContactMode>,
     slip: Vec<[f64; 2]>,
+    onset: Vec<Option<[f64; 2]>>,
     qdd: Vec<f64>,
     score: usize,
     /// At a boundary of its modes within the tolerances (a stick with its margin at 0, a
@@ -108,6 +116,7 @@ pub fn choose_modes_within(
     let mut idx = vec![0usize; closed.len()];
     let mut feasible: Vec<Feasible> = Vec::new();
     let mut trial = state.clone();
+    let mut impending = state.slip.clone();
     let combinations: usize = cands.iter().map(Vec::len).product();
     let mut tried = 0usize;
     loop {
@@ -118,6 +127,7 @@ pub fn choose_modes_within(
         // the combination idx
         let mut from_rest = false;
         for (i, &k) in closed.iter().enumerate() {
+            trial.onset[k] = None;
             trial.mode[k] = match cands[i][idx[i]] {
                 Cand::Stick => ContactMode::Sticking,
                 Cand::Slide { moving } => {
@@ -153,6 +163,7 @@ pub fn choose_modes_within(
                             ok = false;
                         } else {
                             trial.slip[k] = [-f[0] / m, -f[1] / m];
+                            impending[k] = trial.slip[k];
                         }
                     }
                 }
@@ -249,11 +260,24 @@ pub fn choose_modes_within(
                 }
             }
         }
+        if ok && from_rest {
+            // the slides from rest are onsets: their friction's direction follows the sticking
+            // force's impending direction while slower than SLIP_DIRECTION_SPEED
+            // (`forward::onset_anchors`), turned by the rotation from it to the direction chosen
+            for &k in &rest_sliders {
+                let (i, s) = (impending[k], trial.slip[k]);
+                trial.onset[k] = Some([s[0] * i[0] + s[1] * i[1], s[1] * i[0] - s[0] * i[1]]);
+            }
+        }
         if ok && solve_modes(contacts, &trial, stabilization, fd, cd).is_ok() {
             let qdd = &fd.qdd.as_slice()[..nv];
             let qmax = qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
             let fmax = closed.iter().fold(0.0f64, |m, &k| m.max(cd.f_n[k].abs()).max(cd.f_t[k][0].hypot(cd.f_t[k][1])));
             let (tol_f, tol_a) = (1e-8 * (1.0 + fmax), 1e-8 * (1.0 + qmax));
+            // a slide from rest is at the cone when its slip acceleration along s is within what
+            // a force of tol_f along s gives (the stick's tolerance, in the same units):
+            // `a_t · s ≥ −tol_f sᵀ G s`, G the contact's tangential Delassus block
+            let slip_tol = |k: usize, s: [f64; 2]| tol_a.max(tol_f * tangential_delassus(fd, cd, k, s));
             let mut feasible_here = true;
             let mut marginal = false;
             for (i, &k) in closed.iter().enumerate() {
@@ -262,7 +286,7 @@ pub fn choose_modes_within(
                     Cand::Sep => accel(0) <= tol_a,
                     Cand::Stick => cd.margin[k] <= tol_f || cd.f_n[k] <= tol_f,
                     Cand::Slide { moving } => {
-                        cd.f_n[k] <= tol_f || (!moving && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= tol_a)
+                        cd.f_n[k] <= tol_f || (!moving && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k]))
                     }
                 };
             }
@@ -273,13 +297,13 @@ pub fn choose_modes_within(
                     Cand::Sep => accel(0) >= -tol_a,
                     Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= mu_of(&contacts[k]) * f_n + tol_f,
                     Cand::Slide { moving } => {
-                        f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -tol_a)
+                        f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -slip_tol(k, trial.slip[k]))
                     }
                 };
             }
             if feasible_here {
                 let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();
-                feasible.push(Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), qdd: qdd.to_vec(), score, marginal });
+                feasible.push(Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), onset: trial.onset.clone(), qdd: qdd.to_vec(), score, marginal });
             }
         }
         // next combination
@@ -321,6 +345,19 @@ pub fn choose_modes_within(
     for &k in closed {
         state.mode[k] = best.mode[k];
         state.slip[k] = best.slip[k];
+        state.onset[k] = best.onset[k];
     }
     solve_modes(contacts, state, stabilization, fd, cd).map_err(|_| DynamicsError::SingularConstraints { t, constraints: names() })
+}
+
+/// `sᵀ G s` for contact `k`'s tangential rows, `G = J_t M_J⁻¹ J_tᵀ` (the tangential Delassus
+/// block, m s⁻² N⁻¹; Pfeiffer & Glocker 1996, §5.2): the slip acceleration along `s` a unit
+/// force along `s` gives. After [`super::forward::prepare`] (`fd.m_j` holds the factor).
+fn tangential_delassus(fd: &ForwardData, cd: &ContactData, k: usize, s: [f64; 2]) -> f64 {
+    let nv = cd.rows.nv;
+    let (t1, t2) = (cd.rows.row(3 * k + 1), cd.rows.row(3 * k + 2));
+    let w: Vec<f64> = (0..nv).map(|j| s[0] * t1[j] + s[1] * t2[j]).collect();
+    let mut x = w.clone();
+    super::solve::solve_mj(fd.m_j.as_slice(), &fd.l_inv_diag, nv, &mut x);
+    w.iter().zip(&x).map(|(a, b)| a * b).sum()
 }

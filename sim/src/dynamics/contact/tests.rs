@@ -207,7 +207,7 @@ fn sticking_is_a_three_row_weld() {
     let mut fd0 = ForwardData::new(n, 3);
     forward_dynamics(&p, &mut data, &mut fd0, 0.0, &q, &qd, &cur, &cur).expect("weld");
     let contacts = [contact];
-    let state = ContactState { mode: vec![ContactMode::Sticking], slip: vec![[1.0, 0.0]] };
+    let state = ContactState { mode: vec![ContactMode::Sticking], slip: vec![[1.0, 0.0]], onset: vec![None] };
     let (mut fd, mut cd) = (ForwardData::new(n, 1), ContactData::new(n, 1));
     forward_dynamics_contacts(&plant(&model, &drives), &contacts, &state, &mut data, &mut fd, &mut cd, 0.0, &q, &qd, &cur, &cur).expect("sticking");
     let d = (&fd.qdd - &fd0.qdd).amax() / fd0.qdd.amax().max(1.0);
@@ -346,7 +346,7 @@ fn sliding_solve_satisfies_its_equations() {
     let mut data = Data::new(&model);
     let (mut fd, mut cd) = (ForwardData::new(n, 1), ContactData::new(n, 1));
     prepare(&plant(&model, &drives), &contacts, &mut data, &mut fd, &mut cd, 0.0, &q, &qd, &cur).expect("prepare");
-    let state = ContactState { mode: vec![ContactMode::Sliding], slip: vec![[0.6, 0.8]] };
+    let state = ContactState { mode: vec![ContactMode::Sliding], slip: vec![[0.6, 0.8]], onset: vec![None] };
     solve_modes(&contacts, &state, Default::default(), &mut fd, &mut cd).expect("solvable");
     let qdd = fd.qdd.as_slice();
     let res = cd.rows.dot(0, qdd) + cd.rows.bias[0];
@@ -415,4 +415,59 @@ fn the_mode_enumeration_stops_at_the_deadline() {
     assert_eq!(err, DynamicsError::OutOfTime { t: 0.25, during: Phase::ChoosingModes { tried: 1, of: 3 } });
     assert_eq!(state.mode, before);
     assert!(err.to_string().contains("while choosing the contact modes (1 of 3 combinations tried)"), "{err}");
+}
+
+/// The onset anchor (`forward::onset_anchors`, issue 23): a contact sliding from rest
+/// (`onset: Some(r)`, v_t = 0) on a random chain has its friction along the impending direction
+/// of the sticking force at the same state, `−f*/|f*|`, turned by r (1e-12), and then slips
+/// forwards along it, `a_t · s > 0` (Coulomb's maximal dissipation: the radial projection of
+/// the broken sticking force on the disc), for a stick broken by 1e-6 of its force and by half
+/// of it. Without an onset the friction stays along the stored direction (here 90° off the
+/// impending one), where the slip acceleration along it is not the law's.
+#[test]
+fn a_slide_from_rest_in_an_onset_acts_along_the_impending_direction_and_slips_forwards() {
+    let n = 5;
+    let model = random_chain(n, 23);
+    let drives = force_drives(n);
+    let mut rng = SplitMix64(31);
+    let q: Vec<f64> = rng.vector(n, -2.0, 2.0).iter().copied().collect();
+    let qd = vec![0.0; n];
+    let cur: Vec<f64> = rng.vector(n, -3.0, 3.0).iter().copied().collect();
+    let point = BodyPoint { body: Some(n - 1), p_body: Vector3::new(0.05, 0.0, 0.1) };
+    let make = |mu: f64| [Contact::new(PointOnPlane { name: "c".into(), point, normal_world: Unit::new_normalize(Vector3::z()), offset: 0.0 }, ContactModel::Unilateral { restitution: 0.0, friction: mu })];
+    let mut data = Data::new(&model);
+    let (mut fd, mut cd) = (ForwardData::new(n, 1), ContactData::new(n, 1));
+    // the sticking force f* at this state (μ large: it sticks)
+    let stick = ContactState { mode: vec![ContactMode::Sticking], slip: vec![[1.0, 0.0]], onset: vec![None] };
+    prepare(&plant(&model, &drives), &make(100.0), &mut data, &mut fd, &mut cd, 0.0, &q, &qd, &cur).expect("prepare");
+    assert!(cd.rows.slip(0).iter().all(|v| v.abs() <= 1e-15), "at rest");
+    solve_modes(&make(100.0), &stick, Default::default(), &mut fd, &mut cd).expect("sticking");
+    let (f_n, f_t) = (cd.f_n[0], cd.f_t[0]);
+    assert!(f_n > 0.0, "pressed on the table: f_n = {f_n}");
+    let ft = f_t[0].hypot(f_t[1]);
+    let imp = [-f_t[0] / ft, -f_t[1] / ft];
+    for excess in [1e-6, 0.5] {
+        let mu = (1.0 - excess) * ft / f_n;
+        let contacts = make(mu);
+        for turn in [0.0f64, 0.3] {
+            let r = [turn.cos(), turn.sin()];
+            let off = [-imp[1], imp[0]];
+            let state = ContactState { mode: vec![ContactMode::Sliding], slip: vec![off], onset: vec![Some(r)] };
+            solve_modes(&contacts, &state, Default::default(), &mut fd, &mut cd).expect("sliding");
+            let s = [r[0] * imp[0] - r[1] * imp[1], r[1] * imp[0] + r[0] * imp[1]];
+            let a = cd.anchor[0];
+            assert!((a[0] - s[0]).hypot(a[1] - s[1]) <= 1e-12, "excess {excess}, turn {turn}: anchor {a:?}, impending turned {s:?}");
+            let f = cd.f_t[0];
+            assert!((f[0] + mu * cd.f_n[0] * s[0]).hypot(f[1] + mu * cd.f_n[0] * s[1]) <= 1e-12 * (1.0 + cd.f_n[0]), "friction {f:?} not −μ f_n s");
+            if turn == 0.0 {
+                let qdd = fd.qdd.as_slice();
+                let at = [cd.rows.dot(1, qdd) + cd.rows.bias[1], cd.rows.dot(2, qdd) + cd.rows.bias[2]];
+                assert!(at[0] * s[0] + at[1] * s[1] > 0.0, "excess {excess}: the slip decelerates along its direction: a_t = {at:?}");
+            }
+        }
+        // no onset: the stored direction, as before
+        let state = ContactState { mode: vec![ContactMode::Sliding], slip: vec![[-imp[1], imp[0]]], onset: vec![None] };
+        solve_modes(&contacts, &state, Default::default(), &mut fd, &mut cd).expect("sliding");
+        assert_eq!(cd.anchor[0], [-imp[1], imp[0]]);
+    }
 }
