@@ -257,7 +257,8 @@ fn on_link_points_lie_on_the_collision_cylinder_and_the_brace_holds_them() {
 
 /// A calibration that cannot state its error bar is a failed run, not bad input: the small
 /// study with a hand-error bound that nothing keeps (the baseline included) stops before the
-/// search with status 1, naming the study, the design and the reason, and writes no state.
+/// search with status 1, naming the study, the baseline and every design that could replace
+/// it with their reasons, and writes no state.
 #[test]
 fn a_calibration_that_cannot_state_its_error_bar_exits_1_saying_why() {
     let tmp = tempfile::tempdir().unwrap();
@@ -270,6 +271,6 @@ fn a_calibration_that_cannot_state_its_error_bar_exits_1_saying_why() {
     let r = run_sim(&["optimize", f.to_str().unwrap(), "-o", out.to_str().unwrap(), "-j", "2", "-q"]);
     let err = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(1), "{err}");
-    assert!(err.contains("study `small-kd`") && err.contains("strict.json") && err.contains("the baseline at rtol") && err.contains("> the bound 0.000 mm"), "{err}");
+    assert!(err.contains("study `small-kd`") && err.contains("strict.json") && err.contains("the baseline is infeasible (at rtol 1e-4: hand error") && err.contains("> the bound 0.000 mm") && err.contains("and so is every calibration design"), "{err}");
     assert!(!out.join("study-state.json").exists(), "no state for a study that did not start");
 }
