@@ -254,3 +254,23 @@ fn on_link_points_lie_on_the_collision_cylinder_and_the_brace_holds_them() {
     let r = run_sim(&["run", out.join("optimum.json").to_str().unwrap(), "-o", tmp.path().join("rerun").to_str().unwrap(), "-q"]);
     assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
 }
+
+/// A calibration that cannot state its error bar is a failed run, not bad input: the small
+/// study with a hand-error bound that nothing keeps (the baseline included) stops before the
+/// search with status 1, naming the study, the baseline and every design that could replace
+/// it with their reasons, and writes no state.
+#[test]
+fn a_calibration_that_cannot_state_its_error_bar_exits_1_saying_why() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut spec: serde_json::Value = serde_json::from_slice(&std::fs::read(study_file()).unwrap()).unwrap();
+    spec["scene"] = serde_json::Value::from(Path::new(env!("CARGO_MANIFEST_DIR")).join("sim/scenes/small/small.json").display().to_string());
+    spec["constraints"] = serde_json::json!({ "hand_error_max": 1e-9 });
+    let f = tmp.path().join("strict.json");
+    std::fs::write(&f, spec.to_string()).unwrap();
+    let out = tmp.path().join("o");
+    let r = run_sim(&["optimize", f.to_str().unwrap(), "-o", out.to_str().unwrap(), "-j", "2", "-q"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1), "{err}");
+    assert!(err.contains("study `small-kd`") && err.contains("strict.json") && err.contains("the baseline is infeasible (at rtol 1e-4: hand error") && err.contains("> the bound 0.000 mm") && err.contains("and so is every calibration design"), "{err}");
+    assert!(!out.join("study-state.json").exists(), "no state for a study that did not start");
+}

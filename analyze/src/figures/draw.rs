@@ -142,6 +142,25 @@ pub(super) fn write(plot: &Plot, stem: &Path) -> Result<(), String> {
     save_svg_png(stem, plot.size, |a| draw(a, plot))
 }
 
+/// A one-panel chart under a caption, with the figures' margin and label areas (the study
+/// figures and the work–precision diagram).
+pub(super) fn single_chart<'a, DB: DrawingBackend, X: AsRangedCoord, Y: AsRangedCoord>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    x: X,
+    y: Y,
+) -> Result<ChartContext<'a, DB, Cartesian2d<X::CoordDescType, Y::CoordDescType>>, DrawingAreaErrorKind<DB::ErrorType>> {
+    ChartBuilder::on(root).caption(title, ("sans-serif", 22)).margin(16).x_label_area_size(48).y_label_area_size(80).build_cartesian_2d(x, y)
+}
+
+/// The legend box of a one-panel chart ([`single_chart`]), upper right.
+pub(super) fn legend_box<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(chart: &mut ChartContext<'a, DB, CT>) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    DB::ErrorType: 'static,
+{
+    chart.configure_series_labels().background_style(WHITE.mix(0.85)).border_style(BLACK).label_font(("sans-serif", 14)).position(SeriesLabelPosition::UpperRight).draw()
+}
+
 /// Draws a figure of `size` pixels as SVG in memory, renders its PNG from it, and writes
 /// `<stem>.svg` and `<stem>.png` each atomically (`schemas::atomic`). Errors name the file.
 pub(super) fn save_svg_png(

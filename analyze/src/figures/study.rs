@@ -50,13 +50,7 @@ where
         (a - d, b + d)
     };
     let ((x0, x1), (y0, y1)) = (pad(x0, x1), pad(y0, y1));
-    let mut chart = ChartBuilder::on(&root)
-        .caption(labels[0], ("sans-serif", 22))
-        .margin(16)
-        .x_label_area_size(48)
-        .y_label_area_size(80)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(e)?;
+    let mut chart = super::draw::single_chart(&root, labels[0], x0..x1, y0..y1).map_err(e)?;
     chart
         .configure_mesh()
         .x_desc(labels[1])
@@ -89,14 +83,7 @@ where
             }
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(e)?;
+    super::draw::legend_box(&mut chart).map_err(e)?;
     root.present().map_err(e)
 }
 

@@ -8,6 +8,7 @@
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use super::calibration::Calibration;
 use super::optimizer::{Optimizer, Point};
 
 /// One evaluated candidate.
@@ -41,46 +42,6 @@ impl Evaluation {
     /// The value the optimiser is told: +∞ when infeasible.
     pub fn told(&self) -> f64 {
         self.objective.unwrap_or(f64::INFINITY)
-    }
-}
-
-/// How the evaluations' tolerance was chosen (the book: "Find where to brace", cost control).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Calibration {
-    /// The rtol the evaluations run at.
-    pub loose: f64,
-    /// The rtol of the re-runs.
-    pub tight: f64,
-    /// The baseline's objective at each rtol tried, loose to tight: (rtol, objective).
-    pub ladder: Vec<(f64, f64)>,
-    /// The stated error bar of an evaluation, J: [`ERROR_BAR_FACTOR`] × the largest
-    /// |objective(loose) − objective(tight)| over the baseline and the calibration designs
-    /// ([`crate::study::Study::calibration_points`]).
-    pub error_j: f64,
-    /// The designs the error bar was measured at, the baseline first.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub designs: Vec<CalibrationDesign>,
-}
-
-/// The stated error bar is this factor times the largest loose − tight difference measured at
-/// the calibration designs: a few designs sample the design space, the factor covers the
-/// designs between them (the book: "Find where to brace", cost control).
-pub const ERROR_BAR_FACTOR: f64 = 2.0;
-
-/// One design of the calibration: its objective at the loose and at the tight rtol (none when
-/// infeasible there; such a design does not count towards the error bar).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CalibrationDesign {
-    /// What it is: `baseline`, or the design's variables.
-    pub design: String,
-    pub loose: Option<f64>,
-    pub tight: Option<f64>,
-}
-
-impl CalibrationDesign {
-    /// |loose − tight|, when both are feasible.
-    pub fn error(&self) -> Option<f64> {
-        Some((self.loose? - self.tight?).abs())
     }
 }
 

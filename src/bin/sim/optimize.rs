@@ -16,7 +16,8 @@ use rayon::prelude::*;
 use serde_json::Value;
 use sim::run::{run_to_file_tapped, Budget};
 use sim::study::optimizer::{Optimizer, Point};
-use sim::study::state::{shard_file, Calibration, CalibrationDesign, Evaluation, ShardResult, State, ERROR_BAR_FACTOR, STATE_FILE};
+use sim::study::calibration::{self, Calibration, CalibrationDesign, Job, JobResult, ERROR_BAR_FACTOR};
+use sim::study::state::{shard_file, Evaluation, ShardResult, State, STATE_FILE};
 use sim::study::Study;
 use sim::sweep::{Shard, Sweep, Variant};
 
@@ -181,56 +182,20 @@ fn record(index: usize, generation: usize, point: &Point, variant: &Variant, o: 
     }
 }
 
-/// The baseline: the base scene as it is.
-fn baseline(study: &Study) -> Variant {
-    Variant { index: 0, name: format!("{}-baseline", study.spec.name), replacements: Vec::new() }
-}
-
-/// The stated rules: starting from the study's `loose` rtol, the evaluations' rtol is the
-/// loosest (in steps of 10) at which the baseline's objective is within 0.1 % of its value at
-/// `tight`; the error bar of an evaluation is [`ERROR_BAR_FACTOR`] × the largest
-/// |loose − tight| over the baseline and the calibration designs (`Study::calibration_points`:
-/// the centre and the ends of every continuous variable in every discrete combination), run in
-/// parallel.
-fn calibrate(study: &Study, dir: &Path, budget: Budget, pool: &rayon::ThreadPool) -> Result<Option<Calibration>> {
-    let Some(t) = &study.spec.tolerance else { return Ok(None) };
-    let b = baseline(study);
-    let at = |r: f64| -> Result<f64> {
-        let o = evaluate(study, &b, Some(r), dir, false, budget);
-        o.objective.with_context(|| format!("calibrating the tolerance: the baseline at rtol {r:e}: {}", o.infeasible.unwrap_or_default()))
+/// The evaluations' tolerance and error bar (`sim::study::calibration`'s rules), its runs in
+/// parallel on `pool`.
+fn calibrate(study: &Study, dir: &Path, budget: Budget, pool: &rayon::ThreadPool) -> std::result::Result<Option<Calibration>, String> {
+    let mut run = |jobs: &[Job]| -> Vec<JobResult> {
+        pool.install(|| {
+            jobs.par_iter()
+                .map(|j| {
+                    let o = evaluate(study, &j.variant, Some(j.rtol), dir, false, budget);
+                    o.objective.ok_or_else(|| o.infeasible.unwrap_or_else(|| "infeasible".into()))
+                })
+                .collect()
+        })
     };
-    let tight = at(t.tight)?;
-    let mut ladder = Vec::new();
-    let mut r = t.loose;
-    let loose_j = loop {
-        let j = at(r)?;
-        ladder.push((r, j));
-        if (j - tight).abs() <= 1e-3 * tight.abs() || r / 10.0 <= t.tight {
-            ladder.push((t.tight, tight));
-            break j;
-        }
-        r /= 10.0;
-    };
-    let points = study.calibration_points();
-    let cols = study.columns();
-    // every design at both tolerances, in parallel (named apart from the candidates)
-    let jobs: Vec<(usize, f64)> = (0..points.len()).flat_map(|k| [(k, r), (k, t.tight)]).collect();
-    let values: Vec<Option<f64>> = pool.install(|| {
-        jobs.par_iter()
-            .map(|&(k, rtol)| {
-                let mut var = study.variant(k, &points[k]);
-                var.name = format!("{}-calibration-{k:02}-{}", study.spec.name, if rtol == t.tight { "tight" } else { "loose" });
-                evaluate(study, &var, Some(rtol), dir, false, budget).objective
-            })
-            .collect()
-    });
-    let mut designs = vec![CalibrationDesign { design: "baseline".into(), loose: Some(loose_j), tight: Some(tight) }];
-    for (k, p) in points.iter().enumerate() {
-        let label = cols.iter().zip(study.cells(p)).map(|(c, x)| format!("{c} = {x}")).collect::<Vec<_>>().join(", ");
-        designs.push(CalibrationDesign { design: label, loose: values[2 * k], tight: values[2 * k + 1] });
-    }
-    let largest = designs.iter().filter_map(CalibrationDesign::error).fold(0.0, f64::max);
-    Ok(Some(Calibration { loose: r, tight: t.tight, ladder, error_j: ERROR_BAR_FACTOR * largest, designs }))
+    calibration::calibrate(study, &mut run)
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(p: &Path) -> Result<T> {
@@ -261,14 +226,22 @@ pub fn run(args: &OptimizeArgs, v: Verbosity) -> Result<u8> {
         s
     } else {
         let started = Instant::now();
-        let calibration = calibrate(&study, &evals_dir, budget, &pool)?;
+        let calibration = match calibrate(&study, &evals_dir, budget, &pool) {
+            Ok(c) => c,
+            Err(why) => {
+                // a run failed (not the input): status 1, nothing written
+                eprintln!("sim: study `{}` ({}): {why}", study.spec.name, study.file);
+                return Ok(exit::FAILED);
+            }
+        };
         if let (Some(c), false) = (&calibration, v.quiet) {
             eprintln!(
-                "tolerance: evaluations at rtol {:e}; error bar {:.3e} J ({ERROR_BAR_FACTOR} x the largest loose - tight of {} design(s) at rtol {:e}; {:.1} s)",
+                "tolerance: evaluations at rtol {:e}; error bar {:.3e} J ({ERROR_BAR_FACTOR} x the largest loose - tight of {} design(s) at rtol {:e}; {} lost and replaced; {:.1} s)",
                 c.loose,
                 c.error_j,
                 c.designs.iter().filter(|d| d.error().is_some()).count(),
                 c.tight,
+                c.designs.iter().filter(|d| d.lost.is_some()).count(),
                 started.elapsed().as_secs_f64()
             );
         }
@@ -359,7 +332,7 @@ pub fn run(args: &OptimizeArgs, v: Verbosity) -> Result<u8> {
 fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity) -> Result<u8> {
     let best = state.evaluations.iter().filter(|e| e.objective.is_some()).min_by(|a, b| a.told().total_cmp(&b.told()).then(a.index.cmp(&b.index)));
     let tight = state.calibration.as_ref().map(|c| c.tight);
-    let base = baseline(study);
+    let base = study.baseline();
     let base_o = evaluate(study, &base, tight, out, true, budget);
     let mut report = String::new();
     let name = &study.spec.name;
@@ -419,23 +392,27 @@ fn finish(study: &Study, state: &State, out: &Path, budget: Budget, v: Verbosity
         (Some(c), Some(t)) => {
             let err = (loose - t).abs();
             let counted: Vec<&CalibrationDesign> = c.designs.iter().filter(|d| d.error().is_some()).collect();
+            let lost = c.designs.iter().filter(|d| d.lost.is_some()).count();
             writeln!(
                 report,
-                "Error bar: ±{:.2e} J, stated before the search: {ERROR_BAR_FACTOR} × the largest |loose − tight| of the objective over {} design(s) (the baseline, and the centre and the ends of every continuous variable in every discrete combination; {} infeasible at one tolerance not counted). The optimum's objective at rtol {:e} (evaluations) and {:e} (re-run) differ by {err:.2e} J ({:.3} %). Tolerance rule: the loosest rtol (from {:e}, in steps of 10) at which the baseline's objective is within 0.1 % of its tight value: {}.",
+                "Error bar: ±{:.2e} J, stated before the search: {ERROR_BAR_FACTOR} × the largest |loose − tight| of the objective over {} design(s) (the baseline, the centre and the ends of every continuous variable in every discrete combination, and the replacements of the lost ones). {lost} design(s) infeasible at a tolerance (lost), each replaced by the midpoint towards the nearest feasible design of its combination (at most {} times; a design still lost fails the calibration). The optimum's objective at rtol {:e} (evaluations) and {:e} (re-run) differ by {err:.2e} J ({:.3} %). Tolerance rule: the loosest rtol (from {:e}, in steps of 10) at which {}'s objective is within 0.1 % of its tight value: {}.",
                 c.error_j,
                 counted.len(),
-                c.designs.len() - counted.len(),
+                calibration::MAX_REPLACEMENTS,
                 c.loose,
                 c.tight,
                 100.0 * err / t.abs(),
                 study.spec.tolerance.as_ref().map_or(f64::NAN, |t| t.loose),
+                if c.reference.is_empty() { "the baseline".to_string() } else { format!("the design {} (the baseline is infeasible)", c.reference) },
                 c.ladder.iter().map(|(r, j)| format!("rtol {r:e}: {j:.6} J")).collect::<Vec<_>>().join("; ")
             )?;
             if !c.designs.is_empty() {
-                writeln!(report, "\n| calibration design | objective, loose [J] | objective, tight [J] | loose − tight [J] |\n|---|---|---|---|")?;
+                writeln!(report, "\n| # | calibration design | objective, loose [J] | objective, tight [J] | loose − tight [J] | lost: why |\n|---|---|---|---|---|---|")?;
                 let j = |x: Option<f64>| x.map_or("infeasible".into(), |x| format!("{x:.6}"));
-                for d in &c.designs {
-                    writeln!(report, "| {} | {} | {} | {} |", d.design, j(d.loose), j(d.tight), d.error().map_or("-".into(), |e| format!("{e:.2e}")))?;
+                for (k, d) in c.designs.iter().enumerate() {
+                    let design = d.replaces.map_or(d.design.clone(), |r| format!("{} (replaces #{r})", d.design));
+                    let why = d.lost.as_deref().unwrap_or("").replace('|', "\\|").replace('\n', " ");
+                    writeln!(report, "| {k} | {design} | {} | {} | {} | {why} |", j(d.loose), j(d.tight), d.error().map_or("-".into(), |e| format!("{e:.2e}")))?;
                 }
             }
             // the stated error bar holds for the optimum?
