@@ -6,7 +6,7 @@ use crate::dynamics::contact::forward::{forward_dynamics_contacts, forward_dynam
 use crate::dynamics::energy::{link_kinetic_energy, magnetic_energy, potential_energy, rotor_kinetic_energy};
 use crate::dynamics::forward::{forward_dynamics, Plant, Stabilization};
 use crate::dynamics::kinematics::forward_kinematics;
-use crate::dynamics::motor::Electrical;
+use crate::dynamics::motor::{Drives, Electrical};
 use crate::error::{DynamicsError, RunError};
 use crate::integrate::OdeSystem;
 use crate::scene::{Run, Scene};
@@ -143,10 +143,7 @@ impl<'a> ArmSystem<'a> {
     /// The motor currents at `y`: the current states, or for quasi-static motors the currents
     /// the last [`ArmSystem::evaluate`] computed.
     pub(super) fn currents<'y>(&'y self, y: &'y [f64]) -> &'y [f64] {
-        match self.layout.electrical {
-            Electrical::Inductive => &y[self.layout.current()],
-            Electrical::QuasiStatic => &self.ws.current_qs,
-        }
+        currents_in(&self.layout, y, &self.ws.current_qs)
     }
 
     /// Targets, voltages, the stops' torques and the quasi-static currents at (t, y), into the
@@ -192,18 +189,8 @@ impl<'a> ArmSystem<'a> {
         self.inputs(t, y)?;
         let l = self.layout;
         let s = self.scene;
-        let plant = Plant {
-            model: &s.model,
-            drives: &self.ws.drives,
-            contacts: &self.contacts,
-            mass_matrix: s.mass_matrix,
-            solver: s.solver,
-            stabilization: s.stabilization,
-        };
-        let current = match l.electrical {
-            Electrical::Inductive => &y[l.current()],
-            Electrical::QuasiStatic => &self.ws.current_qs[..],
-        };
+        let plant = plant(s, &self.ws.drives, &self.contacts);
+        let current = currents_in(&l, y, &self.ws.current_qs);
         let h = self.hybrid.as_mut().expect("hybrid");
         forward_dynamics_contacts_same_q(&plant, &h.contacts, &h.state, &mut self.ws.data, &mut self.ws.fd, &mut h.cd, t, &y[l.qd()], current, &self.ws.voltage)?;
         if self.drive_modes.is_some() {
@@ -218,18 +205,8 @@ impl<'a> ArmSystem<'a> {
         let l = self.layout;
         let (q, qd) = (&y[l.q()], &y[l.qd()]);
         let s = self.scene;
-        let plant = Plant {
-            model: &s.model,
-            drives: &self.ws.drives,
-            contacts: &self.contacts,
-            mass_matrix: s.mass_matrix,
-            solver: s.solver,
-            stabilization: s.stabilization,
-        };
-        let current = match l.electrical {
-            Electrical::Inductive => &y[l.current()],
-            Electrical::QuasiStatic => &self.ws.current_qs[..],
-        };
+        let plant = plant(s, &self.ws.drives, &self.contacts);
+        let current = currents_in(&l, y, &self.ws.current_qs);
         match &mut self.hybrid {
             None => forward_dynamics(&plant, &mut self.ws.data, &mut self.ws.fd, t, q, qd, current, &self.ws.voltage),
             Some(h) => forward_dynamics_contacts(&plant, &h.contacts, &h.state, &mut self.ws.data, &mut self.ws.fd, &mut h.cd, t, q, qd, current, &self.ws.voltage),
@@ -339,4 +316,19 @@ impl ArmSystem<'_> {
             self.drive_loss_rates(y, dydt);
         }
     }
+}
+
+/// [`ArmSystem::currents`] from the fields it reads, for callers that hold other fields of the
+/// system mutably: the current states of `y`, or for quasi-static motors `current_qs`.
+pub(super) fn currents_in<'y>(layout: &Layout, y: &'y [f64], current_qs: &'y [f64]) -> &'y [f64] {
+    match layout.electrical {
+        Electrical::Inductive => &y[layout.current()],
+        Electrical::QuasiStatic => current_qs,
+    }
+}
+
+/// The plant eq 21 reads: the scene's model and solver settings with `drives` (the workspace's,
+/// with this evaluation's winding resistances, or the scene's) and the bilateral contacts.
+pub(super) fn plant<'p>(scene: &'p Scene, drives: &'p Drives, contacts: &'p [PointOnPlane]) -> Plant<'p> {
+    Plant { model: &scene.model, drives, contacts, mass_matrix: scene.mass_matrix, solver: scene.solver, stabilization: scene.stabilization }
 }

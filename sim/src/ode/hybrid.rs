@@ -32,14 +32,12 @@ use crate::dynamics::contact::rows::contact_gaps_where;
 use crate::dynamics::contact::impact::solve_impact;
 use crate::dynamics::contact::modes::choose_modes_within;
 use crate::dynamics::contact::{Contact, ContactEvent, ContactEventKind, ContactMode, ContactModel, ContactOutput, ContactSettings};
-use crate::dynamics::forward::Plant;
 use crate::dynamics::kinematics::{forward_kinematics, forward_velocities};
-use crate::dynamics::motor::Electrical;
 use crate::error::{DynamicsError, RunError};
 use crate::integrate::Watch;
 use crate::scene::{Run, Scene};
 
-use super::arm::ArmSystem;
+use super::arm::{currents_in, plant, ArmSystem};
 
 /// The hybrid part of an [`ArmSystem`].
 pub(crate) struct Hybrid {
@@ -278,19 +276,9 @@ impl ArmSystem<'_> {
         self.inputs(t, y)?;
         let l = self.layout;
         let s = self.scene;
-        let plant = Plant {
-            model: &s.model,
-            drives: &s.drives,
-            contacts: &self.contacts,
-            mass_matrix: s.mass_matrix,
-            solver: s.solver,
-            stabilization: s.stabilization,
-        };
+        let plant = plant(s, &s.drives, &self.contacts);
         let h = self.hybrid.as_mut().expect("hybrid");
-        let current = match l.electrical {
-            Electrical::Inductive => &y[l.current()],
-            Electrical::QuasiStatic => &self.ws.current_qs[..],
-        };
+        let current = currents_in(&l, y, &self.ws.current_qs);
         prepare(&plant, &h.contacts, &mut self.ws.data, &mut self.ws.fd, &mut h.cd, t, &y[l.q()], &y[l.qd()], current)
     }
 

@@ -175,10 +175,7 @@ impl OdeJacobian for ArmSystem<'_> {
             // the two-node networks and R(T_w) (`dynamics/thermal.rs`), exactly: the copper
             // loss P = R(T_w) i² into the winding, R(T_w) into eq 11 (inductive) or into the
             // algebraic current i = (v − K_e k q̇) / R(T_w) (quasi-static)
-            let cur = match l.electrical {
-                Electrical::Inductive => &y[l.current()],
-                Electrical::QuasiStatic => &self.ws.current_qs[..],
-            };
+            let cur = super::arm::currents_in(&l, y, &self.ws.current_qs);
             for j in 0..nv {
                 let Some(p) = &th.params[j] else { continue };
                 let (tw, thj) = (l.winding_temperature().start + j, l.housing_temperature().start + j);
