@@ -61,6 +61,9 @@ const TIE_TIME: f64 = 1e-4;
 /// What the next derivative turns over within this long counts as 0, s (module docs).
 const TURN_TIME: f64 = 1e-8;
 
+/// Values, slopes and curvatures of [`ArmSystem::probe`], each `3 a + k` for joint `which[a]`.
+type Probe = (Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// A preferred mode as a candidate: a sliding mode's power direction from `km_i` (the joint is
 /// at rest, its speed gives none; [`ArmSystem::gears_consistent`] settles it where K_m i ≈ 0).
 fn normalise(mode: GearMode, km_i: f64) -> GearMode {
@@ -275,7 +278,7 @@ impl ArmSystem<'_> {
     /// (t, y) in the current modes, and their slopes and curvatures along the flow (module
     /// docs), each as `3 a + k` for joint `which[a]`, k = 0 (T), 1 (λ), 2 (q̈). Leaves the
     /// workspace at another state: the caller evaluates again before it reads it.
-    fn probe(&mut self, t: f64, y: &[f64], which: &[usize]) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>), RunError> {
+    fn probe(&mut self, t: f64, y: &[f64], which: &[usize]) -> Result<Probe, RunError> {
         let n = y.len();
         let h = PROBE_STEP;
         let values = |sys: &Self, y: &[f64]| -> Vec<f64> {
