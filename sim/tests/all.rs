@@ -47,6 +47,8 @@ mod drives;
 mod drives_support;
 #[path = "fuzz_scenes.rs"]
 mod fuzz_scenes;
+#[path = "gear_band.rs"]
+mod gear_band;
 #[path = "gear_supply.rs"]
 mod gear_supply;
 #[path = "hand_load.rs"]

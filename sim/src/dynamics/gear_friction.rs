@@ -25,6 +25,34 @@
 //!   `|λ| ≤ τ_s + |1 − c_s| |K_m i|` ([`GearFriction::stick_margin`]): a gear of efficiency
 //!   below 1 holds a part of the motor torque too (self-locking in the limit η_b → 0).
 //!
+//! **The stick band at rest** ([`GearFriction::band`]). At rest the law is set-valued: the
+//! gear's torque is any value between the limits of the two sliding laws as q̇ → 0⁺ and q̇ → 0⁻
+//! (the closure of the graph of a monotone friction law, Pfeiffer & Glocker 1996, ch. 5;
+//! Glocker, *Set-Valued Force Laws*, Springer 2001, ch. 7), with T = K_m i:
+//! `c₊ T − τ_s ≤ τ_gear ≤ c₋ T + τ_s`, `c₊` the factor of sliding + (η if T > 0, 1/η_b if T < 0)
+//! and `c₋` of sliding − (1/η_b if T > 0, η if T < 0). In λ = τ_gear − T:
+//!
+//! ```text
+//! T ≥ 0:  −τ_s − (1 − η) T      ≤ λ ≤ τ_s + (1/η_b − 1) T
+//! T ≤ 0:  −τ_s − (1/η_b − 1) |T| ≤ λ ≤ τ_s + (1 − η) |T|
+//! ```
+//!
+//! a band of width `2 τ_s + (1/η_b − η) |T|` that always holds λ = 0: a motor torque T alone
+//! (no load) breaks away in its own direction, driving. For a load that needs the holding
+//! torque W > 0 (λ = W − T), the joint is held for `η_b W ≤ T ≤ W / η` (τ_s = 0): above, the
+//! motor lifts it (τ_out = η T, the forward efficiency); below, the load drives the motor
+//! (τ_out = T / η_b, the backward one). This is the "stuck" mode of a gear with
+//! load-dependent efficiency in Pelchen, Schweiger & Otter, *Modeling and simulating the
+//! efficiency of gearboxes and of planetary gearboxes*, 2nd Modelica Conference 2002 (Modelica's
+//! `LossyGear`: at rest the output torque lies between the forward and the backward law), in
+//! our variables. [`GearFriction::stick_margin`] is the distance to the near edge,
+//! `τ_s + |1 − c_s| |T| − |λ|` with `s = −sign λ`.
+//!
+//! At T = 0 and τ_s = 0 (an efficiency-only gear, no current) the band is the point λ = 0:
+//! every load breaks away, and an unloaded joint has margin 0 whatever happens next. Which
+//! mode holds there is decided by how the functions leave 0 (their slopes, then curvatures:
+//! `ode/gear_decide.rs`); for that the edges are linear in T on each side of T = 0, with the
+//! slopes [`GearFriction::band_slopes`] of the side T moves to.
 //! The transitions are the events of Pfeiffer & Glocker, *Multibody Dynamics with Unilateral
 //! Contacts* (Wiley 1996, ch. 5: stick–slip transitions as events of a hybrid system), handled in
 //! `ode/drive_modes.rs`: slide → stick/reverse at a root of `s q̇`, stick → slide at a root of
@@ -126,6 +154,27 @@ impl GearFriction {
         self.breakaway[j] + (1.0 - self.factor(j, driving)).abs() * km_i.abs() - lambda.abs()
     }
 
+    /// The stick band at rest (module docs): λ, the gear's torque beyond the ideal train,
+    /// holds the joint while `lo ≤ λ ≤ hi`, N m.
+    #[inline]
+    pub fn band(&self, j: usize, km_i: f64) -> (f64, f64) {
+        let ts = self.breakaway[j];
+        // sliding + is driving for T > 0; sliding − for T < 0 (both factors agree at T = 0)
+        let (c_plus, c_minus) = if km_i >= 0.0 { (self.efficiency[j], 1.0 / self.back_efficiency[j]) } else { (1.0 / self.back_efficiency[j], self.efficiency[j]) };
+        ((c_plus - 1.0) * km_i - ts, (c_minus - 1.0) * km_i + ts)
+    }
+
+    /// dlo/dT and dhi/dT of [`GearFriction::band`] on the side `side` (> 0: T > 0, < 0:
+    /// T < 0) of T = 0, where the band's edges are linear in T.
+    #[inline]
+    pub fn band_slopes(&self, j: usize, side: f64) -> (f64, f64) {
+        if side >= 0.0 {
+            (self.efficiency[j] - 1.0, 1.0 / self.back_efficiency[j] - 1.0)
+        } else {
+            (1.0 / self.back_efficiency[j] - 1.0, self.efficiency[j] - 1.0)
+        }
+    }
+
     /// Whether joint j has any gear law (else its events are constants).
     pub fn active(&self, j: usize) -> bool {
         self.breakaway[j] > 0.0 || self.efficiency[j] != 1.0 || self.back_efficiency[j] != 1.0
@@ -175,5 +224,46 @@ mod tests {
         assert!((g.stick_margin(0, 1.0, -0.7)).abs() < 1e-15);
         // breaking away with λ > 0 means moving −: back-driving, c = 2 → band 1.2
         assert!((g.stick_margin(0, 1.0, 1.2)).abs() < 1e-15);
+    }
+
+    /// The band is the interval between the sliding laws' limits at q̇ → 0±, `c₊ T − τ_s` and
+    /// `c₋ T + τ_s` less T, on both sides of T = 0; its edges are the stick margin's zeros;
+    /// the slopes are the edges' difference quotients on each side; a load W is held for
+    /// `η_b W ≤ T ≤ W / η`.
+    #[test]
+    fn the_band_is_between_the_sliding_limits_and_holds_a_load_between_the_efficiencies() {
+        let (eta, eta_b) = (0.8, 0.6);
+        for ts in [0.0, 0.1] {
+            let g = one(ts, ts, 0.0, eta, eta_b);
+            for t in [-2.0, -0.5, 0.0, 0.5, 2.0] {
+                let (lo, hi) = g.band(0, t);
+                let plus = t + g.sliding_torque(0, GearMode::slide(1.0, t), t, 1e-3);
+                let minus = t + g.sliding_torque(0, GearMode::slide(-1.0, t), t, -1e-3);
+                assert!((lo - (plus - t)).abs() < 1e-15 && (hi - (minus - t)).abs() < 1e-15, "T = {t}: [{lo}, {hi}] vs [{}, {}]", plus - t, minus - t);
+                assert!(lo <= -ts && hi >= ts);
+                assert!((hi - lo - (2.0 * ts + (1.0 / eta_b - eta) * t.abs())).abs() < 1e-15, "width at T = {t}");
+                if lo < 0.0 {
+                    assert!(g.stick_margin(0, t, lo).abs() < 1e-15, "T = {t}: margin at lo");
+                }
+                if hi > 0.0 {
+                    assert!(g.stick_margin(0, t, hi).abs() < 1e-15, "T = {t}: margin at hi");
+                }
+            }
+            for side in [-1.0, 1.0] {
+                let (klo, khi) = g.band_slopes(0, side);
+                let (lo1, hi1) = g.band(0, side);
+                let (lo2, hi2) = g.band(0, 2.0 * side);
+                assert!(((lo2 - lo1) / side - klo).abs() < 1e-15 && ((hi2 - hi1) / side - khi).abs() < 1e-15, "side {side}");
+            }
+        }
+        // a load needing W = 3 N m: λ = W − T in the band exactly for T in [η_b W, W / η]
+        let g = one(0.0, 0.0, 0.0, eta, eta_b);
+        let w = 3.0;
+        let held = |t: f64| {
+            let (lo, hi) = g.band(0, t);
+            (lo - 1e-12..=hi + 1e-12).contains(&(w - t))
+        };
+        assert!(held(eta_b * w) && held(w / eta) && held(w));
+        assert!(!held(eta_b * w * (1.0 - 1e-9)) && !held(w / eta * (1.0 + 1e-9)) && !held(0.0));
     }
 }

@@ -14,7 +14,9 @@
 //! | `3 nv` | the bus, side σ | `σ P_b` | the other side |
 //!
 //! The right-hand side in fixed modes (the sliding torques, the holding torques of the sticking
-//! joints, the gear loss and the supply's rates) is `drive_forces.rs`. When a sliding joint
+//! joints, the gear loss and the supply's rates) is `drive_forces.rs`; the decision of the
+//! joints' modes at an event (together, and by slopes where the deciding functions are 0: an
+//! efficiency-only gear at i = 0) is `gear_decide.rs`. When a sliding joint
 //! stops (slide → stick), the speed the root location leaves (|q̇_j| of the order of the event
 //! time tolerance times q̈) is removed and the kinetic energy it carried booked as gear loss,
 //! as the contacts' slip → stick does (`stop_slip.rs`; Pfeiffer & Glocker 1996, ch. 6).
@@ -33,15 +35,6 @@ pub struct GearEvent {
     pub t: f64,
     pub joint: usize,
     pub mode: GearMode,
-}
-
-/// A preferred mode as a candidate: a sliding mode's power direction from `km_i` (the joint is
-/// at rest, its speed gives none).
-fn normalise(mode: GearMode, km_i: f64) -> GearMode {
-    match mode {
-        GearMode::Stick => GearMode::Stick,
-        GearMode::Slide { dir, .. } => GearMode::slide(f64::from(dir), km_i),
-    }
 }
 
 /// The gear log keeps the first this many events of a run (a diagnostic; bounded memory).
@@ -164,7 +157,7 @@ impl ArmSystem<'_> {
         self.drive_modes.as_ref().map_or(&[], |m| &m.log[..])
     }
 
-    fn log_gear(&mut self, t: f64, joint: usize, mode: GearMode) {
+    pub(super) fn log_gear(&mut self, t: f64, joint: usize, mode: GearMode) {
         let m = self.drive_modes.as_mut().expect("drive modes");
         if m.log.len() < MAX_GEAR_LOG {
             m.log.push(GearEvent { t, joint, mode });
@@ -227,131 +220,6 @@ impl ArmSystem<'_> {
         }
     }
 
-    /// The gear modes of the joints at rest, decided together at (t, y) (module docs, "The
-    /// joints' modes together"): every combination of stick, slide + and slide − over the
-    /// joints at rest is a candidate, tried in the order of how many joints leave their
-    /// `preferred` mode (0 first), then stick before slide; the first consistent one is taken.
-    /// Moving joints keep their sliding modes. No consistent combination: the gears chatter
-    /// ([`RunError::GearsChatter`], naming the joints at rest). Allocates (an event).
-    fn decide_gears(&mut self, t: f64, y: &[f64], preferred: &[GearMode], fired: &[bool], log_all: bool) -> Result<(), RunError> {
-        let scene = self.scene;
-        let Some(g) = &scene.gear_friction else { return Ok(()) };
-        let l = self.layout;
-        let nv = l.nv;
-        let modes = &self.drive_modes.as_ref().expect("drive modes").gear;
-        let rest: Vec<usize> = (0..nv).filter(|&j| g.active(j) && (y[l.qd().start + j] == 0.0 || modes[j] == GearMode::Stick || fired.get(j).copied().unwrap_or(false))).collect();
-        if rest.is_empty() {
-            return Ok(());
-        }
-        self.inputs(t, y)?;
-        let km_i: Vec<f64> = (0..nv).map(|j| self.km_i(y, j)).collect();
-        let before = self.drive_modes.as_ref().expect("drive modes").gear.clone();
-        let n = rest.len();
-        // per joint at rest: its preferred mode first, then the others (stick, slide +, slide −)
-        let options: Vec<[GearMode; 3]> = rest
-            .iter()
-            .map(|&j| {
-                // a sliding mode keeps the power direction its events have tracked (at the root
-                // of `K_m i s` the sign of K_m i says nothing); a new one takes it from K_m i
-                let as_now = |mode: GearMode| match (mode, before[j]) {
-                    (GearMode::Slide { dir, .. }, GearMode::Slide { dir: d0, driving }) if dir == d0 => GearMode::Slide { dir, driving },
-                    _ => normalise(mode, km_i[j]),
-                };
-                let p = as_now(preferred[j]);
-                let mut o = [p; 3];
-                let mut k = 1;
-                for c in [GearMode::Stick, as_now(GearMode::slide(1.0, km_i[j])), as_now(GearMode::slide(-1.0, km_i[j]))] {
-                    if c != p && k < 3 {
-                        o[k] = c;
-                        k += 1;
-                    }
-                }
-                o
-            })
-            .collect();
-        let mut choice = vec![0u8; n];
-        let mut tried = 0u64;
-        for d in 0..=n {
-            // every set of d joints off their preferred mode (bit masks of popcount d), each with
-            // its two other modes (2^d)
-            for mask in 0u64..(1u64 << n) {
-                if mask.count_ones() as usize != d {
-                    continue;
-                }
-                for alt in 0u64..(1u64 << d) {
-                    let mut b = 0;
-                    for (a, c) in choice.iter_mut().enumerate() {
-                        *c = if mask >> a & 1 == 1 {
-                            b += 1;
-                            1 + (alt >> (b - 1) & 1) as u8
-                        } else {
-                            0
-                        };
-                    }
-                    tried += 1;
-                    if self.gears_consistent(t, y, g, &rest, &options, &choice, &km_i, fired)? {
-                        let m = self.drive_modes.as_ref().expect("drive modes");
-                        let changed: Vec<(usize, GearMode)> = rest.iter().map(|&j| (j, m.gear[j])).filter(|&(j, mode)| log_all || mode != before[j]).collect();
-                        for (j, mode) in changed {
-                            self.log_gear(t, j, mode);
-                        }
-                        return Ok(());
-                    }
-                }
-            }
-        }
-        let m = self.drive_modes.as_mut().expect("drive modes");
-        m.gear.copy_from_slice(&before);
-        let joints: Vec<String> = rest.iter().map(|&j| scene.model.bodies[j].joint.clone()).collect();
-        Err(RunError::GearsChatter { t, count: tried as u32, window: 0.0, limit: 0, joints: joints.join(", ") })
-    }
-
-    /// Whether the joints at rest in the modes `options[a][choice[a]]` are consistent at (t, y):
-    /// a sticking joint's holding torque inside its static band (margin ≥ −tol_f,
-    /// `tol_f = 1e-8 (1 N m + max |λ|)`), a joint sliding from rest accelerating its way
-    /// (`s q̈ ≥ −tol_a`, `tol_a = 1e-8 (1 + max |q̈|)`), the tolerances of the contacts' mode
-    /// problem (`dynamics/contact/modes.rs`). A joint whose own event `fired` sits on the boundary
-    /// the event located, to the location's accuracy rather than to rounding: its preferred mode
-    /// (the one the event implies, `choice` 0) holds within 100 times the tolerance, another mode
-    /// only from clearly inside (margin or `s q̈` ≥ +tol), which only another joint's change can
-    /// bring about.
-    #[allow(clippy::too_many_arguments)]
-    fn gears_consistent(
-        &mut self,
-        t: f64,
-        y: &[f64],
-        g: &crate::dynamics::gear_friction::GearFriction,
-        rest: &[usize],
-        options: &[[GearMode; 3]],
-        choice: &[u8],
-        km_i: &[f64],
-        fired: &[bool],
-    ) -> Result<bool, RunError> {
-        {
-            let m = self.drive_modes.as_mut().expect("drive modes");
-            for (a, &j) in rest.iter().enumerate() {
-                m.gear[j] = options[a][choice[a] as usize];
-            }
-        }
-        self.evaluate(t, y)?;
-        let m = self.drive_modes.as_ref().expect("drive modes");
-        let qdd = self.ws.fd.qdd.as_slice();
-        let tol_f = 1e-8 * (1.0 + rest.iter().map(|&j| m.gear_torque[j].abs()).fold(0.0, f64::max));
-        let tol_a = 1e-8 * (1.0 + qdd.iter().map(|x| x.abs()).fold(0.0, f64::max));
-        Ok(rest.iter().enumerate().all(|(a, &j)| {
-            let value = match m.gear[j] {
-                GearMode::Stick => g.stick_margin(j, km_i[j], m.gear_torque[j]),
-                GearMode::Slide { dir, .. } => f64::from(dir) * qdd[j],
-            };
-            let tol = if m.gear[j] == GearMode::Stick { tol_f } else { tol_a };
-            match (fired.get(j).copied().unwrap_or(false), choice[a] == 0) {
-                (true, true) => value >= -100.0 * tol,
-                (true, false) => value >= tol,
-                (false, _) => value >= -tol,
-            }
-        }))
-    }
-
     /// Stop the sliding joints `which` (their speed the root location leaves, |q̇| of the order
     /// of the dense output's error at the root, removed and its kinetic energy booked as gear
     /// loss; each held at rest while the next stops). Returns whether y moved.
@@ -404,14 +272,15 @@ impl ArmSystem<'_> {
             }
             // a first guess for the joints at rest: from every one sticking, free the one
             // whose holding torque is furthest out of its band (the way it pushes), again
-            // until every sticking joint holds (at most one pass per joint)
+            // until every sticking joint holds to its rounding (at most one pass per joint;
+            // a joint on its band's edge, e.g. unloaded at i = 0, is left to the decision)
             for _ in 0..nv {
                 self.evaluate(t, y)?;
                 let m = self.drive_modes.as_ref().expect("drive modes");
                 let worst = (0..nv)
                     .filter(|&j| g.active(j) && m.gear[j] == GearMode::Stick)
                     .map(|j| (j, g.stick_margin(j, self.km_i(y, j), m.gear_torque[j])))
-                    .filter(|&(_, margin)| margin < 0.0)
+                    .filter(|&(j, margin)| margin < -1e-8 * (1.0 + m.gear_torque[j].abs()))
                     .min_by(|a, b| a.1.total_cmp(&b.1));
                 let Some((j, _)) = worst else { break };
                 let (km_i, lambda) = (self.km_i(y, j), m.gear_torque[j]);
