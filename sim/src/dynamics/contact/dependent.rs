@@ -116,7 +116,7 @@ struct Member<'a> {
 /// `z[c p..(c + 1) p]`).
 fn null_space(g: &mut [f64], p: usize, perm: &mut [usize], z: &mut [f64]) -> usize {
     let scale = (0..p).map(|i| g[i * p + i].abs()).fold(0.0, f64::max);
-    if !(scale > 0.0) || !scale.is_finite() {
+    if scale.is_nan() || scale <= 0.0 || !scale.is_finite() {
         return 0;
     }
     for (i, v) in perm.iter_mut().enumerate().take(p) {
@@ -125,7 +125,7 @@ fn null_space(g: &mut [f64], p: usize, perm: &mut [usize], z: &mut [f64]) -> usi
     let mut r = p;
     for k in 0..p {
         let j = (k..p).max_by(|&a, &b| g[a * p + a].total_cmp(&g[b * p + b])).unwrap_or(k);
-        if !(g[j * p + j] > 1e-10 * scale) {
+        if g[j * p + j].is_nan() || g[j * p + j] <= 1e-10 * scale {
             r = k;
             break;
         }
@@ -181,7 +181,7 @@ fn orthonormalise(z: &mut [f64], p: usize, d: usize) -> usize {
             }
         }
         let n0 = (0..p).map(|i| z[kept * p + i] * z[kept * p + i]).sum::<f64>().sqrt();
-        if !(n0 > 0.0) {
+        if n0.is_nan() || n0 <= 0.0 {
             continue;
         }
         for _ in 0..2 {
@@ -328,9 +328,9 @@ fn solve_group(s: &mut DependentScratch, label: usize, p: usize, dg: usize, f_n:
     // w_k(x) = (u, v1, v2): u = μ (f_n + Σ α_c Z_c,n) − t, v = f_t + Σ α_c Z_c,t
     let w_of = |m: &Member, x: &[f64]| -> [f64; 3] {
         let mut w = m.f;
-        for c in 0..dg {
+        for (c, xc) in x.iter().enumerate().take(dg) {
             for (a, wa) in w.iter_mut().enumerate() {
-                *wa += x[c] * m.rows[a][c * p];
+                *wa += xc * m.rows[a][c * p];
             }
         }
         [m.mu * w[0] - x[dg], w[1], w[2]]
@@ -346,7 +346,7 @@ fn solve_group(s: &mut DependentScratch, label: usize, p: usize, dg: usize, f_n:
     // objective −τ t + barrier; None outside the domain
     let objective = |x: &[f64], tau: f64| -> Option<f64> {
         let a2: f64 = x[..dg].iter().map(|v| v * v).sum();
-        if !(a2 < radius * radius) {
+        if a2.is_nan() || a2 >= radius * radius {
             return None;
         }
         let mut phi = -tau * x[dg] - (radius * radius - a2).ln();
@@ -425,7 +425,7 @@ fn solve_group(s: &mut DependentScratch, label: usize, p: usize, dg: usize, f_n:
             crate::dynamics::cholesky::solve_lower(hess, &s.inv[..nx], nx, step);
             crate::dynamics::cholesky::solve_upper_transposed(hess, &s.inv[..nx], nx, step);
             let decrement: f64 = -grad.iter().zip(step.iter()).map(|(g, d)| g * d).sum::<f64>();
-            if !(decrement > 1e-20) {
+            if decrement.is_nan() || decrement <= 1e-20 {
                 break;
             }
             // backtracking (Armijo, α = 0.25, β = 0.5)

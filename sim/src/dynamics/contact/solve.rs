@@ -222,8 +222,8 @@ fn residual(a: &[f64], rhs: &[f64], x: &[f64], res: &mut [f64]) {
 /// diagonal, permuted with the rows as LAPACK's getrf keeps them): the row swaps in order,
 /// then L's and U's substitutions (Golub & Van Loan §3.4.4).
 fn lu_resolve(a: &[f64], m: usize, piv: &[usize], rhs: &mut [f64]) {
-    for k in 0..m {
-        rhs.swap(k, piv[k]);
+    for (k, &p) in piv.iter().enumerate().take(m) {
+        rhs.swap(k, p);
     }
     for k in 0..m {
         for i in k + 1..m {
