@@ -21,6 +21,8 @@ mod contact_shapes;
 mod contacts_converge;
 #[path = "contacts_exact.rs"]
 mod contacts_exact;
+#[path = "contacts_pair.rs"]
+mod contacts_pair;
 #[path = "contacts_paper.rs"]
 mod contacts_paper;
 #[path = "contacts_pendulum.rs"]

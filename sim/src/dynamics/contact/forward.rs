@@ -63,6 +63,9 @@ pub struct ContactData {
     pub anchor: Vec<[f64; 2]>,
     /// Scratch of [`onset_anchors`]: the modes with the onset contacts sticking.
     stick_mode: Vec<ContactMode>,
+    /// Scratch of the groups of sticking contacts dependent across contacts
+    /// ([`super::dependent`]).
+    dependent: super::dependent::DependentScratch,
 }
 
 impl ContactData {
@@ -76,6 +79,7 @@ impl ContactData {
             margin: vec![0.0; nc],
             anchor: vec![[1.0, 0.0]; nc],
             stick_mode: vec![ContactMode::Separated; nc],
+            dependent: super::dependent::DependentScratch::new(nc),
         }
     }
 }
@@ -372,6 +376,32 @@ fn stick_margins(contacts: &[Contact], mode: &[ContactMode], cd: &mut ContactDat
             cd.margin[k] = margin;
         }
     }
+    group_margins(contacts, mode, cd);
+}
+
+/// The sticking contacts whose rows are dependent across contacts (coincident or kinematically
+/// dependent points) get the distribution of the largest common margin and that margin
+/// ([`super::dependent`]); the others keep theirs.
+fn group_margins(contacts: &[Contact], mode: &[ContactMode], cd: &mut ContactData) {
+    let sticking_count = contacts.iter().zip(mode).filter(|(c, &m)| m == ContactMode::Sticking && matches!(c.model, ContactModel::Unilateral { friction, .. } if friction > 0.0)).count();
+    if sticking_count < 2 {
+        return;
+    }
+    let ContactData { rows, active, scratch, f_n, f_t, margin, dependent, .. } = cd;
+    let mu = |k: usize| match contacts[k].model {
+        ContactModel::Unilateral { friction, .. } if mode[k] == ContactMode::Sticking => friction,
+        _ => 0.0,
+    };
+    let sticking = |k: usize| active.iter().position(|a| a.row == 3 * k && a.force == RowForce::Same).filter(|&i| active.get(i + 2).is_some_and(|a| a.row == 3 * k + 2));
+    let gram = |i: usize, j: usize| scratch.gram(rows, active, i, j);
+    let local = |k: usize| {
+        sticking(k).is_some_and(|i| {
+            let b: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|s| scratch.gram(rows, active, i + r, i + s)));
+            super::indeterminate::null_direction(&b).is_some()
+        })
+    };
+    let input = super::dependent::GroupInput { mu: &mu, sticking: &sticking, gram: &gram, local: &local };
+    super::dependent::group_margins(&input, dependent, f_n, f_t, margin);
 }
 
 /// Eq 21 with contacts of any model in the modes of `state` (the bilateral path's outputs in

@@ -230,6 +230,7 @@ impl Default for ContactSettings {
 /// Most unilateral contacts closed at one time: the mode problem enumerates 3^n combinations.
 pub const MAX_CLOSED_CONTACTS: usize = 8;
 
+pub mod dependent;
 pub mod forward;
 pub mod impact;
 pub mod indeterminate;

@@ -119,7 +119,15 @@ pub fn choose_modes_within(
     let mut impending = state.slip.clone();
     let combinations: usize = cands.iter().map(Vec::len).product();
     let mut tried = 0usize;
+    // coincident contacts move as one point: they take the same mode (`dependent.rs`)
+    let twins = super::dependent::twins(contacts, &cd.rows, closed);
     loop {
+        if super::dependent::twins_differ(&twins, &cands, &idx) {
+            if !super::dependent::next_combination(&mut idx, &cands) {
+                break;
+            }
+            continue;
+        }
         if tried > 0 && watch.out_of_time() {
             return Err(DynamicsError::OutOfTime { t, during: Phase::ChoosingModes { tried, of: combinations } });
         }
@@ -172,7 +180,7 @@ pub fn choose_modes_within(
         let rest_sliders: Vec<usize> = closed
             .iter()
             .enumerate()
-            .filter(|&(i, &k)| cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0)
+            .filter(|&(i, &k)| cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 && twins[i].is_none())
             .map(|(_, &k)| k)
             .collect();
         if ok && rest_sliders.len() == 1 {
@@ -183,6 +191,7 @@ pub fn choose_modes_within(
             let s0 = trial.slip[k];
             let eval = |phi: f64, trial: &mut ContactState, fd: &mut ForwardData, cd: &mut ContactData| -> Option<(f64, f64)> {
                 trial.slip[k] = [phi.cos(), phi.sin()];
+                super::dependent::copy_to_twins(&twins, closed, &mut trial.slip);
                 solve_modes(contacts, trial, stabilization, fd, cd).ok()?;
                 let qdd = &fd.qdd.as_slice()[..nv];
                 let a = [cd.rows.dot(3 * k + 1, qdd) + cd.rows.bias[3 * k + 1], cd.rows.dot(3 * k + 2, qdd) + cd.rows.bias[3 * k + 2]];
@@ -230,6 +239,7 @@ pub fn choose_modes_within(
                 Some((phi, _)) => trial.slip[k] = [phi.cos(), phi.sin()],
                 None => trial.slip[k] = s0,
             }
+            super::dependent::copy_to_twins(&twins, closed, &mut trial.slip);
         } else if ok && from_rest {
             // the consistent slip direction from rest: a_t ∥ s (so v_t grows along s and the
             // direction v_t/|v_t| is smooth); fixed-point iteration s ← a_t/|a_t| from the
@@ -268,6 +278,7 @@ pub fn choose_modes_within(
                 let (i, s) = (impending[k], trial.slip[k]);
                 trial.onset[k] = Some([s[0] * i[0] + s[1] * i[1], s[1] * i[0] - s[0] * i[1]]);
             }
+            super::dependent::copy_to_twins(&twins, closed, &mut trial.onset);
         }
         if ok && solve_modes(contacts, &trial, stabilization, fd, cd).is_ok() {
             let qdd = &fd.qdd.as_slice()[..nv];
