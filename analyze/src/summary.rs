@@ -180,6 +180,8 @@ mod render;
 pub use frame::summary_frame;
 #[cfg(feature = "tables")]
 pub use render::render_frame;
+#[cfg(test)]
+mod tests;
 
 /// The summary of `rows` as `format` text: the table of [`summary_frame`] with `params` columns,
 /// `query` applied. Needs the feature `tables` (polars); without it, an error that says so.

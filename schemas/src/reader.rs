@@ -140,6 +140,7 @@ fn read_state(
 ) -> Result<State, Error> {
     let mut state = State::new(label, topics);
     state.typed = visitor.typed();
+    state.by_ref = state.typed && visitor.by_ref();
     if let (Some(summary), Some(_)) = (summary, topics) {
         state.skip = chunks::prefeed(&mut state, summary);
     }
@@ -247,10 +248,14 @@ fn feed_records(
     // skipping chunks: the reader yields them whole, and the skipper decides
     let mut skipper = state.skip.then(chunks::Skipper::default);
     let options = options.with_emit_chunks(skipper.is_some());
+    // where the next record starts: after the magic, each record is opcode, length, content
+    let mut offset = mcap::MAGIC.len() as u64;
     let fed = pump(input, options, &file, &mut bytes, &mut |opcode, data| {
         let mcap_err = |source| Error::McapRead { file: file.clone(), source };
+        let at = offset;
+        offset += 9 + data.len() as u64;
         if let Some(sk) = skipper.as_mut() {
-            if sk.take(opcode, data, state, visitor)? {
+            if sk.take(opcode, data, at, state, visitor)? {
                 return Ok(());
             }
         }
@@ -346,6 +351,13 @@ struct State {
     skip: bool,
     /// Chunks not decompressed ([`chunks`]).
     chunks_skipped: usize,
+    /// The summary's chunk indexes: chunk start offset -> (record length, channels it holds).
+    chunk_plan: BTreeMap<u64, (u64, Vec<u16>)>,
+    /// The visitor takes messages by reference ([`Visitor::by_ref`], with [`State::typed`]).
+    by_ref: bool,
+    /// The last typed message of each kind, decoded into again for a visitor that takes them by
+    /// reference (indexed by [`known::KnownKind`]).
+    slots: [known::Slot; 4],
 }
 
 impl State {
@@ -501,6 +513,9 @@ impl State {
             encoding: info.message_encoding.clone(),
             detail,
         };
+        if let (Decoder::Known(kind), true, None) = (decoder, self.by_ref, &self.pending) {
+            return self.message_by_ref(*kind, header, index, data, visitor);
+        }
         let value = match decoder {
             Decoder::Skip(_) => return Ok(()),
             Decoder::Known(kind) => Body::Known(known::decode(*kind, data).map_err(decode_err)?),
@@ -539,6 +554,49 @@ impl State {
             None => visitor.message(DecodedMessage { file: &self.file, topic, index, log_time_ns: header.log_time, body: value, run: self.run.as_ref() })?,
         }
         Ok(())
+    }
+
+    /// A typed message for a visitor that takes them by reference ([`Visitor::by_ref`]): decoded
+    /// into the message kept for its kind ([`State::slots`]), handed over, kept for the next.
+    /// What the visitor sees, and what is checked, is what [`State::message`] gives.
+    fn message_by_ref(
+        &mut self,
+        kind: known::KnownKind,
+        header: &mcap::records::MessageHeader,
+        index: usize,
+        data: &[u8],
+        visitor: &mut dyn Visitor,
+    ) -> Result<(), Error> {
+        let info = &self.channels[&header.channel_id];
+        let slot = &mut self.slots[kind as usize];
+        known::decode_into(kind, data, slot).map_err(|detail| Error::Decode {
+            file: self.file.clone(),
+            topic: info.topic.clone(),
+            index,
+            log_time_ns: header.log_time,
+            encoding: info.message_encoding.clone(),
+            detail,
+        })?;
+        let Some(known) = slot.message.take() else { return Ok(()) };
+        let body = Body::Known(known);
+        if self.first_joint_array_len.is_none() {
+            if let Body::Known(k) = &body {
+                self.first_joint_array_len = k.first_joint_array_len(&info.topic);
+            }
+            if self.first_joint_array_len.is_some() && self.run.as_ref().is_some_and(|r| r.joint_names.is_empty()) {
+                self.update_run(); // format 0 names its joints after this length
+            }
+        }
+        let info = &self.channels[&header.channel_id];
+        if info.topic == crate::topics::ENERGY && self.energy_has_gear_friction.is_none() {
+            self.energy_has_gear_friction = Some(true); // this crate's schema has the field
+        }
+        let m = DecodedMessage { file: &self.file, topic: &info.topic, index, log_time_ns: header.log_time, body, run: self.run.as_ref() };
+        let seen = visitor.message_ref(&m);
+        if let Body::Known(k) = m.body {
+            self.slots[kind as usize].message = Some(k);
+        }
+        seen
     }
 
     /// Counts a message of the known channel `channel_id` logged at `log_time` (ns), which must

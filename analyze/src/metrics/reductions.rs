@@ -150,13 +150,10 @@ fn check(m: &DecodedMessage<'_>, joints: &mut Option<usize>, contacts: &mut Opti
     if let Some((field, value)) = m.non_finite() {
         return Err(Error::NonFinite { file: m.file.to_string(), topic: m.topic.to_string(), field, value, index: m.index, t_s: m.t_s() });
     }
-    for (field, kind, len) in m.arrays() {
-        match kind {
-            ArrayIndex::Joint => fit(joints, m, field, len, "joint")?,
-            ArrayIndex::Contact => fit(contacts, m, field, len, "contact")?,
-        }
-    }
-    Ok(())
+    m.try_for_each_array(|field, kind, len| match kind {
+        ArrayIndex::Joint => fit(joints, m, field, len, "joint"),
+        ArrayIndex::Contact => fit(contacts, m, field, len, "contact"),
+    })
 }
 
 impl Reductions {
@@ -368,8 +365,17 @@ impl schemas::Visitor for Reductions {
         }
     }
 
+    /// Nothing of a message is kept past [`Reductions::add`] (the energies are copied).
+    fn by_ref(&self) -> bool {
+        true
+    }
+
     fn message(&mut self, m: DecodedMessage<'_>) -> Result<(), schemas::Error> {
-        match self.add(&m) {
+        self.message_ref(&m)
+    }
+
+    fn message_ref(&mut self, m: &DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        match self.add(m) {
             Ok(()) => Ok(()),
             Err(Error::Read(e)) => Err(*e),
             Err(e) => {
@@ -430,7 +436,10 @@ impl Reductions {
                 if self.energy_first.is_none() {
                     self.energy_first = Some(e.clone().into_owned());
                 }
-                self.energy_last = Some(e.into_owned());
+                match self.energy_last.as_mut() {
+                    Some(last) => copy_energy(last, &e),
+                    None => self.energy_last = Some(e.into_owned()),
+                }
             }
             topics::CONTACTS => {
                 let c = m.decode_ref::<ContactState>(sizes)?;
@@ -448,4 +457,36 @@ impl Reductions {
         }
         Ok(())
     }
+}
+
+/// `*to = from.clone()`, reusing `to`'s arrays and names (no allocation per `/energy` message).
+fn copy_energy(to: &mut EnergyState, from: &EnergyState) {
+    let EnergyState {
+        time,
+        link_work,
+        electric_energy,
+        link_work_total,
+        electric_energy_total,
+        kinetic,
+        potential,
+        magnetic,
+        resistive_loss,
+        friction_loss,
+        balance_residual,
+        gear_friction_loss,
+        name,
+    } = from;
+    to.time = *time;
+    to.link_work.clone_from(link_work);
+    to.electric_energy.clone_from(electric_energy);
+    to.link_work_total = *link_work_total;
+    to.electric_energy_total = *electric_energy_total;
+    to.kinetic = *kinetic;
+    to.potential = *potential;
+    to.magnetic = *magnetic;
+    to.resistive_loss = *resistive_loss;
+    to.friction_loss = *friction_loss;
+    to.balance_residual = *balance_residual;
+    to.gear_friction_loss = *gear_friction_loss;
+    to.name.clone_from(name);
 }

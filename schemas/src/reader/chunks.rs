@@ -80,12 +80,16 @@ pub(super) fn summary_of_bytes(bytes: &[u8]) -> Option<&[u8]> {
 /// read without skipping, and the linear pass reports what is wrong.
 pub(super) fn prefeed(state: &mut State, mut summary: &[u8]) -> bool {
     let mut records = Vec::new();
+    let mut indexes = Vec::new();
     while !summary.is_empty() {
         let Some((&opcode, rest)) = summary.split_first() else { return false };
         let Some(len) = rest.get(..8).and_then(|b| b.try_into().ok()).map(u64::from_le_bytes) else { return false };
         let Some(data) = usize::try_from(len).ok().and_then(|n| rest.get(8..8usize.checked_add(n)?)) else { return false };
         if opcode == op::SCHEMA || opcode == op::CHANNEL {
             records.push((opcode, data));
+        }
+        if opcode == op::CHUNK_INDEX {
+            indexes.push(data);
         }
         summary = &rest[8 + data.len()..];
     }
@@ -95,6 +99,7 @@ pub(super) fn prefeed(state: &mut State, mut summary: &[u8]) -> bool {
     let mut trial = State::new(state.file.clone(), None);
     trial.only = state.only.clone();
     trial.typed = state.typed;
+    trial.by_ref = state.by_ref;
     let fed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         records.iter().try_for_each(|&(opcode, data)| match mcap::parse_record(opcode, data) {
             Ok(r) => trial.record(r, &mut Null),
@@ -104,27 +109,64 @@ pub(super) fn prefeed(state: &mut State, mut summary: &[u8]) -> bool {
     if !matches!(fed, Ok(Ok(()))) {
         return false;
     }
+    // where each chunk is and which channels it holds (one that does not parse: none planned)
+    for data in indexes {
+        if let Ok(Record::ChunkIndex(ix)) = mcap::parse_record(op::CHUNK_INDEX, data) {
+            trial.chunk_plan.insert(ix.chunk_start_offset, (ix.chunk_length, ix.message_index_offsets.into_keys().collect()));
+        }
+    }
     *state = trial;
     true
 }
 
-/// A chunk held back until its message indexes are read, and what became of the chunks.
+/// What becomes of the chunks: read at once, skipped, or held back until their message
+/// indexes are read.
 #[derive(Default)]
 pub(super) struct Skipper {
-    /// The chunk record as in the file (opcode, length, content), when one is held.
+    /// The chunk record as in the file (opcode, length, content), when one is held and copied
+    /// (a chunk the summary's chunk index does not describe).
     chunk: Vec<u8>,
     held: bool,
+    /// Whether the held chunk was copied (else the chunk index said to skip it: not copied).
+    copied: bool,
+    /// File offset of the held chunk.
+    offset: u64,
+    /// The channels the chunk index names for the held chunk (`None`: not described).
+    planned: Option<Vec<u16>>,
     /// Its message indexes: channel, and `(offset, log time)` of each message.
     indexes: Vec<(u16, Vec<MessageIndexEntry>)>,
+    /// The zstd context, kept from one chunk to the next.
+    zstd: Option<zstd::bulk::Decompressor<'static>>,
+    /// A chunk's records, decompressed.
+    out: Vec<u8>,
     pub(super) skipped: usize,
     pub(super) read: usize,
 }
 
+/// Whether a chunk whose (message or chunk) indexes name `channels` is read: when they name
+/// none, or one that is decoded or unknown.
+fn wanted(state: &State, channels: &mut dyn Iterator<Item = u16>) -> bool {
+    let mut none = true;
+    let mut decoded = false;
+    for ch in channels {
+        none = false;
+        decoded |= !matches!(state.decoders.get(&ch), Some(super::Decoder::Skip(_)));
+    }
+    none || decoded
+}
+
 impl Skipper {
-    /// Takes a record of the outer pass (which yields chunks whole), after reading or skipping
-    /// the chunk held unless the record is one of its message indexes; `false` when the record
-    /// is neither a chunk nor such an index (the caller reads it).
-    pub(super) fn take(&mut self, opcode: u8, data: &[u8], state: &mut State, visitor: &mut dyn Visitor) -> Result<bool, Error> {
+    /// Takes a record of the outer pass (which yields chunks whole) that starts at byte `offset`
+    /// of the file, after reading or skipping the chunk held unless the record is one of its
+    /// message indexes; `false` when the record is neither a chunk nor such an index (the
+    /// caller reads it).
+    ///
+    /// A chunk that the summary's chunk index describes (same offset and length) is decided
+    /// from it at once: read straight from the reader's buffer ([`Skipper::read_chunk`]), or
+    /// skipped without a copy, its message indexes then counted and checked against the
+    /// decision. A chunk it does not describe is copied and held until its message indexes are
+    /// read.
+    pub(super) fn take(&mut self, opcode: u8, data: &[u8], offset: u64, state: &mut State, visitor: &mut dyn Visitor) -> Result<bool, Error> {
         let mcap_err = |source| Error::McapRead { file: state.file.clone(), source };
         if opcode == op::MESSAGE_INDEX && self.held {
             if let Record::MessageIndex(ix) = mcap::parse_record(opcode, data).map_err(mcap_err)? {
@@ -133,16 +175,30 @@ impl Skipper {
             return Ok(true);
         }
         self.resolve(state, visitor)?;
-        if opcode == op::CHUNK {
-            self.chunk.clear();
-            self.chunk.push(op::CHUNK);
-            self.chunk.extend_from_slice(&(data.len() as u64).to_le_bytes());
-            self.chunk.extend_from_slice(data);
-            self.held = true;
-            self.indexes.clear();
-            return Ok(true);
+        if opcode != op::CHUNK {
+            return Ok(false);
         }
-        Ok(false)
+        let planned = state.chunk_plan.get(&offset).filter(|(len, _)| *len == 9 + data.len() as u64).map(|(_, channels)| channels.clone());
+        match planned {
+            Some(channels) if wanted(state, &mut channels.iter().copied()) => {
+                self.read += 1;
+                self.read_chunk(data, state, visitor)?;
+            }
+            planned => {
+                self.copied = planned.is_none();
+                self.chunk.clear();
+                if self.copied {
+                    self.chunk.push(op::CHUNK);
+                    self.chunk.extend_from_slice(&(data.len() as u64).to_le_bytes());
+                    self.chunk.extend_from_slice(data);
+                }
+                self.planned = planned;
+                self.offset = offset;
+                self.held = true;
+                self.indexes.clear();
+            }
+        }
+        Ok(true)
     }
 
     /// Reads or skips the held chunk (if any): skipped when its message indexes name only
@@ -151,16 +207,22 @@ impl Skipper {
         if !std::mem::take(&mut self.held) {
             return Ok(());
         }
-        let decoded = |ch: &u16| !matches!(state.decoders.get(ch), Some(super::Decoder::Skip(_)));
-        if self.indexes.is_empty() || self.indexes.iter().any(|(ch, _)| decoded(ch)) {
+        let read = self.indexes.is_empty() || wanted(state, &mut self.indexes.iter().map(|(ch, _)| *ch));
+        if read && !self.copied {
+            let named: Vec<u16> = self.indexes.iter().map(|(ch, _)| *ch).collect();
+            return Err(state.malformed(format!(
+                "the chunk at byte {}: the summary's chunk index names channels {:?}, its message indexes {:?}",
+                self.offset,
+                self.planned.as_deref().unwrap_or_default(),
+                named
+            )));
+        }
+        if read {
             self.read += 1;
-            let options = super::reader_options().with_skip_start_magic(true).with_skip_end_magic(true).with_check_finishes_after_end_magic(false);
-            let mut input = self.chunk.as_slice();
-            let mut n = 0;
-            return super::pump(&mut input, options, &state.file.clone(), &mut n, &mut |opcode, data| {
-                let record = mcap::parse_record(opcode, data).map_err(|source| Error::McapRead { file: state.file.clone(), source })?;
-                state.record(record, visitor)
-            });
+            let chunk = std::mem::take(&mut self.chunk);
+            let done = self.read_chunk(&chunk[9..], state, visitor);
+            self.chunk = chunk;
+            return done;
         }
         self.skipped += 1;
         for (channel, entries) in &mut self.indexes {
@@ -170,5 +232,69 @@ impl Skipper {
             }
         }
         Ok(())
+    }
+
+    /// Reads the records of the chunk record with content `data`: decompressed (zstd, or none)
+    /// with the zstd context kept, its CRC and the framing of its records checked before any
+    /// record is used, then each record to `state`. A chunk that is not so (lz4, a bad CRC, a
+    /// record that overruns it) goes through the MCAP reader as before, which says what is
+    /// wrong.
+    fn read_chunk(&mut self, data: &[u8], state: &mut State, visitor: &mut dyn Visitor) -> Result<(), Error> {
+        if let Some(content) = self.unpack(data) {
+            let mut rest = content;
+            while let Some((&opcode, tail)) = rest.split_first() {
+                let len = u64::from_le_bytes(tail[..8].try_into().unwrap_or_default()) as usize;
+                let record = mcap::parse_record(opcode, &tail[8..8 + len]).map_err(|source| Error::McapRead { file: state.file.clone(), source })?;
+                state.record(record, visitor)?;
+                rest = &tail[8 + len..];
+            }
+            return Ok(());
+        }
+        let mut chunk = Vec::with_capacity(9 + data.len());
+        chunk.push(op::CHUNK);
+        chunk.extend_from_slice(&(data.len() as u64).to_le_bytes());
+        chunk.extend_from_slice(data);
+        let options = super::reader_options().with_skip_start_magic(true).with_skip_end_magic(true).with_check_finishes_after_end_magic(false);
+        let mut input = chunk.as_slice();
+        let mut n = 0;
+        super::pump(&mut input, options, &state.file.clone(), &mut n, &mut |opcode, data| {
+            let record = mcap::parse_record(opcode, data).map_err(|source| Error::McapRead { file: state.file.clone(), source })?;
+            state.record(record, visitor)
+        })
+    }
+
+    /// The records of a chunk record's content, decompressed, when it is zstd or uncompressed,
+    /// decompresses to its stated size, has the CRC it states (if any), and is a sequence of
+    /// whole records (opcode, length, content) of at most [`MAX_RECORD_BYTES`]; else `None`.
+    fn unpack<'a>(&'a mut self, data: &'a [u8]) -> Option<&'a [u8]> {
+        let Ok(Record::Chunk { header, data: std::borrow::Cow::Borrowed(compressed) }) = mcap::parse_record(op::CHUNK, data) else { return None };
+        let size = usize::try_from(header.uncompressed_size).ok().filter(|&n| n <= MAX_RECORD_BYTES)?;
+        let content: &[u8] = match header.compression.as_str() {
+            "" => compressed,
+            "zstd" => {
+                if self.zstd.is_none() {
+                    self.zstd = zstd::bulk::Decompressor::new().ok();
+                }
+                let zstd = self.zstd.as_mut()?;
+                self.out.clear();
+                self.out.reserve(size);
+                let n = zstd.decompress_to_buffer(compressed, &mut self.out).ok()?;
+                (n == size).then_some(())?;
+                &self.out
+            }
+            _ => return None,
+        };
+        if content.len() != size || (header.uncompressed_crc != 0 && crc32fast::hash(content) != header.uncompressed_crc) {
+            return None;
+        }
+        let mut rest = content;
+        while !rest.is_empty() {
+            let len = usize::try_from(u64::from_le_bytes(rest.get(1..9)?.try_into().ok()?)).ok()?;
+            if len > MAX_RECORD_BYTES || rest.len() - 9 < len {
+                return None;
+            }
+            rest = &rest[9 + len..];
+        }
+        Some(content)
     }
 }

@@ -158,6 +158,66 @@ struct EnergyWire {
     name: Vec<String>,
 }
 
+// The same mirrors without their `name` field (tag 7, 5 and 13), which prost then skips as an
+// unknown field: the names are read by [`names_into`] into kept strings (prost's repeated
+// string decodes one new `String` per entry and message).
+
+#[derive(Clone, PartialEq, prost::Message)]
+struct MotorNums {
+    #[prost(double, tag = "1")]
+    time: f64,
+    #[prost(double, repeated, tag = "2")]
+    current: Vec<f64>,
+    #[prost(double, repeated, tag = "3")]
+    voltage: Vec<f64>,
+    #[prost(double, repeated, tag = "4")]
+    back_emf: Vec<f64>,
+    #[prost(double, repeated, tag = "5")]
+    electric_power: Vec<f64>,
+    #[prost(double, repeated, tag = "6")]
+    torque: Vec<f64>,
+}
+
+#[derive(Clone, PartialEq, prost::Message)]
+struct ConstraintNums {
+    #[prost(double, tag = "1")]
+    time: f64,
+    #[prost(double, repeated, tag = "2")]
+    normal_force: Vec<f64>,
+    #[prost(double, repeated, tag = "3")]
+    position: Vec<f64>,
+    #[prost(double, repeated, tag = "4")]
+    velocity: Vec<f64>,
+}
+
+#[derive(Clone, PartialEq, prost::Message)]
+struct EnergyNums {
+    #[prost(double, tag = "1")]
+    time: f64,
+    #[prost(double, repeated, tag = "2")]
+    link_work: Vec<f64>,
+    #[prost(double, repeated, tag = "3")]
+    electric_energy: Vec<f64>,
+    #[prost(double, tag = "4")]
+    link_work_total: f64,
+    #[prost(double, tag = "5")]
+    electric_energy_total: f64,
+    #[prost(double, tag = "6")]
+    kinetic: f64,
+    #[prost(double, tag = "7")]
+    potential: f64,
+    #[prost(double, tag = "8")]
+    magnetic: f64,
+    #[prost(double, tag = "9")]
+    resistive_loss: f64,
+    #[prost(double, tag = "10")]
+    friction_loss: f64,
+    #[prost(double, tag = "11")]
+    balance_residual: f64,
+    #[prost(double, tag = "12")]
+    gear_friction_loss: f64,
+}
+
 fn vec3(w: Option<Vec3Wire>) -> Vec3 {
     w.map_or_else(Vec3::default, |w| Vec3 { x: w.x, y: w.y, z: w.z })
 }
@@ -170,6 +230,9 @@ struct Scratch {
     motors: MotorWire,
     constraints: ConstraintWire,
     energy: EnergyWire,
+    motor_nums: MotorNums,
+    constraint_nums: ConstraintNums,
+    energy_nums: EnergyNums,
 }
 
 thread_local! {
@@ -229,6 +292,175 @@ pub(crate) fn decode(kind: KnownKind, data: &[u8]) -> Result<Known, String> {
             }
         })
     })
+}
+
+/// What a reader keeps of one kind for a visitor that takes messages by reference: the last
+/// message decoded, and the bytes its names were read from (names are the same from one
+/// message to the next: equal bytes, nothing to read).
+#[derive(Default)]
+pub(crate) struct Slot {
+    pub(crate) message: Option<Known>,
+    /// The `name` entries of the message (`message`'s names), as in its bytes; empty: unknown.
+    names: Vec<u8>,
+}
+
+/// [`decode`] into `slot`, reusing the arrays and names of the message it holds (a visitor that
+/// takes messages by reference, [`crate::Visitor::by_ref`]): no allocation per message once the
+/// arrays have their size. The numbers go through the same prost mirrors (less the names); the
+/// names are read from the same bytes, each entry of the repeated `string` field in order
+/// (protobuf: a repeated field's entries append), UTF-8 checked. Anything unusual (a decode
+/// error, a name of the wrong wire type or not UTF-8) takes [`decode`] itself, so the result,
+/// or the error, is exactly [`decode`]'s.
+pub(crate) fn decode_into(kind: KnownKind, data: &[u8], slot: &mut Slot) -> Result<(), String> {
+    use prost::Message as _;
+    let Slot { message: slot, names: raw } = slot;
+    let fast = SCRATCH.with_borrow_mut(|s| -> Option<()> {
+        let copy = |dst: &mut Vec<f64>, src: &[f64]| {
+            dst.clear();
+            dst.extend_from_slice(src);
+        };
+        match kind {
+            KnownKind::Hand => {
+                let w = HandWire::decode(data).ok()?;
+                *slot = Some(Known::Hand(HandState { time: w.time, actual: vec3(w.actual), desired: vec3(w.desired), error: vec3(w.error), error_norm: w.error_norm }));
+            }
+            KnownKind::Motors => {
+                let w = &mut s.motor_nums;
+                w.clear();
+                w.merge(data).ok()?;
+                if !matches!(slot, Some(Known::Motors(_))) {
+                    raw.clear();
+                    *slot = Some(Known::Motors(MotorState::default()));
+                }
+                let Some(Known::Motors(m)) = slot else { return None };
+                names_into(data, 7, &mut m.name, raw)?;
+                m.time = w.time;
+                copy(&mut m.current, &w.current);
+                copy(&mut m.voltage, &w.voltage);
+                copy(&mut m.back_emf, &w.back_emf);
+                copy(&mut m.electric_power, &w.electric_power);
+                copy(&mut m.torque, &w.torque);
+            }
+            KnownKind::Constraints => {
+                let w = &mut s.constraint_nums;
+                w.clear();
+                w.merge(data).ok()?;
+                if !matches!(slot, Some(Known::Constraints(_))) {
+                    raw.clear();
+                    *slot = Some(Known::Constraints(ConstraintState::default()));
+                }
+                let Some(Known::Constraints(c)) = slot else { return None };
+                names_into(data, 5, &mut c.name, raw)?;
+                c.time = w.time;
+                copy(&mut c.normal_force, &w.normal_force);
+                copy(&mut c.position, &w.position);
+                copy(&mut c.velocity, &w.velocity);
+            }
+            KnownKind::Energy => {
+                let w = &mut s.energy_nums;
+                w.clear();
+                w.merge(data).ok()?;
+                if !matches!(slot, Some(Known::Energy(_))) {
+                    raw.clear();
+                    *slot = Some(Known::Energy(EnergyState::default()));
+                }
+                let Some(Known::Energy(e)) = slot else { return None };
+                names_into(data, 13, &mut e.name, raw)?;
+                e.time = w.time;
+                copy(&mut e.link_work, &w.link_work);
+                copy(&mut e.electric_energy, &w.electric_energy);
+                e.link_work_total = w.link_work_total;
+                e.electric_energy_total = w.electric_energy_total;
+                e.kinetic = w.kinetic;
+                e.potential = w.potential;
+                e.magnetic = w.magnetic;
+                e.resistive_loss = w.resistive_loss;
+                e.friction_loss = w.friction_loss;
+                e.balance_residual = w.balance_residual;
+                e.gear_friction_loss = w.gear_friction_loss;
+            }
+        }
+        Some(())
+    });
+    if fast.is_none() {
+        raw.clear();
+        *slot = Some(decode(kind, data)?);
+    }
+    Ok(())
+}
+
+/// The entries of the repeated `string` field `tag` of the protobuf message `buf` into `names`;
+/// `None` when the field has another wire type or an entry is not UTF-8 (the caller then decodes
+/// with prost, which says why). The other fields are skipped as prost skips them; `buf` was
+/// decoded by prost before. `raw` holds the bytes `names` were read from (the entries, when
+/// they lie together): the same bytes again are the same names, nothing to read.
+fn names_into(buf: &[u8], tag: u32, names: &mut Vec<String>, raw: &mut Vec<u8>) -> Option<()> {
+    use prost::encoding::{decode_key, decode_varint, skip_field, DecodeContext, WireType};
+    // the same names as the message before, as `sim` writes them: its entries end the message
+    // and no entry comes before them (the fields before end exactly where they start)
+    if let Some(cut) = buf.len().checked_sub(raw.len()).filter(|_| !raw.is_empty() && buf.ends_with(raw)) {
+        let mut rest = &buf[..cut];
+        let mut clean = true;
+        while clean && !rest.is_empty() {
+            clean = match decode_key(&mut rest) {
+                Ok((t, wire)) => t != tag && skip_field(wire, t, &mut rest, DecodeContext::default()).is_ok(),
+                Err(_) => false,
+            };
+        }
+        if clean {
+            return Some(());
+        }
+    }
+    // where the entries lie: from the first one's key to the last one's end
+    let mut rest = buf;
+    let (mut first, mut end, mut together) = (None, 0, true);
+    while !rest.is_empty() {
+        let start = buf.len() - rest.len();
+        let (t, wire) = decode_key(&mut rest).ok()?;
+        if t != tag {
+            skip_field(wire, t, &mut rest, DecodeContext::default()).ok()?;
+            continue;
+        }
+        if wire != WireType::LengthDelimited {
+            return None;
+        }
+        let len = usize::try_from(decode_varint(&mut rest).ok()?).ok()?;
+        rest = rest.get(len..)?;
+        together &= first.is_none() || end == start;
+        first.get_or_insert(start);
+        end = buf.len() - rest.len();
+    }
+    let entries = first.map_or(&[][..], |first| &buf[first..end]);
+    if together && !raw.is_empty() && raw.as_slice() == entries {
+        return Some(());
+    }
+    raw.clear();
+    let mut rest = buf;
+    let mut k = 0;
+    while !rest.is_empty() {
+        let (t, wire) = decode_key(&mut rest).ok()?;
+        if t != tag {
+            skip_field(wire, t, &mut rest, DecodeContext::default()).ok()?;
+            continue;
+        }
+        let len = usize::try_from(decode_varint(&mut rest).ok()?).ok()?;
+        let text = std::str::from_utf8(rest.get(..len)?).ok()?;
+        match names.get_mut(k) {
+            Some(n) if n == text => {}
+            Some(n) => {
+                n.clear();
+                n.push_str(text);
+            }
+            None => names.push(text.to_string()),
+        }
+        k += 1;
+        rest = &rest[len..];
+    }
+    names.truncate(k);
+    if together && !entries.is_empty() {
+        raw.extend_from_slice(entries);
+    }
+    Some(())
 }
 
 /// One field of a known message.

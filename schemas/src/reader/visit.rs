@@ -100,6 +100,18 @@ impl DecodedMessage<'_> {
         generic.chain(known.into_iter().flatten().filter(move |&(field, _, len)| keep(field, len)))
     }
 
+    /// [`DecodedMessage::arrays`], each handed to `f` in the same order until it fails (no
+    /// iterator built: for a check of every message).
+    pub fn try_for_each_array<E>(&self, mut f: impl FnMut(&str, ArrayIndex, usize) -> Result<(), E>) -> Result<(), E> {
+        match &self.body {
+            Body::Known(k) => known_each_array(self.topic, k, |field, kind, len| match len > 0 || array_required(self.topic, field) {
+                true => f(field, kind, len),
+                false => Ok(()),
+            }),
+            Body::Value(_) => self.arrays().try_for_each(|(field, kind, len)| f(field, kind, len)),
+        }
+    }
+
     /// The per-joint and per-contact array sizes of [`DecodedMessage::run`].
     pub fn sizes(&self) -> Option<ArraySizes> {
         self.run.map(|r| ArraySizes { joints: r.joint_names.len(), contacts: r.contacts.len() })
@@ -134,9 +146,7 @@ impl DecodedMessage<'_> {
             Body::Value(v) => decode_typed(self.file, self.topic, self.index, self.log_time_ns, v, sizes).map(Cow::Owned),
             Body::Known(k) => {
                 if let Some(sizes) = sizes {
-                    for (field, kind, len) in known_arrays(self.topic, k) {
-                        check_length(self.file, self.topic, self.index, self.log_time_ns, field, kind, len, sizes)?;
-                    }
+                    known_each_array(self.topic, k, |field, kind, len| check_length(self.file, self.topic, self.index, self.log_time_ns, field, kind, len, sizes))?;
                 }
                 let wrong = || Error::Field {
                     file: self.file.to_string(),
@@ -155,6 +165,27 @@ impl DecodedMessage<'_> {
 fn known_arrays<'a>(topic: &'a str, k: &Known) -> impl Iterator<Item = (&'a str, ArrayIndex, usize)> + use<'a> {
     let (lists, n) = k.lists();
     lists.into_iter().take(n).filter_map(move |(name, len): (&'a str, usize)| array_index(topic, name).map(|kind| (name, kind, len)))
+}
+
+/// [`known_arrays`], each handed to `f` in order until it fails.
+fn known_each_array<E>(topic: &str, k: &Known, mut f: impl FnMut(&str, ArrayIndex, usize) -> Result<(), E>) -> Result<(), E> {
+    use std::ops::ControlFlow;
+    use super::known::Field;
+    let done = k.fields(|name, field| {
+        let len = match field {
+            Field::List(xs) => xs.len(),
+            Field::Names(names) => names.len(),
+            _ => return ControlFlow::Continue(()),
+        };
+        match array_index(topic, name).map(|kind| f(name, kind, len)) {
+            Some(Err(e)) => ControlFlow::Break(e),
+            _ => ControlFlow::Continue(()),
+        }
+    });
+    match done {
+        ControlFlow::Break(e) => Err(e),
+        ControlFlow::Continue(()) => Ok(()),
+    }
 }
 
 fn known_name(k: &Known) -> &'static str {
@@ -204,6 +235,20 @@ pub trait Visitor {
     /// [`Body::Value`].
     fn typed(&self) -> bool {
         false
+    }
+
+    /// Whether this visitor takes the messages by reference ([`Visitor::message_ref`]) and
+    /// keeps nothing of them past the call: the reader then decodes each typed message
+    /// ([`Visitor::typed`]) into storage it keeps from one message to the next (no allocation
+    /// per message). `false` (the default): [`Visitor::message`], which owns each message.
+    fn by_ref(&self) -> bool {
+        false
+    }
+
+    /// One decoded message, borrowed (for a visitor whose [`Visitor::by_ref`] is `true`); the
+    /// default hands a copy to [`Visitor::message`].
+    fn message_ref(&mut self, message: &DecodedMessage<'_>) -> Result<(), Error> {
+        self.message(message.clone())
     }
 }
 
