@@ -425,19 +425,18 @@ pub fn one_contact(contacts: &[Contact], state: &ContactState, k: usize, stabili
     let mut out = None;
     if solve_modes(contacts, &st, stabilization, fd, cd).is_ok() {
         let a0 = accel(fd, cd);
-        let mut g = [[0.0; 3]; 3];
+        let mut cols = [[0.0; 3]; 3];
         let mut ok = true;
-        for a in 0..3 {
+        for (a, col) in cols.iter_mut().enumerate() {
             fd.b.copy_from(&b0);
-            for j in 0..nv {
-                fd.b[j] += cd.rows.row(3 * k + a)[j];
+            for (bj, rj) in fd.b.iter_mut().zip(cd.rows.row(3 * k + a)) {
+                *bj += rj;
             }
             ok &= solve_modes(contacts, &st, stabilization, fd, cd).is_ok();
             let a1 = accel(fd, cd);
-            for r in 0..3 {
-                g[r][a] = a1[r] - a0[r];
-            }
+            *col = std::array::from_fn(|r| a1[r] - a0[r]);
         }
+        let g: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| cols[c][r]));
         fd.b.copy_from(&b0);
         st.mode[k] = ContactMode::Sticking;
         if ok && solve_modes(contacts, &st, stabilization, fd, cd).is_ok() {
