@@ -17,6 +17,8 @@ mod by_hand;
 mod contact_friction_topic;
 #[path = "contact_shapes.rs"]
 mod contact_shapes;
+#[path = "contacts_chatter.rs"]
+mod contacts_chatter;
 #[path = "contacts_converge.rs"]
 mod contacts_converge;
 #[path = "contacts_exact.rs"]

@@ -14,7 +14,8 @@
 //! smallest, 4/3, at tan θ = 2.
 //!
 //! Tested at tan θ = 2, θ̇ = 0, ẋ = −1 m/s: μ = 1.5 > 4/3 is reported as an inconsistency at
-//! t = 0 naming the contact; μ = 1.2 < 4/3 runs, with the closed-form normal force
+//! t = 0 naming the contact, with B/m = G_nn − μ G_nt·s = −0.2 and the critical friction 4/3
+//! in the message; μ = 1.2 < 4/3 runs, with the closed-form normal force
 //! `N = m g / B` (B = 0.16: six times the weight) and friction +μ N along x at t = 0 (1e-9
 //! relative: one small LU solve, condition ~ 1/B).
 
@@ -60,6 +61,14 @@ fn a_rod_above_the_critical_friction_is_reported_as_inconsistent() {
             assert_eq!(contact, "tip");
             assert!(t.abs() <= 1e-12, "at t = {t} s, the start");
             assert!(why.to_lowercase().contains("painlev") || why.contains("no consistent"), "{why}");
+            // the diagnosis (`modes::one_contact`): the effective Delassus terms of the tip at
+            // t = 0 against the closed form, G_nn = (1 + 3 cos²θ)/m = 1.6 and
+            // G_nt·s = 3 sinθ cosθ / m = 1.2 for s = (−1, 0) (the slip direction), so
+            // G_nn − μ G_nt·s = B/m = −0.2 m/(s² N) and the critical friction G_nn/(G_nt·s) =
+            // 4/3; separated, the tip falls at g (the message's 7 digits: a 3 × 3 solve)
+            for part in ["G_nn - mu G_nt.s = -2.000000e-1", "G_nn = 1.600000e0", "G_nt.s = 1.200000e0", "a_n = -9.810000e0", "friction below G_nn/(G_nt.s) = 1.3333 makes the slide consistent"] {
+                assert!(why.contains(part), "the message lacks {part:?}: {why}");
+            }
         }
         Err(e) => panic!("expected InconsistentContact, got: {e}"),
         Ok(c) => panic!("a Painlevé-inconsistent rod was integrated silently ({} samples)", c.samples.len()),

@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | separated (unilateral) | g − g_ref (−1, touch-down) | 1 |
 //! | sticking | f_n (−1, lift-off) | μ f_n − \|f_t\| (−1, stick→slip; a statically indeterminate contact's largest, `contact/indeterminate.rs`) |
-//! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick at its zero, [`stops_here`]; 1 when μ = 0) |
+//! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick at its zero, `stops_here` in `contact_events.rs`; 1 when μ = 0) |
 //! | compliant | g (0) | k δ + c δ̇ while δ > 0, else 1 (0) |
 //! | bilateral | 1 | 1 |
 //!
@@ -25,10 +25,10 @@
 //! contacts, preferring the modes the events imply. An impact jumps q̇ (currents continuous),
 //! adds its kinetic-energy loss to the contacts' impact-loss quadratures and the rotors'
 //! impulsive torque work `−J_m (q̇⁺² − q̇⁻²)/2` to the link works W_j. Allocation happens at
-//! events only (the mode enumeration, the impact), not in the step loop.
+//! events only (the mode enumeration, the impact), not in the step loop. The event functions
+//! and the event handler are in `contact_events.rs` (file size).
 
-use crate::dynamics::contact::forward::{has_rows, prepare, slip_direction, ContactData, ContactState, SLIP_DIRECTION_SPEED};
-use crate::dynamics::contact::rows::contact_gaps_where;
+use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState, SLIP_DIRECTION_SPEED};
 use crate::dynamics::contact::impact::solve_impact;
 use crate::dynamics::contact::modes::choose_modes_within;
 use crate::dynamics::contact::{Contact, ContactEvent, ContactEventKind, ContactMode, ContactModel, ContactOutput, ContactSettings};
@@ -100,26 +100,6 @@ impl Hybrid {
     }
 }
 
-/// The slip→stick rule (issue 23, item 2). A sliding contact's ev1 is `v_t · s_ref` (m/s),
-/// `s_ref` the slip direction at the start of the step: no threshold, its zero is located like
-/// a lift-off or a touch-down (the sliding right-hand side continues the friction's direction
-/// through the zero, `slip_direction`, so the integrator steps across it smoothly). In 1-D the
-/// zero of `v_t · s_ref` is the zero of the slip; in 2-D it is where the slip velocity turns
-/// perpendicular to `s_ref`, which is the stop when `|v_t|` there is at most this bound, and
-/// otherwise a turn of the slip direction by 90° within one step (no stop: `s_ref` is refreshed
-/// and the contact slides on). The bound is the larger of the contact settings' `vel_tol`
-/// (`velocity_tolerance`, 1e-9 m/s) and [`SLIP_DIRECTION_SPEED`] (1e-6 m/s), below which the
-/// friction's direction blends towards the stored one (`friction_direction`): there the slip's
-/// part across `s_ref` is braked less, so a 2-D slip that ends inside that speed may turn across
-/// `s_ref` instead of reaching zero along it, and without the second bound each such turn
-/// restarted the slip at a smaller speed, 90° further, 33 times at one instant
-/// (one-elbow-unilateral at rtol 1e-4, with the direction frozen below that speed). A slip that stops cleanly (1-D,
-/// or 2-D coming to rest along a direction) reaches the zero with `|v_t|` ~1e-12 m/s (the root's
-/// 1e-12 s bracket). What is left is removed by the velocity projection `stop_slip`.
-fn stops_here(v_t: [f64; 2], vel_tol: f64) -> bool {
-    v_t[0].hypot(v_t[1]) <= vel_tol.max(SLIP_DIRECTION_SPEED)
-}
-
 /// The value of a rebounding contact's touch-down function at its restart, m (issue 23). A
 /// contact that leaves the table with ġ > `vel_tol` restarts at a gap g₀ that is 0 up to the
 /// event's bracket (≤ |ġ| · 1e-12 s inside); its touch-down function is `g − min(g₀, 0)` after
@@ -131,14 +111,14 @@ fn stops_here(v_t: [f64; 2], vel_tol: f64) -> bool {
 /// above the table (g > 0) the function is `g` again (`release_rebounds`).
 pub const REBOUND_START: f64 = 1e-14;
 
-fn mu_of(c: &Contact) -> f64 {
+pub(super) fn mu_of(c: &Contact) -> f64 {
     match c.model {
         ContactModel::Unilateral { friction, .. } => friction,
         _ => 0.0,
     }
 }
 
-fn in_touch(m: ContactMode) -> bool {
+pub(super) fn in_touch(m: ContactMode) -> bool {
     matches!(m, ContactMode::Sticking | ContactMode::Sliding)
 }
 
@@ -282,7 +262,7 @@ impl ArmSystem<'_> {
         prepare(&plant, &h.contacts, &mut self.ws.data, &mut self.ws.fd, &mut h.cd, t, &y[l.q()], &y[l.qd()], current)
     }
 
-    fn log(&mut self, e: ContactEvent) -> Result<(), RunError> {
+    pub(super) fn log(&mut self, e: ContactEvent) -> Result<(), RunError> {
         let h = self.hybrid.as_mut().expect("hybrid");
         h.count += 1;
         if h.count > h.settings.max_events {
@@ -295,7 +275,7 @@ impl ArmSystem<'_> {
     /// An impact at (t, y): the contacts in touch and the separated unilateral ones at the
     /// table take part; q̇ jumps, the losses and the rotors' work are booked, events logged.
     /// Returns the contacts that stay closed (ġ⁺ ≤ vel_tol) and those that separate.
-    fn impact(&mut self, t: f64, y: &mut [f64], approaching: &[usize]) -> Result<(Vec<usize>, Vec<usize>), RunError> {
+    pub(super) fn impact(&mut self, t: f64, y: &mut [f64], approaching: &[usize]) -> Result<(Vec<usize>, Vec<usize>), RunError> {
         let l = self.layout;
         let nv = l.nv;
         self.prepare_at(t, y)?;
@@ -349,7 +329,7 @@ impl ArmSystem<'_> {
 
     /// The mode problem over `closed` at (t, y) with `preferred` modes; logs the mode changes
     /// not logged yet (`logged`), and refreshes `s_ref`.
-    fn resolve_modes(&mut self, t: f64, y: &[f64], closed: &[usize], preferred: &[ContactMode], logged: &[usize]) -> Result<(), RunError> {
+    pub(super) fn resolve_modes(&mut self, t: f64, y: &[f64], closed: &[usize], preferred: &[ContactMode], logged: &[usize]) -> Result<(), RunError> {
         self.prepare_at(t, y)?;
         let stab = self.scene.stabilization;
         let h = self.hybrid.as_mut().expect("hybrid");
@@ -388,7 +368,7 @@ impl ArmSystem<'_> {
     /// `resolve_modes`): every separated unilateral contact at the table (|g| ≤ gap_tol) that
     /// leaves it with ġ > vel_tol has its touch-down function re-based at the restart
     /// ([`REBOUND_START`]); a contact that closes has it at `g` again.
-    fn mark_rebounds(&mut self) {
+    pub(super) fn mark_rebounds(&mut self) {
         let Some(h) = &mut self.hybrid else { return };
         let st = h.settings;
         for (k, c) in h.contacts.iter().enumerate() {
@@ -411,7 +391,7 @@ impl ArmSystem<'_> {
     /// table (g > 0) has its touch-down function back at `g` (the next step's start values are
     /// taken after this), so its next touch-down is located at g = 0. A flight shorter than one
     /// step returns to its restart gap g₀ (≤ |ġ| · 1e-12 s below the table).
-    fn release_rebounds(&mut self, y: &[f64]) {
+    pub(super) fn release_rebounds(&mut self, y: &[f64]) {
         let l = self.layout;
         let model = &self.scene.model;
         let Some(h) = &mut self.hybrid else { return };
@@ -428,7 +408,7 @@ impl ArmSystem<'_> {
     }
 
     /// After an accepted step: the slip directions the next step's ev1 refers to.
-    fn refresh_slip_reference(&mut self, y: &[f64]) {
+    pub(super) fn refresh_slip_reference(&mut self, y: &[f64]) {
         let l = self.layout;
         let model = &self.scene.model;
         let Some(h) = &mut self.hybrid else { return };
@@ -449,242 +429,5 @@ impl ArmSystem<'_> {
                 }
             }
         }
-    }
-}
-
-/// The contacts' part of the [`HybridSystem`] (`drive_modes.rs` has the drives' part; the
-/// trait's implementation there joins them: the contacts' functions come first).
-impl ArmSystem<'_> {
-    pub(super) fn contact_n_events(&self) -> usize {
-        self.hybrid.as_ref().map_or(0, |h| 2 * h.contacts.len())
-    }
-
-    pub(super) fn contact_event_direction(&self, i: usize) -> i8 {
-        let Some(h) = &self.hybrid else { return 0 };
-        match h.contacts[i / 2].model {
-            ContactModel::Compliant { .. } => 0,
-            _ => -1,
-        }
-    }
-
-    /// The dead band of a function that starts on its firing side (`integrate::events`): a gap
-    /// must close by more than the closed-contact tolerance (`gap_tol`, m), a force turn
-    /// negative (or leave the friction cone) by more than 1e-8 N, a slip speed fall by more than
-    /// `vel_tol` (m/s) — far above the solver's noise at f_n = 0, far below any force that
-    /// matters — before the event is taken at the restart itself.
-    pub(super) fn contact_event_tolerance(&self, i: usize) -> Option<f64> {
-        let h = self.hybrid.as_ref()?;
-        let k = i / 2;
-        let cs = &self.scene.contact_settings;
-        match (h.contacts[k].model, h.state.mode[k], i % 2) {
-            (ContactModel::Unilateral { .. }, ContactMode::Separated, 0) => Some(cs.gap_tol),
-            (ContactModel::Unilateral { .. }, ContactMode::Sliding, 1) => Some(cs.vel_tol),
-            (ContactModel::Unilateral { .. }, ContactMode::Sticking | ContactMode::Sliding, _) => Some(1e-8),
-            _ => None,
-        }
-    }
-
-    /// After an [`ArmSystem::evaluate`] (whose solve leaves the separated rigid contacts
-    /// untouched, `contact_rows_only`): their gaps and velocities from the kinematics it left,
-    /// for the event functions and the event handler.
-    fn separated_gaps(&mut self) {
-        let Some(h) = self.hybrid.as_mut() else { return };
-        let (contacts, mode) = (&h.contacts, &h.state.mode);
-        contact_gaps_where(&self.ws.data, contacts, &mut h.cd.rows, |k| !has_rows(contacts, mode, k));
-    }
-
-    pub(super) fn contact_events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
-        if self.hybrid.is_none() {
-            return Ok(());
-        }
-        self.evaluate(t, y)?;
-        self.separated_gaps();
-        let h = self.hybrid.as_mut().expect("hybrid");
-        let r = &h.cd.rows;
-        for (k, c) in h.contacts.iter().enumerate() {
-            if h.rebound[k] {
-                // the restart after the contact left with a separating speed
-                h.gap_ref[k] = r.gap[k].min(0.0);
-                h.rebound_t[k] = t;
-                h.rebound[k] = false;
-            }
-            let f_n = h.cd.f_n[k];
-            let (e0, e1) = match (c.model, h.state.mode[k]) {
-                (ContactModel::Bilateral, _) => (1.0, 1.0),
-                (ContactModel::Compliant { stiffness, damping, .. }, _) => {
-                    let (delta, delta_d) = (-r.gap[k], -r.vel[3 * k]);
-                    (r.gap[k], if delta > 0.0 { stiffness * delta + damping * delta_d } else { 1.0 })
-                }
-                (_, ContactMode::Separated | ContactMode::Bilateral) => (if t == h.rebound_t[k] { REBOUND_START } else { r.gap[k] - h.gap_ref[k] }, 1.0),
-                // the stick margin (a statically indeterminate contact's largest; jammed: no slip)
-                (_, ContactMode::Sticking) => (f_n, if h.cd.margin[k].is_finite() { h.cd.margin[k] } else { 1.0 }),
-                (_, ContactMode::Sliding) => {
-                    let v = r.slip(k);
-                    (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
-                }
-            };
-            out[2 * k] = e0;
-            out[2 * k + 1] = e1;
-        }
-        Ok(())
-    }
-
-    pub(super) fn contact_init_modes(&mut self, t: f64, y: &mut [f64]) -> Result<bool, RunError> {
-        if self.hybrid.is_none() {
-            return Ok(false);
-        }
-        self.prepare_at(t, y)?;
-        let h = self.hybrid.as_ref().expect("hybrid");
-        let st = h.settings;
-        let mut approaching = Vec::new();
-        let mut closed = Vec::new();
-        for (k, c) in h.contacts.iter().enumerate() {
-            if matches!(c.model, ContactModel::Unilateral { .. }) && h.cd.rows.gap[k].abs() <= st.gap_tol {
-                if h.cd.rows.vel[3 * k] < -st.vel_tol {
-                    approaching.push(k);
-                } else if h.cd.rows.vel[3 * k] <= st.vel_tol {
-                    closed.push(k);
-                }
-            }
-        }
-        let mut moved = false;
-        if !approaching.is_empty() {
-            let (c2, _) = self.impact(t, y, &approaching)?;
-            closed = c2;
-            moved = true;
-        }
-        // a contact at rest on the table at t0 is taken as closed when both are consistent
-        let h = self.hybrid.as_ref().expect("hybrid");
-        let preferred: Vec<ContactMode> = h
-            .contacts
-            .iter()
-            .enumerate()
-            .map(|(k, c)| if mu_of(c) > 0.0 && h.cd.rows.slip(k)[0].hypot(h.cd.rows.slip(k)[1]) <= st.vel_tol { ContactMode::Sticking } else { ContactMode::Sliding })
-            .collect();
-        let before_log = self.hybrid.as_ref().map_or(0, |h| h.log.len());
-        self.resolve_modes(t, y, &closed, &preferred, &[])?;
-        self.mark_rebounds();
-        // the initial choice is not an event
-        let h = self.hybrid.as_mut().expect("hybrid");
-        let n = h.log.len();
-        let dropped = h.log.drain(before_log..n).filter(|e| e.kind != ContactEventKind::Impact && e.kind != ContactEventKind::Rest).count();
-        h.count -= dropped as u64;
-        Ok(moved)
-    }
-
-    pub(super) fn contact_handle_events(&mut self, t: f64, y: &mut [f64], fired: &[bool]) -> Result<bool, RunError> {
-        if self.hybrid.is_none() {
-            return Ok(false);
-        }
-        // forces and rows at the event in the current modes
-        self.evaluate(t, y)?;
-        self.separated_gaps();
-        let h = self.hybrid.as_mut().expect("hybrid");
-        let st = h.settings;
-        let nc = h.contacts.len();
-        let mut preferred = h.state.mode.clone();
-        let mut closed: Vec<usize> = (0..nc).filter(|&k| in_touch(h.state.mode[k])).collect();
-        let mut approaching = Vec::new();
-        let mut touched = Vec::new();
-        let mut pending = Vec::new();
-        let mut logged = Vec::new();
-        let mut stopping = Vec::new();
-        for k in 0..nc {
-            let (f0, f1) = (fired[2 * k], fired[2 * k + 1]);
-            if !(f0 || f1) {
-                continue;
-            }
-            let gd = h.cd.rows.vel[3 * k];
-            let c = &h.contacts[k];
-            match (c.model, h.state.mode[k]) {
-                (ContactModel::Bilateral, _) => {}
-                (ContactModel::Compliant { .. }, _) => {
-                    if f0 {
-                        let kind = if gd < 0.0 { ContactEventKind::TouchDown } else { ContactEventKind::LiftOff };
-                        pending.push(ContactEvent { t, contact: k, kind, impulse: 0.0, energy_lost: 0.0, gap_rate_before: gd, gap_rate_after: gd });
-                    }
-                }
-                (_, ContactMode::Separated | ContactMode::Bilateral) => {
-                    if f0 {
-                        if gd < -st.vel_tol {
-                            approaching.push(k);
-                        } else if gd > st.vel_tol {
-                            // separating: the gap is not closing (a contact is closed only with
-                            // its gap rate at zero); its return is located from the restart
-                            h.rebound[k] = true;
-                        } else {
-                            touched.push(k);
-                            preferred[k] = if mu_of(c) > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
-                        }
-                    }
-                }
-                (_, mode) => {
-                    if f0 {
-                        preferred[k] = ContactMode::Separated;
-                    } else if f1 && mode == ContactMode::Sticking {
-                        preferred[k] = ContactMode::Sliding;
-                        let f = h.cd.f_t[k];
-                        let m = f[0].hypot(f[1]);
-                        if m > 0.0 {
-                            h.state.slip[k] = [-f[0] / m, -f[1] / m];
-                        }
-                        // the slide starts from rest: the stick's drift (~1e-13 m/s) is removed
-                        // as at a stop, else it turns the friction's blend by |v_t|/v_s (~1e-7
-                        // rad, ~1e-6 N of 13 N) and the slide from rest reads a deceleration
-                        // the stick's margin does not have (one-elbow at rtol 1e-5, 0.7161 s)
-                        stopping.push(k);
-                    } else if f1 && stops_here(h.cd.rows.slip(k), st.vel_tol) {
-                        preferred[k] = ContactMode::Sticking;
-                        stopping.push(k);
-                    }
-                }
-            }
-        }
-        for e in pending {
-            self.log(e)?;
-        }
-        let mut moved = false;
-        if !approaching.is_empty() {
-            let (c2, opened) = self.impact(t, y, &approaching)?;
-            moved = true;
-            for k in c2 {
-                if !closed.contains(&k) {
-                    closed.push(k);
-                }
-                let c = &self.hybrid.as_ref().expect("hybrid").contacts[k];
-                if preferred[k] == ContactMode::Separated && approaching.contains(&k) {
-                    preferred[k] = if mu_of(c) > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
-                }
-                if approaching.contains(&k) {
-                    logged.push(k);
-                }
-            }
-            closed.retain(|k| !opened.contains(k));
-            // only the approaching contacts were logged by the impact (Impact/Rest); a contact
-            // that was in touch and is thrown off by the impulse gets its LiftOff from
-            // resolve_modes (review F3)
-            for k in opened {
-                if approaching.contains(&k) {
-                    logged.push(k);
-                }
-            }
-        }
-        for k in touched {
-            if !closed.contains(&k) {
-                closed.push(k);
-            }
-        }
-        if !stopping.is_empty() {
-            self.stop_slip(t, y, &stopping)?;
-            moved = true;
-        }
-        self.resolve_modes(t, y, &closed, &preferred, &logged)?;
-        self.mark_rebounds();
-        Ok(moved)
-    }
-
-    pub(super) fn contact_after_step(&mut self, y: &[f64]) {
-        self.refresh_slip_reference(y);
-        self.release_rebounds(y);
     }
 }

@@ -43,6 +43,7 @@ mod arm;
 mod describe;
 mod drive_forces;
 mod drive_modes;
+mod contact_events;
 mod gear_decide;
 mod hybrid;
 mod jacobian;

@@ -336,10 +336,22 @@ pub fn choose_modes_within(
     }
     let mus = closed.iter().map(|&k| format!("{} (mu = {})", contacts[k].name(), mu_of(&contacts[k]))).collect::<Vec<_>>().join(", ");
     let Some(best) = feasible.iter().enumerate().max_by_key(|(i, f)| (f.score, usize::MAX - i)).map(|(_, f)| f) else {
+        // say why at each frictional contact (the rigid problem's terms at this state)
+        let whys: Vec<String> = closed
+            .iter()
+            .filter(|&&k| mu_of(&contacts[k]) > 0.0)
+            .filter_map(|&k| {
+                let v = cd.rows.slip(k);
+                let speed = v[0].hypot(v[1]);
+                let moving = (speed > vel_tol).then(|| [v[0] / speed, v[1] / speed]);
+                one_contact(contacts, state, k, stabilization, fd, cd).map(|o| painleve_why(contacts[k].name(), &o, moving))
+            })
+            .collect();
+        let whys = if whys.is_empty() { String::new() } else { format!(": {}", whys.join("; ")) };
         return Err(DynamicsError::InconsistentContact {
             t,
             contact: names(),
-            why: format!("no consistent contact forces: Painleve inconsistency ({mus}); try a smaller friction"),
+            why: format!("no consistent contact forces: Painleve inconsistency ({mus}){whys}; no combination of the closed contacts' modes passed (the enumeration, with its slip directions from rest): use a smaller friction or a compliant contact"),
         });
     };
     let qmax = best.qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -372,3 +384,102 @@ fn tangential_delassus(fd: &ForwardData, cd: &ContactData, k: usize, s: [f64; 2]
     super::solve::solve_mj(fd.m_j.as_slice(), &fd.l_inv_diag, nv, &mut x);
     w.iter().zip(&x).map(|(a, b)| a * b).sum()
 }
+
+/// What the rigid problem of one frictional contact `k` reads at a state (after
+/// [`super::forward::prepare`]), with the other contacts in the modes of `state`: its
+/// effective Delassus block `G` (3 × 3, rows normal, t1, t2, m s⁻² N⁻¹; `J_k M_J⁻¹ J_kᵀ`
+/// less what the other contacts' active rows take, found column by column as the change of
+/// contact k's acceleration under a unit force on each of its rows, the equations being
+/// linear), its acceleration `a0` with no force of its own, and the sticking force `f*` (with
+/// the others as they are). From these (Pfeiffer & Glocker 1996, §5.2; Brogliato, *Nonsmooth
+/// Mechanics*, 2016, §5.5; Génot & Brogliato 1999): a slide along `s` (friction `−μ f_n s`)
+/// has `f_n = −a0_n / p(s)` with `p(s) = G_nn − μ G_nt·s`, and when it starts from the stick at
+/// the cone, `a_t·s = δ (g_t g_n − g_c²) / p(s)` (δ = |f*_t| − μ f*_n, `g_c = G_nt·s`,
+/// `g_t = sᵀ G_tt s`): with `p(s) ≤ 0` a slide along `s` is not a solution (Painlevé).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OneContact {
+    pub g: [[f64; 3]; 3],
+    pub a0: [f64; 3],
+    pub f_n: f64,
+    pub f_t: [f64; 2],
+    pub mu: f64,
+}
+
+impl OneContact {
+    /// The slide's normal coefficient `p(s) = G_nn − μ G_nt·s` (m s⁻² N⁻¹).
+    pub fn p(&self, s: [f64; 2]) -> f64 {
+        self.g[0][0] - self.mu * (self.g[0][1] * s[0] + self.g[0][2] * s[1])
+    }
+    /// The impending slip direction `−f*_t/|f*_t|` (None when the stick has no tangential force).
+    pub fn impending(&self) -> Option<[f64; 2]> {
+        let m = self.f_t[0].hypot(self.f_t[1]);
+        (m > 0.0).then(|| [-self.f_t[0] / m, -self.f_t[1] / m])
+    }
+    /// The stick margin `μ f*_n − |f*_t|` (N).
+    pub fn margin(&self) -> f64 {
+        self.mu * self.f_n - self.f_t[0].hypot(self.f_t[1])
+    }
+}
+
+/// [`OneContact`] of contact `k` (unilateral with friction) with the others in `state`'s
+/// modes; None when a solve is singular. Allocates (events and diagnostics only).
+pub fn one_contact(contacts: &[Contact], state: &ContactState, k: usize, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) -> Option<OneContact> {
+    let nv = cd.rows.nv;
+    let mut st = state.clone();
+    st.onset[k] = None;
+    st.mode[k] = ContactMode::Separated;
+    let b0 = fd.b.clone();
+    let accel = |fd: &ForwardData, cd: &ContactData| -> [f64; 3] {
+        let qdd = &fd.qdd.as_slice()[..nv];
+        std::array::from_fn(|a| cd.rows.dot(3 * k + a, qdd) + cd.rows.bias[3 * k + a])
+    };
+    let mut out = None;
+    if solve_modes(contacts, &st, stabilization, fd, cd).is_ok() {
+        let a0 = accel(fd, cd);
+        let mut cols = [[0.0; 3]; 3];
+        let mut ok = true;
+        for (a, col) in cols.iter_mut().enumerate() {
+            fd.b.copy_from(&b0);
+            for (bj, rj) in fd.b.iter_mut().zip(cd.rows.row(3 * k + a)) {
+                *bj += rj;
+            }
+            ok &= solve_modes(contacts, &st, stabilization, fd, cd).is_ok();
+            let a1 = accel(fd, cd);
+            *col = std::array::from_fn(|r| a1[r] - a0[r]);
+        }
+        let g: [[f64; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| cols[c][r]));
+        fd.b.copy_from(&b0);
+        st.mode[k] = ContactMode::Sticking;
+        if ok && solve_modes(contacts, &st, stabilization, fd, cd).is_ok() {
+            out = Some(OneContact { g, a0, f_n: cd.f_n[k], f_t: cd.f_t[k], mu: mu_of(&contacts[k]) });
+        }
+    }
+    fd.b.copy_from(&b0);
+    out
+}
+
+/// Why the rigid problem has no solution at contact `k` (the message's part for it): the stick
+/// outside the cone, the separation pressing into the table, and the slide along the impending
+/// direction with `p(s) ≤ 0`, with the numbers and the friction below which the slide would be
+/// consistent (`μ < G_nn / (G_nt·s)`).
+fn painleve_why(name: &str, o: &OneContact, moving: Option<[f64; 2]>) -> String {
+    let Some(s) = moving.or(o.impending()) else {
+        return format!("{name}: the stick has no tangential force (f_n = {:.6e} N)", o.f_n);
+    };
+    let along = if moving.is_some() { "its slip direction" } else { "the impending direction" };
+    let stick = match (moving, o.margin() < 0.0) {
+        (Some(_), _) => String::new(),
+        (None, true) => format!("sticking needs |f_t| = {:.6e} N > mu f_n = {:.6e} N (margin {:.3e} N); ", o.f_t[0].hypot(o.f_t[1]), o.mu * o.f_n, o.margin()),
+        (None, false) => format!("sticking alone would hold (margin {:.3e} N, f_n = {:.6e} N); ", o.margin(), o.f_n),
+    };
+    let gc = o.g[0][1] * s[0] + o.g[0][2] * s[1];
+    let terms = format!("G_nn - mu G_nt.s = {:.6e} m/(s^2 N) (G_nn = {:.6e}, G_nt.s = {:.6e})", o.p(s), o.g[0][0], gc);
+    let slide = if o.p(s) <= 0.0 {
+        let limit = if gc > 0.0 { format!("friction below G_nn/(G_nt.s) = {:.4} makes the slide consistent", o.g[0][0] / gc) } else { String::new() };
+        format!("sliding along {along} s = ({:.4}, {:.4}) has {terms}, so its normal force -a_n/(G_nn - mu G_nt.s) has the sign of a_n and its slip cannot grow: no slide either (Painleve's paradox; Genot & Brogliato 1999); {limit}", s[0], s[1])
+    } else {
+        format!("sliding along {along} s = ({:.4}, {:.4}) alone would be consistent ({terms} > 0): the other contacts' modes make the combination inconsistent", s[0], s[1])
+    };
+    format!("{name} (mu = {}): {stick}separated it would accelerate {} (a_n = {:.6e} m/s^2); {slide}", o.mu, if o.a0[0] < 0.0 { "into the table" } else { "away" }, o.a0[0])
+}
+
