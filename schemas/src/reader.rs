@@ -207,6 +207,11 @@ pub(crate) fn panic_text(panic: &(dyn std::any::Any + Send)) -> String {
 
 /// The reader options: every CRC the format has is checked, chunks before any of their records
 /// are used, and no record may be longer than [`MAX_RECORD_BYTES`].
+/// The error of message `index` of `info`'s channel that did not decode (`detail` says why).
+fn decode_error(file: &str, info: &ChannelInfo, index: usize, header: &mcap::records::MessageHeader, detail: String) -> Error {
+    Error::Decode { file: file.to_owned(), topic: info.topic.clone(), index, log_time_ns: header.log_time, encoding: info.message_encoding.clone(), detail }
+}
+
 fn reader_options() -> mcap::sans_io::LinearReaderOptions {
     mcap::sans_io::LinearReaderOptions::default()
         .with_record_length_limit(MAX_RECORD_BYTES)
@@ -505,14 +510,7 @@ impl State {
         if skip {
             return Ok(());
         }
-        let decode_err = |detail: String| Error::Decode {
-            file: self.file.clone(),
-            topic: info.topic.clone(),
-            index,
-            log_time_ns: header.log_time,
-            encoding: info.message_encoding.clone(),
-            detail,
-        };
+        let decode_err = |detail: String| decode_error(&self.file, info, index, header, detail);
         if let (Decoder::Known(kind), true, None) = (decoder, self.by_ref, &self.pending) {
             return self.message_by_ref(*kind, header, index, data, visitor);
         }
@@ -569,14 +567,7 @@ impl State {
     ) -> Result<(), Error> {
         let info = &self.channels[&header.channel_id];
         let slot = &mut self.slots[kind as usize];
-        known::decode_into(kind, data, slot).map_err(|detail| Error::Decode {
-            file: self.file.clone(),
-            topic: info.topic.clone(),
-            index,
-            log_time_ns: header.log_time,
-            encoding: info.message_encoding.clone(),
-            detail,
-        })?;
+        known::decode_into(kind, data, slot).map_err(|detail| decode_error(&self.file, info, index, header, detail))?;
         let Some(known) = slot.message.take() else { return Ok(()) };
         let body = Body::Known(known);
         if self.first_joint_array_len.is_none() {
