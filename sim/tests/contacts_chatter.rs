@@ -1,7 +1,7 @@
 //! The stick → slip event and the mode problem must not chatter where Coulomb's law has a
-//! solution (issue 23, item 6). OPEN: these reproducers fail on this code and are ignored until
-//! the onset's slip → stick rule is fixed (the diagnosis and a candidate fix are in the book's
-//! `explanation/contacts.md`, "The onset's stop (open)"); run them with `--ignored`.
+//! solution (issue 23, item 6): the onset's slip → stick function is the stick's excess, not
+//! the slip's noise (the book's `explanation/contacts.md`, "The onset's stop"). Each failed
+//! before that rule (link 9 and the three seeds: 33 events at one instant).
 //!
 //! Reproducers: the where-elbow study's candidates that stopped with 33 stick → slip events at
 //! one instant (`scenes/contacts/chatter-*.json`, built from the study's rows: the elbow's
@@ -45,7 +45,6 @@ fn completes_with_the_audit_and_the_balance(what: &str, scene: &sim::scene::Scen
 /// onset at 0.24688 s) the balance residual is the integration's (bound rtol · E, measured
 /// 1.9e-6 E, from the first 10 ms), and at rtol 1e-8 it is within 1e-8 of E.
 #[test]
-#[ignore = "open (issue 23 item 6): the onset's slip -> stick fires on the slip's noise; see explanation/contacts.md"]
 fn the_where_elbow_candidate_on_link_7_completes() {
     completes_with_the_audit_and_the_balance("link 7, s = 0.828, 0 kg, rtol 1e-5", &scene("chatter-link7-0kg.json", None), "one-elbow", 1e-5);
     completes_with_the_audit_and_the_balance("link 7, s = 0.828, 0 kg, rtol 1e-8", &scene("chatter-link7-0kg.json", Some(1e-8)), "one-elbow", 1e-8);
@@ -54,7 +53,6 @@ fn the_where_elbow_candidate_on_link_7_completes() {
 /// where-elbow, 1 kg, the elbow on link 9 at s = 0.874: stopped at 2.7756 s in the study; as
 /// above (measured 3.9e-8 E at rtol 1e-5).
 #[test]
-#[ignore = "open (issue 23 item 6): stops at 2.775593 s, 33 events (the onset's slip -> stick on the slip's noise)"]
 fn the_where_elbow_candidate_on_link_9_with_1_kg_completes() {
     completes_with_the_audit_and_the_balance("link 9, s = 0.874, 1 kg, rtol 1e-5", &scene("chatter-link9-1kg.json", None), "one-elbow", 1e-5);
     completes_with_the_audit_and_the_balance("link 9, s = 0.874, 1 kg, rtol 1e-8", &scene("chatter-link9-1kg.json", Some(1e-8)), "one-elbow", 1e-8);
@@ -63,7 +61,6 @@ fn the_where_elbow_candidate_on_link_9_with_1_kg_completes() {
 /// The random unilateral scenes (`contacts_exact::random_scene`) that chattered on main
 /// (elbow7 at μ ≈ 1.3–1.4) complete.
 #[test]
-#[ignore = "open (issue 23 item 6): the three seeds stop with 33 events at 0.0669, 0.0579, 0.0600 s"]
 fn the_random_scenes_that_chattered_complete() {
     for seed in [0xd658_92bc_0659_5083u64, 0xb22b_fa16_184a_836b, 0x3650_0992_7f4c_8fe7] {
         assert_eq!(crate::contacts_exact::check_random(seed), None, "seed {seed:#x} stopped");
