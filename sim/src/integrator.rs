@@ -182,6 +182,16 @@ impl Integrator {
         integrate_sampled_within(stepper.as_mut(), sys, 0.0, y0, t_end, dt_out, deadline, on_sample)
     }
 
+    /// The step control's tolerances `(rtol, atol)` of an adaptive method (`None` for rk4's
+    /// fixed step): a step is accepted with each component's error within about
+    /// `atol + rtol |y_i|` (HNW I (4.11)).
+    pub fn tolerances(&self) -> Option<(f64, f64)> {
+        match *self {
+            Integrator::Rk4 { .. } => None,
+            Integrator::Dopri45(c) | Integrator::Imex(c) | Integrator::Rosenbrock { control: c, .. } | Integrator::Rodas { control: c, .. } => Some((c.rtol, c.atol)),
+        }
+    }
+
     /// The stepper of this method for a system of dimension `dim`.
     fn stepper<S: OdeJacobian + SplitSystem>(&self, dim: usize) -> Box<dyn Stepper<S>> {
         match *self {

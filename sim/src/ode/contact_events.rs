@@ -4,13 +4,13 @@
 //! modes at t0, and what an event does (impacts, stops, the modes chosen). Split from
 //! `hybrid.rs` (file size); Pfeiffer & Glocker 1996, ch. 5–6; Acary & Brogliato 2008, ch. 7.
 
-use crate::dynamics::contact::forward::{has_rows, SLIP_DIRECTION_SPEED};
+use crate::dynamics::contact::forward::{has_rows, slip_direction, SLIP_DIRECTION_SPEED};
 use crate::dynamics::contact::rows::contact_gaps_where;
 use crate::dynamics::contact::{ContactEvent, ContactEventKind, ContactMode, ContactModel};
 use crate::error::RunError;
 
 use super::arm::ArmSystem;
-use super::hybrid::{in_touch, mu_of, REBOUND_START};
+use super::hybrid::{in_touch, mu_of, slip_resolution, REBOUND_START};
 
 /// The slip→stick rule (issue 23, item 2). A sliding contact's ev1 is `v_t · s_ref` (m/s),
 /// `s_ref` the slip direction at the start of the step: no threshold, its zero is located like
@@ -28,6 +28,17 @@ use super::hybrid::{in_touch, mu_of, REBOUND_START};
 /// (one-elbow-unilateral at rtol 1e-4, with the direction frozen below that speed). A slip that stops cleanly (1-D,
 /// or 2-D coming to rest along a direction) reaches the zero with `|v_t|` ~1e-12 m/s (the root's
 /// 1e-12 s bracket). What is left is removed by the velocity projection `stop_slip`.
+///
+/// During an onset (a slip from rest, `ContactState::onset`, until the end of the step where it
+/// passes `SLIP_DIRECTION_SPEED`) ev1 is instead the stick's excess `|f*_t| − μ f*_n` at the
+/// state (`ContactData::onset_excess`, N; dead band 1e-8 N as the stick's): by Coulomb's law a
+/// slip from rest goes on while the stick is broken, and stops where the stick is feasible
+/// again, which at `|v_t| ≤ SLIP_DIRECTION_SPEED` is the stop up to `SLIP_DIRECTION_SPEED/|a_t|`.
+/// The onset's slip (1e-13 … 1e-10 m/s over its first microsecond) is far below what the
+/// integrator controls, and `v_t · s_ref` there read its noise: a where-elbow candidate had its
+/// slip swing to +3e-10 and −2e-10 m/s within 4e-7 s while its stick's excess grew, the stop
+/// fired, the stick was refused, the slide from rest taken again, 33 times at one instant
+/// (issue 23 item 6; `tests/contacts_chatter.rs`).
 fn stops_here(v_t: [f64; 2], vel_tol: f64) -> bool {
     v_t[0].hypot(v_t[1]) <= vel_tol.max(SLIP_DIRECTION_SPEED)
 }
@@ -58,7 +69,7 @@ impl ArmSystem<'_> {
         let cs = &self.scene.contact_settings;
         match (h.contacts[k].model, h.state.mode[k], i % 2) {
             (ContactModel::Unilateral { .. }, ContactMode::Separated, 0) => Some(cs.gap_tol),
-            (ContactModel::Unilateral { .. }, ContactMode::Sliding, 1) => Some(cs.vel_tol),
+            (ContactModel::Unilateral { .. }, ContactMode::Sliding, 1) if h.state.onset[k].is_none() => Some(cs.vel_tol),
             (ContactModel::Unilateral { .. }, ContactMode::Sticking | ContactMode::Sliding, _) => Some(1e-8),
             _ => None,
         }
@@ -98,6 +109,8 @@ impl ArmSystem<'_> {
                 (_, ContactMode::Separated | ContactMode::Bilateral) => (if t == h.rebound_t[k] { REBOUND_START } else { r.gap[k] - h.gap_ref[k] }, 1.0),
                 // the stick margin (a statically indeterminate contact's largest; jammed: no slip)
                 (_, ContactMode::Sticking) => (f_n, if h.cd.margin[k].is_finite() { h.cd.margin[k] } else { 1.0 }),
+                // an onset: the stick's excess (the slip → stick rule of an onset, `stops_here`)
+                (_, ContactMode::Sliding) if mu_of(c) > 0.0 && h.state.onset[k].is_some() && h.cd.onset_excess[k].is_finite() => (f_n, h.cd.onset_excess[k]),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
                     (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
@@ -159,6 +172,7 @@ impl ArmSystem<'_> {
         // forces and rows at the event in the current modes
         self.evaluate(t, y)?;
         self.separated_gaps();
+        let (tolerances, qd) = (self.scene.integrator().tolerances(), self.layout.qd());
         let h = self.hybrid.as_mut().expect("hybrid");
         let st = h.settings;
         let nc = h.contacts.len();
@@ -213,9 +227,17 @@ impl ArmSystem<'_> {
                         // rad, ~1e-6 N of 13 N) and the slide from rest reads a deceleration
                         // the stick's margin does not have (one-elbow at rtol 1e-5, 0.7161 s)
                         stopping.push(k);
-                    } else if f1 && stops_here(h.cd.rows.slip(k), st.vel_tol) {
+                    } else if f1 && stops_here(h.cd.rows.slip(k), if h.state.onset[k].is_some() { st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len())) } else { st.vel_tol }) {
                         preferred[k] = ContactMode::Sticking;
                         stopping.push(k);
+                    } else if f1 && h.state.onset[k].is_some() {
+                        // the onset's stick became feasible with the slip already past the
+                        // stop bound: a slip like any other from here, along its own direction,
+                        // stopped at its zero
+                        h.state.onset[k] = None;
+                        let v = h.cd.rows.slip(k);
+                        h.s_ref[k] = slip_direction(v, v);
+                        h.state.slip[k] = h.s_ref[k];
                     }
                 }
             }

@@ -411,6 +411,7 @@ impl ArmSystem<'_> {
     pub(super) fn refresh_slip_reference(&mut self, y: &[f64]) {
         let l = self.layout;
         let model = &self.scene.model;
+        let tolerances = self.scene.integrator().tolerances();
         let Some(h) = &mut self.hybrid else { return };
         if !h.state.mode.iter().any(|&m| m == ContactMode::Sliding) {
             return;
@@ -421,13 +422,52 @@ impl ArmSystem<'_> {
             if h.state.mode[k] == ContactMode::Sliding {
                 let v = c.touch_velocity(&self.ws.data);
                 let v_t = [c.t1.dot(&v), c.t2.dot(&v)];
-                h.s_ref[k] = slip_direction(v_t, h.state.slip[k]);
+                // an onset ends once its slip is past the blend (`forward::onset_anchors`) along
+                // the direction its friction opposes (`cd.anchor`, the last solve's); its friction
+                // followed the turning anchor, not the event's direction, so the slip's own
+                // direction is the reference from here (keeping the side of the event's
+                // direction flipped it when the anchor had turned by more than 90°: the friction
+                // then pushed the slip on, random seed 0xd65892bc06595083 at 0.0669 s). A slip
+                // past the blend but run back across the anchor is the integrator's noise (at
+                // rtol 1e-3 a step's slip error is ~atol = 1e-5 m/s): the onset goes on, its
+                // friction opposing that slip and its stop the stick's excess (ending it there
+                // made the noise the reference: whole-table at rtol 1e-3 took a slip of 2.7e-5
+                // m/s against the anchor for the slip at 0.24477 s, stopped it 2e-8 s later, and
+                // recorded friction along the slip, π rad, at 0.245 s). "Past the blend" is past
+                // what the integrator resolves too ([`slip_resolution`]; above v_s only at loose
+                // tolerances): at rtol 1e-3, atol 1e-5 the slip's first steps after whole-table's
+                // onset at 0.24476 s were its error (2e-5 … 8e-5 m/s, turning by up to 180°
+                // from step to step, where rtol 1e-6 has 1e-8 m/s along the anchor); an onset
+                // ended on the first of them (2.3e-5 m/s, 35° off the anchor) took that noise
+                // as its reference, the reference turned round with the next steps, a slip
+                // reversal inside a step went unseen by v_t · s_ref and the friction kept on
+                // the reference's side pushed it on (π rad at 0.245 s). Until then the
+                // reference keeps the anchor's side (the sticking force's impending direction)
+                let a = h.cd.anchor[k];
+                let resolved = SLIP_DIRECTION_SPEED.max(slip_resolution(tolerances, &h.cd.rows, k, &y[l.qd()], y.len()));
+                let ends = h.state.onset[k].is_some() && v_t[0].hypot(v_t[1]) > resolved && v_t[0] * a[0] + v_t[1] * a[1] > 0.0;
+                h.s_ref[k] = slip_direction(v_t, if ends { v_t } else { a });
                 h.state.slip[k] = h.s_ref[k];
-                // an onset ends once its slip is past the blend (`forward::onset_anchors`)
-                if v_t[0].hypot(v_t[1]) > SLIP_DIRECTION_SPEED {
+                if ends {
                     h.state.onset[k] = None;
                 }
             }
         }
     }
+}
+
+/// The slip speed of contact `k` below which the integrator does not resolve the slip (m/s):
+/// the largest error in `v_t = J_t q̇` an accepted step may carry. A step is accepted with
+/// `sqrt(1/n Σ_i (e_i/w_i)²) ≤ 1` over the state's `n` components, `w_i = atol + rtol |y_i|`
+/// (the step control's weights, HNW I (4.11)), so by Cauchy–Schwarz the error of a tangential
+/// row's `J_t · q̇` is at most `sqrt(n) (Σ_i (J_t,i w_i)²)^½` over the joint speeds (the rows
+/// of the last solve, `rows`); the two rows' bounds combined as a vector. 0 for a fixed-step
+/// method. At rtol 1e-8, atol 1e-10 (the paper's runs) it is ~1e-8 m/s, below
+/// [`SLIP_DIRECTION_SPEED`]; at rtol 1e-3, atol 1e-5 (whole-table at 0.2448 s) ~1e-4 m/s,
+/// where an onset's first step carried a slip of 2.3e-5 m/s 35° off the direction the slip
+/// takes at rtol 1e-6 (within 0.03° of its anchor up to 8e-6 m/s).
+pub(super) fn slip_resolution(tolerances: Option<(f64, f64)>, rows: &crate::dynamics::contact::rows::ContactRows, k: usize, qd: &[f64], n: usize) -> f64 {
+    let Some((rtol, atol)) = tolerances else { return 0.0 };
+    let along = |r: usize| rows.row(r).iter().zip(qd).map(|(j, v)| (j * (atol + rtol * v.abs())).powi(2)).sum::<f64>();
+    (n as f64 * (along(3 * k + 1) + along(3 * k + 2))).sqrt()
 }

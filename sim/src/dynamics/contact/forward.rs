@@ -61,6 +61,14 @@ pub struct ContactData {
     /// [`SLIP_DIRECTION_SPEED`] in the last solve (unit, tangent basis): the stored slip
     /// direction, or during an onset the impending direction ([`onset_anchors`]).
     pub anchor: Vec<[f64; 2]>,
+    /// Per contact in an onset (`ContactState::onset`, sliding with friction): the excess
+    /// `|f*_t| − μ f*_n` (N) of the force `f*` that would keep it sticking at this state (the
+    /// largest margin's, as the stick's event), from [`onset_anchors`]; NaN otherwise. Positive
+    /// while the stick stays broken; the onset's slip → stick function (`ode/hybrid.rs`).
+    pub onset_excess: Vec<f64>,
+    /// Per contact: in an onset in the last solve (`ContactState::onset`): its friction opposes
+    /// a slip that runs back across the anchor ([`active_rows_of`]).
+    onset_now: Vec<bool>,
     /// Scratch of [`onset_anchors`]: the modes with the onset contacts sticking.
     stick_mode: Vec<ContactMode>,
     /// Scratch of the groups of sticking contacts dependent across contacts
@@ -78,6 +86,8 @@ impl ContactData {
             f_t: vec![[0.0; 2]; nc],
             margin: vec![0.0; nc],
             anchor: vec![[1.0, 0.0]; nc],
+            onset_excess: vec![f64::NAN; nc],
+            onset_now: vec![false; nc],
             stick_mode: vec![ContactMode::Separated; nc],
             dependent: super::dependent::DependentScratch::new(nc),
         }
@@ -96,6 +106,11 @@ impl ContactData {
 /// ≈ 2e-7 s at 5 m/s², over which the position moves ≤ `SLIP_DIRECTION_SPEED² / |a_t|` ≈
 /// 2e-13 m; in 1-D (a slip along a fixed line) the direction is exact.
 pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
+
+/// An onset's slip run back across its anchor by more than this (m/s; the contact settings'
+/// default `vel_tol`, the contact audit's slip bound) has a friction that opposes it
+/// ([`active_rows_of`]); below it the anchor's direction holds.
+pub const ONSET_REVERSE_SPEED: f64 = 1e-9;
 
 /// The slip direction of a sliding contact, continued through the stop: `±v_t/|v_t|` when
 /// `|v_t|` > [`SLIP_DIRECTION_SPEED`], with the sign that keeps it on the side of `stored` (the
@@ -227,6 +242,7 @@ fn compliant_forces(contacts: &[Contact], fd: &mut ForwardData, cd: &mut Contact
 pub fn active_rows(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, cd: &mut ContactData) {
     for k in 0..contacts.len() {
         cd.anchor[k] = state.slip[k];
+        cd.onset_now[k] = state.onset[k].is_some();
     }
     active_rows_of(contacts, &state.mode, stabilization, cd);
 }
@@ -257,7 +273,20 @@ fn active_rows_of(contacts: &[Contact], mode: &[ContactMode], stabilization: Sta
                 }
             }
             ContactMode::Sticking | ContactMode::Sliding => {
-                let s = friction_direction(r.slip(k), cd.anchor[k]);
+                let (v, anchor) = (r.slip(k), cd.anchor[k]);
+                let mut s = friction_direction(v, anchor);
+                if cd.onset_now[k] && v[0] * anchor[0] + v[1] * anchor[1] < -ONSET_REVERSE_SPEED {
+                    // an onset's slip run back across its anchor (the integrator's noise: the
+                    // slip from rest grows along the anchor while the stick is broken, and its
+                    // stop is the stick's excess, not this zero): Coulomb's friction opposes it,
+                    // so it returns (not `friction_direction`'s side-keeping, meant for the
+                    // trial stages past a located stop, which would push it on). Not within
+                    // ONSET_REVERSE_SPEED of 0: at the onset itself (the mode problem, the slip
+                    // projected to ~1e-13 m/s) the friction is the anchor's, else the rounding
+                    // of v_t picks one of two slides (an "indeterminate" error at 0.130 s on
+                    // two-elbow at rtol 1e-5)
+                    s = [-s[0], -s[1]];
+                }
                 cd.active.push(normal(if mu > 0.0 { RowForce::Sliding { mu, s } } else { RowForce::Same }));
             }
         }
@@ -269,6 +298,7 @@ fn active_rows_of(contacts: &[Contact], mode: &[ContactMode], stabilization: Sta
 pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) -> Result<(), Singular> {
     for k in 0..contacts.len() {
         cd.anchor[k] = state.slip[k];
+        cd.onset_now[k] = state.onset[k].is_some();
     }
     onset_anchors(contacts, state, stabilization, fd, cd);
     active_rows_of(contacts, &state.mode, stabilization, cd);
@@ -278,8 +308,7 @@ pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: St
     Ok(())
 }
 
-/// The friction's anchor of the sliding contacts in an onset (`state.onset`) slower than
-/// [`SLIP_DIRECTION_SPEED`]: `−f_t/|f_t|` of the force that would keep them sticking at this
+/// The friction's anchor of the sliding contacts in an onset (`state.onset`): `−f_t/|f_t|` of the force that would keep them sticking at this
 /// state (the same modes with those contacts sticking; a statically indeterminate contact's
 /// largest-margin force), turned by the onset's rotation (at the event it is the direction the
 /// mode problem chose, so the anchor starts there), into `cd.anchor` (the others keep
@@ -299,17 +328,24 @@ pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: St
 /// 1e-6). Anchored on `−f*/|f*|` (the radial projection of f* on the disc, which is the G
 /// projection up to O(δ/μ f_n)), `a_t · s = δ sᵀ G s > 0` whenever the stick is broken: the
 /// slip grows along the direction the sticking force leaves the cone, and the anchor turns
-/// with it. One more constrained solve per evaluation, only while such a slip is below v_s.
+/// with it. One more constrained solve per evaluation, only while a slip is in its onset (until
+/// the end of the step where it passes v_s and the integrator's resolution along the anchor,
+/// `ode/hybrid.rs`); the same solve gives the stick's excess `cd.onset_excess`, the onset's
+/// slip → stick function. Above v_s the friction is Coulomb's `−μ f_n v_t/|v_t|` (the blend's
+/// side taken from the anchor, and a slip run back across it opposed: [`active_rows_of`]), so
+/// the anchor only decides the side and the onset's end: at rtol 1e-3 the slip's first
+/// steps after an onset are the integrator's error (2e-5 … 8e-5 m/s, turning by up to 180°
+/// from step to step, whole-table at 0.2448 s) and a reference kept on the side of the
+/// previous step's slip turned round with them (a friction along the slip in the audit).
 fn onset_anchors(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) {
-    let slow = |k: usize, cd: &ContactData| {
-        let v = cd.rows.slip(k);
-        state.onset[k].is_some() && state.mode[k] == ContactMode::Sliding && v[0].hypot(v[1]) < SLIP_DIRECTION_SPEED && matches!(contacts[k].model, ContactModel::Unilateral { friction, .. } if friction > 0.0)
-    };
-    if !(0..contacts.len()).any(|k| slow(k, cd)) {
+    // every onset gets its stick's excess (its slip → stick function) and its anchor
+    let in_onset = |k: usize| state.onset[k].is_some() && state.mode[k] == ContactMode::Sliding && matches!(contacts[k].model, ContactModel::Unilateral { friction, .. } if friction > 0.0);
+    cd.onset_excess.fill(f64::NAN);
+    if !(0..contacts.len()).any(in_onset) {
         return;
     }
     for k in 0..contacts.len() {
-        cd.stick_mode[k] = if slow(k, cd) { ContactMode::Sticking } else { state.mode[k] };
+        cd.stick_mode[k] = if in_onset(k) { ContactMode::Sticking } else { state.mode[k] };
     }
     let mode = std::mem::take(&mut cd.stick_mode);
     active_rows_of(contacts, &mode, stabilization, cd);
@@ -319,6 +355,8 @@ fn onset_anchors(contacts: &[Contact], state: &ContactState, stabilization: Stab
         forces_of(contacts, &mode, cd);
         for (k, (&now, &was)) in mode.iter().zip(&state.mode).enumerate() {
             if now == ContactMode::Sticking && was == ContactMode::Sliding {
+                // a jammed stick (margin +∞) holds: a finite negative excess
+                cd.onset_excess[k] = if cd.margin[k].is_finite() { -cd.margin[k] } else { -1.0 };
                 let f = cd.f_t[k];
                 let m = f[0].hypot(f[1]);
                 if let (true, Some(r)) = (m > 1e-12 * (1.0 + cd.f_n[k].abs()), state.onset[k]) {

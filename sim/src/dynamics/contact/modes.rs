@@ -289,6 +289,7 @@ pub fn choose_modes_within(
             // a force of tol_f along s gives (the stick's tolerance, in the same units):
             // `a_t · s ≥ −tol_f sᵀ G s`, G the contact's tangential Delassus block
             let slip_tol = |k: usize, s: [f64; 2]| tol_a.max(tol_f * tangential_delassus(fd, cd, k, s));
+            let breaking = |k: usize| state.mode[k] == ContactMode::Sticking && preferred[k] == ContactMode::Sliding;
             let mut feasible_here = true;
             let mut marginal = false;
             for (i, &k) in closed.iter().enumerate() {
@@ -306,15 +307,34 @@ pub fn choose_modes_within(
                 let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
                 feasible_here &= match cands[i][idx[i]] {
                     Cand::Sep => accel(0) >= -tol_a,
-                    Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= mu_of(&contacts[k]) * f_n + tol_f,
+                    // at a stick → slip event (a sticking contact preferred sliding: its margin
+                    // crossed 0 falling) a stick at the cone does not go on
+                    Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= mu_of(&contacts[k]) * f_n + tol_f && !(breaking(k) && cd.margin[k] <= tol_f),
                     Cand::Slide { moving } => {
                         f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -slip_tol(k, trial.slip[k]))
                     }
                 };
             }
+            // the slides from rest at the cone (a_t·s within its tolerance of 0: the onset,
+            // where the slide and the stick are the same solution): they go on only if their slip
+            // acceleration grows with the stick's excess, p(s) > 0 ([`onset_grows`])
+            // (per twin group: judged once, on the group's first contact carrying the group's
+            // force, [`as_one`]; a twin's own p(s) is 0 while its twin takes the load)
+            let at_cone: Vec<usize> = closed
+                .iter()
+                .enumerate()
+                .filter(|&(i, &k)| {
+                    let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
+                    twins[i].is_none() && cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k])
+                })
+                .map(|(i, _)| i)
+                .collect();
             if feasible_here {
                 let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();
-                feasible.push(Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), onset: trial.onset.clone(), qdd: qdd.to_vec(), score, marginal });
+                let found = Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), onset: trial.onset.clone(), qdd: qdd.to_vec(), score, marginal };
+                if at_cone.iter().all(|&i| onset_grows(contacts, &as_one(&trial, &twins, closed, i), closed[i], stabilization, fd, cd)) {
+                    feasible.push(found);
+                }
             }
         }
         // next combination
@@ -337,14 +357,16 @@ pub fn choose_modes_within(
     let mus = closed.iter().map(|&k| format!("{} (mu = {})", contacts[k].name(), mu_of(&contacts[k]))).collect::<Vec<_>>().join(", ");
     let Some(best) = feasible.iter().enumerate().max_by_key(|(i, f)| (f.score, usize::MAX - i)).map(|(_, f)| f) else {
         // say why at each frictional contact (the rigid problem's terms at this state)
+        // (a twin group once, as one contact carrying the group's force: [`as_one`])
         let whys: Vec<String> = closed
             .iter()
-            .filter(|&&k| mu_of(&contacts[k]) > 0.0)
-            .filter_map(|&k| {
+            .enumerate()
+            .filter(|&(i, &k)| mu_of(&contacts[k]) > 0.0 && twins[i].is_none())
+            .filter_map(|(i, &k)| {
                 let v = cd.rows.slip(k);
                 let speed = v[0].hypot(v[1]);
                 let moving = (speed > vel_tol).then(|| [v[0] / speed, v[1] / speed]);
-                one_contact(contacts, state, k, stabilization, fd, cd).map(|o| painleve_why(contacts[k].name(), &o, moving))
+                one_contact(contacts, &as_one(state, &twins, closed, i), k, stabilization, fd, cd).map(|o| painleve_why(contacts[k].name(), &o, moving))
             })
             .collect();
         let whys = if whys.is_empty() { String::new() } else { format!(": {}", whys.join("; ")) };
@@ -483,3 +505,46 @@ fn painleve_why(name: &str, o: &OneContact, moving: Option<[f64; 2]>) -> String 
     format!("{name} (mu = {}): {stick}separated it would accelerate {} (a_n = {:.6e} m/s^2); {slide}", o.mu, if o.a0[0] < 0.0 { "into the table" } else { "away" }, o.a0[0])
 }
 
+/// Whether a slide from rest of contact `k` at the cone (the stick → slip onset, where the
+/// slide's slip acceleration `a_t·s` is 0 and the stick's margin is 0) is a solution after the
+/// instant: with the other contacts in `trial`'s modes, `a_t·s = δ (g_t g_n − g_c²) / p(s)`
+/// (δ = |f*_t| − μ f*_n, the stick's excess, > 0 once the stick is broken; [`OneContact`]), and
+/// `g_t g_n − g_c² > 0` (G is positive definite), so the slip grows along `s` iff
+/// `p(s) = G_nn − μ G_nt·s > 0` (Pfeiffer & Glocker 1996, §5.2, the acceleration-level problem
+/// whose degenerate case this is; Génot & Brogliato 1999, the slide's normal coefficient in
+/// Painlevé's paradox; Brogliato 2016, §5.5). With `p(s) ≤ 0` the slide decelerates as soon as
+/// it starts, the slip → stick event fires ~1e-7 s later with the stick broken, and the modes
+/// chattered (issue 23 item 6: elbow7 at μ ≈ 1.3, `contacts_chatter`); refused, the stick's
+/// excess goes to the other candidates: separation when the contact's free normal acceleration
+/// `a0_n = −p(s) f*_n` is positive (the friction was pressing it on), else no solution
+/// (Painlevé's inconsistency, reported with these terms).
+fn onset_grows(contacts: &[Contact], trial: &ContactState, k: usize, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) -> bool {
+    one_contact(contacts, trial, k, stabilization, fd, cd).is_none_or(|o| o.p(trial.slip[k]) > 0.0)
+}
+
+/// `state` with the twins of `closed[i]` (the later contacts of its twin group, `dependent::twins`)
+/// separated: the group as one contact, `closed[i]`, carrying the group's force. Twins have the
+/// same rows `W` (normal, t1, t2), the same μ and, sliding, the same slip direction s, so their
+/// forces enter the dynamics only as `Wᵀ (Σ f_n,j, Σ f_t,j)`, and a slide's as
+/// `(W_n − μ sᵀ W_t)ᵀ Σ f_n,j`: only the sum is determined, and the sum of forces on one ray of
+/// one cone is on that ray (Coulomb's cone is convex and positively homogeneous; Glocker,
+/// *Set-Valued Force Laws*, 2001, §7: the force law of the group is the law of one contact in
+/// the summed force, and so is its maximal dissipation, `−Σ f_t,j · v_t = −(Σ f_t,j) · v_t`).
+/// The group's Delassus matrix is `G_group = 1 1ᵀ ⊗ G_1` (every block the one contact's `G_1`),
+/// so a split `f_j` of the group's force gives the point the acceleration `a0 + G_1 Σ f_j`: the
+/// rigid problem of the group (Pfeiffer & Glocker 1996, §5.2), restricted to the group's one
+/// normal and one slip direction, is that of one contact, and its slide's normal coefficient is
+/// `G_nn − μ G_nt·s` of `closed[i]` with its twins absent. With a twin left sliding beside it instead, a unit push on
+/// `closed[i]`'s normal row is taken back by the twin's identical row, its `G_nn` and `G_nt·s`
+/// are 0 and `p(s) = 0` says nothing about the group (the refused slides of both
+/// `contacts_pair` runs, "Painlevé inconsistency" with every term 0). For events only (allocates).
+fn as_one(state: &ContactState, twins: &[Option<usize>], closed: &[usize], i: usize) -> ContactState {
+    let mut st = state.clone();
+    for (j, t) in twins.iter().enumerate() {
+        if *t == Some(i) {
+            st.mode[closed[j]] = ContactMode::Separated;
+            st.onset[closed[j]] = None;
+        }
+    }
+    st
+}
