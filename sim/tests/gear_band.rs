@@ -216,7 +216,7 @@ fn the_paper_arm_runs_with_efficiency_only_gears() {
 /// `scenes/drives/paper_efficiency_gears.json`, dopri45 rtol 1e-10): several joints of the chain
 /// stick at once and share the load with the table, their holding torques are not unique, and
 /// the one chosen (`ode/gear_hold.rs`) must lie in every sticking joint's band. Each run completes
-/// its 5 s (before: two-elbow stopped at 0.1546 s, "no consistent stick/slide modes"), the
+/// its 5 s (before: two-elbow stopped at 0.1544 s, "no consistent stick/slide modes" for joints 2-8), the
 /// balance closes at every sample to 1e-9 of E, every sticking joint's λ is inside its band
 /// `[lo(K_m i), hi(K_m i)]` at every sample (to 1e-9 (1 N m + |λ|)), no joint's gear changes
 /// mode twice within 1e-9 s, and some sample has two or more joints of the chain sticking at

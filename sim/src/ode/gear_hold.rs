@@ -44,7 +44,10 @@
 //! contacts' group stick margin for redundant sticking contacts (`dynamics/contact/dependent.rs`).
 //!
 //! Algorithm (allocation-free on scratch sized once for nv joints):
-//! 1. G symmetrised and factored by Cholesky with diagonal pivoting (Higham, *Accuracy and
+//! 0. Gaussian elimination of `G λ = b` as before this choice existed: when no pivot falls
+//!    below 1e-12 of the largest diagonal, G is regular, λ is unique, and it is taken (bit for
+//!    bit the earlier solve: the open chains' runs are unchanged).
+//! 1. Otherwise G symmetrised and factored by Cholesky with diagonal pivoting (Higham, *Accuracy and
 //!    Stability of Numerical Algorithms*, 2nd ed., SIAM 2002, §10.3): a remaining pivot
 //!    ≤ 1e-10 of the largest diagonal ends it at rank k; the particular solution `λ_p` has the
 //!    trailing n − k unknowns (in pivot order) 0 (the basic solution), the null basis
@@ -104,6 +107,14 @@ impl HoldScratch {
 /// read), `lambda` holds b on entry and λ on return, `lo`/`hi` the bands. Returns the null
 /// dimension r (0: λ was unique), or `None` on a non-finite entry.
 pub(crate) fn hold_torques(s: &mut HoldScratch, g: &[f64], lambda: &mut [f64], lo: &[f64], hi: &[f64], n: usize) -> Option<usize> {
+    // 0. a unique λ (G regular: every pivot of the elimination above 1e-12 of the largest
+    // diagonal) as before this choice existed, bit for bit
+    s.a[..n * n].copy_from_slice(&g[..n * n]);
+    s.x[..n].copy_from_slice(&lambda[..n]);
+    if !solve_psd(&mut s.a, &mut s.x, n)? {
+        lambda[..n].copy_from_slice(&s.x[..n]);
+        return Some(0);
+    }
     // 1. the pivoted Cholesky factor of the symmetrised G
     for i in 0..n {
         for j in 0..n {
@@ -183,6 +194,50 @@ pub(crate) fn hold_torques(s: &mut HoldScratch, g: &[f64], lambda: &mut [f64], l
         lambda[a] += dz;
     }
     lambda[..n].iter().all(|v| v.is_finite()).then_some(r)
+}
+
+/// Solve `a x = b` for the n x n symmetric positive semi-definite `a` (row-major; `b`
+/// overwritten by x) by Gaussian elimination without pivoting, skipping (x = 0) the
+/// directions whose pivot is below 1e-12 of the largest diagonal. Returns whether it skipped
+/// one (then G is singular to rounding and the caller chooses among the solutions), `None` on
+/// a non-finite entry. (The solve of `drive_forces.rs` before the choice, kept for regular G.)
+fn solve_psd(a: &mut [f64], b: &mut [f64], n: usize) -> Option<bool> {
+    let scale = (0..n).map(|k| a[k * n + k].abs()).fold(0.0, f64::max);
+    if !scale.is_finite() {
+        return None;
+    }
+    let tol = 1e-12 * scale;
+    let mut skipped = false;
+    for k in 0..n {
+        if a[k * n + k] <= tol {
+            for c in 0..n {
+                a[k * n + c] = 0.0;
+                a[c * n + k] = 0.0;
+            }
+            b[k] = 0.0;
+            skipped = true;
+            continue;
+        }
+        for r in k + 1..n {
+            let f = a[r * n + k] / a[k * n + k];
+            for c in k..n {
+                a[r * n + c] -= f * a[k * n + c];
+            }
+            b[r] -= f * b[k];
+        }
+    }
+    for k in (0..n).rev() {
+        if a[k * n + k] == 0.0 {
+            b[k] = 0.0;
+            continue;
+        }
+        let mut s = b[k];
+        for c in k + 1..n {
+            s -= a[k * n + c] * b[c];
+        }
+        b[k] = s / a[k * n + k];
+    }
+    b[..n].iter().all(|x| x.is_finite()).then_some(skipped)
 }
 
 /// Cholesky with diagonal pivoting of the n x n symmetric PSD `a` (row-major; L in its lower
