@@ -302,7 +302,7 @@ fn every_method_keeps_its_order_with_efficiency_only_gears() {
 fn rk4_is_refused_with_efficiency_only_gears() {
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_efficiency_gears.json");
     let scene = Scene::load(std::path::Path::new(file)).unwrap();
-    let err = scene.vary(|s| s.integrator = IntegratorSpec::rk4(2e-4)).err().expect("rk4 accepted with efficiency-only gears").to_string();
+    let err = scene.vary(|s| s.integrator = IntegratorSpec::rk4(2e-4)).expect_err("rk4 accepted with efficiency-only gears").to_string();
     for part in ["integrator.method", "rk4", "joint1", "joint10", "efficiency below 1 and no breakaway torque", "fixed step", "adaptive method", "gear_friction.breakaway > 0"] {
         assert!(err.contains(part), "{part:?} not in {err}");
     }
@@ -312,8 +312,7 @@ fn rk4_is_refused_with_efficiency_only_gears() {
             s.integrator = IntegratorSpec::rk4(2e-4);
             s.gear_friction = Some(GearFrictionSpec { breakaway: Some(PerJoint::Each((0..10).map(|j| if j == 0 { 0.1 } else { 0.0 }).collect())), ..gear_law(0.0, 0.8, 0.7) });
         })
-        .err()
-        .expect("rk4 accepted")
+        .expect_err("rk4 accepted")
         .to_string();
     assert!(!some.contains("joint1,") && some.contains("joint2, "), "{some}");
     scene.vary(|s| {

@@ -250,6 +250,7 @@ fn the_event_driver_does_not_allocate_per_step_or_event() {
 /// old solve's choice left a band at 0.154 s); 20 right-hand sides at every sample of the first
 /// 0.5 s with two or more joints sticking.
 #[test]
+#[allow(clippy::result_large_err)] // the sink returns RunError, as `sim::run`'s
 fn the_holding_torques_of_a_closed_chain_do_not_allocate() {
     use sim::dynamics::gear_friction::GearMode;
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_efficiency_gears.json");

@@ -415,7 +415,8 @@ fn newton(pb: &Slacks, phase1: bool, tau: f64, x: &mut [f64], grad: &mut [f64], 
             return false;
         }
         let dec2: f64 = -(0..d).map(|i| grad[i] * step[i]).sum::<f64>();
-        if !(dec2 >= 0.0) || dec2 < 1e-24 {
+        // NaN or below the threshold: done
+        if dec2.is_nan() || dec2 < 1e-24 {
             break;
         }
         let mut h = 1.0;
@@ -451,7 +452,7 @@ fn cholesky_solve(h: &mut [f64], g: &[f64], x: &mut [f64], d: usize) -> bool {
         for c in 0..k {
             v -= h[k * d + c] * h[k * d + c];
         }
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return false;
         }
         let l = v.sqrt();
