@@ -41,7 +41,8 @@
 //! - output samples `t_k < t*` come from the pre-event dense output, `y* = y(t*)` from the same;
 //!   [`HybridSystem::handle_events`] switches the modes and may jump `y*`; the state is then
 //!   projected ([`OdeSystem::project`], with the new modes), the stepper restarted at
-//!   `(t*, y*)` with [`Stepper::init`] (its statistics accumulated over the restarts), and
+//!   `(t*, y*)` with [`Stepper::restart`] (its statistics accumulated over the restarts; an
+//!   adaptive stepper may keep its step size), and
 //!   samples `t_k ≥ t*` come from after the event.
 //!
 //! Guards: more than [`EventSettings::max_events`] events in a run is
@@ -288,7 +289,7 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
         pace.after_event(t_star)?;
         sys.project(t_star, &mut y_star).map_err(rhs)?;
         done = add_stats(done, stepper.stats());
-        stepper.init(sys, t_star, &y_star)?;
+        stepper.restart(sys, t_star, &y_star)?;
         br.refresh_directions(sys);
         sys.events(t_star, stepper.y(), &mut br.g_lo).map_err(rhs)?;
         br.set_bases(sys);

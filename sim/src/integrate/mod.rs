@@ -399,6 +399,13 @@ pub trait Stepper<S: OdeSystem> {
     /// accepted state (`t()`, `y()`, dense output), so the caller can report or inspect it.
     /// Panics if called before a successful `init`.
     fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>>;
+    /// Restart at `(t0, y0)` after an event ([`integrate_hybrid`]): like [`Stepper::init`]
+    /// (statistics reset), except that a stepper may carry over what the steps before the event
+    /// learned about the step size (e.g. [`Rodas`] tries the last accepted step's size first).
+    /// The default is `init`.
+    fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        self.init(sys, t0, y0)
+    }
     /// Current time.
     fn t(&self) -> f64;
     /// Current state (length `dim`).

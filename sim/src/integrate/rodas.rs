@@ -23,7 +23,19 @@
 //! - error norm and step-size control: the RMS norm of HNW I §II.4 with `atol + rtol max(|y|,
 //!   |y_new|)`; `h_new = h min(6, max(0.2, 0.9 err^(-1/(q+1))))` with `q` the embedded order
 //!   (Hairer's `rodas.f`: SAFE = 0.9, FAC1 = 5, FAC2 = 1/6); after a rejection the next
-//!   accepted step may not grow.
+//!   accepted step may not grow. (Gustafsson's predictive controller, HNW II §IV.8 (8.21),
+//!   was measured here, issue 24: with `h_max` 1 s it cut the paper-unilateral runs' right-hand
+//!   sides, but it broke RODAS5P's tolerance proportionality with gear friction (error ∝
+//!   rtol^0.85, `convergence.rs`) and the restitution run's balance bound (1e-9 E); not kept.)
+//! - restart after an event ([`Stepper::restart`]): the state, Jacobian and statistics restart
+//!   as in `init`, but the first step is the smaller of Hairer's starting step (or `h_init`)
+//!   and the last accepted step's size (and at most `h_max`). Hairer's step alone ignores what
+//!   the steps before the event learned about the solution's scale: on the elbow runs it was
+//!   often far too large (56 of two-elbow-unilateral's rejections at its 16 restarts). It stays
+//!   the bound where it is smaller: an event function left exactly at 0 by the event (a ball
+//!   leaving the table) is disarmed for the first step (`events.rs`), so that step must be
+//!   short enough not to jump over the function's next root (a bounce shorter than the step
+//!   before it).
 //! - Jacobian: [`OdeJacobian::exact_jacobian`]; if the system has none, forward differences
 //!   (HNW II §IV.8, [`super::fd_jacobian_columns`], increment `sqrt(eps) max(|y_j|, floor)`
 //!   with `floor = atol / rtol` within `[1e-5, 1]`, the scale below which the error norm
@@ -475,6 +487,21 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
         }
         eval_finite(&mut self.core.stats, sys, t0, y0, &mut self.f0)?;
         self.core.initialized = true;
+        Ok(())
+    }
+
+    /// `init`, then the first step tries the last accepted step's size if the fresh starting
+    /// step is larger, at most `h_max` (module docs); as `init` before any accepted step.
+    fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        let h_last = if self.core.initialized { self.core.h_last } else { 0.0 };
+        self.init(sys, t0, y0)?;
+        if h_last > 0.0 {
+            let fresh = match self.core.control.h_init {
+                Some(h) => h,
+                None => Adaptive::<S>::starting_step(self, sys)?,
+            };
+            self.core.h_next = Some(h_last.min(fresh).min(self.core.control.h_max));
+        }
         Ok(())
     }
 
