@@ -48,6 +48,7 @@ mod tap;
 mod regroup;
 mod typed;
 mod visit;
+mod wire;
 use crate::Error;
 pub use input::{open_regular, starts_with_mcap_magic};
 pub use recover::{read_recording_recover, read_recording_recover_bytes, stream_recording_recover, RecoverReport};
@@ -362,7 +363,7 @@ struct State {
     by_ref: bool,
     /// The last typed message of each kind, decoded into again for a visitor that takes them by
     /// reference (indexed by [`known::KnownKind`]).
-    slots: [known::Slot; 4],
+    slots: [known::Slot; known::KINDS],
 }
 
 impl State {
