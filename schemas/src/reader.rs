@@ -48,6 +48,7 @@ mod tap;
 mod regroup;
 mod typed;
 mod visit;
+mod wire;
 use crate::Error;
 pub use input::{open_regular, starts_with_mcap_magic};
 pub use recover::{read_recording_recover, read_recording_recover_bytes, stream_recording_recover, RecoverReport};
@@ -362,7 +363,7 @@ struct State {
     by_ref: bool,
     /// The last typed message of each kind, decoded into again for a visitor that takes them by
     /// reference (indexed by [`known::KnownKind`]).
-    slots: [known::Slot; 4],
+    slots: [known::Slot; known::KINDS],
 }
 
 impl State {
@@ -503,17 +504,21 @@ impl State {
             return Err(self.malformed(format!("message on unknown channel id {}", header.channel_id)));
         };
         let skip = matches!(decoder, Decoder::Skip(_));
-        let index = self.count(header.channel_id, header.log_time)?;
-        let (Some(info), Some(decoder)) = (self.channels.get(&header.channel_id), self.decoders.get(&header.channel_id)) else {
-            return Ok(()); // (known: counted above)
+        let known = match decoder {
+            Decoder::Known(kind) => Some(*kind),
+            _ => None,
         };
+        let index = self.count(header.channel_id, header.log_time)?;
         if skip {
             return Ok(());
         }
-        let decode_err = |detail: String| decode_error(&self.file, info, index, header, detail);
-        if let (Decoder::Known(kind), true, None) = (decoder, self.by_ref, &self.pending) {
-            return self.message_by_ref(*kind, header, index, data, visitor);
+        if let (Some(kind), true, None) = (known, self.by_ref, &self.pending) {
+            return self.message_by_ref(kind, header, index, data, visitor);
         }
+        let (Some(info), Some(decoder)) = (self.channels.get(&header.channel_id), self.decoders.get(&header.channel_id)) else {
+            return Ok(()); // (known: counted above)
+        };
+        let decode_err = |detail: String| decode_error(&self.file, info, index, header, detail);
         let value = match decoder {
             Decoder::Skip(_) => return Ok(()),
             Decoder::Known(kind) => Body::Known(known::decode(*kind, data).map_err(decode_err)?),
@@ -565,14 +570,13 @@ impl State {
         data: &[u8],
         visitor: &mut dyn Visitor,
     ) -> Result<(), Error> {
-        let info = &self.channels[&header.channel_id];
         let slot = &mut self.slots[kind as usize];
-        known::decode_into(kind, data, slot).map_err(|detail| decode_error(&self.file, info, index, header, detail))?;
+        known::decode_into(kind, data, slot).map_err(|detail| decode_error(&self.file, &self.channels[&header.channel_id], index, header, detail))?;
         let Some(known) = slot.message.take() else { return Ok(()) };
         let body = Body::Known(known);
         if self.first_joint_array_len.is_none() {
             if let Body::Known(k) = &body {
-                self.first_joint_array_len = k.first_joint_array_len(&info.topic);
+                self.first_joint_array_len = k.first_joint_array_len(&self.channels[&header.channel_id].topic);
             }
             if self.first_joint_array_len.is_some() && self.run.as_ref().is_some_and(|r| r.joint_names.is_empty()) {
                 self.update_run(); // format 0 names its joints after this length
@@ -597,12 +601,18 @@ impl State {
             return Err(Error::Malformed { file: self.file.clone(), detail: format!("message on unknown channel id {channel_id}") });
         };
         let index = info.message_count;
-        if let Some(&previous_ns) = self.last_time.get(&channel_id) {
-            if log_time < previous_ns {
-                return Err(Error::TimeBackwards { file: self.file.clone(), topic: info.topic.clone(), index, log_time_ns: log_time, previous_ns });
+        match self.last_time.entry(channel_id) {
+            std::collections::btree_map::Entry::Occupied(mut last) => {
+                let previous_ns = *last.get();
+                if log_time < previous_ns {
+                    return Err(Error::TimeBackwards { file: self.file.clone(), topic: info.topic.clone(), index, log_time_ns: log_time, previous_ns });
+                }
+                last.insert(log_time);
+            }
+            std::collections::btree_map::Entry::Vacant(last) => {
+                last.insert(log_time);
             }
         }
-        self.last_time.insert(channel_id, log_time);
         self.t_end_ns = Some(self.t_end_ns.map_or(log_time, |t| t.max(log_time)));
         self.span = Some(self.span.map_or((log_time, log_time), |(a, b)| (a.min(log_time), b.max(log_time))));
         info.message_count += 1;

@@ -25,6 +25,8 @@ mod recover;
 mod robustness;
 #[path = "round_trip.rs"]
 mod round_trip;
+#[path = "wire.rs"]
+mod wire;
 #[path = "writer.rs"]
 mod writer;
 #[path = "writer_options.rs"]

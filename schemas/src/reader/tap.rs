@@ -38,7 +38,11 @@ impl Tap {
     /// A tap labelled `file` (as errors and [`Recording::source`] name it: the reader uses the
     /// path as given), decoding the messages of `topics` (all when `None`) for `visitor`.
     pub fn new(file: String, topics: Option<&[&str]>, visitor: Box<dyn Visitor + Send>) -> Self {
-        Tap { state: State::new(file, topics), visitor, error: None }
+        let mut state = State::new(file, topics);
+        // as a read of the file decodes for this visitor: typed, into kept storage (`read_state`)
+        state.typed = visitor.typed();
+        state.by_ref = state.typed && visitor.by_ref();
+        Tap { state, visitor, error: None }
     }
 
     fn feed(&mut self, record: Record<'_>) {

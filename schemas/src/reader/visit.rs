@@ -171,13 +171,15 @@ fn known_arrays<'a>(topic: &'a str, k: &Known) -> impl Iterator<Item = (&'a str,
 fn known_each_array<E>(topic: &str, k: &Known, mut f: impl FnMut(&str, ArrayIndex, usize) -> Result<(), E>) -> Result<(), E> {
     use std::ops::ControlFlow;
     use super::known::Field;
+    let own = k.array_kind().filter(|_| topic == k.topic());
     let done = k.fields(|name, field| {
         let len = match field {
             Field::List(xs) => xs.len(),
             Field::Names(names) => names.len(),
+            Field::Codes(codes) => codes.len(),
             _ => return ControlFlow::Continue(()),
         };
-        match array_index(topic, name).map(|kind| f(name, kind, len)) {
+        match own.or_else(|| array_index(topic, name)).map(|kind| f(name, kind, len)) {
             Some(Err(e)) => ControlFlow::Break(e),
             _ => ControlFlow::Continue(()),
         }
@@ -194,6 +196,7 @@ fn known_name(k: &Known) -> &'static str {
         Known::Motors(_) => "MotorState",
         Known::Constraints(_) => "ConstraintState",
         Known::Energy(_) => "EnergyState",
+        Known::Contacts(_) => "ContactState",
     }
 }
 

@@ -287,6 +287,20 @@ impl schemas::Visitor for MetricsTap {
         self.0.lock().unwrap_or_else(PoisonError::into_inner).message(m)
     }
 
+    /// As `analyze` reads a file: the metric messages typed, by reference (no generic tree,
+    /// no allocation per message).
+    fn typed(&self) -> bool {
+        true
+    }
+
+    fn by_ref(&self) -> bool {
+        true
+    }
+
+    fn message_ref(&mut self, m: &schemas::DecodedMessage<'_>) -> Result<(), schemas::Error> {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner).message_ref(m)
+    }
+
     fn metadata(&mut self, name: &str, entries: &std::collections::BTreeMap<String, String>) {
         self.0.lock().unwrap_or_else(PoisonError::into_inner).metadata(name, entries)
     }
