@@ -7,7 +7,9 @@
 //! Candidates per closed contact: separated; sticking (μ > 0 and `|v_t| ≤ vel_tol`); sliding
 //! (along `v_t/|v_t|` when `|v_t| > vel_tol`; from rest along the direction s with `a_t ∥ s`,
 //! found by the fixed-point iteration `s ← a_t/|a_t|` started from the impending direction
-//! `−f_t/|f_t|` of the same combination with the contact sticking; frictionless: the normal
+//! `−f_t/|f_t|` of the same combination with the contact sticking — one contact: a scan of its
+//! angle; two, when the fixed point does not settle and its combination fails: once more with
+//! Newton's root of both angles, `pair_slip.rs`; frictionless: the normal
 //! row alone). Feasibility, with tolerances relative to the solution's scale
 //! (`tol_f = 1e-8 (1 N + max |f|)`, `tol_a = 1e-8 (1 + max |q̈|)`): separated → `g̈ ≥ −tol_a`;
 //! sticking → `f_n ≥ −tol_f`, `|f_t| ≤ μ f_n + tol_f`; sliding → `f_n ≥ −tol_f` and from rest
@@ -152,6 +154,7 @@ pub fn choose_modes_within(
             };
         }
         let mut ok = true;
+        let mut pair_root: Option<[[f64; 2]; 2]> = None;
         if from_rest {
             // the impending slip directions: the same combination with those contacts sticking
             let mut stick = trial.clone();
@@ -243,7 +246,10 @@ pub fn choose_modes_within(
         } else if ok && from_rest {
             // the consistent slip direction from rest: a_t ∥ s (so v_t grows along s and the
             // direction v_t/|v_t| is smooth); fixed-point iteration s ← a_t/|a_t| from the
-            // impending direction, to 1e-12 (at most 50 solves)
+            // impending direction, to 1e-12 (at most 50 solves); when it does not settle and
+            // two contacts start together, Newton's iteration on both angles from the impending
+            // directions (`pair_slip.rs`: at their common onset |a_t| is rounding noise)
+            let mut settled = false;
             for _ in 0..50 {
                 if solve_modes(contacts, &trial, stabilization, fd, cd).is_err() {
                     ok = false;
@@ -266,74 +272,98 @@ pub fn choose_modes_within(
                     }
                 }
                 if change <= 1e-12 {
+                    settled = true;
                     break;
                 }
             }
+            if ok && !settled && rest_sliders.len() == 2 && twins.iter().all(Option::is_none) {
+                let mut pair = trial.clone();
+                for &k in &rest_sliders {
+                    pair.slip[k] = impending[k];
+                }
+                if super::pair_slip::newton(contacts, &mut pair, [rest_sliders[0], rest_sliders[1]], stabilization, fd, cd) {
+                    pair_root = Some([pair.slip[rest_sliders[0]], pair.slip[rest_sliders[1]]]);
+                }
+            }
         }
-        if ok && from_rest {
-            // the slides from rest are onsets: their friction's direction follows the sticking
-            // force's impending direction while slower than SLIP_DIRECTION_SPEED
-            // (`forward::onset_anchors`), turned by the rotation from it to the direction chosen
-            for &k in &rest_sliders {
-                let (i, s) = (impending[k], trial.slip[k]);
-                trial.onset[k] = Some([s[0] * i[0] + s[1] * i[1], s[1] * i[0] - s[0] * i[1]]);
-            }
-            super::dependent::copy_to_twins(&twins, closed, &mut trial.onset);
-        }
-        if ok && solve_modes(contacts, &trial, stabilization, fd, cd).is_ok() {
-            let qdd = &fd.qdd.as_slice()[..nv];
-            let qmax = qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            let fmax = closed.iter().fold(0.0f64, |m, &k| m.max(cd.f_n[k].abs()).max(cd.f_t[k][0].hypot(cd.f_t[k][1])));
-            let (tol_f, tol_a) = (1e-8 * (1.0 + fmax), 1e-8 * (1.0 + qmax));
-            // a slide from rest is at the cone when its slip acceleration along s is within what
-            // a force of tol_f along s gives (the stick's tolerance, in the same units):
-            // `a_t · s ≥ −tol_f sᵀ G s`, G the contact's tangential Delassus block
-            let slip_tol = |k: usize, s: [f64; 2]| tol_a.max(tol_f * tangential_delassus(fd, cd, k, s));
-            let breaking = |k: usize| state.mode[k] == ContactMode::Sticking && preferred[k] == ContactMode::Sliding;
-            let mut feasible_here = true;
-            let mut marginal = false;
-            for (i, &k) in closed.iter().enumerate() {
-                let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
-                marginal |= match cands[i][idx[i]] {
-                    Cand::Sep => accel(0) <= tol_a,
-                    Cand::Stick => cd.margin[k] <= tol_f || cd.f_n[k] <= tol_f,
-                    Cand::Slide { moving } => {
-                        cd.f_n[k] <= tol_f || (!moving && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k]))
+        // the combination with the fixed point's directions; if it fails and Newton's root of the
+        // pair differs, once more with the root (`pair_slip.rs`)
+        let feasible_before = feasible.len();
+        for attempt in 0..2 {
+            if attempt == 1 {
+                match pair_root {
+                    Some(root) if feasible.len() == feasible_before && (root[0] != trial.slip[rest_sliders[0]] || root[1] != trial.slip[rest_sliders[1]]) => {
+                        trial.slip[rest_sliders[0]] = root[0];
+                        trial.slip[rest_sliders[1]] = root[1];
                     }
-                };
+                    _ => break,
+                }
             }
-            for (i, &k) in closed.iter().enumerate() {
-                let (f_n, f_t) = (cd.f_n[k], cd.f_t[k]);
-                let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
-                feasible_here &= match cands[i][idx[i]] {
-                    Cand::Sep => accel(0) >= -tol_a,
-                    // at a stick → slip event (a sticking contact preferred sliding: its margin
-                    // crossed 0 falling) a stick at the cone does not go on
-                    Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= mu_of(&contacts[k]) * f_n + tol_f && !(breaking(k) && cd.margin[k] <= tol_f),
-                    Cand::Slide { moving } => {
-                        f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -slip_tol(k, trial.slip[k]))
-                    }
-                };
+            if ok && from_rest {
+                // the slides from rest are onsets: their friction's direction follows the sticking
+                // force's impending direction while slower than SLIP_DIRECTION_SPEED
+                // (`forward::onset_anchors`), turned by the rotation from it to the direction chosen
+                for &k in &rest_sliders {
+                    let (i, s) = (impending[k], trial.slip[k]);
+                    trial.onset[k] = Some([s[0] * i[0] + s[1] * i[1], s[1] * i[0] - s[0] * i[1]]);
+                }
+                super::dependent::copy_to_twins(&twins, closed, &mut trial.onset);
             }
-            // the slides from rest at the cone (a_t·s within its tolerance of 0: the onset,
-            // where the slide and the stick are the same solution): they go on only if their slip
-            // acceleration grows with the stick's excess, p(s) > 0 ([`onset_grows`])
-            // (per twin group: judged once, on the group's first contact carrying the group's
-            // force, [`as_one`]; a twin's own p(s) is 0 while its twin takes the load)
-            let at_cone: Vec<usize> = closed
-                .iter()
-                .enumerate()
-                .filter(|&(i, &k)| {
+            if ok && solve_modes(contacts, &trial, stabilization, fd, cd).is_ok() {
+                let qdd = &fd.qdd.as_slice()[..nv];
+                let qmax = qdd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let fmax = closed.iter().fold(0.0f64, |m, &k| m.max(cd.f_n[k].abs()).max(cd.f_t[k][0].hypot(cd.f_t[k][1])));
+                let (tol_f, tol_a) = (1e-8 * (1.0 + fmax), 1e-8 * (1.0 + qmax));
+                // a slide from rest is at the cone when its slip acceleration along s is within what
+                // a force of tol_f along s gives (the stick's tolerance, in the same units):
+                // `a_t · s ≥ −tol_f sᵀ G s`, G the contact's tangential Delassus block
+                let slip_tol = |k: usize, s: [f64; 2]| tol_a.max(tol_f * tangential_delassus(fd, cd, k, s));
+                let breaking = |k: usize| state.mode[k] == ContactMode::Sticking && preferred[k] == ContactMode::Sliding;
+                let mut feasible_here = true;
+                let mut marginal = false;
+                for (i, &k) in closed.iter().enumerate() {
                     let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
-                    twins[i].is_none() && cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k])
-                })
-                .map(|(i, _)| i)
-                .collect();
-            if feasible_here {
-                let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();
-                let found = Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), onset: trial.onset.clone(), qdd: qdd.to_vec(), score, marginal };
-                if at_cone.iter().all(|&i| onset_grows(contacts, &as_one(&trial, &twins, closed, i), closed[i], stabilization, fd, cd)) {
-                    feasible.push(found);
+                    marginal |= match cands[i][idx[i]] {
+                        Cand::Sep => accel(0) <= tol_a,
+                        Cand::Stick => cd.margin[k] <= tol_f || cd.f_n[k] <= tol_f,
+                        Cand::Slide { moving } => {
+                            cd.f_n[k] <= tol_f || (!moving && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k]))
+                        }
+                    };
+                }
+                for (i, &k) in closed.iter().enumerate() {
+                    let (f_n, f_t) = (cd.f_n[k], cd.f_t[k]);
+                    let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
+                    feasible_here &= match cands[i][idx[i]] {
+                        Cand::Sep => accel(0) >= -tol_a,
+                        // at a stick → slip event (a sticking contact preferred sliding: its margin
+                        // crossed 0 falling) a stick at the cone does not go on
+                        Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= mu_of(&contacts[k]) * f_n + tol_f && !(breaking(k) && cd.margin[k] <= tol_f),
+                        Cand::Slide { moving } => {
+                            f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -slip_tol(k, trial.slip[k]))
+                        }
+                    };
+                }
+                // the slides from rest at the cone (a_t·s within its tolerance of 0: the onset,
+                // where the slide and the stick are the same solution): they go on only if their slip
+                // acceleration grows with the stick's excess, p(s) > 0 ([`onset_grows`])
+                // (per twin group: judged once, on the group's first contact carrying the group's
+                // force, [`as_one`]; a twin's own p(s) is 0 while its twin takes the load)
+                let at_cone: Vec<usize> = closed
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, &k)| {
+                        let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
+                        twins[i].is_none() && cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k])
+                    })
+                    .map(|(i, _)| i)
+                    .collect();
+                if feasible_here {
+                    let score = closed.iter().filter(|&&k| trial.mode[k] == preferred[k]).count();
+                    let found = Feasible { mode: trial.mode.clone(), slip: trial.slip.clone(), onset: trial.onset.clone(), qdd: qdd.to_vec(), score, marginal };
+                    if at_cone.iter().all(|&i| onset_grows(contacts, &as_one(&trial, &twins, closed, i), closed[i], stabilization, fd, cd)) {
+                        feasible.push(found);
+                    }
                 }
             }
         }
