@@ -579,6 +579,19 @@ fn the_random_scene_generator_redraws_a_circle_out_of_reach() {
     assert!(scene.run("two-elbow-unilateral").is_some(), "{what}");
 }
 
+/// Seed 0xe08f20ace809c12a (elbow4 μ = 1.34, elbow7 μ = 1.44): at 0.049179627 s both sticks
+/// reach their cones at once (statically indeterminate together: each one's Delassus block with
+/// the other sticking is singular, det ≈ 1e-15), and the slides from rest of both along their
+/// impending directions are consistent (f_n 3.2059 and 2.2064 N, p(s) 4.08 and 3.98 m/(s² N) > 0,
+/// a_t ∥ s to 1e-14 m/s²). The fixed-point iteration `s ← a_t/|a_t|` read the direction from
+/// |a_t| ≈ 1e-12 m/s² of rounding and the run stopped there with "no consistent contact forces";
+/// with the two-angle Newton iteration (`pair_slip.rs`) it completes its 0.15 s with the audit
+/// and the energy balance (≤ 1e-8 of E) at every sample (`check_random`).
+#[test]
+fn a_common_onset_of_two_contacts_slides_both_from_rest() {
+    assert_eq!(check_random(0xe08f_20ac_e809_c12a), None);
+}
+
 /// The case of `ELBOW_CONTACT_SEED` (a failing property case's seed), when set.
 #[test]
 fn random_unilateral_scene_of_a_given_seed() {
