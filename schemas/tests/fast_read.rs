@@ -11,16 +11,6 @@ const METRICS: [&str; 4] = [topics::HAND, topics::MOTORS, topics::CONSTRAINTS, t
 /// Everything but the metric topics: one group of chunks; the metric topics another.
 const BULK: [&str; 4] = [topics::TF, topics::HAND_POINTS, topics::JOINT_STATES, topics::ROBOT_DESCRIPTION];
 
-/// Equal trees, numbers compared bit for bit (NaN payloads, signed zeros).
-fn same(a: &Value, b: &Value) -> bool {
-    match (a, b) {
-        (Value::F64(x), Value::F64(y)) => x.to_bits() == y.to_bits(),
-        (Value::List(x), Value::List(y)) => x.len() == y.len() && x.iter().zip(y).all(|(a, b)| same(a, b)),
-        (Value::Struct(x), Value::Struct(y)) => x.len() == y.len() && x.iter().zip(y).all(|((ka, a), (kb, b))| ka == kb && same(a, b)),
-        _ => a == b,
-    }
-}
-
 /// What a visitor sees of one message, comparable between the two paths.
 struct Seen {
     topic: String,
@@ -89,7 +79,7 @@ fn typed_decoding_gives_the_generic_tree_on_every_message() {
         let at = format!("{} #{}", g.topic, g.index);
         assert!(!g.known && t.known, "{at}: the generic path gives trees, the typed path structs");
         assert_eq!((&g.topic, g.index, g.log_time_ns), (&t.topic, t.index, t.log_time_ns), "{at}");
-        assert!(same(&g.value, &t.value), "{at}:\n{:?}\n{:?}", g.value, t.value);
+        assert!(g.value.same_bits(&t.value), "{at}:\n{:?}\n{:?}", g.value, t.value);
         assert_eq!(g.non_finite, t.non_finite, "{at}");
         assert_eq!(g.arrays, t.arrays, "{at}");
         assert_eq!(g.typed, t.typed, "{at}");
@@ -146,7 +136,7 @@ fn only_the_chunks_of_the_wanted_topics_are_read_and_they_read_the_same() {
             for topic in METRICS {
                 for (k, (t, v)) in full.messages(topic).unwrap().iter().enumerate() {
                     let s = seen.find(|s| s.topic == topic && s.index == k).unwrap_or_else(|| panic!("{name}: {topic} #{k} missing"));
-                    assert!(s.log_time_ns == *t && same(&s.value, v), "{name}: {topic} #{k}");
+                    assert!(s.log_time_ns == *t && s.value.same_bits(v), "{name}: {topic} #{k}");
                 }
                 seen = keep.seen.iter();
             }

@@ -12,16 +12,6 @@
 use prost::encoding::{encode_key, encode_varint, WireType};
 use schemas::{topics, Body, ConstraintState, ContactState, DecodedMessage, EnergyState, Error, HandState, Message, MotorState, Value, Visitor};
 
-/// Equal trees, numbers compared bit for bit.
-fn same(a: &Value, b: &Value) -> bool {
-    match (a, b) {
-        (Value::F64(x), Value::F64(y)) => x.to_bits() == y.to_bits(),
-        (Value::List(x), Value::List(y)) => x.len() == y.len() && x.iter().zip(y).all(|(a, b)| same(a, b)),
-        (Value::Struct(x), Value::Struct(y)) => x.len() == y.len() && x.iter().zip(y).all(|((ka, a), (kb, b))| ka == kb && same(a, b)),
-        _ => a == b,
-    }
-}
-
 /// A protobuf message built record by record.
 #[derive(Default, Clone)]
 struct Pb(Vec<u8>);
@@ -154,7 +144,7 @@ fn agree(messages: &[(&str, Vec<u8>)]) {
         for (g, t) in generic.iter().zip(&seen) {
             let at = format!("{how}: {} #{}", g.topic, g.index);
             assert!(!g.known && t.known, "{at}");
-            assert!(same(&g.value, &t.value), "{at}:\ngeneric {:?}\n  typed {:?}", g.value, t.value);
+            assert!(g.value.same_bits(&t.value), "{at}:\ngeneric {:?}\n  typed {:?}", g.value, t.value);
         }
     }
 }

@@ -83,14 +83,6 @@ impl schemas::Visitor for Keep {
 #[test]
 fn typed_reads_equal_the_generic_read_on_a_whole_table_recording() {
     use schemas::{topics, Value};
-    fn same(a: &Value, b: &Value) -> bool {
-        match (a, b) {
-            (Value::F64(x), Value::F64(y)) => x.to_bits() == y.to_bits(),
-            (Value::List(x), Value::List(y)) => x.len() == y.len() && x.iter().zip(y).all(|(a, b)| same(a, b)),
-            (Value::Struct(x), Value::Struct(y)) => x.len() == y.len() && x.iter().zip(y).all(|((ka, a), (kb, b))| ka == kb && same(a, b)),
-            _ => a == b,
-        }
-    }
     let scene = sim::scene::Scene::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper_unilateral.json")).unwrap();
     let scene = scene.vary(|spec| spec.duration = 0.3).unwrap();
     let run = scene.run("whole-table").unwrap().clone();
@@ -109,7 +101,7 @@ fn typed_reads_equal_the_generic_read_on_a_whole_table_recording() {
         assert_eq!(typed.len(), generic.len());
         for (g, t) in generic.iter().zip(&typed) {
             assert!(!g.2 && t.2, "{} #{}: typed", g.0, g.1);
-            assert!(same(&g.3, &t.3), "{} #{}:\n{:?}\n{:?}", g.0, g.1, g.3, t.3);
+            assert!(g.3.same_bits(&t.3), "{} #{}:\n{:?}\n{:?}", g.0, g.1, g.3, t.3);
         }
     }
     // the file's /contacts: nine contacts, two of them in touch at some sample

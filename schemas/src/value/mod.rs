@@ -34,6 +34,19 @@ pub enum Value {
 }
 
 impl Value {
+    /// Equal trees with every number compared bit for bit: NaN payloads equal, `0.0` and `-0.0`
+    /// different, where `==` would say the opposite of both. What a second decoder of the same
+    /// bytes must reproduce exactly (the format's tests compare the typed and hand-walked reads
+    /// with the generic one this way).
+    pub fn same_bits(&self, other: &Value) -> bool {
+        match (self, other) {
+            (Value::F64(x), Value::F64(y)) => x.to_bits() == y.to_bits(),
+            (Value::List(x), Value::List(y)) => x.len() == y.len() && x.iter().zip(y).all(|(a, b)| a.same_bits(b)),
+            (Value::Struct(x), Value::Struct(y)) => x.len() == y.len() && x.iter().zip(y).all(|((ka, a), (kb, b))| ka == kb && a.same_bits(b)),
+            _ => self == other,
+        }
+    }
+
     /// Follows a dotted path: struct field names and list indices, e.g. `"actual.x"`,
     /// `"current"`, `"transforms.0.translation.x"`. The empty path is `self`. For generic tools and
     /// the format's own tests: readers of our topics use typed structs ([`from_value`],
