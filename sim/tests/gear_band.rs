@@ -22,7 +22,7 @@
 use std::f64::consts::PI;
 
 use sim::dynamics::gear_friction::GearMode;
-use sim::ode::{GearEvent, Outputs};
+use sim::ode::GearEvent;
 use sim::scene::spec::{AdaptiveSpec, IntegratorSpec};
 use sim::scene::Scene;
 
@@ -76,17 +76,6 @@ fn lift(qa: f64, qb: f64, kd: f64, l: f64, duration: f64) -> Scene {
     scene.vary(|s| s.gear_friction = Some(gear_law(0.0, ETA, ETA_B))).unwrap()
 }
 
-fn samples(scene: &Scene, run: &str) -> Vec<Outputs> {
-    let run = scene.run(run).unwrap().clone();
-    let mut out = Vec::new();
-    sim::run::simulate(scene, &run, |o| {
-        out.push(o.clone());
-        Ok(())
-    })
-    .unwrap();
-    out
-}
-
 /// τ of the cubic at rest at both ends, `3τ² − 2τ³ = c` (0 < c < 1), by Newton from τ = c
 /// (monotone on [0, 1]), to rounding.
 fn cubic_at(c: f64) -> f64 {
@@ -128,7 +117,7 @@ fn a_held_load_breaks_away_where_the_motor_torque_leaves_the_efficiency_band() {
         assert_eq!(first.mode, GearMode::Slide { dir, driving }, "{log:?}");
         assert!((first.t - t_star).abs() < 1e-10, "breaks away at {} s, hand {t_star} s ({:e})", first.t, first.t - t_star);
         assert_apart(&log, 1e-9, "lift");
-        for o in samples(&scene, "lift") {
+        for o in crate::gear_supply::samples(&scene, "lift") {
             if o.t < t_star {
                 assert!(o.q[0] == 0.0 && o.qd[0] == 0.0 && o.gear_stuck[0], "t = {}: q {} q' {} not held", o.t, o.q[0], o.qd[0]);
                 // the holding torque λ = W − K_m i inside the band [(η − 1) T, (1/η_b − 1) T]
@@ -157,7 +146,7 @@ fn a_load_released_at_zero_current_slides_back_driving_decided_once() {
         assert!(!log.is_empty(), "L = {l}: no gear event");
         assert_eq!((log[0].t, log[0].mode), (0.0, GearMode::Slide { dir: -1, driving: false }), "L = {l}: {log:?}");
         assert_apart(&log, 1e-9, "released");
-        let out = samples(&scene, "lift");
+        let out = crate::gear_supply::samples(&scene, "lift");
         for o in out.iter().filter(|o| o.t > 0.0 && o.t < 5e-3) {
             // falling, the motor's torque opposing it: K_m i s < 0
             assert!(o.qd[0] < 0.0 && o.current[0] > 0.0, "L = {l}, t = {}: q' {} i {}", o.t, o.qd[0], o.current[0]);

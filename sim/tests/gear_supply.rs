@@ -29,7 +29,8 @@ fn resting() -> Scene {
     Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/checks/resting.json"))).unwrap()
 }
 
-fn samples(scene: &Scene, run: &str) -> Vec<Outputs> {
+/// Every output sample of a run, integrated as `sim` does.
+pub(crate) fn samples(scene: &Scene, run: &str) -> Vec<Outputs> {
     let run = scene.run(run).unwrap().clone();
     let mut out = Vec::new();
     sim::run::simulate(scene, &run, |o| {
