@@ -113,8 +113,10 @@ pub enum RunError {
     /// combination of the joints at rest (`count` combinations tried, `window` 0), or the gears'
     /// events chattered at one instant ([`RunError::Chattering`] where every event is a gear's:
     /// `count` events within `window` s, more than `limit`).
-    #[error("the run stopped at t = {t:.9} s: the gears of {joints} have no consistent stick/slide modes there ({count} {what}): the motions of these joints are coupled (a closed chain through the table, or their shared mass matrix) and every combination of their stick and slide modes contradicts itself, or they switch without end. Remedies: leave the Coulomb/static friction off all but one of these joints (gear_friction values per joint: coulomb and breakaway 0; their efficiencies can stay), lower their breakaway torques, or run the elbow-free run", what = gears_what(.window, .limit))]
-    GearsChatter { t: f64, count: u32, window: f64, limit: u32, joints: String },
+    #[error("the run stopped at t = {t:.9} s: the gears of {joints} have no consistent stick/slide modes there ({count} {what}): the motions of these joints are coupled (a closed chain through the table, or their shared mass matrix) and every combination of their stick and slide modes contradicts itself, or they switch without end. {remedy}", what = gears_what(.window, .limit), remedy = gears_remedy(*.breakaway))]
+    /// `breakaway`: some of these gears have a Coulomb or static torque (else they are
+    /// efficiency-only, and the remedy differs).
+    GearsChatter { t: f64, count: u32, window: f64, limit: u32, joints: String, breakaway: bool },
     /// The recording could not be written (I/O error, full disk, another writer of the same
     /// path): `source` names the path and the OS reason.
     #[error("writing the recording: {source}")]
@@ -128,6 +130,18 @@ fn gears_what(window: &f64, limit: &u32) -> String {
         "combinations of stick, slide + and slide - tried".to_string()
     } else {
         format!("switches in a row within {window:e} s, events.max_events_at_one_time = {limit}")
+    }
+}
+
+/// The remedy of [`RunError::GearsChatter`]: with a Coulomb or static torque on some of the
+/// gears, fewer or weaker such torques; efficiency-only gears hold only in proportion to their
+/// motor torque, nothing at zero current, so a breakaway torque is what widens their bands
+/// there (a remedy about Coulomb friction would name a torque they do not have).
+fn gears_remedy(breakaway: bool) -> &'static str {
+    if breakaway {
+        "Remedies: leave the Coulomb/static friction off all but one of these joints (gear_friction values per joint: coulomb and breakaway 0; their efficiencies can stay), lower their breakaway torques, or run the elbow-free run"
+    } else {
+        "These gears have no Coulomb or static friction (efficiency only): a sticking one holds at most (1/back_efficiency - efficiency) |K_m i| beyond its motor's torque, nothing at zero current, so their modes turn on how the currents leave 0. Remedies: give them a small breakaway torque (gear_friction.breakaway > 0), which lets each hold that much at zero current; set their efficiencies to 1 (no gear law on them); or run the elbow-free run"
     }
 }
 

@@ -161,7 +161,7 @@ pub fn simulate_outputs(
         // current modes (review F5)
         RunError::Chattering { t, count, window, limit, events } => match sys.chattering_gears(&events) {
             // only gears' functions: their stick decisions, not the contacts' (issue 26)
-            Some(joints) => RunError::GearsChatter { t, count, window, limit, joints: joints.join(", ") },
+            Some((joints, breakaway)) => RunError::GearsChatter { t, count, window, limit, joints: joints.join(", "), breakaway },
             None => RunError::Chattering { t, count, window, limit, events: sys.describe_event_functions(&events) },
         },
         other => other,

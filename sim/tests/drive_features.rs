@@ -189,12 +189,20 @@ fn coupled_gears_on_a_closed_chain_are_decided_together_and_run() {
     assert_eq!(rep.samples, 301);
     assert!(stuck_samples > 0, "no joint ever sticks");
     assert!(worst <= 1e-6 * drawn, "balance residual {worst} of {drawn} J");
-    let err = sim::error::RunError::GearsChatter { t: 1e-3, count: 27, window: 0.0, limit: 0, joints: "joint4, joint7".into() };
+    let err = sim::error::RunError::GearsChatter { t: 1e-3, count: 27, window: 0.0, limit: 0, joints: "joint4, joint7".into(), breakaway: true };
     let text = err.to_string();
     for part in ["t = 0.001000000 s", "the gears of joint4, joint7 have no consistent stick/slide modes", "27 combinations", "coupled", "coulomb and breakaway 0"] {
         assert!(text.contains(part), "{part:?} not in {text}");
     }
     assert!(!text.contains("compliant"), "{text}");
+    // efficiency-only gears have no Coulomb friction to leave off: the remedy says what they
+    // hold and offers a breakaway torque instead
+    let err = sim::error::RunError::GearsChatter { t: 1e-3, count: 27, window: 0.0, limit: 0, joints: "joint4, joint7".into(), breakaway: false };
+    let text = err.to_string();
+    for part in ["the gears of joint4, joint7 have no consistent stick/slide modes", "efficiency only", "nothing at zero current", "gear_friction.breakaway > 0"] {
+        assert!(text.contains(part), "{part:?} not in {text}");
+    }
+    assert!(!text.contains("leave the Coulomb") && !text.contains("lower their breakaway"), "{text}");
 }
 
 /// The stiff methods' structured Jacobian against central differences with every drive feature

@@ -169,10 +169,8 @@ fn paper_with(law: GearFrictionSpec, rtol: f64, duration: f64) -> Scene {
 /// The paper arm with efficiency-only gears (η 0.85, η_b 0.7) on every joint (its open chain),
 /// and with Coulomb friction 0.2 N m as well (open chain and two-elbow chain): each run completes
 /// its 5 s; the balance closes at every sample to 1e-9 of E = Σ ∫ i v dt at rtol 1e-10; with
-/// efficiency-only gears no joint's gear changes mode twice within 1e-9 s. (Efficiency-only gears on the closed chains
-/// still stop, with the gears' error, where several joints of the chain stick at once: their
-/// holding torques are not unique there, and the one the solve takes can lie outside bands as
-/// narrow as (1/η_b − η) |K_m i|; TESTING.md, NOT covered.)
+/// efficiency-only gears no joint's gear changes mode twice within 1e-9 s. (Efficiency-only
+/// gears on the closed chains: `the_closed_chains_run_with_efficiency_only_gears`.)
 #[test]
 fn the_paper_arm_runs_with_efficiency_only_gears() {
     for (what, law, runs) in [("efficiency only", gear_law(0.0, 0.85, 0.7), &["no-elbow"][..]), ("efficiency + Coulomb", gear_law(0.2, 0.85, 0.7), &["no-elbow", "two-elbow"][..])] {
@@ -199,6 +197,51 @@ fn the_paper_arm_runs_with_efficiency_only_gears() {
             let close = log.iter().enumerate().filter(|&(a, e)| log[a + 1..].iter().find(|f| f.joint == e.joint).is_some_and(|f| f.t - e.t < 1e-9)).count();
             eprintln!("{what}, {run}: E = {e:.4} J, worst residual {worst:.3e} J, gear loss {:.4} J, {} gear events, {close} within 1e-9 s of the joint's next", out.last().unwrap().2, log.len());
         }
+    }
+}
+
+/// The paper arm's closed chains (two-elbow, one-elbow; the bilateral table) with an
+/// efficiency-only gear on every joint (η 0.8, η_b 0.7, no Coulomb;
+/// `scenes/drives/paper_efficiency_gears.json`, dopri45 rtol 1e-10): several joints of the chain
+/// stick at once and share the load with the table, their holding torques are not unique, and
+/// the one chosen (`ode/gear_hold.rs`) must lie in every sticking joint's band. Each run completes
+/// its 5 s (before: two-elbow stopped at 0.1544 s, "no consistent stick/slide modes" for joints 2-8), the
+/// balance closes at every sample to 1e-9 of E, every sticking joint's λ is inside its band
+/// `[lo(K_m i), hi(K_m i)]` at every sample (to 1e-9 (1 N m + |λ|)), no joint's gear changes
+/// mode twice within 1e-9 s, and some sample has two or more joints of the chain sticking at
+/// once (the redundant case).
+#[test]
+fn the_closed_chains_run_with_efficiency_only_gears() {
+    let scene = Scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_efficiency_gears.json"))).unwrap();
+    let g = scene.gear_friction().expect("gear friction").clone();
+    let km = scene.drives().km.clone();
+    for run in ["two-elbow", "one-elbow"] {
+        let r = scene.run(run).unwrap().clone();
+        let (mut worst, mut most_stuck, mut outside) = (0.0f64, 0usize, Vec::new());
+        let rep = sim::run::simulate(&scene, &r, |o| {
+            worst = worst.max(o.balance_residual.abs());
+            most_stuck = most_stuck.max(o.gear_stuck.iter().filter(|&&s| s).count());
+            for j in 0..o.gear_stuck.len() {
+                if o.gear_stuck[j] {
+                    let (lo, hi) = g.band(j, km[j] * o.current[j]);
+                    let lam = o.gear_torque[j];
+                    let tol = 1e-9 * (1.0 + lam.abs());
+                    if lam < lo - tol || lam > hi + tol {
+                        outside.push((o.t, j, lo, lam, hi));
+                    }
+                }
+            }
+            Ok(())
+        });
+        let rep = rep.unwrap_or_else(|e| panic!("{run}: {e}"));
+        assert_eq!(rep.samples, 5001, "{run}");
+        let e: f64 = rep.last.electric_energy.iter().sum();
+        assert!(e > 0.0 && worst <= 1e-9 * e, "{run}: residual {worst} J of E = {e} J");
+        assert!(outside.is_empty(), "{run}: holding torques outside their bands (t, joint, lo, λ, hi): {:?}", &outside[..outside.len().min(5)]);
+        assert!(most_stuck >= 2, "{run}: never two joints sticking at once");
+        let log = crate::gear_supply::gear_log(&scene, run);
+        assert_apart(&log, 1e-9, run);
+        eprintln!("{run}: E = {e:.4} J, worst residual {worst:.3e} J, up to {most_stuck} joints sticking at once, {} gear events", log.len());
     }
 }
 
@@ -236,7 +279,36 @@ fn every_method_keeps_its_order_with_efficiency_only_gears() {
         eprintln!("{method}: error ~ rtol^{q:.3} ({e:?})");
         assert!((q - 1.0).abs() <= 0.15, "{method}: error ~ rtol^{q:.2} ({e:?})");
     }
-    // rk4 is left out: at h = 2e-4 s its gears of joints 5 and 8 chatter at t = 0 (TESTING.md,
-    // NOT covered)
+    // rk4 is refused with efficiency-only gears (`rk4_is_refused_with_efficiency_only_gears`)
+}
+
+/// rk4 with an efficiency-only gear (η < 1, no breakaway torque) on some joint is refused when
+/// the scene is read, with an error naming the field, the method, the joints and the reason
+/// (`scene/spec_gear_supply.rs::refuse_fixed_step`; before: the paper arm's run started and
+/// stopped at t = 0 with 33 switches of joints 5 and 8 at h = 2e-4 s); the same gears with a
+/// breakaway torque are accepted, as are the adaptive methods.
+#[test]
+fn rk4_is_refused_with_efficiency_only_gears() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_efficiency_gears.json");
+    let scene = Scene::load(std::path::Path::new(file)).unwrap();
+    let err = scene.vary(|s| s.integrator = IntegratorSpec::rk4(2e-4)).expect_err("rk4 accepted with efficiency-only gears").to_string();
+    for part in ["integrator.method", "rk4", "joint1", "joint10", "efficiency below 1 and no breakaway torque", "fixed step", "adaptive method", "gear_friction.breakaway > 0"] {
+        assert!(err.contains(part), "{part:?} not in {err}");
+    }
+    // only the efficiency-only joints are named: joint1 with a breakaway torque is not
+    let some = scene
+        .vary(|s| {
+            s.integrator = IntegratorSpec::rk4(2e-4);
+            s.gear_friction = Some(GearFrictionSpec { breakaway: Some(PerJoint::Each((0..10).map(|j| if j == 0 { 0.1 } else { 0.0 }).collect())), ..gear_law(0.0, 0.8, 0.7) });
+        })
+        .expect_err("rk4 accepted")
+        .to_string();
+    assert!(!some.contains("joint1,") && some.contains("joint2, "), "{some}");
+    scene.vary(|s| {
+        s.integrator = IntegratorSpec::rk4(2e-4);
+        s.gear_friction = Some(gear_law(0.1, 0.8, 0.7));
+    })
+    .expect("rk4 with Coulomb gears");
+    scene.vary(|s| s.integrator = IntegratorSpec::adaptive("rosenbrock", 1e-6, None).unwrap()).expect("an adaptive method");
 }
 

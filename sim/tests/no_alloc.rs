@@ -242,3 +242,42 @@ fn the_event_driver_does_not_allocate_per_step_or_event() {
         assert_eq!(a, b, "{name}: {a} vs {b} allocations");
     }
 }
+
+/// The sticking gears' holding torques where they are not unique allocate nothing per
+/// evaluation: the paper arm's two-elbow chain with efficiency-only gears
+/// (`scenes/drives/paper_efficiency_gears.json`), where several joints of the chain stick at
+/// once and `ode/gear_hold.rs` chooses among their torques by Newton's method on scratch (the
+/// old solve's choice left a band at 0.154 s); 20 right-hand sides at every sample of the first
+/// 0.5 s with two or more joints sticking.
+#[test]
+#[allow(clippy::result_large_err)] // the sink returns RunError, as `sim::run`'s
+fn the_holding_torques_of_a_closed_chain_do_not_allocate() {
+    use sim::dynamics::gear_friction::GearMode;
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/drives/paper_efficiency_gears.json");
+    let scene = Scene::load(std::path::Path::new(file)).unwrap().vary(|s| s.duration = 0.5).unwrap();
+    let run = scene.run("two-elbow").unwrap().clone();
+    let mut sys = ArmSystem::new(&scene, &run);
+    let y0 = sys.initial_state();
+    let mut dydt = vec![0.0; y0.len()];
+    let (mut checked, mut worst) = (0, 0);
+    scene
+        .integrator()
+        .integrate_hybrid(&mut sys, &y0, 0.5, 1e-3, None, EventSettings::default(), |t, y, sys| {
+            let mut mode = [None; 10];
+            for e in sys.gear_events() {
+                mode[e.joint] = Some(e.mode);
+            }
+            if mode.iter().filter(|m| **m == Some(GearMode::Stick)).count() >= 2 {
+                let before = allocs();
+                for _ in 0..20 {
+                    sys.rhs(t, y, &mut dydt)?;
+                }
+                worst = worst.max(allocs() - before);
+                checked += 1;
+            }
+            Ok(())
+        })
+        .unwrap();
+    assert!(checked >= 100, "{checked} samples with two joints sticking");
+    assert_eq!(worst, 0, "allocations per 20 evaluations");
+}

@@ -9,9 +9,11 @@
 //! their modes: eq 21 is affine in the joint torques for fixed modes, so with `S` the sticking
 //! joints, `q̈_S(τ + E_S λ) = q̈_S(τ) + G_SS λ` where column a of G is the change of q̈ for a
 //! unit torque at joint S_a (one more solve per sticking joint, exact up to rounding), and
-//! `G_SS λ = −q̈_S(τ)` is solved by Gaussian elimination ([`ArmSystem::lock_stuck`]; the
-//! lock of a joint as a holding torque: Pfeiffer & Glocker, *Multibody Dynamics with Unilateral
-//! Contacts*, Wiley 1996, ch. 5). The gear loss quadrature `E_g = ∫ Σ (K_m i_j − τ_gear,j) q̇_j
+//! `G_SS λ = −q̈_S(τ)` is solved in `gear_hold.rs` ([`ArmSystem::lock_stuck`]; the lock of a
+//! joint as a holding torque: Pfeiffer & Glocker, *Multibody Dynamics with Unilateral
+//! Contacts*, Wiley 1996, ch. 5): uniquely when G_SS is regular, and where several sticking
+//! joints of a closed chain share the load with the constraint forces (G_SS singular) the
+//! analytic centre of the distributions that lie in every joint's band. The gear loss quadrature `E_g = ∫ Σ (K_m i_j − τ_gear,j) q̇_j
 //! dt` and the supply's `E_supply`, `E_regen`, `E_dump`, `E_sloss` follow the contacts'
 //! quadratures in the state; each integrand is smooth between events, so the adaptive methods
 //! integrate them to their order. Allocates nothing.
@@ -21,50 +23,7 @@ use crate::dynamics::motor::Electrical;
 use crate::error::DynamicsError;
 
 use super::arm::ArmSystem;
-
-/// Solve `a x = b` for the n x n symmetric positive semi-definite `a` (row-major; `b`
-/// overwritten by x) by Gaussian elimination without pivoting, skipping the directions whose
-/// pivot is below `1e-12` of the largest diagonal: there the locked joints' accelerations are
-/// already tied by the constraints (two sticking joints of one closed chain), the system is
-/// consistent and the skipped unknowns are set to 0 (all of them when every locked joint is
-/// held by the constraints alone: a joint whose motion the closed chain fixes needs no holding
-/// torque from its gear). False on a non-finite entry.
-fn solve_psd(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
-    let scale = (0..n).map(|k| a[k * n + k].abs()).fold(0.0, f64::max);
-    if !scale.is_finite() {
-        return false;
-    }
-    let tol = 1e-12 * scale;
-    for k in 0..n {
-        if a[k * n + k] <= tol {
-            for c in 0..n {
-                a[k * n + c] = 0.0;
-                a[c * n + k] = 0.0;
-            }
-            b[k] = 0.0;
-            continue;
-        }
-        for r in k + 1..n {
-            let f = a[r * n + k] / a[k * n + k];
-            for c in k..n {
-                a[r * n + c] -= f * a[k * n + c];
-            }
-            b[r] -= f * b[k];
-        }
-    }
-    for k in (0..n).rev() {
-        if a[k * n + k] == 0.0 {
-            b[k] = 0.0;
-            continue;
-        }
-        let mut s = b[k];
-        for c in k + 1..n {
-            s -= a[k * n + c] * b[c];
-        }
-        b[k] = s / a[k * n + k];
-    }
-    b.iter().all(|x| x.is_finite())
-}
+use super::gear_hold::hold_torques;
 
 impl ArmSystem<'_> {
     /// `K_m i_j` with the currents of this evaluation (after `inputs`).
@@ -121,12 +80,20 @@ impl ArmSystem<'_> {
                 m.g[b * n + a] = self.ws.fd.qdd[r] - m.qdd0[r];
             }
         }
-        let m = self.drive_modes.as_mut().expect("drive modes");
+        let gf = self.scene.gear_friction.as_ref();
         for b in 0..n {
-            m.lambda[b] = -m.qdd0[m.stuck[b]];
+            let j = self.drive_modes.as_ref().expect("drive modes").stuck[b];
+            let (lo, hi) = gf.map_or((0.0, 0.0), |g| g.band(j, self.km_i(y, j)));
+            let m = self.drive_modes.as_mut().expect("drive modes");
+            m.lambda[b] = -m.qdd0[j];
+            m.lo[b] = lo;
+            m.hi[b] = hi;
         }
-        let (g, lambda) = (&mut m.g[..n * n], &mut m.lambda[..n]);
-        if !solve_psd(g, lambda, n) {
+        // the absolute scale of G's pivots (gear_hold.rs): the largest free mobility bound
+        // 1/(M + J_m)_aa of the sticking joints
+        let m = self.drive_modes.as_mut().expect("drive modes");
+        let free = m.stuck.iter().map(|&j| 1.0 / (self.ws.data.m[(j, j)] + self.ws.drives.jm[j])).filter(|v| v.is_finite() && *v > 0.0).fold(0.0, f64::max);
+        if hold_torques(&mut m.hold, &m.g[..n * n], &mut m.lambda[..n], &m.lo[..n], &m.hi[..n], n, free).is_none() {
             return Err(DynamicsError::NonFinite { t, what: "the holding torque of a sticking gear (its joint has no inertia of its own)".into() });
         }
         for a in 0..n {

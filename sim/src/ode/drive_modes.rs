@@ -28,6 +28,7 @@ use crate::error::RunError;
 use crate::integrate::HybridSystem;
 
 use super::arm::ArmSystem;
+use super::gear_hold::HoldScratch;
 
 /// A change of a gear's mode: at time `t` (s), joint `joint` entered `mode`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,6 +58,10 @@ pub(crate) struct DriveModes {
     pub(super) qdd0: Vec<f64>,
     pub(super) g: Vec<f64>,
     pub(super) lambda: Vec<f64>,
+    /// Scratch: the sticking joints' bands and the choice among their holding torques.
+    pub(super) lo: Vec<f64>,
+    pub(super) hi: Vec<f64>,
+    pub(super) hold: HoldScratch,
     /// Scratch: the electric powers p_j (nv).
     pub(crate) power: Vec<f64>,
     /// The gears' mode changes (events and the start), first [`MAX_GEAR_LOG`].
@@ -74,6 +79,9 @@ impl DriveModes {
             qdd0: vec![0.0; nv],
             g: vec![0.0; nv * nv],
             lambda: vec![0.0; nv],
+            lo: vec![0.0; nv],
+            hi: vec![0.0; nv],
+            hold: HoldScratch::new(nv),
             power: vec![0.0; nv],
             log: Vec::new(),
         }
@@ -365,25 +373,28 @@ impl ArmSystem<'_> {
     }
 
     /// The joints whose gear functions are all of `text`'s event functions (the driver's
-    /// "event functions [i, j, ...]" of a chattering error), or `None` when another function is
-    /// among them (a contact's, a supply's) or the text is not such a list.
-    pub fn chattering_gears(&self, text: &str) -> Option<Vec<String>> {
+    /// "event functions [i, j, ...]" of a chattering error), and whether any of their gears has
+    /// a breakaway torque; `None` when another function is among them (a contact's, a
+    /// supply's) or the text is not such a list.
+    pub fn chattering_gears(&self, text: &str) -> Option<(Vec<String>, bool)> {
         let list = text.strip_prefix("event functions [")?.strip_suffix(']')?;
         let nc = self.contact_n_events();
         let nv = self.layout.nv;
-        self.scene.gear_friction.as_ref()?;
+        let g = self.scene.gear_friction.as_ref()?;
         let mut joints: Vec<String> = Vec::new();
+        let mut breakaway = false;
         for part in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             let i = part.parse::<usize>().ok()?.checked_sub(nc)?;
             if i >= 2 * nv {
                 return None;
             }
+            breakaway |= g.breakaway[i / 2] > 0.0;
             let name = self.scene.model.bodies[i / 2].joint.clone();
             if !joints.contains(&name) {
                 joints.push(name);
             }
         }
-        (!joints.is_empty()).then_some(joints)
+        (!joints.is_empty()).then_some((joints, breakaway))
     }
 
     /// "gear of <joint> (...)" or "supply (...)" for the drives' event function `i`.

@@ -182,7 +182,8 @@ impl ArmSystem<'_> {
         let m = self.drive_modes.as_mut().expect("drive modes");
         m.gear.copy_from_slice(&before);
         let joints: Vec<String> = rest.iter().map(|&j| scene.model.bodies[j].joint.clone()).collect();
-        Err(RunError::GearsChatter { t, count: tried as u32, window: 0.0, limit: 0, joints: joints.join(", ") })
+        let breakaway = rest.iter().any(|&j| g.breakaway[j] > 0.0);
+        Err(RunError::GearsChatter { t, count: tried as u32, window: 0.0, limit: 0, joints: joints.join(", "), breakaway })
     }
 
     /// Whether the joints at rest in the modes `options[a][choice[a]]` are consistent at (t, y)

@@ -45,6 +45,7 @@ mod drive_forces;
 mod drive_modes;
 mod contact_events;
 mod gear_decide;
+mod gear_hold;
 mod hybrid;
 mod jacobian;
 mod layout;

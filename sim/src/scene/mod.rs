@@ -594,6 +594,7 @@ fn build(spec: SceneSpec, file: &str, urdf_xml: String, dir: Option<&Path>, targ
 
     let integrator = Integrator::from_spec(&spec.integrator, file, duration, 1.0 / output_rate)?;
     let gear_friction = spec_gear_supply::gear_friction(&c, spec.gear_friction.as_ref(), nv, &drives.passive)?;
+    spec_gear_supply::refuse_fixed_step(&c, gear_friction.as_ref(), integrator.method(), |j| model.bodies[j].joint.clone())?;
     let supply = spec_gear_supply::supply(&c, spec.supply.as_ref(), nv)?;
     if integrator.method() == "imex" && drives.electrical == Electrical::Inductive && controller.reads_current() {
         return Err(c.err(

@@ -110,6 +110,33 @@ pub(super) fn gear_friction(c: &Ctx, spec: Option<&GearFrictionSpec>, nv: usize,
     Ok(Some(GearFriction { coulomb, breakaway, stribeck_velocity, efficiency: eta, back_efficiency: eta_b }))
 }
 
+/// rk4 is refused with an efficiency-only gear (an efficiency below 1 and no breakaway torque
+/// on some joint): that gear's stick band is `(1/η_b − η) |K_m i|` wide, a point where its
+/// current is 0, and whether the joint sticks there is decided by how its torques leave 0
+/// within nanoseconds (`ode/gear_decide.rs`). Measured on the paper arm (η 0.8 / η_b 0.7,
+/// no-elbow): with rk4 steps of 5e-5 s and longer joints 5 and 8 switch 33 times at t = 0 and
+/// the run stops; 2e-5 s runs the first 0.3 s; the adaptive methods run. The mechanism, as far
+/// as traced: a function that starts at 0 is watched from its start value and fires at the
+/// restart when it reaches its firing side by more than its tolerance within the first step
+/// (`integrate/events.rs`); an adaptive method's first step after a restart is short, rk4's is
+/// its fixed step, and the same decision at the same state restarts it without end. Refused
+/// before the run starts rather than left to a step size that depends on the scene.
+pub(super) fn refuse_fixed_step(c: &Ctx, g: Option<&GearFriction>, method: &str, joint: impl Fn(usize) -> String) -> Result<(), SceneError> {
+    let Some(g) = g else { return Ok(()) };
+    let bare: Vec<String> = (0..g.nv()).filter(|&j| g.active(j) && g.breakaway[j] == 0.0).map(joint).collect();
+    if method != "rk4" || bare.is_empty() {
+        return Ok(());
+    }
+    Err(c.err(
+        "integrator.method",
+        "rk4",
+        format!(
+            "cannot run gears with an efficiency below 1 and no breakaway torque ({}): such a gear holds nothing at zero current, and whether its joint sticks or slides there is decided by what its torques do within nanoseconds, which rk4's fixed step cannot follow (its events are located on the step's interpolant and the step does not shrink after a mode change, so the joint switches at the same instant without end); use an adaptive method (dopri45, rosenbrock, imex, rodas5p), or give these gears a breakaway torque (gear_friction.breakaway > 0)",
+            bare.join(", ")
+        ),
+    ))
+}
+
 /// The scene's supply, validated (`None` when absent).
 pub(super) fn supply(c: &Ctx, spec: Option<&SupplySpec>, nv: usize) -> Result<Option<Supply>, SceneError> {
     let Some(s) = spec else { return Ok(None) };
