@@ -95,6 +95,8 @@ mod with_the_feature {
         messages: BTreeMap<String, Vec<(u64, usize)>>,
         robot_description: Vec<Vec<u8>>,
         server_name: Option<String>,
+        /// Subscriptions sent again after the server refused them as unknown (see `frame`).
+        resubscribed: usize,
     }
 
     impl Received {
@@ -105,6 +107,23 @@ mod with_the_feature {
                     let v: serde_json::Value = serde_json::from_str(text.as_str()).expect("text frames are JSON");
                     match v["op"].as_str() {
                         Some("serverInfo") => self.server_name = v["name"].as_str().map(str::to_string),
+                        // The `foxglove` crate (0.30.3, `ConnectedClient::advertise_channels`)
+                        // sends an advertisement before it enters the channel in the client's
+                        // map; a client that answers before the server's thread gets there is
+                        // refused with this status (level 2) and its subscription dropped. A
+                        // channel advertised mid-run (`/contact_events`, at the first event)
+                        // met it on a loaded machine. Our advertisement stands, so the client
+                        // subscribes again, as a robust client would; anything else refused fails.
+                        Some("status") if v["level"].as_u64() == Some(2) => {
+                            let message = v["message"].as_str().unwrap_or_default();
+                            let channel: u64 = message.strip_prefix("Unknown channel ID: ").and_then(|n| n.trim().parse().ok()).unwrap_or_else(|| panic!("the server refused: {v}"));
+                            let sub = *self.subscriptions.iter().find(|(_, c)| **c == channel).unwrap_or_else(|| panic!("refused a channel never subscribed: {v}")).0;
+                            self.resubscribed += 1;
+                            eprintln!("live test: {message}; subscribing again");
+                            assert!(self.resubscribed <= 100, "a subscription refused 100 times: {v}");
+                            std::thread::sleep(std::time::Duration::from_millis(10));
+                            return Some(serde_json::json!({ "op": "subscribe", "subscriptions": [{ "id": sub, "channelId": channel }] }).to_string());
+                        }
                         Some("advertise") => {
                             let mut subs = Vec::new();
                             for c in v["channels"].as_array().expect("channels") {
