@@ -125,7 +125,9 @@ pub fn read_recording_topics(path: &Path, topics: Option<&[&str]>) -> Result<Rec
 pub fn stream_recording(path: &Path, topics: Option<&[&str]>, visitor: &mut dyn Visitor) -> Result<Recording, Error> {
     let (mut file, len, label) = input::open(path)?;
     let summary = topics.and_then(|_| chunks::summary_of_file(&mut file, len));
-    Ok(read_state(&mut file, len, label, topics, summary.as_deref(), visitor)?.into_recording())
+    // read through maps of the file, a window at a time (`input::Windows`)
+    let mut input = input::Windows::new(file.into_inner(), len).map_err(|source| Error::Io { file: label.clone(), op: "reading", source })?;
+    Ok(read_state(&mut input, len, label, topics, summary.as_deref(), visitor)?.into_recording())
 }
 
 /// Reads a whole MCAP input of `len` bytes into the state (messages to `visitor`) and checks
