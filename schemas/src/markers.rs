@@ -1,7 +1,8 @@
 //! The scene entities of a recording for Foxglove's 3D panel: [`topics::SCENE`] (once, t = 0: the
 //! table planes and the target path of the hand) and [`topics::CONTACT_MARKERS`] (every sample:
-//! one marker per contact coloured by its mode, an arrow of the contact force on the arm, and the
-//! actual and desired hand as spheres coloured apart).
+//! one marker per contact that touches coloured by its mode, an arrow of the contact force on
+//! the arm, and the actual and desired hand as spheres coloured apart; a contact that separates
+//! is deleted).
 //!
 //! Message types and conventions are Foxglove's `foxglove.SceneUpdate` and its primitives
 //! (<https://docs.foxglove.dev/docs/visualization/message-schemas/scene-update>,
@@ -32,6 +33,8 @@
 //!
 //! [`ContactMarkers`] builds its message once and only overwrites numbers (and the `mode`
 //! metadata value, within its capacity) per sample: recording it allocates nothing per sample.
+//! A contact that does not touch is not drawn: its entities are deleted when it separates
+//! (`markers/contact_markers.rs`).
 
 use foxglove::messages::{
     line_primitive, ArrowPrimitive, Color, CubePrimitive, KeyValuePair, LinePrimitive, Point3, Pose, Quaternion, SceneEntity,
@@ -49,6 +52,8 @@ pub use scale::{round_125_down, ForceGlyph, ForceScale};
 use scale::fmt_num;
 pub use scene::{ids, recorded_arrow_scale, scene_update, ScaleBar, SceneDescription, SceneRead, TableBox, TablePlane};
 pub use labels::{default_anchor, label_capacity, place_labels, write_label, LabelBox, LABEL_CHAR_WIDTH_M, LABEL_GAP_M, LABEL_LIFT_M, LABEL_ROW_M};
+mod contact_markers;
+pub use contact_markers::ContactMarkers;
 mod shapes;
 pub use shapes::{circle, shape_entities, shape_glyphs, ShapeGlyph, SHAPE_ALPHA, SHAPE_ID};
 
@@ -251,184 +256,8 @@ pub struct MarkerContact {
     pub offset: f64,
 }
 
-/// The message of [`topics::CONTACT_MARKERS`], built once for a run's contacts and updated in
-/// place every sample. Entities, in this order: per contact `contact/<name>` (a translucent
-/// sphere at the contact point, larger than the link there, and a ring on the table around
-/// the point's projection, both coloured by mode) and `force/<name>` (the force arrow from the
-/// point on the surface, [`ForceGlyph`], and its label, [`write_label`]), then `hand/actual`
-/// and `hand/desired`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ContactMarkers {
-    msg: SceneUpdate,
-    contacts: Vec<MarkerContact>,
-    scale: ForceScale,
-    /// The labels' boxes, one per contact, placed every sample ([`place_labels`]).
-    labels: Vec<LabelBox>,
-}
-
 /// Index of the metadata entry `mode` of a contact entity.
 const MODE_KEY: usize = 1;
-
-impl ContactMarkers {
-    /// The message for `contacts` in frame `frame_id`, arrows at `scale`.
-    pub fn new(frame_id: &str, contacts: &[MarkerContact], scale: ForceScale) -> Self {
-        let mut entities = Vec::with_capacity(2 * contacts.len() + 2);
-        let entity = |id: String, metadata: Vec<KeyValuePair>| SceneEntity {
-            timestamp: Some(timestamp(0)),
-            frame_id: frame_id.into(),
-            id,
-            metadata,
-            ..Default::default()
-        };
-        let sphere = |r: f64, c: Color| SpherePrimitive {
-            pose: Some(pose([0.0; 3], identity())),
-            size: Some(Vector3 { x: 2.0 * r, y: 2.0 * r, z: 2.0 * r }),
-            color: Some(c),
-        };
-        // the longest mode name, so that writing any mode later needs no allocation
-        let longest = [MarkerMode::Separated, MarkerMode::Sticking, MarkerMode::Sliding, MarkerMode::Pushing, MarkerMode::Pulling]
-            .iter()
-            .map(|m| m.name().len())
-            .max()
-            .unwrap_or(0);
-        // a ring in the xy plane of its pose (turned onto the contact's plane)
-        let ring: Vec<Point3> = (0..CONTACT_RING_POINTS)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / CONTACT_RING_POINTS as f64;
-                Point3 { x: CONTACT_RING_RADIUS_M * a.cos(), y: CONTACT_RING_RADIUS_M * a.sin(), z: 0.0 }
-            })
-            .collect();
-        for c in contacts {
-            let name = &c.name;
-            let mut mode = String::with_capacity(longest);
-            mode.push_str(MarkerMode::Separated.name());
-            let mut e = entity(
-                format!("contact/{name}"),
-                vec![
-                    kv("what", format!("contact point of {name} (sphere) and its point on the table (ring), coloured by mode")),
-                    KeyValuePair { key: "mode".into(), value: mode },
-                    kv("sphere_radius_m", CONTACT_MARKER_RADIUS_M.to_string()),
-                    kv("ring_radius_m", CONTACT_RING_RADIUS_M.to_string()),
-                    kv("units", "m"),
-                ],
-            );
-            e.spheres.push(sphere(CONTACT_MARKER_RADIUS_M, colors::color(colors::SEPARATED, 0.45)));
-            e.lines.push(LinePrimitive {
-                r#type: line_primitive::Type::LineLoop as i32,
-                pose: Some(pose([0.0; 3], quat(rotation_between([0.0, 0.0, 1.0], c.normal)))),
-                thickness: RING_LINE_WIDTH_M,
-                scale_invariant: false,
-                points: ring.clone(),
-                color: Some(colors::color(colors::SEPARATED, 1.0)),
-                colors: Vec::new(),
-                indices: Vec::new(),
-            });
-            entities.push(e);
-            let mut a = entity(
-                format!("force/{name}"),
-                vec![
-                    kv("what", format!("force of the table on the arm at {name} (normal + friction), from the point on the table, length = max(|F| x scale, min_length_m)")),
-                    kv("scale_m_per_n", scale.m_per_n.to_string()),
-                    kv("min_length_m", MIN_ARROW_LENGTH_M.to_string()),
-                    kv("units", "m per N"),
-                ],
-            );
-            a.arrows.push(ArrowPrimitive {
-                pose: Some(pose([0.0; 3], identity())),
-                shaft_length: 0.0,
-                shaft_diameter: ARROW_SHAFT_DIAMETER_M,
-                head_length: 0.0,
-                head_diameter: ARROW_HEAD_DIAMETER_M,
-                color: Some(colors::color(colors::SEPARATED, 1.0)),
-            });
-            let mut text = String::with_capacity(label_capacity(name));
-            write_label(&mut text, name, 0.0, MarkerMode::Separated);
-            a.texts.push(TextPrimitive {
-                pose: Some(pose([0.0; 3], identity())),
-                billboard: true,
-                font_size: LABEL_FONT_PX,
-                scale_invariant: true,
-                color: Some(colors::color(colors::SEPARATED, 1.0)),
-                text,
-            });
-            entities.push(a);
-        }
-        let mut actual = entity("hand/actual".into(), vec![kv("what", "the hand, actual position"), kv("units", "m")]);
-        actual.spheres.push(sphere(HAND_ACTUAL_RADIUS_M, colors::color(colors::HAND_ACTUAL, 0.7)));
-        entities.push(actual);
-        let mut desired = entity("hand/desired".into(), vec![kv("what", "the hand, desired position (target)"), kv("units", "m")]);
-        desired.spheres.push(sphere(HAND_DESIRED_RADIUS_M, colors::color(colors::HAND_DESIRED, 0.35)));
-        entities.push(desired);
-        let labels = vec![LabelBox::new([0.0; 3], 0); contacts.len()];
-        ContactMarkers { msg: SceneUpdate { deletions: Vec::new(), entities }, contacts: contacts.to_vec(), scale, labels }
-    }
-
-    /// The scale of the arrows.
-    pub fn scale(&self) -> ForceScale {
-        self.scale
-    }
-
-    /// The message at `t_ns` for `contacts` (in the order of `new`'s contacts; missing ones
-    /// keep their last state) and the hand `actual` and `desired` (world frame, m).
-    pub fn update(&mut self, t_ns: u64, contacts: impl IntoIterator<Item = ContactSample>, actual: [f64; 3], desired: [f64; 3]) -> &SceneUpdate {
-        let stamp = Some(timestamp(t_ns));
-        for e in &mut self.msg.entities {
-            e.timestamp = stamp;
-        }
-        let (contact_entities, hand) = self.msg.entities.split_at_mut(2 * self.contacts.len());
-        for (((pair, c), info), label) in contact_entities.chunks_exact_mut(2).zip(contacts).zip(&self.contacts).zip(&mut self.labels) {
-            let (marker, arrow) = pair.split_at_mut(1);
-            let (marker, arrow) = (&mut marker[0], &mut arrow[0]);
-            let mode = &mut marker.metadata[MODE_KEY].value;
-            mode.clear();
-            mode.push_str(c.mode.name());
-            let glyph = ForceGlyph::new(c.point, info.normal, info.offset, c.force, &self.scale);
-            if let Some(s) = marker.spheres.first_mut() {
-                s.pose = Some(pose(c.point, identity()));
-                s.color = Some(colors::color(c.mode.hex(), 0.45));
-            }
-            if let Some(l) = marker.lines.first_mut() {
-                if let Some(p) = l.pose.as_mut() {
-                    p.position = Some(Vector3 { x: glyph.tail[0], y: glyph.tail[1], z: glyph.tail[2] });
-                }
-                l.color = Some(colors::color(c.mode.hex(), 1.0));
-            }
-            let color = colors::color(c.mode.hex(), 1.0);
-            if let Some(a) = arrow.arrows.first_mut() {
-                a.pose = Some(pose(glyph.tail, quat(rotation_between([1.0, 0.0, 0.0], glyph.direction))));
-                a.head_length = ARROW_HEAD_SHARE * glyph.length_m;
-                a.shaft_length = glyph.length_m - a.head_length;
-                a.color = Some(color);
-            }
-            if let Some(t) = arrow.texts.first_mut() {
-                // above the tip (the marker when there is no force); placed below, with the others
-                t.color = Some(color);
-                write_label(&mut t.text, &info.name, glyph.magnitude_n, c.mode);
-                *label = LabelBox::new(default_anchor(&glyph, c.point, info.normal), t.text.chars().count());
-            }
-        }
-        // the labels apart (`labels`): the same placement as `analyze view`'s Rerun labels
-        place_labels(&mut self.labels);
-        for (pair, label) in contact_entities.chunks_exact_mut(2).zip(&self.labels) {
-            if let Some(t) = pair[1].texts.first_mut() {
-                t.pose = Some(pose(label.anchor, identity()));
-            }
-        }
-        for (e, p) in hand.iter_mut().zip([actual, desired]) {
-            if let Some(s) = e.spheres.first_mut() {
-                if let Some(ps) = s.pose.as_mut() {
-                    ps.position = Some(Vector3 { x: p[0], y: p[1], z: p[2] });
-                }
-            }
-        }
-        &self.msg
-    }
-
-    /// The message as last updated.
-    pub fn message(&self) -> &SceneUpdate {
-        &self.msg
-    }
-}
 
 #[cfg(test)]
 mod tests {
@@ -485,10 +314,93 @@ mod tests {
         assert_eq!((hd.x, hd.y, hd.z), (1.0, 2.0, 3.5));
         assert_eq!(msg.entities[4].timestamp, Some(timestamp(5_000_000)));
         const { assert!(HAND_ACTUAL_RADIUS_M > 0.015 && HAND_DESIRED_RADIUS_M > HAND_ACTUAL_RADIUS_M) };
-        // no force: no arrow
-        let none = [ContactSample { point: [0.0; 3], force: [0.0; 3], mode: MarkerMode::Separated }; 2];
+        // touching with no force: no arrow
+        let none = [ContactSample { point: [0.0; 3], force: [0.0; 3], mode: MarkerMode::Sticking }; 2];
         let msg = m.update(6_000_000, none, [0.0; 3], [0.0; 3]);
         assert_eq!(msg.entities[1].arrows[0].shaft_length + msg.entities[1].arrows[0].head_length, 0.0);
+    }
+
+    /// The ids a viewer shows after each message, applying it as Foxglove does (deletions of
+    /// the entities stamped before them, then the entities added or replaced), with each
+    /// contact entity's mode.
+    fn replay(shown: &mut std::collections::BTreeMap<String, (u64, String)>, msg: &SceneUpdate) {
+        let ns = |t: &Option<foxglove::messages::Timestamp>| t.map_or(0, |t| t.total_nanos());
+        for d in &msg.deletions {
+            assert_eq!(d.r#type, foxglove::messages::scene_entity_deletion::Type::MatchingId as i32);
+            if shown.get(&d.id).is_some_and(|(t, _)| *t < ns(&d.timestamp)) {
+                shown.remove(&d.id);
+            }
+        }
+        for e in &msg.entities {
+            let mode = e.metadata.get(MODE_KEY).map(|kv| kv.value.clone()).unwrap_or_default();
+            shown.insert(e.id.clone(), (ns(&e.timestamp), mode));
+        }
+    }
+
+    /// A contact that separates is deleted in the message of that sample and absent while it
+    /// stays separated (its deletions once per separation, its entities in every message while
+    /// it touches); a viewer replaying the messages from the start, or only the last one (a
+    /// seek), shows at every sample exactly the touching contacts in their modes; the labels
+    /// are placed apart among the drawn contacts only. Fails on the old rule (every contact
+    /// drawn every sample, a separated one grey).
+    #[test]
+    fn a_separated_contact_is_deleted_once_and_not_drawn() {
+        let contacts: Vec<MarkerContact> = ["a", "b", "c"].iter().map(|n| MarkerContact { name: n.to_string(), normal: [0.0, 0.0, 1.0], offset: 0.0 }).collect();
+        let mut m = ContactMarkers::new("world", &contacts, ForceScale::for_arm(1.0, 3.0, 10));
+        use MarkerMode::{Separated as Sep, Sliding as Sli, Sticking as Sti};
+        // per sample, the three contacts' modes: c starts separated, a separates twice, b never
+        let modes = [[Sti, Sti, Sep], [Sep, Sli, Sep], [Sep, Sli, Sep], [Sli, Sti, Sep], [Sep, Sti, Sti], [Sep, Sti, Sti], [Sti, Sti, Sti]];
+        let mut shown = std::collections::BTreeMap::new();
+        let mut deletions = [0; 3];
+        for (i, row) in modes.iter().enumerate() {
+            let t = (i as u64 + 1) * 1_000_000;
+            let samples = row.iter().enumerate().map(|(k, &mode)| ContactSample { point: [0.0, 0.01 * k as f64, 0.0], force: [0.0, 0.0, if mode == Sep { 0.0 } else { 5.0 }], mode });
+            let msg = m.update(t, samples, [0.0; 3], [0.0; 3]).clone();
+            for (k, name) in ["a", "b", "c"].iter().enumerate() {
+                let separates = row[k] == Sep && (i == 0 || modes[i - 1][k] != Sep);
+                let ids = [format!("contact/{name}"), format!("force/{name}")];
+                let deleted = msg.deletions.iter().filter(|d| ids.contains(&d.id)).count();
+                assert_eq!(deleted, if separates { 2 } else { 0 }, "sample {i}, {name}: {deleted} deletions");
+                deletions[k] += deleted;
+                let written = msg.entities.iter().filter(|e| ids.contains(&e.id)).count();
+                assert_eq!(written, if row[k] == Sep { 0 } else { 2 }, "sample {i}, {name}: {written} entities");
+                assert_eq!(m.drawn(k), row[k] != Sep);
+            }
+            replay(&mut shown, &msg);
+            // the last message alone (a seek) shows the same
+            let mut seek = std::collections::BTreeMap::new();
+            replay(&mut seek, &msg);
+            for view in [&shown, &seek] {
+                for (k, name) in ["a", "b", "c"].iter().enumerate() {
+                    let marker = view.get(&format!("contact/{name}"));
+                    match row[k] {
+                        Sep => assert!(marker.is_none() && !view.contains_key(&format!("force/{name}")), "sample {i}: separated {name} shown"),
+                        mode => {
+                            assert_eq!(marker.map(|(t, s)| (*t, s.as_str())), Some((t, mode.name())), "sample {i}, {name}");
+                            assert_eq!(view.get(&format!("force/{name}")).map(|(t, _)| *t), Some(t));
+                        }
+                    }
+                }
+                assert!(view.contains_key("hand/actual") && view.contains_key("hand/desired"));
+                assert_eq!(view.len(), 2 + 2 * row.iter().filter(|&&x| x != Sep).count(), "sample {i}");
+            }
+            // the drawn labels apart; a lone drawn contact's label at its default place
+            let texts: Vec<LabelBox> = msg
+                .entities
+                .iter()
+                .filter(|e| e.id.starts_with("force/"))
+                .map(|e| {
+                    let p = e.texts[0].pose.as_ref().unwrap().position.as_ref().unwrap();
+                    LabelBox::new([p.x, p.y, p.z], e.texts[0].text.chars().count())
+                })
+                .collect();
+            for a in 0..texts.len() {
+                for b in 0..a {
+                    assert!(texts[a].clearance_m(&texts[b]) >= -1e-9, "sample {i}: labels clash");
+                }
+            }
+        }
+        assert_eq!(deletions, [4, 0, 2], "a separates twice, c once (at the first sample)");
     }
 
     /// Every nonzero force leaves the marker sphere by at least 25 mm - 1e-12 m, whatever its

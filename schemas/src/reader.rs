@@ -40,6 +40,8 @@ use crate::value::Value;
 
 mod chunks;
 mod decode;
+mod idmap;
+use idmap::IdMap;
 mod input;
 mod known;
 mod recover;
@@ -123,7 +125,9 @@ pub fn read_recording_topics(path: &Path, topics: Option<&[&str]>) -> Result<Rec
 pub fn stream_recording(path: &Path, topics: Option<&[&str]>, visitor: &mut dyn Visitor) -> Result<Recording, Error> {
     let (mut file, len, label) = input::open(path)?;
     let summary = topics.and_then(|_| chunks::summary_of_file(&mut file, len));
-    Ok(read_state(&mut file, len, label, topics, summary.as_deref(), visitor)?.into_recording())
+    // read through maps of the file, a window at a time (`input::Windows`)
+    let mut input = input::Windows::new(file.into_inner(), len).map_err(|source| Error::Io { file: label.clone(), op: "reading", source })?;
+    Ok(read_state(&mut input, len, label, topics, summary.as_deref(), visitor)?.into_recording())
 }
 
 /// Reads a whole MCAP input of `len` bytes into the state (messages to `visitor`) and checks
@@ -331,11 +335,11 @@ struct State {
     /// Decode this crate's metric messages typed when their schema is ours ([`Visitor::typed`]).
     typed: bool,
     schemas: BTreeMap<u16, SchemaRec>,
-    channels: BTreeMap<u16, ChannelInfo>,
-    decoders: BTreeMap<u16, Decoder>,
+    channels: IdMap<ChannelInfo>,
+    decoders: IdMap<Decoder>,
     metadata: BTreeMap<String, BTreeMap<String, String>>,
     /// Log time of the last message of each channel (time must not go backwards).
-    last_time: BTreeMap<u16, u64>,
+    last_time: IdMap<u64>,
     /// Largest log time of any message, ns.
     t_end_ns: Option<u64>,
     /// Smallest and largest log time of the messages counted since it was last reset, ns
@@ -601,16 +605,16 @@ impl State {
             return Err(Error::Malformed { file: self.file.clone(), detail: format!("message on unknown channel id {channel_id}") });
         };
         let index = info.message_count;
-        match self.last_time.entry(channel_id) {
-            std::collections::btree_map::Entry::Occupied(mut last) => {
-                let previous_ns = *last.get();
+        match self.last_time.get_mut(&channel_id) {
+            Some(last) => {
+                let previous_ns = *last;
                 if log_time < previous_ns {
                     return Err(Error::TimeBackwards { file: self.file.clone(), topic: info.topic.clone(), index, log_time_ns: log_time, previous_ns });
                 }
-                last.insert(log_time);
+                *last = log_time;
             }
-            std::collections::btree_map::Entry::Vacant(last) => {
-                last.insert(log_time);
+            None => {
+                self.last_time.insert(channel_id, log_time);
             }
         }
         self.t_end_ns = Some(self.t_end_ns.map_or(log_time, |t| t.max(log_time)));

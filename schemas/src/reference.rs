@@ -75,7 +75,7 @@ fn topic_docs() -> Vec<TopicDoc> {
         doc::<fm::SceneUpdate>(
             topics::CONTACT_MARKERS,
             "every recording (format ≥ 3), every sample",
-            "contact markers coloured by mode, contact forces as arrows, the actual and desired hand",
+            "markers of the contacts that touch, coloured by mode (a contact that separates is deleted in that sample's message and absent while it stays separated), contact forces as arrows, the actual and desired hand",
         ),
     ]
 }

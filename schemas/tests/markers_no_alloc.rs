@@ -1,7 +1,7 @@
 //! `/contact_markers` costs no allocation per sample: after the first update, updating the
 //! message (every mode, forces of both signs, zero force, huge forces whose labels are longest,
-//! moving points and hands, the labels rewritten) allocates
-//! nothing (a counting global allocator, per thread).
+//! moving points and hands, the labels rewritten, contacts separating and touching again)
+//! allocates nothing (a counting global allocator, per thread).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -48,11 +48,20 @@ fn updating_the_contact_markers_does_not_allocate() {
     };
     m.update(0, (0..3).map(|k| sample(k, 0)), [0.0; 3], [0.0; 3]);
     let before = allocs();
-    let mut entities = 0;
+    let (mut entities, mut deletions) = (0, 0);
     for i in 1..200 {
         let msg = m.update(i as u64 * 1_000_000, (0..3).map(|k| sample(k, i)), [0.01 * i as f64, 0.0, 0.4], [0.0, 0.01 * i as f64, 0.4]);
         entities += msg.entities.len();
+        deletions += msg.deletions.len();
     }
     assert_eq!(allocs() - before, 0, "allocations in 199 updates");
-    assert_eq!(entities, 199 * 8);
+    // a contact touching is drawn (two entities), a separated one is not, and is deleted (two
+    // deletions) at the sample it separates: one of the three contacts is separated at each
+    // sample, a different one each time
+    let separated = |k: usize, i: usize| sample(k, i).mode == MarkerMode::Separated;
+    let drawn: usize = (1..200).map(|i| (0..3).filter(|&k| !separated(k, i)).count()).sum();
+    let separations: usize = (1..200).map(|i| (0..3).filter(|&k| separated(k, i) && !separated(k, i - 1)).count()).sum();
+    assert_eq!(entities, 199 * 2 + 2 * drawn);
+    assert_eq!(deletions, 2 * separations);
+    assert!(separations > 100, "{separations}");
 }

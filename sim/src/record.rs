@@ -10,9 +10,11 @@
 //! drawn fainter when this run has no contact on it, so that the no-elbow arm's sinking below
 //! the table shows; the hand's target path, sampled on the output grid before the run; the
 //! force arrows' scale bar, [`force_scale`]: one scale per scene, from the arm) and
-//! `/contact_markers` every sample (the contact points coloured by mode, their rings on the
-//! table, the contact force arrows from the table's surface with their labels, the actual and
-//! desired hand), from [`Outputs::contact_point`], `normal_force` and `contacts`.
+//! `/contact_markers` every sample (the points of the contacts that touch coloured by mode,
+//! their rings on the table, the contact force arrows from the table's surface with their
+//! labels, the actual and desired hand; a contact that separates is deleted in that sample's
+//! message and costs nothing while it stays separated: `schemas::markers::ContactMarkers`),
+//! from [`Outputs::contact_point`], `normal_force` and `contacts`.
 //!
 //! Runs with a non-bilateral contact (issue 11: rigid unilateral contacts after Pfeiffer &
 //! Glocker, *Multibody Dynamics with Unilateral Contacts*, 1996; compliant ones) also get

@@ -77,11 +77,17 @@ fn layouts_and_scene_entities_pass_foxglove_checks() {
         assert_eq!(code, 0, "{}: {stderr}\n{stdout}", layout.display());
         let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
         assert_eq!(summary["failures"], 0);
-        // every contact of every sample had its arrow checked
+        // every contact of every sample had its arrow checked, or was separated and not drawn
+        // (its deletions checked)
         for r in summary["recordings"].as_array().unwrap() {
             let samples = r["contact_marker_messages"].as_u64().unwrap();
             assert_eq!(samples, 201, "{r}");
-            assert_eq!(r["arrows_checked"].as_u64().unwrap(), samples * r["contacts"].as_u64().unwrap(), "{r}");
+            let separated = r["separated_checked"].as_u64().unwrap();
+            assert_eq!(r["arrows_checked"].as_u64().unwrap() + separated, samples * r["contacts"].as_u64().unwrap(), "{r}");
+            if rec.to_string_lossy().contains("whole-table") {
+                // seven of its nine candidates never touch: each deleted once, at the first sample
+                assert!(separated >= 7 * samples && r["deletions_checked"].as_u64().unwrap() >= 14, "{r}");
+            }
         }
     }
 

@@ -18,7 +18,8 @@
 //! - at every sample of `/contact_markers`, each contact's marker is where the shape touches,
 //!   from the recorded joint positions by the closed forms (the sphere's centre less r ẑ; a rim
 //!   tilted by θ: its centre less r (sin θ, 0, cos θ)), 1e-9 m, and on the table (|z| ≤ 1e-6 m)
-//!   whenever its mode is sticking or sliding;
+//!   whenever its mode is sticking or sliding; a contact separated at a sample (`/contacts`) is
+//!   not drawn at it, in either viewer;
 //! - the `.rrd`: the same shapes below each link's entity (`Ellipsoids3D`, `Capsules3D`,
 //!   `Cylinders3D` and the rims' `LineStrips3D`, same numbers in f32), and at every sample each
 //!   Rerun marker where the Foxglove one is (2e-6 m, f32); `rerun rrd verify` passes on it.
@@ -279,13 +280,25 @@ fn contact_shapes_are_drawn_as_they_are_in_both_viewers() {
     // /contact_markers at every sample: the marker where the shape touches
     let q: Vec<Vec<f64>> = rec.read::<schemas::JointState>().unwrap().into_iter().map(|(_, j)| j.position).collect();
     let markers = rec.messages(schemas::topics::CONTACT_MARKERS).unwrap();
+    let states = rec.read::<schemas::ContactState>().unwrap();
     assert_eq!(markers.len(), q.len());
+    assert_eq!(states.len(), q.len());
     assert!(q.len() > 400, "{} samples", q.len());
     let mut fox: Vec<Vec<[f64; 3]>> = vec![Vec::new(); expected().len()];
-    let (mut closed, mut worst) = (0, 0.0f64);
-    for ((_, m), q) in markers.iter().zip(&q) {
+    let (mut closed, mut worst, mut separated) = (0, 0.0f64, 0);
+    for (((_, m), q), (_, st)) in markers.iter().zip(&q).zip(&states) {
         for (k, (name, ..)) in expected().into_iter().enumerate() {
-            let e = entity(m, &format!("contact/{name}"));
+            // a separated contact is not drawn (deleted when it separates): Rerun neither
+            let id = format!("contact/{name}");
+            let i = st.name.iter().position(|n| n == name).unwrap_or_else(|| panic!("{name} not on /contacts"));
+            let shown = list(m, "entities").iter().any(|e| e.get("id").and_then(Value::as_str) == Some(id.as_str()));
+            assert_eq!(shown, st.mode[i] != schemas::contact_mode::SEPARATED, "t = {} s, {name}: mode {}, drawn {shown}", st.time, st.mode[i]);
+            if !shown {
+                separated += 1;
+                fox[k].push([f64::NAN; 3]);
+                continue;
+            }
+            let e = entity(m, &id);
             let p = xyz(e, "spheres.0.pose.position");
             let want = touching(k, q);
             worst = worst.max((0..3).map(|i| (p[i] - want[i]).abs()).fold(0.0, f64::max));
@@ -298,7 +311,7 @@ fn contact_shapes_are_drawn_as_they_are_in_both_viewers() {
             fox[k].push(p);
         }
     }
-    eprintln!("contact shapes: markers at the closed-form touching points within {worst:e} m; {closed} closed marker-samples on the table");
+    eprintln!("contact shapes: markers at the closed-form touching points within {worst:e} m; {closed} closed marker-samples on the table; {separated} separated ones not drawn");
     assert!(closed > 1000, "the contacts touch the table: {closed}");
 
     // the .rrd: the same shapes below the links, the same markers
@@ -331,14 +344,17 @@ fn contact_shapes_are_drawn_as_they_are_in_both_viewers() {
     }
     let mut rerun: BTreeMap<String, Vec<[f64; 3]>> = BTreeMap::new();
     for b in batches.iter().filter(|b| path_of(b).starts_with("/world/contacts/") && b.column_by_name("Points3D:positions").is_some()) {
-        rerun.entry(path_of(b)).or_default().extend(f32_rows::<3>(b, "Points3D:positions").into_iter().map(|row| row[0]));
+        // a row without a point: the contact is separated at that sample, not drawn
+        rerun.entry(path_of(b)).or_default().extend(f32_rows::<3>(b, "Points3D:positions").into_iter().map(|row| row.first().copied().unwrap_or([f64::NAN; 3])));
     }
     for (k, (name, ..)) in expected().into_iter().enumerate() {
         let path = format!("/world/contacts/{}", analyze::view::run::escape(name));
         let pts = rerun.get(&path).unwrap_or_else(|| panic!("no Rerun marker {path}: {:?}", rerun.keys()));
         assert_eq!(pts.len(), fox[k].len(), "{name}");
         for (i, (a, b)) in pts.iter().zip(&fox[k]).enumerate() {
-            assert!(close(*a, *b, 2e-6), "{name}, sample {i}: Rerun {a:?}, Foxglove {b:?}");
+            let (a_shown, b_shown) = (!a[0].is_nan(), !b[0].is_nan());
+            assert_eq!(a_shown, b_shown, "{name}, sample {i}: drawn in Rerun {a_shown}, in Foxglove {b_shown}");
+            assert!(!a_shown || close(*a, *b, 2e-6), "{name}, sample {i}: Rerun {a:?}, Foxglove {b:?}");
         }
     }
 

@@ -13,7 +13,9 @@
 //     non-empty string) in at least one message of the recordings;
 // (c) every /scene and /contact_markers message decodes (protobufjs on the embedded descriptor,
 //     whose foxglove.* message fields are compared with @foxglove/schemas' definitions by the
-//     .proto text @foxglove/schemas generates), with the entity counts, the mode colours, the
+//     .proto text @foxglove/schemas generates), with the entities (each touching contact's two
+//     in every message, a separated one's deleted at the sample it separates and absent while
+//     it stays separated), the mode colours, the
 //     arrow lengths max(|F| x scale, shortest) (1e-9 m) at the one scale of /scene's scale bar
 //     (the same in every recording given), the arrows' normal component f_n (1e-9 N), each
 //     arrow starting on the plane at the contact point's projection, every nonzero force's
@@ -348,27 +350,54 @@ function checkScene(rec) {
     if (!legend.texts[0]?.text.startsWith(`${bar} N = `)) fail(`${rec.path}: the scale bar's text is ${JSON.stringify(legend.texts[0]?.text)}`);
   }
   out.force_scale_m_per_n = sceneScale;
+  // a separated contact is not drawn: its two entities are deleted (MATCHING_ID, stamped at the
+  // sample) in the message of the sample where it separates (and in the first one), and absent
+  // while it stays separated; a touching one is in every message (schemas::markers::ContactMarkers)
+  const drawnBefore = new Map(contacts.map((name) => [name, true]));
+  let separatedChecked = 0;
+  let deletionsChecked = 0;
   for (const [i, { logTime, msg }] of markers.entries()) {
-    if (msg.entities.length !== 2 * contacts.length + 2) {
-      fail(`${rec.path}: /contact_markers at ${logTime} has ${msg.entities.length} entities, want ${2 * contacts.length + 2}`);
-      break;
-    }
     const f = forces[i]?.msg;
     const c = constraints[i]?.msg;
     if (forces[i]?.logTime !== logTime) {
       fail(`${rec.path}: /contact_markers and the forces are not sample for sample at ${logTime}`);
       break;
     }
+    const deleted = new Map((msg.deletions ?? []).map((d) => [d.id, d]));
+    const wantIds = [];
     const labelBoxes = [];
     for (const [k, name] of contacts.entries()) {
-      const marker = msg.entities[2 * k];
-      const arrowEnt = msg.entities[2 * k + 1];
-      if (marker.id !== `contact/${name}` || arrowEnt.id !== `force/${name}`) fail(`${rec.path}: entity ids ${marker.id}, ${arrowEnt.id} for ${name}`);
       const fn = f.normal_force[k];
       const ft = hybrid ? [f.friction_force_t1[k], f.friction_force_t2[k]] : [0, 0];
       const code = hybrid ? f.mode[k] : 3;
       const mode = code === 3 ? (fn < 0 ? "pulling" : "pushing") : MODE_BY_CODE[code];
       modesSeen[mode] = (modesSeen[mode] ?? 0) + 1;
+      const ids = [`contact/${name}`, `force/${name}`];
+      const drawnHere = msg.entities.filter((e) => ids.includes(e.id)).length;
+      const deletions = ids.filter((id) => deleted.has(id));
+      if (mode === "separated") {
+        if (drawnHere !== 0) fail(`${rec.path}: /contact_markers at ${logTime}: ${name} is separated and drawn`);
+        const want = drawnBefore.get(name) ? 2 : 0;
+        if (deletions.length !== want) fail(`${rec.path}: /contact_markers at ${logTime}: ${deletions.length} deletions of ${name}, want ${want} (separated, ${want ? "drawn" : "not drawn"} before)`);
+        for (const id of deletions) {
+          const d = deleted.get(id);
+          const t = d.timestamp ? Number(d.timestamp.seconds ?? d.timestamp.sec) * 1e9 + Number(d.timestamp.nanos ?? d.timestamp.nsec) : -1;
+          if (d.type !== 0 || t !== Number(logTime)) fail(`${rec.path}: /contact_markers at ${logTime}: deletion of ${id} of type ${d.type} stamped ${t} ns`);
+          deletionsChecked++;
+        }
+        drawnBefore.set(name, false);
+        separatedChecked++;
+        continue;
+      }
+      if (deletions.length !== 0) fail(`${rec.path}: /contact_markers at ${logTime}: ${name} is ${mode} and deleted`);
+      drawnBefore.set(name, true);
+      wantIds.push(...ids);
+      const marker = msg.entities.find((e) => e.id === ids[0]);
+      const arrowEnt = msg.entities.find((e) => e.id === ids[1]);
+      if (!marker || !arrowEnt) {
+        fail(`${rec.path}: /contact_markers at ${logTime}: ${name} is ${mode} and not drawn`);
+        continue;
+      }
       if (!sameRgb(marker.spheres[0].color, MODE_COLORS[mode])) fail(`${rec.path}: ${marker.id} at ${logTime}: colour ${JSON.stringify(marker.spheres[0].color)} for mode ${mode}`);
       const a = arrowEnt.arrows[0];
       if (!sameRgb(a.color, MODE_COLORS[mode])) fail(`${rec.path}: ${arrowEnt.id} at ${logTime}: arrow colour for mode ${mode}`);
@@ -435,7 +464,10 @@ function checkScene(rec) {
         if (clearance < -1e-9) fail(`${rec.path}: /contact_markers at ${logTime}: the labels of ${q.name} and ${p.name} overlap (${-clearance} m)`);
       }
     }
-    const [actual, desired] = msg.entities.slice(2 * contacts.length);
+    wantIds.push("hand/actual", "hand/desired");
+    const ids = msg.entities.map((e) => e.id);
+    if (ids.join() !== wantIds.join()) fail(`${rec.path}: /contact_markers at ${logTime} has entities ${ids.join()}, want ${wantIds.join()}`);
+    const [actual, desired] = msg.entities.slice(-2);
     const h = hand[i].msg;
     const pa = actual.spheres[0].pose.position;
     const pd = desired.spheres[0].pose.position;
@@ -445,6 +477,8 @@ function checkScene(rec) {
     if (!(actual.spheres[0].size.x / 2 > 0.015)) fail(`${rec.path}: the actual hand's sphere is not larger than the URDF's hand sphere (0.015 m)`);
   }
   out.contact_marker_messages = markers.length;
+  out.separated_checked = separatedChecked;
+  out.deletions_checked = deletionsChecked;
   out.arrows_checked = arrows;
   out.labels_checked = labels;
   out.min_label_clearance_m = Number.isFinite(minLabelClearance) ? minLabelClearance : null;

@@ -1,4 +1,5 @@
-//! The contacts of one run in Rerun (issue 27 item 2): per contact and sample a translucent
+//! The contacts of one run in Rerun (issue 27 item 2): per contact and sample where it touches
+//! (a separated contact is not drawn, as on `sim`'s `/contact_markers`) a translucent
 //! marker at the contact point (`P/world/contacts/<c>`, `Points3D` larger than the link there),
 //! a ring on the table around the point's projection (`…/ring`), the force of the table on the
 //! arm as an arrow from that point on the surface (`…/force`, `Arrows3D`) and its label
@@ -49,7 +50,7 @@ pub fn contact_chunks(run: &Run, world: &str, contact_points: &[Vec<[f64; 3]>], 
         out.push(
             Chunk::new(&base, ft.clone())
                 .with(POINTS, "colors", "rerun.components.Color", u32_lists(&translucent))
-                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&d.points.iter().map(|p| vec![f3(*p)]).collect::<Vec<_>>())),
+                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&d.each(|k| f3(d.points[k])))),
         );
         // the marker has no label of its own: the force's label names the contact (two labels
         // at one contact overlapped)
@@ -57,7 +58,7 @@ pub fn contact_chunks(run: &Run, world: &str, contact_points: &[Vec<[f64; 3]>], 
             Chunk::new(&base, Index::Static)
                 .with(POINTS, "radii", "rerun.components.Radius", f32_lists(&[vec![schemas::markers::CONTACT_MARKER_RADIUS_M as f32]])),
         );
-        let rings: Vec<Vec<Vec<[f32; 3]>>> = d.glyphs.iter().map(|g| vec![ring(g.tail, d.normal)]).collect();
+        let rings: Vec<Vec<Vec<[f32; 3]>>> = d.each(|k| ring(d.glyphs[k].tail, d.normal));
         out.push(
             Chunk::new(format!("{base}/ring"), ft.clone())
                 .with(STRIPS, "colors", "rerun.components.Color", u32_lists(&colors))
@@ -70,12 +71,12 @@ pub fn contact_chunks(run: &Run, world: &str, contact_points: &[Vec<[f64; 3]>], 
         out.push(
             Chunk::new(format!("{base}/force"), ft.clone())
                 .with(ARROWS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.tail)]).collect::<Vec<_>>()))
+                .with(ARROWS, "origins", "rerun.components.Position3D", vec3_lists(&d.each(|k| f3(d.glyphs[k].tail))))
                 .with(
                     ARROWS,
                     "vectors",
                     "rerun.components.Vector3D",
-                    vec3_lists(&d.glyphs.iter().map(|g| vec![f3(g.direction.map(|x| x * g.length_m))]).collect::<Vec<_>>()),
+                    vec3_lists(&d.each(|k| f3(d.glyphs[k].direction.map(|x| x * d.glyphs[k].length_m)))),
                 ),
         );
         out.push(
@@ -87,8 +88,8 @@ pub fn contact_chunks(run: &Run, world: &str, contact_points: &[Vec<[f64; 3]>], 
         out.push(
             Chunk::new(format!("{base}/label"), ft)
                 .with(POINTS, "colors", "rerun.components.Color", u32_lists(&colors))
-                .with(POINTS, "labels", "rerun.components.Text", str_lists(&texts.into_iter().map(|t| vec![t]).collect::<Vec<_>>()))
-                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&anchors.iter().map(|p| vec![f3(*p)]).collect::<Vec<_>>())),
+                .with(POINTS, "labels", "rerun.components.Text", str_lists(&texts.into_iter().enumerate().map(|(k, t)| if d.drawn(k) { vec![t] } else { Vec::new() }).collect::<Vec<_>>()))
+                .with(POINTS, "positions", "rerun.components.Position3D", vec3_lists(&d.each(|k| f3(anchors[k])))),
         );
         out.push(
             Chunk::new(format!("{base}/label"), Index::Static)
@@ -100,24 +101,30 @@ pub fn contact_chunks(run: &Run, world: &str, contact_points: &[Vec<[f64; 3]>], 
 }
 
 /// Every drawn contact's label per sample (text, anchor: world frame, m), placed apart
-/// sample by sample with `schemas::markers::place_labels` (the contacts in their order, as
-/// `sim` places Foxglove's): `names[i]` is `drawings[i]`'s contact.
+/// sample by sample with `schemas::markers::place_labels` among the contacts that touch at
+/// that sample (in their order, as `sim` places Foxglove's; a separated contact is not drawn
+/// and its anchor is NaN): `names[i]` is `drawings[i]`'s contact.
 pub fn contact_labels(names: &[&str], drawings: &[&ContactDrawing]) -> Vec<(Vec<String>, Vec<[f64; 3]>)> {
     use schemas::markers::{default_anchor, label_capacity, place_labels, write_label, LabelBox};
     let n = drawings.iter().map(|d| d.glyphs.len()).min().unwrap_or(0);
     let mut out: Vec<(Vec<String>, Vec<[f64; 3]>)> = drawings.iter().map(|_| (Vec::with_capacity(n), Vec::with_capacity(n))).collect();
-    let mut boxes = vec![LabelBox::new([0.0; 3], 0); drawings.len()];
+    let mut boxes = Vec::with_capacity(drawings.len());
     let mut text = String::with_capacity(names.iter().map(|s| label_capacity(s)).max().unwrap_or(0));
     for k in 0..n {
+        boxes.clear();
         for (i, (d, name)) in drawings.iter().zip(names).enumerate() {
             let g = &d.glyphs[k];
             write_label(&mut text, name, g.magnitude_n, d.modes[k]);
-            boxes[i] = LabelBox::new(default_anchor(g, d.points[k], d.normal), text.chars().count());
+            if d.drawn(k) {
+                boxes.push(LabelBox::new(default_anchor(g, d.points[k], d.normal), text.chars().count()));
+            }
             out[i].0.push(text.clone());
         }
+        // apart among the drawn contacts only, as `sim` places Foxglove's
         place_labels(&mut boxes);
-        for (o, b) in out.iter_mut().zip(&boxes) {
-            o.1.push(b.anchor);
+        let mut placed = boxes.iter();
+        for (o, d) in out.iter_mut().zip(drawings) {
+            o.1.push(if d.drawn(k) { placed.next().map_or([0.0; 3], |b| b.anchor) } else { [f64::NAN; 3] });
         }
     }
     out
@@ -136,6 +143,20 @@ pub struct ContactDrawing {
     pub glyphs: Vec<schemas::markers::ForceGlyph>,
     /// The plane's unit normal.
     pub normal: [f64; 3],
+}
+
+impl ContactDrawing {
+    /// Whether the contact is drawn at sample `k`: not when it is separated (as `sim`'s
+    /// `/contact_markers` deletes it, `schemas::markers::ContactMarkers`).
+    pub fn drawn(&self, k: usize) -> bool {
+        self.modes.get(k).is_some_and(|m| *m != schemas::markers::MarkerMode::Separated)
+    }
+
+    /// Per sample, `f(k)` when the contact is drawn, else nothing (a Rerun row with no
+    /// instance: nothing shown at that time).
+    fn each<T>(&self, f: impl Fn(usize) -> T) -> Vec<Vec<T>> {
+        (0..self.points.len()).map(|k| if self.drawn(k) { vec![f(k)] } else { Vec::new() }).collect()
+    }
 }
 
 /// The drawing of contact `c` at its `points` (per sample) with normal forces `f_n`, friction

@@ -244,9 +244,15 @@ impl Skipper {
             let mut rest = content;
             while let Some((&opcode, tail)) = rest.split_first() {
                 let len = u64::from_le_bytes(tail[..8].try_into().unwrap_or_default()) as usize;
-                let record = mcap::parse_record(opcode, &tail[8..8 + len]).map_err(|source| Error::McapRead { file: state.file.clone(), source })?;
-                state.record(record, visitor)?;
+                let body = &tail[8..8 + len];
                 rest = &tail[8 + len..];
+                // a message (most records): its header read here, as `mcap::parse_record` reads it
+                if let Some((header, data)) = (opcode == op::MESSAGE).then(|| message_header(body)).flatten() {
+                    state.message(&header, data, visitor)?;
+                    continue;
+                }
+                let record = mcap::parse_record(opcode, body).map_err(|source| Error::McapRead { file: state.file.clone(), source })?;
+                state.record(record, visitor)?;
             }
             return Ok(());
         }
@@ -296,5 +302,37 @@ impl Skipper {
             rest = &rest[9 + len..];
         }
         Some(content)
+    }
+}
+
+/// The header and data of a Message record's content (spec, "Message": channel id u16, sequence
+/// u32, log time u64, publish time u64, all little-endian, then the data), as
+/// `mcap::parse_record` gives them; `None` when the content is shorter than the header (then
+/// `mcap::parse_record` gives the error).
+fn message_header(body: &[u8]) -> Option<(mcap::records::MessageHeader, &[u8])> {
+    let (head, data) = body.split_first_chunk::<22>()?;
+    let channel_id = u16::from_le_bytes([head[0], head[1]]);
+    let sequence = u32::from_le_bytes(head[2..6].try_into().ok()?);
+    let log_time = u64::from_le_bytes(head[6..14].try_into().ok()?);
+    let publish_time = u64::from_le_bytes(head[14..22].try_into().ok()?);
+    Some((mcap::records::MessageHeader { channel_id, sequence, log_time, publish_time }, data))
+}
+
+#[cfg(test)]
+mod tests {
+    /// The header read by hand is `mcap::parse_record`'s, on messages of every length from the
+    /// bare header up; shorter contents are left to `mcap::parse_record` (an error).
+    #[test]
+    fn message_header_is_mcaps() {
+        let mut body: Vec<u8> = (0u8..22).map(|b| b.wrapping_mul(37).wrapping_add(11)).collect();
+        for extra in 0..40u8 {
+            let Ok(mcap::records::Record::Message { header, data }) = mcap::parse_record(mcap::records::op::MESSAGE, &body) else { panic!("mcap refuses {body:?}") };
+            assert_eq!(super::message_header(&body), Some((header, &data[..])));
+            body.push(extra.wrapping_mul(91));
+        }
+        for short in 0..22 {
+            assert!(super::message_header(&body[..short]).is_none());
+            assert!(mcap::parse_record(mcap::records::op::MESSAGE, &body[..short]).is_err());
+        }
     }
 }

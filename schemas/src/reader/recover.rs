@@ -241,7 +241,7 @@ const RECORD_HEAD: usize = 9;
 struct Snapshot {
     schemas: BTreeSet<u16>,
     channels: BTreeMap<u16, usize>,
-    last_time: BTreeMap<u16, u64>,
+    last_time: super::IdMap<u64>,
     t_end_ns: Option<u64>,
     metadata: BTreeMap<String, BTreeMap<String, String>>,
     first_joint_array_len: Option<usize>,
