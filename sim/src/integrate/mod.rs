@@ -384,6 +384,20 @@ pub struct Stats {
     pub implicit_solves: u64,
 }
 
+/// What an event left behind at a restart ([`Stepper::first_step_after_restart`]), read by
+/// [`integrate_hybrid`] from the event functions at the restart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RestartStart {
+    /// Every event function is away from 0, or on its firing side and watched from its start
+    /// value (`events.rs`): the driver sees any root of the first step, whatever its length
+    /// (a stick ↔ slip change, a lift-off).
+    Armed,
+    /// Some event function that is not watched starts at 0 or on its firing side, so it is
+    /// disarmed for the first step (a ball left on the table by a bounce): a root of it within
+    /// that step goes unseen, so the step must stay short.
+    Disarmed,
+}
+
 /// A one-step method that owns its state between steps.
 pub trait Stepper<S: OdeSystem> {
     /// Set initial condition; may evaluate f once. Resets [`Stats`].
@@ -399,6 +413,23 @@ pub trait Stepper<S: OdeSystem> {
     /// accepted state (`t()`, `y()`, dense output), so the caller can report or inspect it.
     /// Panics if called before a successful `init`.
     fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>>;
+    /// Restart at `(t0, y0)` after an event ([`integrate_hybrid`]): like [`Stepper::init`]
+    /// (statistics reset), except that a stepper may carry over what the steps before the event
+    /// learned about the step size (e.g. [`Rodas`] tries the last accepted step's size first).
+    /// What the event left behind (whether an event function is disarmed for the first step,
+    /// [`RestartStart`]) the driver reads from the functions at `(t0, y0)` after this call and
+    /// passes to [`Stepper::first_step_after_restart`]. Called only for a system that allows
+    /// it ([`HybridSystem::restart_keeps_step_size`]). The default is `init`.
+    fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        self.init(sys, t0, y0)
+    }
+    /// After [`Stepper::restart`] and before the first step: what the event left behind at the
+    /// restart ([`RestartStart`]), for a stepper that chooses its first step by it. The default
+    /// does nothing.
+    fn first_step_after_restart(&mut self, sys: &mut S, start: RestartStart) -> Result<(), IntegrateError<S::Error>> {
+        let _ = (sys, start);
+        Ok(())
+    }
     /// Current time.
     fn t(&self) -> f64;
     /// Current state (length `dim`).

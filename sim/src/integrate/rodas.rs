@@ -23,7 +23,28 @@
 //! - error norm and step-size control: the RMS norm of HNW I §II.4 with `atol + rtol max(|y|,
 //!   |y_new|)`; `h_new = h min(6, max(0.2, 0.9 err^(-1/(q+1))))` with `q` the embedded order
 //!   (Hairer's `rodas.f`: SAFE = 0.9, FAC1 = 5, FAC2 = 1/6); after a rejection the next
-//!   accepted step may not grow.
+//!   accepted step may not grow. (Gustafsson's predictive controller, HNW II §IV.8 (8.21),
+//!   was measured here, issue 24: with `h_max` 1 s it cut the paper-unilateral runs' right-hand
+//!   sides, but it broke RODAS5P's tolerance proportionality with gear friction (error ∝
+//!   rtol^0.85, `convergence.rs`) and the restitution run's balance bound (1e-9 E); not kept.
+//!   Gustafsson's PI controller, HNW II §IV.2, β = 0.04 as `dopri5.f`, brought the
+//!   paper-unilateral runs' rejected steps from 6–7 % to 4.1–4.5 % for 6–9 % more steps, but
+//!   put RODAS5P's dense output on Prothero–Robinson at 114 tol (tol 1e-6; bound 100,
+//!   `contract.rs`); not kept either, BENCHMARKS.md.)
+//! - restart after an event ([`Stepper::restart`], then
+//!   [`Stepper::first_step_after_restart`]): the state, Jacobian and statistics
+//!   restart as in `init`, but the first step is the last accepted step's size (at most
+//!   `h_max`) when every event function is armed at the restart ([`RestartStart::Armed`]: a
+//!   stick ↔ slip change, a lift-off, a touch-down whose functions the driver watches from
+//!   their start values), and the smaller of that and Hairer's starting step (or `h_init`)
+//!   when one is disarmed ([`RestartStart::Disarmed`]: a function left at 0, or on its firing side, and not
+//!   watched, e.g. a ball leaving the table, is not tested in the first step, `events.rs`, so
+//!   that step must be short enough not to jump over the function's next root: a bounce shorter
+//!   than the step before it). Hairer's step alone ignores what the steps before the event
+//!   learned about the solution's scale: on the elbow runs it was often far too large (56 of
+//!   two-elbow-unilateral's rejections at its 16 restarts). Only for systems that allow it
+//!   ([`super::HybridSystem::restart_keeps_step_size`]): over the arm's gear events either rule
+//!   broke RODAS5P's error ∝ rtol, so there the driver calls `init`.
 //! - Jacobian: [`OdeJacobian::exact_jacobian`]; if the system has none, forward differences
 //!   (HNW II §IV.8, [`super::fd_jacobian_columns`], increment `sqrt(eps) max(|y_j|, floor)`
 //!   with `floor = atol / rtol` within `[1e-5, 1]`, the scale below which the error norm
@@ -48,7 +69,7 @@ use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::rosenbrock::{stage_argument, stage_rhs, time_derivative};
 use super::{
     dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeJacobian, Phase, SettingsError,
-    Stats, StepControl, Stepper, Watch,
+    RestartStart, Stats, StepControl, Stepper, Watch,
 };
 
 pub(crate) mod tableau;
@@ -124,6 +145,9 @@ pub struct Rodas {
     f_new: Vec<f64>,
     /// The deadline the difference Jacobian and the factorisation look at.
     watch: Watch,
+    /// The last accepted step's size before a [`Stepper::restart`], until the first step after
+    /// it is chosen (0: none).
+    h_carry: f64,
 }
 
 impl Rodas {
@@ -172,6 +196,7 @@ impl Rodas {
             y_new: z(),
             f_new: z(),
             watch: Watch::default(),
+            h_carry: 0.0,
         })
     }
 
@@ -475,6 +500,38 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
         }
         eval_finite(&mut self.core.stats, sys, t0, y0, &mut self.f0)?;
         self.core.initialized = true;
+        self.h_carry = 0.0;
+        Ok(())
+    }
+
+    /// `init`, keeping the last accepted step's size for [`Stepper::first_step_after_restart`]
+    /// (module docs).
+    fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        let h_last = if self.core.initialized { self.core.h_last } else { 0.0 };
+        self.init(sys, t0, y0)?;
+        self.h_carry = h_last;
+        Ok(())
+    }
+
+    /// The first step after an event (module docs): the last accepted step's size where every
+    /// event function is armed, the smaller of it and the fresh starting step where one is
+    /// disarmed; at most `h_max`. As `init` before any accepted step.
+    fn first_step_after_restart(&mut self, sys: &mut S, start: RestartStart) -> Result<(), IntegrateError<S::Error>> {
+        let h_last = std::mem::take(&mut self.h_carry);
+        if h_last <= 0.0 || self.core.stats.steps > 0 {
+            return Ok(());
+        }
+        let h = match start {
+            RestartStart::Armed => h_last,
+            RestartStart::Disarmed => {
+                let fresh = match self.core.control.h_init {
+                    Some(h) => h,
+                    None => Adaptive::<S>::starting_step(self, sys)?,
+                };
+                h_last.min(fresh)
+            }
+        };
+        self.core.h_next = Some(h.min(self.core.control.h_max));
         Ok(())
     }
 

@@ -474,4 +474,12 @@ impl HybridSystem for ArmSystem<'_> {
     fn after_step(&mut self, _t: f64, y: &[f64]) {
         self.contact_after_step(y);
     }
+
+    /// Only without the drives' events (gear friction, the supply): carrying RODAS5P's step
+    /// over them broke its error ∝ rtol (`HybridSystem::restart_keeps_step_size`); over the
+    /// contacts' events it keeps the event lists and cuts the paper-unilateral runs' work by
+    /// 45 % (BENCHMARKS.md, issue 24).
+    fn restart_keeps_step_size(&self) -> bool {
+        self.drive_modes.is_none()
+    }
 }

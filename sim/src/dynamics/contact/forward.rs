@@ -107,10 +107,33 @@ impl ContactData {
 /// 2e-13 m; in 1-D (a slip along a fixed line) the direction is exact.
 pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 
-/// An onset's slip run back across its anchor by more than this (m/s; the contact settings'
-/// default `vel_tol`, the contact audit's slip bound) has a friction that opposes it
-/// ([`active_rows_of`]); below it the anchor's direction holds.
-pub const ONSET_REVERSE_SPEED: f64 = 1e-9;
+/// The direction an onset's friction opposes (unit, tangent basis; `ContactState::onset`):
+/// `w/|w|` with `w = v_t + v_s ψ(|v_t|/v_s) anchor`, [`friction_direction`]'s blend without its
+/// side-keeping sign. Coulomb's law (Glocker, *Set-Valued Force Laws*, 2001, §7; Pfeiffer &
+/// Glocker 1996, §5.2): the friction opposes the slip, `−μ f_n v_t/|v_t|`, from `v_s` on in
+/// every direction, a slip run back across the anchor included (it returns); below `v_s` the
+/// direction is regularised towards the anchor, the direction the sticking force leaves the
+/// cone ([`onset_anchors`]). `w` is smooth in `v_t` wherever it is not 0, and it is 0 at one
+/// point only, `v_t = −0.525 v_s anchor` (`r = (1 − r²)²`), a slip running back along the
+/// anchor at half `v_s`, 500× the integrator's noise on an onset's slip at rtol 1e-8. It
+/// replaces a flip of the direction (`−friction_direction`) once the slip ran back across the
+/// anchor by more than 1e-9 m/s: a jump of the friction by `2 μ f_n` (7.6 N on elbow7 at
+/// 0.2446 s) on a surface `v_t · anchor = −1e-9 m/s` that the onset's noise-level slip
+/// (|v_t| ≈ 4e-9 m/s, mostly across the anchor) sat on, which RODAS5P's stages straddled in
+/// each of the 440 steps it rejected in that onset (two-elbow-unilateral, rtol 1e-8, with the
+/// event-aware restart; BENCHMARKS.md, issue 24 item 1, fourth attempt).
+pub fn onset_direction(v_t: [f64; 2], anchor: [f64; 2]) -> [f64; 2] {
+    let vs = SLIP_DIRECTION_SPEED;
+    let r2 = (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (vs * vs);
+    let blend = if r2 < 1.0 { vs * (1.0 - r2) * (1.0 - r2) } else { 0.0 };
+    let w = [v_t[0] + blend * anchor[0], v_t[1] + blend * anchor[1]];
+    let n = w[0].hypot(w[1]);
+    if n > 0.0 {
+        [w[0] / n, w[1] / n]
+    } else {
+        anchor
+    }
+}
 
 /// The slip direction of a sliding contact, continued through the stop: `±v_t/|v_t|` when
 /// `|v_t|` > [`SLIP_DIRECTION_SPEED`], with the sign that keeps it on the side of `stored` (the
@@ -274,19 +297,7 @@ fn active_rows_of(contacts: &[Contact], mode: &[ContactMode], stabilization: Sta
             }
             ContactMode::Sticking | ContactMode::Sliding => {
                 let (v, anchor) = (r.slip(k), cd.anchor[k]);
-                let mut s = friction_direction(v, anchor);
-                if cd.onset_now[k] && v[0] * anchor[0] + v[1] * anchor[1] < -ONSET_REVERSE_SPEED {
-                    // an onset's slip run back across its anchor (the integrator's noise: the
-                    // slip from rest grows along the anchor while the stick is broken, and its
-                    // stop is the stick's excess, not this zero): Coulomb's friction opposes it,
-                    // so it returns (not `friction_direction`'s side-keeping, meant for the
-                    // trial stages past a located stop, which would push it on). Not within
-                    // ONSET_REVERSE_SPEED of 0: at the onset itself (the mode problem, the slip
-                    // projected to ~1e-13 m/s) the friction is the anchor's, else the rounding
-                    // of v_t picks one of two slides (an "indeterminate" error at 0.130 s on
-                    // two-elbow at rtol 1e-5)
-                    s = [-s[0], -s[1]];
-                }
+                let s = if cd.onset_now[k] { onset_direction(v, anchor) } else { friction_direction(v, anchor) };
                 cd.active.push(normal(if mu > 0.0 { RowForce::Sliding { mu, s } } else { RowForce::Same }));
             }
         }

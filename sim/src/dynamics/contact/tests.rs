@@ -471,3 +471,47 @@ fn a_slide_from_rest_in_an_onset_acts_along_the_impending_direction_and_slips_fo
         assert_eq!(cd.anchor[0], [-imp[1], imp[0]]);
     }
 }
+
+/// The onset's friction direction (`forward::onset_direction`): Coulomb's `v_t/|v_t|` from
+/// `v_s` on in every direction (to 1e-15), a slip run back across the anchor included (the
+/// friction opposes it, so it returns); the anchor at rest; and continuous in v_t with a
+/// bounded slope near rest: over a grid within |v_t| ≤ 0.1 v_s, 1e-3 v_s apart, the direction
+/// moves by at most `4 |Δv| / v_s` (there `|w| ≥ v_s (0.99² − 0.1) ≥ 0.88 v_s` and
+/// `|Δw| ≤ (1 + 4 |v_t|/v_s) |Δv|`, and `|Δ(w/|w|)| ≤ 2 |Δw| / |w|`), on the
+/// surface `v_t · anchor = −1e-9 m/s` too, where the flip it replaced (`−friction_direction`
+/// past that surface) jumped by 2 (the 440 rejected steps of elbow7's onset at 0.2446 s,
+/// BENCHMARKS.md issue 24 item 1, fourth attempt).
+#[test]
+fn an_onsets_friction_direction_is_coulombs_past_v_s_and_smooth_near_rest() {
+    use super::forward::{onset_direction, SLIP_DIRECTION_SPEED as VS};
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    for &anchor_angle in &[0.0f64, 0.7, -2.1, 2.8] {
+        let anchor = [anchor_angle.cos(), anchor_angle.sin()];
+        assert!(dist(onset_direction([0.0, 0.0], anchor), anchor) <= 1e-15, "at rest");
+        for k in 0..36 {
+            let ray = [(anchor_angle + 0.1745 * f64::from(k)).cos(), (anchor_angle + 0.1745 * f64::from(k)).sin()];
+            for &speed in &[VS, 1.5 * VS, 1e-3, 2.0] {
+                let d = onset_direction([speed * ray[0], speed * ray[1]], anchor);
+                assert!(dist(d, ray) <= 1e-15, "Coulomb's direction at {speed:e} m/s, ray {k}: {d:?}");
+            }
+        }
+        let step = 1e-3 * VS;
+        let bound = 4.0 * step / VS;
+        for i in -70..=70 {
+            for j in -70..70 {
+                // (along, across) the anchor, and the next point across
+                let at = |a: f64, c: f64| onset_direction([a * anchor[0] - c * anchor[1], a * anchor[1] + c * anchor[0]], anchor);
+                let (a, c) = (step * f64::from(i), step * f64::from(j));
+                let (d, next) = (at(a, c), at(a, c + step));
+                assert!(dist(d, next) <= bound, "a jump of {} at ({a:e}, {c:e}) m/s", dist(d, next));
+                if i < 70 {
+                    assert!(dist(d, at(a + step, c)) <= bound, "a jump of {} at ({a:e}, {c:e}) m/s", dist(d, at(a + step, c)));
+                }
+            }
+        }
+        // elbow7's onset: 4e-9 m/s, mostly across the anchor, on both sides of v_t · a = −1e-9
+        let across = [-anchor[1], anchor[0]];
+        let side = |along: f64| onset_direction([along * anchor[0] + 3.7e-9 * across[0], along * anchor[1] + 3.7e-9 * across[1]], anchor);
+        assert!(dist(side(-0.9e-9), side(-1.1e-9)) <= 1e-3, "{:?} vs {:?}", side(-0.9e-9), side(-1.1e-9));
+    }
+}

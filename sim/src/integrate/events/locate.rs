@@ -115,6 +115,21 @@ impl Bracket {
         any
     }
 
+    /// At a (re)start, after [`Bracket::set_bases`]: whether a function that is not watched
+    /// starts at 0 or on its firing side (`≤ 0` for direction −1, `≥ 0` for +1), so that
+    /// [`crosses`] cannot fire it in the first step (disarmed; a NaN too).
+    pub(super) fn any_disarmed(&self) -> bool {
+        (0..self.g_lo.len()).any(|i| {
+            let g = self.g_lo[i];
+            !self.watched[i]
+                && !match self.dir[i] {
+                    d if d < 0 => g > 0.0,
+                    d if d > 0 => g < 0.0,
+                    _ => g != 0.0,
+                }
+        })
+    }
+
     /// Reads the directions of the current mode from `sys`.
     pub(super) fn refresh_directions<S: HybridSystem>(&mut self, sys: &S) {
         for (i, d) in self.dir.iter_mut().enumerate() {

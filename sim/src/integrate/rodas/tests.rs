@@ -308,3 +308,88 @@ fn jacobian_reuse_stays_within_tolerance() {
     }
     assert!(Rodas::new(2, StepControl::new(1e-6, 1e-6)).try_with_jacobian_reuse(0).is_err());
 }
+
+/// `y' = cos(omega t)`: its first derivatives are small against the higher ones (omega^k), so
+/// Hairer's starting step, which sees only `f` and `f'`, is far longer than what the tolerance
+/// allows (the case of the elbow runs' restarts).
+struct FastCosine {
+    omega: f64,
+}
+
+impl OdeSystem for FastCosine {
+    type Error = std::convert::Infallible;
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&mut self, t: f64, _y: &[f64], dydt: &mut [f64]) -> Result<(), Self::Error> {
+        dydt[0] = (self.omega * t).cos();
+        Ok(())
+    }
+}
+
+impl OdeJacobian for FastCosine {
+    fn jacobian(&mut self, _t: f64, _y: &[f64], _fy: &[f64], jac: &mut [f64]) -> Result<(), Self::Error> {
+        jac[0] = 0.0;
+        Ok(())
+    }
+}
+
+// After an event the driver restarts the stepper (`Stepper::restart`, then
+// `first_step_after_restart` with what the event left): where every event function is armed,
+// RODAS's first step is the last accepted step (at most h_max); where one is disarmed, the
+// smaller of that and Hairer's starting step; nothing else carries over (statistics reset as by
+// `init`). On y' = cos(1000 t) (rtol 1e-8, atol 1e-10): 40 steps, a restart at the same point;
+// Hairer's step there is more than 10x the last accepted step (checked), so the restart tries
+// the last step either way and is accepted at once, to the rounding of t + h. `init` there
+// (what the driver called before) would try Hairer's step (h_next None). On the oscillator,
+// where Hairer's step is the smaller, an armed restart keeps the last step and a disarmed one
+// takes Hairer's.
+#[test]
+fn restart_tries_the_last_accepted_step() {
+    let fresh_step = |st: &mut Rodas, sys: &mut FastCosine| Adaptive::<FastCosine>::starting_step(st, sys).unwrap();
+    let mut p = FastCosine { omega: 1000.0 };
+    for h_max in [f64::INFINITY] {
+        for start in [RestartStart::Armed, RestartStart::Disarmed] {
+            let c = StepControl { h_max, ..StepControl::new(1e-8, 1e-10) };
+            let mut st = Rodas::new(1, c);
+            st.init(&mut p, 0.0, &[0.0]).unwrap();
+            for _ in 0..40 {
+                st.step(&mut p, 100.0).unwrap();
+            }
+            let (t, h_last) = (st.t(), st.core.h_last);
+            let y = st.y().to_vec();
+            let hairer = fresh_step(&mut st, &mut p);
+            assert!(hairer > 10.0 * h_last, "h_max {h_max}: Hairer's step {hairer:e} vs the last {h_last:e}");
+            Stepper::restart(&mut st, &mut p, t, &y).unwrap();
+            Stepper::first_step_after_restart(&mut st, &mut p, start).unwrap();
+            assert_eq!(st.stats().steps, 0);
+            assert_eq!(st.h_next(), Some(h_last.min(h_max)), "h_max {h_max}, {start:?}");
+            st.step(&mut p, 100.0).unwrap();
+            assert_eq!(st.stats().rejected, 0, "h_max {h_max}, {start:?}");
+            assert!((st.t() - t - h_last.min(h_max)).abs() <= 4.0 * f64::EPSILON * t, "h_max {h_max}: {} vs {h_last}", st.t() - t);
+            Stepper::init(&mut st, &mut p, t, &y).unwrap();
+            assert_eq!(st.h_next(), None);
+        }
+    }
+    // the oscillator: Hairer's step (2.5e-4 s at x = 1, v = 0) is below the last accepted one
+    let mut o = HarmonicOscillator { omega: std::f64::consts::TAU };
+    let y0 = [1.0, 0.0];
+    let mut first = |start| {
+        let mut st = Rodas::new(2, StepControl::new(1e-8, 1e-10));
+        st.init(&mut o, 0.0, &[1.0, 0.0]).unwrap();
+        for _ in 0..40 {
+            st.step(&mut o, 100.0).unwrap();
+        }
+        let h_last = st.core.h_last;
+        Stepper::restart(&mut st, &mut o, 1.0, &y0).unwrap();
+        Stepper::first_step_after_restart(&mut st, &mut o, start).unwrap();
+        let restart = st.h_next().unwrap();
+        Stepper::init(&mut st, &mut o, 1.0, &y0).unwrap();
+        let hairer = Adaptive::<HarmonicOscillator>::starting_step(&mut st, &mut o).unwrap();
+        (restart, hairer, h_last)
+    };
+    let (armed, hairer, h_last) = first(RestartStart::Armed);
+    assert!(hairer < h_last && armed == h_last, "armed {armed:e}, Hairer {hairer:e}, last {h_last:e}");
+    let (disarmed, hairer, h_last) = first(RestartStart::Disarmed);
+    assert!(hairer < h_last && disarmed == hairer, "disarmed {disarmed:e}, Hairer {hairer:e}, last {h_last:e}");
+}
