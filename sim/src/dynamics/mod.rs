@@ -12,6 +12,7 @@ pub mod gear_friction;
 pub mod kinematics;
 pub mod model;
 pub mod motor;
+pub mod psd_null;
 pub mod rnea;
 pub mod samples;
 pub mod spatial;

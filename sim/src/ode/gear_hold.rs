@@ -77,6 +77,8 @@
 //! Cost: at most a few hundred Newton steps of size r + 1 ≤ n + 1 (r the null dimension) per
 //! evaluation with a redundant sticking set; none without one (an open chain: r = 0).
 
+use crate::dynamics::psd_null::{null_basis, pivoted_cholesky};
+
 /// Scratch of [`hold_torques`], sized once for n joints.
 #[derive(Clone, Debug)]
 pub(crate) struct HoldScratch {
@@ -135,7 +137,7 @@ pub(crate) fn hold_torques(s: &mut HoldScratch, g: &[f64], lambda: &mut [f64], l
             s.a[i * n + j] = 0.5 * (g[i * n + j] + g[j * n + i]);
         }
     }
-    let k = pivoted_cholesky(&mut s.a, n, &mut s.perm, free)?;
+    let k = factor(&mut s.a, n, &mut s.perm, free)?;
     // the basic solution: L11 L11ᵀ x1 = (P b)_1, x2 = 0, scattered back
     {
         let (a, perm, x) = (&s.a, &s.perm, &mut s.x);
@@ -255,93 +257,21 @@ fn solve_psd(a: &mut [f64], b: &mut [f64], n: usize, free: f64) -> Option<bool> 
     b[..n].iter().all(|x| x.is_finite()).then_some(skipped)
 }
 
-/// Cholesky with diagonal pivoting of the n x n symmetric PSD `a` (row-major; L in its lower
-/// triangle, in pivot order `perm`): the rank k, where the largest remaining pivot is
-/// ≤ 1e-10 of the scale (the largest diagonal, or `free` if larger). `None` on a non-finite diagonal.
-fn pivoted_cholesky(a: &mut [f64], n: usize, perm: &mut [usize], free: f64) -> Option<usize> {
-    for (i, p) in perm.iter_mut().enumerate().take(n) {
-        *p = i;
-    }
+/// The rank of the symmetrised G in `a`, factored in place by [`pivoted_cholesky`] (L in its
+/// lower triangle, in pivot order `perm`), a remaining pivot ≤ 1e-10 of the scale (the largest
+/// diagonal, or `free` if larger) ending it. `None` on a non-finite diagonal.
+fn factor(a: &mut [f64], n: usize, perm: &mut [usize], free: f64) -> Option<usize> {
     let scale = (0..n).map(|i| a[i * n + i]).fold(free, f64::max);
     if !scale.is_finite() || (0..n).any(|i| a[i * n + i].is_nan()) {
         return None;
     }
     if scale <= 0.0 {
+        for (i, p) in perm.iter_mut().enumerate().take(n) {
+            *p = i;
+        }
         return Some(0);
     }
-    for k in 0..n {
-        let j = (k..n).max_by(|&p, &q| a[p * n + p].total_cmp(&a[q * n + q])).unwrap_or(k);
-        if a[j * n + j] <= 1e-10 * scale {
-            return Some(k);
-        }
-        if j != k {
-            perm.swap(j, k);
-            for c in 0..n {
-                a.swap(k * n + c, j * n + c);
-            }
-            for row in 0..n {
-                a.swap(row * n + k, row * n + j);
-            }
-        }
-        let d = a[k * n + k].sqrt();
-        a[k * n + k] = d;
-        for i in k + 1..n {
-            a[i * n + k] /= d;
-        }
-        for i in k + 1..n {
-            for c in k + 1..=i {
-                let v = a[i * n + k] * a[c * n + k];
-                a[i * n + c] -= v;
-                a[c * n + i] = a[i * n + c];
-            }
-        }
-    }
-    Some(n)
-}
-
-/// The null basis of the factored G (rank k): column c (at `z[c n..]`) has x2 = e_c and
-/// `x1 = −L₁₁⁻ᵀ l` (l the first k entries of L's row k + c), scattered to the joints' order,
-/// then orthonormalised. Returns r = n − k less any column lost to the orthonormalisation.
-fn null_basis(a: &[f64], n: usize, k: usize, perm: &[usize], z: &mut [f64]) -> usize {
-    let d = n - k;
-    for c in 0..d {
-        let col = &mut z[c * n..(c + 1) * n];
-        col.fill(0.0);
-        for i in (0..k).rev() {
-            let mut v = -a[(k + c) * n + i];
-            for q in i + 1..k {
-                v -= a[q * n + i] * col[perm[q]];
-            }
-            col[perm[i]] = v / a[i * n + i];
-        }
-        col[perm[k + c]] = 1.0;
-    }
-    // modified Gram–Schmidt, twice; a column that falls below 1e-8 of its length is dropped
-    let mut kept = 0;
-    for c in 0..d {
-        if c != kept {
-            for i in 0..n {
-                z[kept * n + i] = z[c * n + i];
-            }
-        }
-        let n0 = (0..n).map(|i| z[kept * n + i] * z[kept * n + i]).sum::<f64>().sqrt();
-        for _ in 0..2 {
-            for prev in 0..kept {
-                let dot: f64 = (0..n).map(|i| z[prev * n + i] * z[kept * n + i]).sum();
-                for i in 0..n {
-                    z[kept * n + i] -= dot * z[prev * n + i];
-                }
-            }
-        }
-        let norm = (0..n).map(|i| z[kept * n + i] * z[kept * n + i]).sum::<f64>().sqrt();
-        if norm.is_finite() && norm > 1e-8 * n0 {
-            for i in 0..n {
-                z[kept * n + i] /= norm;
-            }
-            kept += 1;
-        }
-    }
-    kept
+    Some(pivoted_cholesky(a, n, perm, 1e-10 * scale))
 }
 
 /// The slacks `s_{2p}(z) = c_{2p} + Zm_p z`, `s_{2p+1}(z) = c_{2p+1} − Zm_p z` of the moved

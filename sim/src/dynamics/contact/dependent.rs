@@ -54,6 +54,8 @@
 //!    jammed single contact does. The margin reported is `min_k m_k(α*)` at the optimum found
 //!    (a value the distribution attains, within the gap bound of the maximum).
 
+use crate::dynamics::psd_null::{null_basis, orthonormalise, pivoted_cholesky};
+
 /// Scratch of [`group_margins`], sized once for nc contacts (no allocation in the step loop).
 #[derive(Clone, Debug)]
 pub struct DependentScratch {
@@ -119,88 +121,8 @@ fn null_space(g: &mut [f64], p: usize, perm: &mut [usize], z: &mut [f64]) -> usi
     if scale.is_nan() || scale <= 0.0 || !scale.is_finite() {
         return 0;
     }
-    for (i, v) in perm.iter_mut().enumerate().take(p) {
-        *v = i;
-    }
-    let mut r = p;
-    for k in 0..p {
-        let j = (k..p).max_by(|&a, &b| g[a * p + a].total_cmp(&g[b * p + b])).unwrap_or(k);
-        if g[j * p + j].is_nan() || g[j * p + j] <= 1e-10 * scale {
-            r = k;
-            break;
-        }
-        if j != k {
-            perm.swap(j, k);
-            for c in 0..p {
-                g.swap(k * p + c, j * p + c);
-            }
-            for row in 0..p {
-                g.swap(row * p + k, row * p + j);
-            }
-        }
-        let d = g[k * p + k].sqrt();
-        g[k * p + k] = d;
-        for i in k + 1..p {
-            g[i * p + k] /= d;
-        }
-        for i in k + 1..p {
-            for c in k + 1..=i {
-                let v = g[i * p + k] * g[c * p + k];
-                g[i * p + c] -= v;
-                g[c * p + i] = g[i * p + c];
-            }
-        }
-    }
-    let d = p - r;
-    // basis vector c: x2 = e_c, x1 = −L11⁻ᵀ L21ᵀ e_c (L21 row r + c), back in original order
-    for c in 0..d {
-        let col = &mut z[c * p..(c + 1) * p];
-        col.fill(0.0);
-        // solve L11ᵀ y = −l (l = row r + c of L, first r entries) by back substitution, in place
-        // in the permuted order, then scatter
-        for i in (0..r).rev() {
-            let mut s = -g[(r + c) * p + i];
-            for k in i + 1..r {
-                s -= g[k * p + i] * col[perm[k]];
-            }
-            col[perm[i]] = s / g[i * p + i];
-        }
-        col[perm[r + c]] = 1.0;
-    }
-    orthonormalise(z, p, d)
-}
-
-/// Modified Gram–Schmidt, twice, on the `d` columns of length `p` in `z`; a column whose norm
-/// falls below 1e-8 of its original is dropped. Returns the count kept (packed first).
-fn orthonormalise(z: &mut [f64], p: usize, d: usize) -> usize {
-    let mut kept = 0;
-    for c in 0..d {
-        if c != kept {
-            for i in 0..p {
-                z[kept * p + i] = z[c * p + i];
-            }
-        }
-        let n0 = (0..p).map(|i| z[kept * p + i] * z[kept * p + i]).sum::<f64>().sqrt();
-        if n0.is_nan() || n0 <= 0.0 {
-            continue;
-        }
-        for _ in 0..2 {
-            for prev in 0..kept {
-                let dot: f64 = (0..p).map(|i| z[prev * p + i] * z[kept * p + i]).sum();
-                for i in 0..p {
-                    z[kept * p + i] -= dot * z[prev * p + i];
-                }
-            }
-        }
-        let n = (0..p).map(|i| z[kept * p + i] * z[kept * p + i]).sum::<f64>().sqrt();
-        if n > 1e-8 * n0 {
-            for i in 0..p {
-                z[kept * p + i] /= n;
-            }
-            kept += 1;
-        }
-    }
-    kept
+    let r = pivoted_cholesky(g, p, perm, 1e-10 * scale);
+    null_basis(g, p, r, perm, z)
 }
 
 /// The rows and forces the group program reads, and what it writes back.
