@@ -88,3 +88,17 @@ fn the_random_scenes_that_chattered_complete() {
 
 
 
+
+/// where-elbow's calibration design with 0.5 kg in the hand and the elbow at joint 7's origin
+/// (`crawl-onset-05kg.json`, cut to 0.9 s, the study's rtol 1e-5): after the elbow's
+/// stick → slip at 0.837754356 s it crawled with no event (150 s of wall time reached
+/// 0.8449 s): the onset's friction flipped by 2 μ f_n where its noise-level slip ran back
+/// across the anchor by 1e-9 m/s, and the state rode that surface (every step straddling it
+/// rejected). With the onset's direction smooth (`forward::onset_direction`) it completes:
+/// measured 952 steps, 13 rejected. Bound: at most 15 % rejected, as the link-7 candidate.
+#[test]
+fn the_where_elbow_candidate_that_crawled_after_its_onset_completes() {
+    let c = completes_with_the_audit_and_the_balance("joint 7, 0.5 kg, rtol 1e-5", &scene("crawl-onset-05kg.json", None), "one-elbow-unilateral", 1e-5);
+    assert!(c.report.stats.rejected as f64 <= 0.15 * c.report.stats.steps as f64, "joint 7, 0.5 kg: {} of {} steps rejected", c.report.stats.rejected, c.report.stats.steps);
+    assert!(c.events.iter().any(|e| (e.t - 0.837754356).abs() < 1e-6), "the stick -> slip onset at 0.837754356 s: {:?}", c.events);
+}
