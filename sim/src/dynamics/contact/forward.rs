@@ -124,14 +124,21 @@ pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 /// event-aware restart; BENCHMARKS.md, issue 24 item 1, fourth attempt).
 pub fn onset_direction(v_t: [f64; 2], anchor: [f64; 2]) -> [f64; 2] {
     let vs = SLIP_DIRECTION_SPEED;
-    let r2 = (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (vs * vs);
+    blended(v_t, (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (vs * vs), anchor)
+}
+
+/// `w/|w|`, `w = v + v_s (1 − r²)² toward` for `r² = |v_t|²/v_s² < 1` (else `w = v`): the
+/// blend of [`friction_direction`] and [`onset_direction`], `v` the slip (signed by the
+/// caller) and `r2` as the caller computed it; `toward` itself when `w = 0`.
+fn blended(v: [f64; 2], r2: f64, toward: [f64; 2]) -> [f64; 2] {
+    let vs = SLIP_DIRECTION_SPEED;
     let blend = if r2 < 1.0 { vs * (1.0 - r2) * (1.0 - r2) } else { 0.0 };
-    let w = [v_t[0] + blend * anchor[0], v_t[1] + blend * anchor[1]];
+    let w = [v[0] + blend * toward[0], v[1] + blend * toward[1]];
     let n = w[0].hypot(w[1]);
     if n > 0.0 {
         [w[0] / n, w[1] / n]
     } else {
-        anchor
+        toward
     }
 }
 
@@ -168,15 +175,7 @@ pub fn friction_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
     let vs = SLIP_DIRECTION_SPEED;
     let speed = v_t[0].hypot(v_t[1]);
     let sign = if v_t[0] * stored[0] + v_t[1] * stored[1] < 0.0 { -1.0 } else { 1.0 };
-    let r2 = (speed / vs).powi(2);
-    let blend = if r2 < 1.0 { vs * (1.0 - r2) * (1.0 - r2) } else { 0.0 };
-    let w = [sign * v_t[0] + blend * stored[0], sign * v_t[1] + blend * stored[1]];
-    let n = w[0].hypot(w[1]);
-    if n > 0.0 {
-        [w[0] / n, w[1] / n]
-    } else {
-        stored
-    }
+    blended([sign * v_t[0], sign * v_t[1]], (speed / vs).powi(2), stored)
 }
 
 /// Kinematics, b (with compliant forces), `M_J` and its Cholesky factor (in `fd.m_j`,
