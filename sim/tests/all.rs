@@ -21,6 +21,8 @@ mod contact_shapes;
 mod contacts_chatter;
 #[path = "contacts_converge.rs"]
 mod contacts_converge;
+#[path = "contacts_idle.rs"]
+mod contacts_idle;
 #[path = "contacts_exact.rs"]
 mod contacts_exact;
 #[path = "contacts_pair.rs"]

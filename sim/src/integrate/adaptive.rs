@@ -11,19 +11,25 @@
 use super::control::{Controller, StepControl};
 use super::{IntegrateError, OdeSystem, Stats};
 
-/// `sqrt(1/n sum (e_i / sc_i)^2)`, `sc_i = atol + rtol max(|y_i|, |y_new_i|)` (HNW I (4.11));
-/// 0 for `n = 0`. NaN/inf propagate.
-pub(super) fn error_norm(e: &[f64], y: &[f64], y_new: &[f64], atol: f64, rtol: f64) -> f64 {
+/// `sqrt(1/m sum (e_i / sc_i)^2)` over the `m` components `i` with `measured[i]`,
+/// `sc_i = atol + rtol max(|y_i|, |y_new_i|)` (HNW I (4.11)); 0 for `m = 0`. NaN/inf
+/// propagate. `measured` is the system's [`OdeSystem::error_measured`] (all true: every
+/// component, summed over `0..n` in order, bit for bit the norm before the mask existed).
+pub(super) fn error_norm(e: &[f64], y: &[f64], y_new: &[f64], atol: f64, rtol: f64, measured: &[bool]) -> f64 {
     let n = e.len();
-    if n == 0 {
+    assert_eq!(measured.len(), n, "error_norm: mask length vs dim");
+    let (mut sum, mut m) = (0.0, 0usize);
+    for i in 0..n {
+        if measured[i] {
+            let sk = atol + rtol * y[i].abs().max(y_new[i].abs());
+            sum += (e[i] / sk).powi(2);
+            m += 1;
+        }
+    }
+    if m == 0 {
         return 0.0;
     }
-    let mut sum = 0.0;
-    for i in 0..n {
-        let sk = atol + rtol * y[i].abs().max(y_new[i].abs());
-        sum += (e[i] / sk).powi(2);
-    }
-    (sum / n as f64).sqrt()
+    (sum / m as f64).sqrt()
 }
 
 /// How the last rejected attempt failed, for the error returned when the step size collapses.
@@ -79,6 +85,9 @@ pub(super) struct Core {
     pub t_stop: f64,
     /// Singular iteration matrices in a row (the implicit methods; [`Core::reject_singular`]).
     pub singular_run: u32,
+    /// The components the error norm measures (`dim` long), read from the system in every
+    /// [`Core::init`] ([`OdeSystem::error_measured`]); allocated by the first.
+    pub measured: Vec<bool>,
 }
 
 impl Core {
@@ -96,20 +105,31 @@ impl Core {
             initialized: false,
             t_stop: 0.0,
             singular_run: 0,
+            measured: Vec::new(),
         }
     }
 
+    /// [`error_norm`] with this stepper's tolerances and the system's measured components.
+    pub fn error_norm(&self, e: &[f64], y: &[f64], y_new: &[f64]) -> f64 {
+        error_norm(e, y, y_new, self.control.atol, self.control.rtol, &self.measured)
+    }
+
     /// The start of every `init`: checks the dimensions (panics, naming the stepper `name`),
-    /// resets the statistics, rejects a non-finite `y0` and restarts the step control at `t0`.
-    pub fn init<E>(
+    /// reads which components the error norm measures (the system's choice at this state and
+    /// mode: an event's restart reads it again), resets the statistics, rejects a non-finite
+    /// `y0` and restarts the step control at `t0`. Allocates the mask on the first call only.
+    pub fn init<S: OdeSystem>(
         &mut self,
         name: &str,
         dim: usize,
-        sys_dim: usize,
+        sys: &S,
         t0: f64,
         y0: &[f64],
-    ) -> Result<(), IntegrateError<E>> {
-        assert_eq!(sys_dim, dim, "{name}::init: system dim vs stepper dim");
+    ) -> Result<(), IntegrateError<S::Error>> {
+        assert_eq!(sys.dim(), dim, "{name}::init: system dim vs stepper dim");
+        self.measured.clear();
+        self.measured.resize(dim, true);
+        sys.error_measured(&mut self.measured);
         assert_eq!(y0.len(), dim, "{name}::init: y0 length vs dim");
         self.initialized = false;
         self.stats = Stats::default();
@@ -254,7 +274,7 @@ pub(super) fn step_collapsed(h: f64, t: f64, h_min: f64) -> bool {
 }
 
 /// Hairer's starting step (HNW I §II.4, (a)–(f)) for a method of order `order`, in the RMS
-/// norm above; `f0 = f(t, y)`. Uses one evaluation of `rhs` (counted), with `y1`, `f1` as
+/// norm above over the `measured` components ([`Core::measured`]); `f0 = f(t, y)`. Uses one evaluation of `rhs` (counted), with `y1`, `f1` as
 /// scratch. A non-finite probe is ignored (the step then comes from `f0` alone).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn initial_step<S: OdeSystem>(
@@ -266,12 +286,14 @@ pub(super) fn initial_step<S: OdeSystem>(
     y1: &mut [f64],
     f1: &mut [f64],
     c: &StepControl,
+    measured: &[bool],
     order: i32,
 ) -> Result<f64, IntegrateError<S::Error>> {
     let n = y.len();
-    let inv_n = 1.0 / n.max(1) as f64;
+    assert_eq!(measured.len(), n, "initial_step: mask length vs dim");
+    let inv_n = 1.0 / measured.iter().filter(|&&m| m).count().max(1) as f64;
     let (mut d0, mut d1) = (0.0, 0.0);
-    for i in 0..n {
+    for i in (0..n).filter(|&i| measured[i]) {
         let sk = c.atol + c.rtol * y[i].abs();
         d0 += (y[i] / sk).powi(2);
         d1 += (f0[i] / sk).powi(2);
@@ -289,7 +311,7 @@ pub(super) fn initial_step<S: OdeSystem>(
     stats.rhs_evals += 1;
     sys.rhs(t + h0, y1, f1).map_err(IntegrateError::Rhs)?;
     let mut d2 = 0.0;
-    for i in 0..n {
+    for i in (0..n).filter(|&i| measured[i]) {
         let sk = c.atol + c.rtol * y[i].abs();
         d2 += ((f1[i] - f0[i]) / sk).powi(2);
     }
@@ -326,7 +348,65 @@ mod tests {
         let y_new = [0.0, -3.0];
         // sc = [1e-6, 1e-6 + 3e-6]
         let expect = ((1.0f64 + 0.25) / 2.0).sqrt();
-        assert!((error_norm(&e, &y, &y_new, 1e-6, 1e-6) - expect).abs() < 1e-15);
-        assert_eq!(error_norm(&[], &[], &[], 1.0, 1.0), 0.0);
+        assert!((error_norm(&e, &y, &y_new, 1e-6, 1e-6, &[true; 2]) - expect).abs() < 1e-15);
+        assert_eq!(error_norm(&[], &[], &[], 1.0, 1.0, &[]), 0.0);
+    }
+
+    /// A component left out changes neither the sum nor the divisor: the norm of `[a, x, x, b]`
+    /// measuring components 0 and 3 is the RMS of `[a, b]` whatever `x` is (0, as a separated
+    /// contact's quadratures, or large), exactly; measuring all four it is the RMS over all
+    /// four, as before the mask existed (bit for bit: same terms, same order), where the two
+    /// zeros dilute it by sqrt(2/4).
+    #[test]
+    fn a_component_left_out_does_not_change_the_norm() {
+        let (atol, rtol) = (1e-10, 1e-8);
+        let y = [0.3, 2.0, 0.0, -1.5];
+        let y_new = [0.31, 2.0, 0.0, -1.49];
+        let two = error_norm(&[4e-10, -2e-10], &[0.3, -1.5], &[0.31, -1.49], atol, rtol, &[true; 2]);
+        let ends = [true, false, false, true];
+        for x in [0.0, 1e-9, 3.0, -1e6] {
+            let e = [4e-10, x, x, -2e-10];
+            assert_eq!(error_norm(&e, &y, &y_new, atol, rtol, &ends), two, "x = {x}");
+        }
+        let four = error_norm(&[4e-10, 0.0, 0.0, -2e-10], &y, &y_new, atol, rtol, &[true; 4]);
+        assert!((four - two * 0.5f64.sqrt()).abs() <= 1e-15 * two, "{four} vs {two}");
+        let mut sum = 0.0;
+        for (i, e) in [4e-10, 0.0, 0.0, -2e-10].iter().enumerate() {
+            let sk = atol + rtol * f64::abs(y[i]).max(y_new[i].abs());
+            sum += (e / sk).powi(2);
+        }
+        assert_eq!(four, (sum / 4.0).sqrt());
+        // nothing measured: 0, as the empty norm
+        assert_eq!(error_norm(&[1.0, 2.0], &[0.0; 2], &[0.0; 2], atol, rtol, &[false; 2]), 0.0);
+    }
+
+    /// The system's mask reaches the stepper's norm and starting step through `Core::init`,
+    /// read again by every `init` (an event's restart), without allocating after the first.
+    #[test]
+    fn core_init_reads_the_systems_mask_at_every_init() {
+        struct Quad(bool);
+        impl OdeSystem for Quad {
+            type Error = std::convert::Infallible;
+            fn dim(&self) -> usize {
+                3
+            }
+            fn rhs(&mut self, _t: f64, y: &[f64], dydt: &mut [f64]) -> Result<(), Self::Error> {
+                dydt.copy_from_slice(&[-y[0], y[0] * y[0], 1.0]);
+                Ok(())
+            }
+            fn error_measured(&self, measured: &mut [bool]) {
+                measured[1] = self.0;
+            }
+        }
+        let controller = Controller { safety: 0.9, fac_min: 0.2, fac_max: 6.0 };
+        let mut core = Core::new(StepControl::new(1e-6, 1e-9), controller);
+        let (y, y_new) = ([1.0, 0.0, 0.0], [0.9, 0.1, 0.1]);
+        core.init("Test", 3, &Quad(false), 0.0, &y).expect("init");
+        assert_eq!(core.measured, [true, false, true]);
+        assert_eq!(core.error_norm(&[1e-7, 5.0, 1e-7], &y, &y_new), core.error_norm(&[1e-7, 0.0, 1e-7], &y, &y_new));
+        let ptr = core.measured.as_ptr();
+        core.init("Test", 3, &Quad(true), 0.0, &y).expect("init");
+        assert_eq!((core.measured.as_slice(), core.measured.as_ptr()), ([true; 3].as_slice(), ptr));
+        assert!(core.error_norm(&[1e-7, 5.0, 1e-7], &y, &y_new) > 1e5);
     }
 }

@@ -38,7 +38,7 @@
 //! - `max_steps` counts attempts (accepted + rejected) since `init`; every rejection is counted in
 //!   [`Stats::rejected`], including those before the first accepted step.
 
-use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
 use super::{
     dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeSystem, SettingsError,
@@ -234,6 +234,7 @@ impl<S: OdeSystem> Adaptive<S> for DormandPrince45 {
             &mut self.y_stage,
             &mut self.k2,
             &core.control,
+            &core.measured,
             4,
         )
     }
@@ -353,7 +354,6 @@ impl DormandPrince45 {
         }
 
         // error estimate (into y_stage) in the tolerance-weighted RMS norm, HNW I §II.4
-        let StepControl { atol, rtol, .. } = self.core.control;
         let Controller {
             safety,
             fac_min,
@@ -366,7 +366,7 @@ impl DormandPrince45 {
             self.y_stage[i] =
                 h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
         }
-        let err = error_norm(&self.y_stage, y, &self.y_new, atol, rtol);
+        let err = self.core.error_norm(&self.y_stage, y, &self.y_new);
 
         // step-size controller (dopri5.f): fac = h / h_new, bounded to [1/fac_max, 1/fac_min]
         let fac11 = err.powf(self.expo1);
@@ -420,7 +420,7 @@ impl<S: OdeSystem> Stepper<S> for DormandPrince45 {
     /// Evaluates `f(t0, y0)` once (the FSAL first stage).
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.core
-            .init("DormandPrince45", self.dim, sys.dim(), t0, y0)?;
+            .init("DormandPrince45", self.dim, &*sys, t0, y0)?;
         self.err_old = 1e-4;
         (self.stiff_checks, self.non_stiff_checks, self.h_lambda) = (0, 0, 0.0);
         self.y.copy_from_slice(y0);

@@ -53,7 +53,7 @@
 //! stages shrink the step; `max_steps` counts attempts; stop times are hit exactly).
 
 use self::tableau::{AE, AI, B, B_DENSE, B_HAT, C, GAMMA};
-use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
 use super::{
     dense_output, first_non_finite, hermite, IntegrateError, SettingsError, SplitSystem, Stats,
@@ -197,6 +197,7 @@ impl<S: SplitSystem> Adaptive<S> for ArkImex {
             &mut self.z,
             &mut self.scratch,
             &core.control,
+            &core.measured,
             4,
         )
     }
@@ -260,8 +261,7 @@ impl<S: SplitSystem> Adaptive<S> for ArkImex {
         for i in 0..n {
             self.r[i] = self.z[i] - self.scratch[i];
         }
-        let c = self.core.control;
-        let err = error_norm(&self.r, &self.y, &self.y_new, c.atol, c.rtol);
+        let err = self.core.error_norm(&self.r, &self.y, &self.y_new);
         let fac = CONTROLLER.factor(err, 0.25);
         let passed = err <= 1.0;
         if !passed {
@@ -289,7 +289,7 @@ impl<S: SplitSystem> Adaptive<S> for ArkImex {
             let hermite = 0.5 * (self.y[i] + self.y_new[i]) + 0.125 * h * (f0 - f1);
             self.r[i] = kc - hermite;
         }
-        let err_dense = error_norm(&self.r, &self.y, &self.y_new, c.atol, c.rtol) / DENSE_SLACK;
+        let err_dense = self.core.error_norm(&self.r, &self.y, &self.y_new) / DENSE_SLACK;
         let interpolation_ok = err_dense <= 1.0;
         if !interpolation_ok {
             let h_next = h * CONTROLLER.factor(err_dense, 0.25).min(1.0);
@@ -313,7 +313,7 @@ impl<S: SplitSystem> Adaptive<S> for ArkImex {
 impl<S: SplitSystem> Stepper<S> for ArkImex {
     /// Evaluates `rhs_split(t0, y0)` once (the first stage of the first step).
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
-        self.core.init("ArkImex", self.dim, sys.dim(), t0, y0)?;
+        self.core.init("ArkImex", self.dim, &*sys, t0, y0)?;
         self.y.copy_from_slice(y0);
         self.y_prev.copy_from_slice(y0);
         let (fe, fi) = (&mut self.fe[0], &mut self.fi[0]);

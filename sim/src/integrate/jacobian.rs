@@ -185,6 +185,9 @@ impl<S: OdeSystem> OdeSystem for FdJacobian<S> {
     fn rhs_column(&mut self, t: f64, y: &[f64], col: usize, dydt: &mut [f64]) -> Result<(), S::Error> {
         self.sys.rhs_column(t, y, col, dydt)
     }
+    fn error_measured(&self, measured: &mut [bool]) {
+        self.sys.error_measured(measured)
+    }
 }
 
 impl<S: OdeSystem> OdeJacobian for FdJacobian<S> {

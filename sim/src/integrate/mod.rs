@@ -152,6 +152,19 @@ pub trait OdeSystem {
         let _ = col;
         self.rhs(t, y, dydt)
     }
+    /// Which components the adaptive steppers' error norm measures: `measured` (length `dim`)
+    /// comes all true, and a system sets false what the norm must leave out. The norm is the
+    /// RMS over the rest (`adaptive.rs`); the components left out are still integrated, by the
+    /// steps the others choose. Read by every `init`, so at the start of a run and after every
+    /// event ([`integrate_hybrid`] restarts the stepper): a hybrid system may choose by its
+    /// modes, which change only at events. Meant for quadratures that feed nothing back into
+    /// `f` and whose error need not steer the step size, as SUNDIALS CVODES leaves its
+    /// quadrature variables out of the local error test unless asked (`CVodeSetQuadErrCon`,
+    /// `errconQ`, default false; Hindmarsh et al., *SUNDIALS*, ACM TOMS 31 (2005) 363; the CVODES
+    /// guide, "Quadrature integration"). The default measures every component.
+    fn error_measured(&self, measured: &mut [bool]) {
+        let _ = measured;
+    }
     /// Called by [`integrate_sampled`] after every accepted step: may move `y` back onto an
     /// invariant manifold (e.g. constraints C = 0, Ċ = 0) and returns whether it changed it.
     /// The default leaves `y` alone.

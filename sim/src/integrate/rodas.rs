@@ -21,7 +21,7 @@
 //!   `y(t + theta h) = (1 - theta) y + theta (y_new + (1 - theta) (w_1 + theta (w_2 +
 //!   theta w_3)))` with `w_k = sum_j H_kj u_j` (RODAS4: `w_1`, `w_2` only).
 //! - error norm and step-size control: the RMS norm of HNW I §II.4 with `atol + rtol max(|y|,
-//!   |y_new|)`; `h_new = h min(6, max(0.2, 0.9 err^(-1/(q+1))))` with `q` the embedded order
+//!   |y_new|)` over the components the system measures ([`super::OdeSystem::error_measured`]); `h_new = h min(6, max(0.2, 0.9 err^(-1/(q+1))))` with `q` the embedded order
 //!   (Hairer's `rodas.f`: SAFE = 0.9, FAC1 = 5, FAC2 = 1/6); after a rejection the next
 //!   accepted step may not grow. (Gustafsson's predictive controller, HNW II §IV.8 (8.21),
 //!   was measured here, issue 24: with `h_max` 1 s it cut the paper-unilateral runs' right-hand
@@ -62,7 +62,7 @@
 //! - singular matrix, non-finite stages, `t_stop`, `max_steps`: as in [`super::Rosenbrock`].
 
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
-use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
 use super::jacobian::{fd_jacobian_columns_within, DifferenceIncrement};
 use super::lu::{lu_factor_within, lu_solve, LuStop};
@@ -381,6 +381,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
             &mut self.y_stage,
             &mut self.f_stage,
             &core.control,
+            &core.measured,
             self.tab.order as i32,
         )
     }
@@ -442,8 +443,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
             }
             self.y_new[i] = yn;
         }
-        let c = self.core.control;
-        let err = error_norm(&self.u[s_last], &self.y, &self.y_new, c.atol, c.rtol);
+        let err = self.core.error_norm(&self.u[s_last], &self.y, &self.y_new);
         let fac = CONTROLLER.factor(err, 1.0 / f64::from(tab.embedded_order + 1));
         if err > 1.0 {
             return Ok(self.core.reject(h * fac.min(1.0), Failure::None));
@@ -486,7 +486,7 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
     /// # Panics
     /// Also if `sys.coupled_dim() > dim`.
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
-        self.core.init("Rodas", self.dim, sys.dim(), t0, y0)?;
+        self.core.init("Rodas", self.dim, &*sys, t0, y0)?;
         self.nc = sys.coupled_dim();
         assert!(self.nc <= self.dim, "Rodas::init: coupled_dim {} > dim {}", self.nc, self.dim);
         self.jac_valid = false;

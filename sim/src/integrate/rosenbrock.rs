@@ -53,7 +53,7 @@
 //! `t_stop` do not reduce the next step; `max_steps` counts attempts.
 
 use self::tableau::{Tableau, GAMMA};
-use super::adaptive::{self, error_norm, initial_step, Adaptive, Attempt, Core, Failure};
+use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
 use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::{
@@ -298,6 +298,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
             &mut self.y_stage,
             &mut self.f_stage,
             &core.control,
+            &core.measured,
             3,
         )
     }
@@ -360,8 +361,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
             self.y_new[i] = yn;
             self.y_stage[i] = e;
         }
-        let c = self.core.control;
-        let err = error_norm(&self.y_stage, &self.y, &self.y_new, c.atol, c.rtol);
+        let err = self.core.error_norm(&self.y_stage, &self.y, &self.y_new);
         let fac = CONTROLLER.factor(err, 1.0 / 3.0);
         let passed = err <= 1.0;
         if !passed {
@@ -397,7 +397,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
 impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
     /// Evaluates `f(t0, y0)` once; the Jacobian is evaluated by the first step.
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
-        self.core.init("Rosenbrock", self.dim, sys.dim(), t0, y0)?;
+        self.core.init("Rosenbrock", self.dim, &*sys, t0, y0)?;
         self.jac_valid = false;
         self.jac_fresh = false;
         self.dfdt_fresh = false;

@@ -110,6 +110,11 @@ impl Layout {
     pub fn impact_loss(&self, k: usize) -> usize {
         self.loss_r() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * k
     }
+    /// Contact k's three quadratures: impact loss, friction work, damping loss.
+    pub fn contact_quadratures(&self, k: usize) -> [usize; 3] {
+        let first = self.impact_loss(k);
+        [first, first + 1, first + 2]
+    }
     /// Contact k's friction work `∫ −f_t · v_t dt`, J.
     pub fn friction_work(&self, k: usize) -> usize {
         self.impact_loss(k) + 1
