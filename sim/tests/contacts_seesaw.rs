@@ -138,8 +138,8 @@ fn ends_closed(file: &str, settled: f64, mode: ContactMode, max_events: usize) -
 
 /// where-pair's evaluation 18 (`seesaw-pair.json`, 0.7 s, rtol 1e-5): elbow7 lands at
 /// 0.647019 s and lifts elbow4 off; the landings alternate (measured 1.8e-3, 2.2e-4, 4.4e-5,
-/// 5.7e-6 m/s) and at 0.647320 s elbow4 is held closed (the lift-off elbow7's rest would give
-/// it is below the gap resolution, ~1e-5 m/s here). det A = 21.3 (m/(s² N))² > 0 there: both
+/// 5.7e-6 m/s) and at 0.647320 s elbow4 is held closed (the lift-off elbow7's landing would give
+/// it, 1.0e-6 m/s, is below the gap resolution; elbow7's 5.7e-6 m/s one landing earlier was not). det A = 21.3 (m/(s² N))² > 0 there: both
 /// closed is Coulomb's solution (f_n 4.17 and 1.00 N). Before: 16 485 lift-off/rest pairs of
 /// each elbow, stopped at 0.6505 s on the limit of 100 000 events. Now: both closed and sliding
 /// from 0.648 s to the end, at most 30 events.

@@ -254,10 +254,11 @@ impl ArmSystem<'_> {
             // `crawl-pair.json`, 0.142069 s: elbow4 at 3e-8 m/s against a resolution of 1.3e-6
             // m/s, elbow7 stopping; 100 000 events by 0.1438 s). A resolved slip stops at its
             // own zero (`contacts_start::two_slips_stopping_at_once_…`, 1e-12 s)
-            for k in 0..nc {
+            for (k, pref) in preferred.iter_mut().enumerate() {
+                let v = h.cd.rows.slip(k);
                 let resolved = st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len()));
-                if !stopping.contains(&k) && h.state.mode[k] == ContactMode::Sliding && mu_of(&h.contacts[k]) > 0.0 && { let v = h.cd.rows.slip(k); v[0].hypot(v[1]) <= resolved } {
-                    preferred[k] = ContactMode::Sticking;
+                if !stopping.contains(&k) && h.state.mode[k] == ContactMode::Sliding && mu_of(&h.contacts[k]) > 0.0 && v[0].hypot(v[1]) <= resolved {
+                    *pref = ContactMode::Sticking;
                     stopping.push(k);
                 }
             }
