@@ -39,6 +39,8 @@ mod contacts_recording;
 mod contacts_real_arms;
 #[path = "contacts_rod.rs"]
 mod contacts_rod;
+#[path = "contacts_seesaw.rs"]
+mod contacts_seesaw;
 #[path = "contacts_scene.rs"]
 mod contacts_scene;
 #[path = "contacts_start.rs"]

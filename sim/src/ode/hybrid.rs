@@ -297,7 +297,28 @@ impl ArmSystem<'_> {
             }
         }
         let fd = &self.ws.fd;
-        let imp = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &uni, &bil, t)?;
+        let mut imp = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &uni, &bil, t)?;
+        // the end of an accumulation of impacts ([`gap_resolution`]): a plastic contact the
+        // impulse leaves separating slower than the step control resolves stays closed, its
+        // ġ⁺ held at 0 as a bilateral row's in the impact (its impulse and the energy it takes
+        // are the impact's, booked below); repeated while the held set grows (≤ m solves)
+        let tolerances = self.scene.integrator().tolerances();
+        let qd0 = &y[l.qd()];
+        let mut held: Vec<usize> = Vec::new();
+        loop {
+            let more: Vec<usize> = uni
+                .iter()
+                .filter(|&&(k, e)| e == 0.0 && !held.contains(&k) && imp.gap_rate_after[k] > st.vel_tol && imp.gap_rate_after[k] <= gap_resolution(tolerances, &h.cd.rows, k, qd0, y.len()))
+                .map(|&(k, _)| k)
+                .collect();
+            if more.is_empty() {
+                break;
+            }
+            held.extend(more);
+            let free: Vec<(usize, f64)> = uni.iter().copied().filter(|(k, _)| !held.contains(k)).collect();
+            let fixed: Vec<usize> = bil.iter().chain(&held).copied().collect();
+            imp = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &free, &fixed, t)?;
+        }
         let d = &self.scene.drives;
         for j in 0..nv {
             let before = y[l.qd().start + j];
@@ -454,6 +475,25 @@ impl ArmSystem<'_> {
             }
         }
     }
+}
+
+/// The gap rate of contact `k` below which the integrator does not resolve it (m/s): the
+/// normal analogue of [`slip_resolution`], `sqrt(n) |J_n (atol + rtol |q̇|)|` over the joint
+/// speeds (an accepted step has `sqrt(1/n Σ (e_i/w_i)²) ≤ 1`, HNW I (4.11); Cauchy–Schwarz);
+/// 0 for a fixed-step method. It ends an accumulation of impacts (issue 23 item 6, the see-saw
+/// of two landings: each plastic landing lifted the other contact off at `G₄₇/G₄₄` of its
+/// speed, a Zeno sequence whose speeds fell to the integrator's noise and then chattered):
+/// a contact a plastic impact leaves separating slower than this is held closed with ġ = 0
+/// ([`ArmSystem::impact`]), and the acceleration-level mode problem decides its lift-off by g̈.
+/// This is the event-driven schemes' handling of an accumulation point (Acary & Brogliato 2008,
+/// §7.2: near an accumulation point the impacts are stopped and the contact closed when the
+/// velocity falls below a threshold; Brogliato, *Nonsmooth Mechanics*, 2016, §1.3 and §5.3 on
+/// Zeno sequences of impacts, whose limit is the persistent contact), with the threshold the
+/// step control's own resolution instead of a fixed speed. At the paper's rtol 1e-8,
+/// atol 1e-10 it is ~1e-8 m/s.
+pub(super) fn gap_resolution(tolerances: Option<(f64, f64)>, rows: &crate::dynamics::contact::rows::ContactRows, k: usize, qd: &[f64], n: usize) -> f64 {
+    let Some((rtol, atol)) = tolerances else { return 0.0 };
+    (n as f64 * rows.row(3 * k).iter().zip(qd).map(|(j, v)| (j * (atol + rtol * v.abs())).powi(2)).sum::<f64>()).sqrt()
 }
 
 /// The slip speed of contact `k` below which the integrator does not resolve the slip (m/s):

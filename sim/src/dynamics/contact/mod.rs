@@ -235,6 +235,7 @@ pub mod forward;
 pub mod impact;
 pub mod indeterminate;
 pub mod modes;
+pub mod pair_normal;
 pub mod pair_slip;
 pub mod rows;
 pub mod shape;

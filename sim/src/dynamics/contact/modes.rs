@@ -399,6 +399,8 @@ pub fn choose_modes_within(
                 one_contact(contacts, &as_one(state, &twins, closed, i), k, stabilization, fd, cd).map(|o| painleve_why(contacts[k].name(), &o, moving))
             })
             .collect();
+        let mut whys = whys;
+        whys.splice(0..0, super::pair_normal::painleve_pairs(contacts, state, closed, vel_tol, stabilization, fd, cd));
         let whys = if whys.is_empty() { String::new() } else { format!(": {}", whys.join("; ")) };
         return Err(DynamicsError::InconsistentContact {
             t,
