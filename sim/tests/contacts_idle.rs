@@ -4,10 +4,10 @@
 //! (`two-elbow-unilateral`), in `sim/scenes/paper_unilateral.json`.
 //!
 //! What makes it exact: a separated contact adds no force (its rows are not in the contact
-//! problem) and its three quadratures (impact loss, friction work, damping loss) stay 0; they
-//! feed nothing back, and the step-size control leaves every contact's quadratures out of its
-//! error norm (`OdeSystem::error_excluded`, `ode/arm.rs`; SUNDIALS CVODES leaves quadratures
-//! out of its error test by default, `errconQ`). Measured in the norm, the seven idle contacts'
+//! problem) and its three quadratures (impact loss, friction work, damping loss) stay constant
+//! until the next event; they feed nothing back, and the step-size control leaves a separated
+//! contact's quadratures out of its error norm (`OdeSystem::error_measured`, `ode/arm.rs`;
+//! SUNDIALS CVODES leaves quadratures out of its error test by default, `errconQ`). Measured in the norm, the seven idle contacts'
 //! 21 zeros only raised the RMS's divisor (whole-table's 80 components against two-elbow's
 //! 59), loosening whole-table's effective tolerance by √(80/59) = 1.16: over these 0.3 s, 865 steps /
 //! 67 rejected against 893 / 74 (and 5756 / 120 against 5799 / 122 over the 5-s runs).
