@@ -13,6 +13,8 @@
 
 use std::path::Path;
 
+use sim::dynamics::contact::ContactEventKind;
+
 use crate::contacts_support::*;
 
 /// The reproducer `file` at its own tolerance (the study's rtol 1e-5), or at `rtol` (atol
@@ -101,4 +103,29 @@ fn the_where_elbow_candidate_that_crawled_after_its_onset_completes() {
     let c = completes_with_the_audit_and_the_balance("joint 7, 0.5 kg, rtol 1e-5", &scene("crawl-onset-05kg.json", None), "one-elbow-unilateral", 1e-5);
     assert!(c.report.stats.rejected as f64 <= 0.15 * c.report.stats.steps as f64, "joint 7, 0.5 kg: {} of {} steps rejected", c.report.stats.rejected, c.report.stats.steps);
     assert!(c.events.iter().any(|e| (e.t - 0.837754356).abs() < 1e-6), "the stick -> slip onset at 0.837754356 s: {:?}", c.events);
+}
+
+/// where-elbow's evaluation 95 (0.5 kg, link 8 at s = 0.834; `audit-slip-reversal-05kg.json`,
+/// cut to 3.69 s, the study's rtol 1e-5) broke the audit on 884b8cf: "friction not opposing
+/// the slip 3.142 rad" at the 3.683 s sample. The slip, slowing along a line, crossed its zero
+/// inside a RODAS5P step whose end had it back on the same side (the slip → stick function
+/// `v_t · s_ref` kept its sign), because past the zero the friction kept the reference's side
+/// (`friction_direction`'s old sign): it pushed the reversed slip's cross part on instead of
+/// damping it, and recorded friction along a reversed slip of 1.36e-6 m/s; the stop came at
+/// 3.687096 s. With the friction opposing the slip past the zero (maximal dissipation;
+/// Glocker 2001, §7) the run holds the audit at every sample, and its events are those of
+/// rtol 1e-8, kind for kind, each within 1e-4 s (measured 5.2e-5 s, the stop at 3.683006 s
+/// against 3.683058 s; it was 4.0e-3 s late); the electric energy is within the study's error
+/// bar (2.43e-4 J) of rtol 1e-8's.
+#[test]
+fn the_where_elbow_candidate_whose_slip_reversed_inside_a_step_holds_the_audit() {
+    let loose = completes_with_the_audit_and_the_balance("link 8, s = 0.834, 0.5 kg, rtol 1e-5", &scene("audit-slip-reversal-05kg.json", None), "one-elbow-unilateral", 1e-5);
+    let tight = completes_with_the_audit_and_the_balance("link 8, s = 0.834, 0.5 kg, rtol 1e-8", &scene("audit-slip-reversal-05kg.json", Some(1e-8)), "one-elbow-unilateral", 1e-8);
+    assert_eq!(loose.events.len(), tight.events.len(), "link 8: the events at rtol 1e-5 {:?} and at 1e-8 {:?}", loose.events, tight.events);
+    for (a, b) in loose.events.iter().zip(&tight.events) {
+        assert!(a.kind == b.kind && a.contact == b.contact && (a.t - b.t).abs() <= 1e-4, "link 8: event {a:?} at rtol 1e-5, {b:?} at rtol 1e-8");
+    }
+    assert!(loose.events.iter().any(|e| e.kind == ContactEventKind::SlipToStick && (e.t - 3.683).abs() < 1e-4), "the stop near 3.683 s: {:?}", loose.events);
+    let e = |c: &Collected| c.samples.last().unwrap().electric_energy.iter().sum::<f64>();
+    assert!((e(&loose) - e(&tight)).abs() <= 2.43e-4, "electric energy {} J at rtol 1e-5, {} J at 1e-8", e(&loose), e(&tight));
 }

@@ -108,8 +108,8 @@ impl ContactData {
 pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 
 /// The direction an onset's friction opposes (unit, tangent basis; `ContactState::onset`):
-/// `w/|w|` with `w = v_t + v_s ψ(|v_t|/v_s) anchor`, [`friction_direction`]'s blend without its
-/// side-keeping sign. Coulomb's law (Glocker, *Set-Valued Force Laws*, 2001, §7; Pfeiffer &
+/// `w/|w|` with `w = v_t + v_s ψ(|v_t|/v_s) anchor`, [`friction_direction`]'s blend (the same
+/// since that lost its side-keeping sign) towards the anchor. Coulomb's law (Glocker, *Set-Valued Force Laws*, 2001, §7; Pfeiffer &
 /// Glocker 1996, §5.2): the friction opposes the slip, `−μ f_n v_t/|v_t|`, from `v_s` on in
 /// every direction, a slip run back across the anchor included (it returns); below `v_s` the
 /// direction is regularised towards the anchor, the direction the sticking force leaves the
@@ -160,22 +160,31 @@ pub fn slip_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
 }
 
 /// The direction a sliding contact's friction opposes (unit, tangent basis): `w/|w|` with
-/// `w = σ v_t + v_s ψ(|v_t|/v_s) stored`, `v_s` = [`SLIP_DIRECTION_SPEED`], `σ = ±1` the sign
-/// of `v_t · stored` (+1 at 0: the side of `stored`, as [`slip_direction`]) and
-/// `ψ(r) = (1 − r²)²` for `r < 1`, else 0. So it is `σ v_t/|v_t|` (Coulomb's law) from `v_s` on,
-/// `stored` at rest, and in between turns with a bounded rate (`|w| ≥ 0.3 v_s`): continuous with
-/// its first derivative in `v_t` everywhere except across `v_t · stored = 0` (the located
-/// slip→stick event). A switch from `stored` to `v_t/|v_t|` at `v_s` instead (the frozen
-/// direction) is a jump of the friction's direction by the angle between them: a slip from rest
-/// whose velocity grows across `stored` (the inverse tangential inertia turns it) then
-/// chattered on `|v_t| = v_s`, the integrator taking 1e-10-s steps (one-elbow-unilateral at
-/// 0.7168 s: 15 000 rejected steps at rtol 1e-8, a collapse at 1e-12). `w` never vanishes: its
-/// part along `stored` is `|v_t · stored| + v_s ψ ≥ 0`, and 0 only where `ψ = 0`, `|v_t| ≥ v_s`.
+/// `w = v_t + v_s ψ(|v_t|/v_s) stored`, `v_s` = [`SLIP_DIRECTION_SPEED`] and
+/// `ψ(r) = (1 − r²)²` for `r < 1`, else 0: [`onset_direction`]'s blend towards the stored
+/// direction (the slip direction at the start of the step). So it is Coulomb's `v_t/|v_t|`
+/// from `v_s` on in every direction (the friction opposes the slip: maximal dissipation,
+/// `−f_t · v_t = μ f_n |v_t|`; Moreau 1988; Glocker, *Set-Valued Force Laws*, 2001, §7),
+/// `stored` at rest, and in between turns smoothly; along `stored` it is `stored` for every
+/// `v_t · stored > −0.525 v_s`, so a slip that slows along a line and crosses its zero inside a
+/// step meets the same friction on both sides, and the located slip → stick event
+/// (`v_t · s_ref`, [`slip_direction`]) brackets the zero. `w` is 0 at one point only,
+/// `v_t = −0.525 v_s stored`.
+///
+/// It kept the side of `stored` before (`σ v_t` for `w`'s slip, `σ` the sign of
+/// `v_t · stored`), meant for the trial stages past a located stop. Past the zero that is
+/// friction *along* the slip's part across `stored`: it pushes that part on where on
+/// `stored`'s side it damps it (with a gain ~`μ f_n / v_s`, stiff), and beyond `v_s` it is
+/// anti-Coulomb. A RODAS5P step that straddled the zero then had a dense
+/// output running the slip through 0 and back to the same side (where-elbow's evaluation 95,
+/// 0.5 kg, link 8 at s = 0.834, rtol 1e-5: the slip, 4.1e-6 m/s at the 3.682 s sample and
+/// slowing at 4e-3 m/s², crossed 0 near 3.6828 s inside a step that ended with it at ~1.5e-5
+/// m/s along `stored` again, so the slip → stick function kept its sign and the stop came
+/// 4.3 ms late, at 3.687096 s; the 3.683 s sample recorded a slip of 1.36e-6 m/s reversed with
+/// the friction along it: the audit's π rad; `scenes/contacts/audit-slip-reversal-05kg.json`).
 pub fn friction_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
     let vs = SLIP_DIRECTION_SPEED;
-    let speed = v_t[0].hypot(v_t[1]);
-    let sign = if v_t[0] * stored[0] + v_t[1] * stored[1] < 0.0 { -1.0 } else { 1.0 };
-    blended([sign * v_t[0], sign * v_t[1]], (speed / vs).powi(2), stored)
+    blended(v_t, (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (vs * vs), stored)
 }
 
 /// Kinematics, b (with compliant forces), `M_J` and its Cholesky factor (in `fd.m_j`,
@@ -537,7 +546,7 @@ mod friction_direction_tests {
         (a[0] - b[0]).hypot(a[1] - b[1])
     }
 
-    /// Coulomb's direction `σ v_t/|v_t|` from `SLIP_DIRECTION_SPEED` on (to 1e-15), the stored
+    /// Coulomb's direction `v_t/|v_t|` from `SLIP_DIRECTION_SPEED` on (to 1e-15), the stored
     /// direction at rest and along it (1-D: exact at every speed), a unit vector everywhere, and
     /// continuous across `|v_t| = SLIP_DIRECTION_SPEED` with a bounded slope: on every ray at
     /// an angle to `stored` (on its side), the direction moves by at most `2 |Δv| / (0.3 v_s)`
@@ -554,7 +563,7 @@ mod friction_direction_tests {
                 assert!(dist(d, stored) <= 1e-15, "along stored at {speed:e}: {d:?}");
             }
             for k in 0..24 {
-                // rays within 89° of stored (on its side; σ flips across 90°: the located stop)
+                // rays within 89° of stored (past 90°: `past_the_zero_the_friction_opposes_the_slip`)
                 let off = -1.55 + 3.1 * f64::from(k) / 23.0;
                 let ray = unit(stored_angle + off);
                 for &speed in &[VS, 1.5 * VS, 1e-3, 2.0] {

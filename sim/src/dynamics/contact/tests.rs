@@ -515,3 +515,38 @@ fn an_onsets_friction_direction_is_coulombs_past_v_s_and_smooth_near_rest() {
         assert!(dist(side(-0.9e-9), side(-1.1e-9)) <= 1e-3, "{:?} vs {:?}", side(-0.9e-9), side(-1.1e-9));
     }
 }
+
+/// Past the slip's zero the friction opposes the slip (Coulomb's law, maximal
+/// dissipation) from `v_s` on, in every direction: on rays 91°…179° from `stored` at
+/// `v_s`, 1.5 `v_s`, 1e-3 and 2 m/s, `friction_direction` is `v_t/|v_t|` to 1e-15. Along
+/// `−stored` it stays `stored` up to 0.5 `v_s` (the zero of a slip slowing along a line
+/// is crossed smoothly and bracketed) and is `−stored` from `v_s` on. Before the fix
+/// (side-keeping: `σ v_t`, σ the sign of `v_t · stored`) it was `−v_t/|v_t|` on every
+/// such ray, π from Coulomb's: where-elbow's evaluation 95 recorded that (the audit's
+/// "friction not opposing the slip 3.142 rad").
+#[test]
+fn past_the_zero_the_friction_opposes_the_slip() {
+    use super::forward::{friction_direction, SLIP_DIRECTION_SPEED as VS};
+    let unit = |a: f64| [a.cos(), a.sin()];
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    for &stored_angle in &[0.0, 0.7, -2.1] {
+        let stored = unit(stored_angle);
+        for k in 1..=88 {
+            let off = (90.0 + f64::from(k)) * std::f64::consts::PI / 180.0;
+            for ray in [unit(stored_angle + off), unit(stored_angle - off)] {
+                for &speed in &[VS, 1.5 * VS, 1e-3, 2.0] {
+                    let d = friction_direction([speed * ray[0], speed * ray[1]], stored);
+                    assert!(dist(d, ray) <= 1e-15, "past the zero at {speed:e}, {off} rad from stored: {d:?} vs the slip {ray:?}");
+                }
+            }
+        }
+        for &speed in &[1e-12, 1e-8, 0.25 * VS, 0.5 * VS] {
+            let d = friction_direction([-speed * stored[0], -speed * stored[1]], stored);
+            assert!(dist(d, stored) <= 1e-15, "just past the zero along the line, {speed:e}: {d:?}");
+        }
+        for &speed in &[VS, 3.0 * VS, 1.0] {
+            let d = friction_direction([-speed * stored[0], -speed * stored[1]], stored);
+            assert!(dist(d, [-stored[0], -stored[1]]) <= 1e-15, "reversed along the line, {speed:e}: {d:?}");
+        }
+    }
+}
