@@ -314,10 +314,15 @@ impl ArmSystem<'_> {
             if more.is_empty() {
                 break;
             }
-            held.extend(more);
-            let free: Vec<(usize, f64)> = uni.iter().copied().filter(|(k, _)| !held.contains(k)).collect();
-            let fixed: Vec<usize> = bil.iter().chain(&held).copied().collect();
-            imp = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &free, &fixed, t)?;
+            let mut trial = held.clone();
+            trial.extend(more);
+            let free: Vec<(usize, f64)> = uni.iter().copied().filter(|(k, _)| !trial.contains(k)).collect();
+            let fixed: Vec<usize> = bil.iter().chain(&trial).copied().collect();
+            // no solution with them held (every active set singular or infeasible): the impact
+            // as solved, they leave as before
+            let Ok(i) = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &free, &fixed, t) else { break };
+            imp = i;
+            held = trial;
         }
         let d = &self.scene.drives;
         for j in 0..nv {
