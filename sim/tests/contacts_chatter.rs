@@ -129,3 +129,29 @@ fn the_where_elbow_candidate_whose_slip_reversed_inside_a_step_holds_the_audit()
     let e = |c: &Collected| c.samples.last().unwrap().electric_energy.iter().sum::<f64>();
     assert!((e(&loose) - e(&tight)).abs() <= 2.43e-4, "electric energy {} J at rtol 1e-5, {} J at 1e-8", e(&loose), e(&tight));
 }
+
+/// where-pair's calibration design with elbow4 under the hand (t = 8) and elbow7 at joint 7's
+/// origin (`touchdown-refire-pair.json`, the study's rtol 1e-5) stopped at 0.072268131 s with 33
+/// touch-downs of elbow7 at one instant: elbow7's plastic landing throws elbow4 off (+4.54 mm/s,
+/// a real separation) and the restart's first step carried elbow4 back through the table
+/// (a sign change inside the step) while elbow7, pivoting on it, went 2.5e-7 m below the table
+/// at the step's end after rising only 1.1e-11 m; its touch-down, watched from its start value,
+/// fired at the step's start and pre-empted elbow4's landing inside the step, and the handler
+/// found elbow7 separating again, 33 times. Now the other root is located first and the start
+/// firing stands only if the watched function had left its dead band by then
+/// (`integrate/events.rs`). The run completes with the audit at every sample and the balance
+/// within rtol · E (measured 2.5e-7 E), and elbow4 lands again after the ballistic flight of a
+/// point leaving at ġ⁺ with the normal acceleration the trace measured there (g̈ = −102.2
+/// m/s²): t = 2 ġ⁺ / |g̈| = 88.9 µs (measured 88.6 µs; bound 2 %, g̈ changes along the flight).
+#[test]
+fn the_where_pair_design_whose_touch_down_refired_completes() {
+    let c = completes_with_the_audit_and_the_balance("elbow4 under the hand, elbow7 at joint 7, rtol 1e-5", &scene("touchdown-refire-pair.json", None), "two-elbow-unilateral", 1e-5);
+    let landing = c.events.iter().find(|e| e.kind == ContactEventKind::Impact && e.contact == 1 && (e.t - 0.072268131).abs() < 1e-6).unwrap_or_else(|| panic!("elbow7's landing at 0.072268131 s: {:?}", c.events));
+    let thrown = c.events.iter().find(|e| e.kind == ContactEventKind::LiftOff && e.contact == 0 && e.t == landing.t).unwrap_or_else(|| panic!("elbow4 thrown off at elbow7's landing: {:?}", c.events));
+    let back = c.events.iter().find(|e| e.contact == 0 && e.t > landing.t && matches!(e.kind, ContactEventKind::Impact | ContactEventKind::Rest)).unwrap_or_else(|| panic!("elbow4 lands again: {:?}", c.events));
+    let flight = 2.0 * thrown.gap_rate_after / 102.2;
+    assert!(((back.t - landing.t) - flight).abs() <= 0.02 * flight, "elbow4's flight {} s, ballistic {flight} s", back.t - landing.t);
+    for w in c.events.windows(2) {
+        assert!(!(w[0].contact == w[1].contact && w[0].kind == w[1].kind && w[1].t - w[0].t < 1e-9), "repeated event {:?} {:?}", w[0], w[1]);
+    }
+}

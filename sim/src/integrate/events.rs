@@ -30,7 +30,11 @@
 //!   function found off its firing side there left and came back inside the step (a gear that
 //!   starts sliding from rest, turns and stops within one step), so its return is located like
 //!   any other root instead of firing at the start, where the handler would restart it into
-//!   the same mode without end (`locate::departed_inside`). Other functions exactly 0 at a
+//!   the same mode without end (`locate::departed_inside`). And unless another function
+//!   changes sign inside the same step: its root is located first, and the start firing stands
+//!   only if the watched function had moved past its tolerance by that root (an elbow still at
+//!   its start gap, inside its dead band, when the other elbow lands cannot have touched down
+//!   before it; `Bracket::hold_start_firing`). Other functions exactly 0 at a
 //!   start are disarmed for that step;
 //! - the bracket `[t_lo, t_hi]` is narrowed by the Illinois secant on the function with the
 //!   largest `|g(t_hi)| / |g(t_hi) − g(t_lo)|` (all functions are evaluated at each trial point;
@@ -276,7 +280,20 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
         }
 
         // an event in [t_lo, t_hi]: its time, then the samples before it
-        let t_star = if at_start { t_before } else { locate_root(stepper, sys, &mut br, t_lo, t_hi, tol, watch, &mut buf)? };
+        let t_star = if at_start && br.hold_start_firing() {
+            // another function's root in the same step: the start firing only if it had moved
+            // past its dead band by that root
+            let t_root = locate_root(stepper, sys, &mut br, t_lo, t_hi, tol, watch, &mut buf)?;
+            if br.start_firing_before_root() {
+                t_before
+            } else {
+                t_root
+            }
+        } else if at_start {
+            t_before
+        } else {
+            locate_root(stepper, sys, &mut br, t_lo, t_hi, tol, watch, &mut buf)?
+        };
         while k <= n_out && grid.time(k) < t_star {
             let t_k = grid.time(k);
             stepper.interpolate(t_k, &mut buf);

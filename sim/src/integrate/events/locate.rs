@@ -24,6 +24,9 @@ pub(super) struct Bracket {
     watched: Vec<bool>,
     /// `event_tolerance(i)` of the watched functions, read with the bases.
     tolerance: Vec<f64>,
+    /// The functions [`Bracket::left_at_start`] fired, kept while another function's root in
+    /// the same step is located ([`Bracket::hold_start_firing`]).
+    start_fired: Vec<bool>,
 }
 
 /// Which end of the bracket a fresh evaluation of the functions went into.
@@ -43,6 +46,7 @@ impl Bracket {
             base: vec![0.0; n],
             watched: vec![false; n],
             tolerance: vec![0.0; n],
+            start_fired: vec![false; n],
         }
     }
 
@@ -113,6 +117,42 @@ impl Bracket {
             any |= self.fired[i];
         }
         any
+    }
+
+    /// After [`Bracket::left_at_start`] fired watched functions, which did not leave and come
+    /// back inside the step ([`departed_inside`]): whether another function changes sign in the
+    /// same step. Then the start firing is held (`fired` cleared, the fired set kept) while that
+    /// root is located: a function watched from its start value that has not yet moved past its
+    /// tolerance at the other function's root cannot have fired before it (it was still at its
+    /// start value, inside its dead band, when the other event happened).
+    pub(super) fn hold_start_firing(&mut self) -> bool {
+        let n = self.g_lo.len();
+        let other = (0..n).any(|i| !self.fired[i] && crosses(self.dir[i], self.g_lo[i], self.g_hi[i]));
+        if other {
+            self.start_fired.copy_from_slice(&self.fired);
+            self.fired.iter_mut().for_each(|f| *f = false);
+        }
+        other
+    }
+
+    /// After [`Bracket::hold_start_firing`] and the location of the other root (`g_hi` its
+    /// values there): whether a held function had already moved past its tolerance to its
+    /// firing side by then — then it fires at the step's start after all (the earliest event),
+    /// and `fired` is the held set again; otherwise the other root's firing stands.
+    pub(super) fn start_firing_before_root(&mut self) -> bool {
+        let n = self.g_lo.len();
+        let past = (0..n).any(|i| {
+            self.start_fired[i]
+                && match self.dir[i] {
+                    d if d < 0 => self.g_hi[i] < -self.tolerance[i],
+                    d if d > 0 => self.g_hi[i] > self.tolerance[i],
+                    _ => false,
+                }
+        });
+        if past {
+            self.fired.copy_from_slice(&self.start_fired);
+        }
+        past
     }
 
     /// At a (re)start, after [`Bracket::set_bases`]: whether a function that is not watched
