@@ -459,3 +459,63 @@ fn the_deadline_stops_an_event_location() {
     // the functions at the start and at the step's end, no trial point, no event handled
     assert_eq!((toy.event_calls, toy.log.len()), (2, 0));
 }
+
+/// Two functions of a point `x = t²/2` (from rest, `x'' = 1`), both direction −1 and watched:
+/// `g₀ = −ε x`, 0 at the start (on its firing side, so watched from 0, dead band `tol`), past
+/// `−tol` only from `t_w = √(2 tol / ε)`; `g₁ = c − x`, a threshold at `t_r = √(2 c)` < `t_w`.
+/// The first step spans both (rk4's step, and the adaptive methods' first step of 1, exact
+/// for a quadratic). `g₀` still within its dead band at `t_r` cannot have fired before `g₁`:
+/// the first event is `g₁` alone at `t_r` (to 1e-12 s). The driver fired `g₀` at the step's
+/// start before (`Bracket::hold_start_firing`; the arm's elbow whose touch-down pre-empted
+/// the other elbow's landing, `touchdown-refire-pair.json`).
+struct DeadBandAndThreshold {
+    eps: f64,
+    c: f64,
+    tol: f64,
+    reached: [bool; 2],
+}
+
+impl Law for DeadBandAndThreshold {
+    fn n(&self) -> usize {
+        2
+    }
+    fn dir(&self, _i: usize) -> i8 {
+        -1
+    }
+    fn acc(&self, _t: f64, _y: &[f64]) -> f64 {
+        1.0
+    }
+    fn events(&self, _t: f64, y: &[f64], out: &mut [f64]) {
+        // a function that has fired is done (its mode switched): positive from then on
+        out[0] = if self.reached[0] { 1.0 } else { -self.eps * y[0] };
+        out[1] = if self.reached[1] { 1.0 } else { self.c - y[0] };
+    }
+    fn handle(&mut self, _t: f64, _y: &mut [f64], fired: &[bool]) -> bool {
+        self.reached[0] |= fired[0];
+        self.reached[1] |= fired[1];
+        false
+    }
+    fn watch(&self) -> Option<f64> {
+        Some(self.tol)
+    }
+}
+
+#[test]
+fn a_function_within_its_dead_band_does_not_pre_empt_another_root_in_the_step() {
+    let (eps, c, tol): (f64, f64, f64) = (2e-8, 0.02, 1e-9);
+    let t_r = (2.0 * c).sqrt();
+    assert!(t_r < (2.0 * tol / eps).sqrt());
+    let ctl = StepControl { h_max: 1.0, h_init: Some(1.0), ..StepControl::new(1e-8, 1e-10) };
+    let steppers: Vec<(&str, Box<dyn Stepper<Toy<DeadBandAndThreshold>>>)> = vec![
+        ("rk4", Box::new(Rk4::new(2, 1.0))),
+        ("dopri45", Box::new(DormandPrince45::new(2, ctl))),
+        ("rodas5p", Box::new(Rodas::new(2, ctl))),
+    ];
+    for (name, mut st) in steppers {
+        let mut toy = Toy::new(DeadBandAndThreshold { eps, c, tol, reached: [false; 2] });
+        run(st.as_mut(), &mut toy, [0.0, 0.0], 1.0, 1.0, EventSettings::default()).expect(name);
+        let (t, fired, _) = &toy.log[0];
+        assert_eq!(fired, &vec![false, true], "{name}: first event {:?}", toy.log);
+        assert!((t - t_r).abs() <= 1e-12, "{name}: first event at {t}, closed form {t_r}");
+    }
+}
