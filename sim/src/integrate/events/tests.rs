@@ -1,7 +1,7 @@
 //! The event driver on abstract hybrid problems with closed-form event times, for every
 //! method (`toys.rs`).
 
-use super::toys::{methods, Ball, Blip, LiftOff, Law, MovedStart, Thresholds, Toy};
+use super::toys::{methods, Ball, Blip, LiftOff, Law, MovedStart, Named, Thresholds, Toy};
 use super::*;
 use crate::integrate::test_problems::{HarmonicOscillator, Kepler, RhsFailure, StiffLinear};
 use crate::integrate::{integrate_sampled, ArkImex, DormandPrince45, Rk4, Rodas, Rosenbrock, StepControl};
@@ -506,7 +506,7 @@ fn a_function_within_its_dead_band_does_not_pre_empt_another_root_in_the_step() 
     let t_r = (2.0 * c).sqrt();
     assert!(t_r < (2.0 * tol / eps).sqrt());
     let ctl = StepControl { h_max: 1.0, h_init: Some(1.0), ..StepControl::new(1e-8, 1e-10) };
-    let steppers: Vec<(&str, Box<dyn Stepper<Toy<DeadBandAndThreshold>>>)> = vec![
+    let steppers: Vec<Named<DeadBandAndThreshold>> = vec![
         ("rk4", Box::new(Rk4::new(2, 1.0))),
         ("dopri45", Box::new(DormandPrince45::new(2, ctl))),
         ("rodas5p", Box::new(Rodas::new(2, ctl))),
