@@ -10,7 +10,7 @@ use crate::dynamics::contact::{ContactEvent, ContactEventKind, ContactMode, Cont
 use crate::error::RunError;
 
 use super::arm::ArmSystem;
-use super::hybrid::{in_touch, mu_of, slip_resolution, REBOUND_START};
+use super::hybrid::{in_touch, slip_resolution, REBOUND_START};
 
 /// The slip→stick rule (issue 23, item 2). A sliding contact's ev1 is `v_t · s_ref` (m/s),
 /// `s_ref` the slip direction at the start of the step: no threshold, its zero is located like
@@ -110,10 +110,10 @@ impl ArmSystem<'_> {
                 // the stick margin (a statically indeterminate contact's largest; jammed: no slip)
                 (_, ContactMode::Sticking) => (f_n, if h.cd.margin[k].is_finite() { h.cd.margin[k] } else { 1.0 }),
                 // an onset: the stick's excess (the slip → stick rule of an onset, `stops_here`)
-                (_, ContactMode::Sliding) if mu_of(c) > 0.0 && h.state.onset[k].is_some() && h.cd.onset_excess[k].is_finite() => (f_n, h.cd.onset_excess[k]),
+                (_, ContactMode::Sliding) if c.unilateral_friction() > 0.0 && h.state.onset[k].is_some() && h.cd.onset_excess[k].is_finite() => (f_n, h.cd.onset_excess[k]),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
-                    (f_n, if mu_of(c) > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
+                    (f_n, if c.unilateral_friction() > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
                 }
             };
             out[2 * k] = e0;
@@ -152,7 +152,7 @@ impl ArmSystem<'_> {
             .contacts
             .iter()
             .enumerate()
-            .map(|(k, c)| if mu_of(c) > 0.0 && h.cd.rows.slip(k)[0].hypot(h.cd.rows.slip(k)[1]) <= st.vel_tol { ContactMode::Sticking } else { ContactMode::Sliding })
+            .map(|(k, c)| if c.unilateral_friction() > 0.0 && h.cd.rows.slip(k)[0].hypot(h.cd.rows.slip(k)[1]) <= st.vel_tol { ContactMode::Sticking } else { ContactMode::Sliding })
             .collect();
         let before_log = self.hybrid.as_ref().map_or(0, |h| h.log.len());
         self.resolve_modes(t, y, &closed, &preferred, &[])?;
@@ -209,7 +209,7 @@ impl ArmSystem<'_> {
                             h.rebound[k] = true;
                         } else {
                             touched.push(k);
-                            preferred[k] = if mu_of(c) > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
+                            preferred[k] = if c.unilateral_friction() > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
                         }
                     }
                 }
@@ -257,7 +257,7 @@ impl ArmSystem<'_> {
             for (k, pref) in preferred.iter_mut().enumerate() {
                 let v = h.cd.rows.slip(k);
                 let resolved = st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len()));
-                if !stopping.contains(&k) && h.state.mode[k] == ContactMode::Sliding && mu_of(&h.contacts[k]) > 0.0 && v[0].hypot(v[1]) <= resolved {
+                if !stopping.contains(&k) && h.state.mode[k] == ContactMode::Sliding && h.contacts[k].unilateral_friction() > 0.0 && v[0].hypot(v[1]) <= resolved {
                     *pref = ContactMode::Sticking;
                     stopping.push(k);
                 }
@@ -276,7 +276,7 @@ impl ArmSystem<'_> {
                 }
                 let c = &self.hybrid.as_ref().expect("hybrid").contacts[k];
                 if preferred[k] == ContactMode::Separated && approaching.contains(&k) {
-                    preferred[k] = if mu_of(c) > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
+                    preferred[k] = if c.unilateral_friction() > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
                 }
                 if approaching.contains(&k) {
                     logged.push(k);

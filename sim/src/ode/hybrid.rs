@@ -111,12 +111,6 @@ impl Hybrid {
 /// above the table (g > 0) the function is `g` again (`release_rebounds`).
 pub const REBOUND_START: f64 = 1e-14;
 
-pub(super) fn mu_of(c: &Contact) -> f64 {
-    match c.model {
-        ContactModel::Unilateral { friction, .. } => friction,
-        _ => 0.0,
-    }
-}
 
 pub(super) fn in_touch(m: ContactMode) -> bool {
     matches!(m, ContactMode::Sticking | ContactMode::Sliding)
@@ -498,7 +492,7 @@ impl ArmSystem<'_> {
 /// atol 1e-10 it is ~1e-8 m/s.
 pub(super) fn gap_resolution(tolerances: Option<(f64, f64)>, rows: &crate::dynamics::contact::rows::ContactRows, k: usize, qd: &[f64], n: usize) -> f64 {
     let Some((rtol, atol)) = tolerances else { return 0.0 };
-    (n as f64 * rows.row(3 * k).iter().zip(qd).map(|(j, v)| (j * (atol + rtol * v.abs())).powi(2)).sum::<f64>()).sqrt()
+    (n as f64 * weighted_row_sq(rows, 3 * k, qd, rtol, atol)).sqrt()
 }
 
 /// The slip speed of contact `k` below which the integrator does not resolve the slip (m/s):
@@ -513,6 +507,11 @@ pub(super) fn gap_resolution(tolerances: Option<(f64, f64)>, rows: &crate::dynam
 /// takes at rtol 1e-6 (within 0.03° of its anchor up to 8e-6 m/s).
 pub(super) fn slip_resolution(tolerances: Option<(f64, f64)>, rows: &crate::dynamics::contact::rows::ContactRows, k: usize, qd: &[f64], n: usize) -> f64 {
     let Some((rtol, atol)) = tolerances else { return 0.0 };
-    let along = |r: usize| rows.row(r).iter().zip(qd).map(|(j, v)| (j * (atol + rtol * v.abs())).powi(2)).sum::<f64>();
-    (n as f64 * (along(3 * k + 1) + along(3 * k + 2))).sqrt()
+    (n as f64 * (weighted_row_sq(rows, 3 * k + 1, qd, rtol, atol) + weighted_row_sq(rows, 3 * k + 2, qd, rtol, atol))).sqrt()
+}
+
+/// `Σ_i (J_r,i w_i)²` of contact row `r` over the joint speeds, `w_i = atol + rtol |q̇_i|` (the
+/// step control's weights): the squared bound [`slip_resolution`] and [`gap_resolution`] scale.
+fn weighted_row_sq(rows: &crate::dynamics::contact::rows::ContactRows, r: usize, qd: &[f64], rtol: f64, atol: f64) -> f64 {
+    rows.row(r).iter().zip(qd).map(|(j, v)| (j * (atol + rtol * v.abs())).powi(2)).sum::<f64>()
 }

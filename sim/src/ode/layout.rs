@@ -112,8 +112,7 @@ impl Layout {
     }
     /// Contact k's three quadratures: impact loss, friction work, damping loss.
     pub fn contact_quadratures(&self, k: usize) -> [usize; 3] {
-        let first = self.impact_loss(k);
-        [first, first + 1, first + 2]
+        [self.impact_loss(k), self.friction_work(k), self.damping_loss(k)]
     }
     /// Contact k's friction work `∫ −f_t · v_t dt`, J.
     pub fn friction_work(&self, k: usize) -> usize {

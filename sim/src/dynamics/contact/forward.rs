@@ -290,10 +290,7 @@ fn active_rows_of(contacts: &[Contact], mode: &[ContactMode], stabilization: Sta
     for (k, c) in contacts.iter().enumerate() {
         let normal_extra = 2.0 * alpha * r.vel[3 * k] + beta * beta * r.gap[k];
         let normal = |force| ActiveRow { row: 3 * k, force, extra: normal_extra };
-        let mu = match c.model {
-            ContactModel::Unilateral { friction, .. } => friction,
-            _ => 0.0,
-        };
+        let mu = c.unilateral_friction();
         match mode[k] {
             ContactMode::Separated => {}
             ContactMode::Bilateral => cd.active.push(normal(RowForce::Same)),

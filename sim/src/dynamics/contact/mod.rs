@@ -91,6 +91,16 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// Coulomb's friction coefficient μ of a unilateral (rigid) contact, the μ of its modes;
+    /// 0 for the other models (a bilateral contact is frictionless; a compliant contact's
+    /// regularised friction is part of its own force law, not of the mode problem).
+    pub fn unilateral_friction(&self) -> f64 {
+        match self.model {
+            ContactModel::Unilateral { friction, .. } => friction,
+            _ => 0.0,
+        }
+    }
+
     pub fn new(plane: PointOnPlane, model: ContactModel) -> Self {
         let (t1, t2) = tangent_basis(&plane.normal_world);
         Contact { plane, model, t1, t2, shape: ContactShape::Point }

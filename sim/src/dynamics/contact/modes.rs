@@ -28,17 +28,11 @@
 //! contacts, then the first in the order sticking, sliding, separated.
 
 use super::forward::{solve_modes, ContactData, ContactState};
-use super::{Contact, ContactMode, ContactModel, MAX_CLOSED_CONTACTS};
+use super::{Contact, ContactMode, MAX_CLOSED_CONTACTS};
 use crate::dynamics::forward::{ForwardData, Stabilization};
 use crate::error::DynamicsError;
 use crate::integrate::{Phase, Watch};
 
-fn mu_of(c: &Contact) -> f64 {
-    match c.model {
-        ContactModel::Unilateral { friction, .. } => friction,
-        _ => 0.0,
-    }
-}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Cand {
@@ -108,7 +102,7 @@ pub fn choose_modes_within(
         .map(|&k| {
             let v = cd.rows.slip(k);
             let moving = v[0].hypot(v[1]) > vel_tol;
-            if mu_of(&contacts[k]) == 0.0 || moving {
+            if contacts[k].unilateral_friction() == 0.0 || moving {
                 vec![Cand::Slide { moving }, Cand::Sep]
             } else {
                 vec![Cand::Stick, Cand::Slide { moving: false }, Cand::Sep]
@@ -145,7 +139,7 @@ pub fn choose_modes_within(
                     if moving {
                         let s = v[0].hypot(v[1]);
                         trial.slip[k] = [v[0] / s, v[1] / s];
-                    } else if mu_of(&contacts[k]) > 0.0 {
+                    } else if contacts[k].unilateral_friction() > 0.0 {
                         from_rest = true;
                     }
                     ContactMode::Sliding
@@ -159,14 +153,14 @@ pub fn choose_modes_within(
             // the impending slip directions: the same combination with those contacts sticking
             let mut stick = trial.clone();
             for (i, &k) in closed.iter().enumerate() {
-                if cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 {
+                if cands[i][idx[i]] == (Cand::Slide { moving: false }) && contacts[k].unilateral_friction() > 0.0 {
                     stick.mode[k] = ContactMode::Sticking;
                 }
             }
             ok = solve_modes(contacts, &stick, stabilization, fd, cd).is_ok();
             if ok {
                 for (i, &k) in closed.iter().enumerate() {
-                    if cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 {
+                    if cands[i][idx[i]] == (Cand::Slide { moving: false }) && contacts[k].unilateral_friction() > 0.0 {
                         let f = cd.f_t[k];
                         let m = f[0].hypot(f[1]);
                         // no impending slip: sliding from rest is the sticking solution (not a separate candidate)
@@ -183,7 +177,7 @@ pub fn choose_modes_within(
         let rest_sliders: Vec<usize> = closed
             .iter()
             .enumerate()
-            .filter(|&(i, &k)| cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 && twins[i].is_none())
+            .filter(|&(i, &k)| cands[i][idx[i]] == (Cand::Slide { moving: false }) && contacts[k].unilateral_friction() > 0.0 && twins[i].is_none())
             .map(|(_, &k)| k)
             .collect();
         if ok && rest_sliders.len() == 1 {
@@ -258,7 +252,7 @@ pub fn choose_modes_within(
                 let qdd = &fd.qdd.as_slice()[..nv];
                 let mut change = 0.0f64;
                 for (i, &k) in closed.iter().enumerate() {
-                    if cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 {
+                    if cands[i][idx[i]] == (Cand::Slide { moving: false }) && contacts[k].unilateral_friction() > 0.0 {
                         let a = [cd.rows.dot(3 * k + 1, qdd) + cd.rows.bias[3 * k + 1], cd.rows.dot(3 * k + 2, qdd) + cd.rows.bias[3 * k + 2]];
                         let m = a[0].hypot(a[1]);
                         if m > 0.0 {
@@ -327,7 +321,7 @@ pub fn choose_modes_within(
                         Cand::Sep => accel(0) <= tol_a,
                         Cand::Stick => cd.margin[k] <= tol_f || cd.f_n[k] <= tol_f,
                         Cand::Slide { moving } => {
-                            cd.f_n[k] <= tol_f || (!moving && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k]))
+                            cd.f_n[k] <= tol_f || (!moving && contacts[k].unilateral_friction() > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k]))
                         }
                     };
                 }
@@ -338,9 +332,9 @@ pub fn choose_modes_within(
                         Cand::Sep => accel(0) >= -tol_a,
                         // at a stick → slip event (a sticking contact preferred sliding: its margin
                         // crossed 0 falling) a stick at the cone does not go on
-                        Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= mu_of(&contacts[k]) * f_n + tol_f && !(breaking(k) && cd.margin[k] <= tol_f),
+                        Cand::Stick => f_n >= -tol_f && f_t[0].hypot(f_t[1]) <= contacts[k].unilateral_friction() * f_n + tol_f && !(breaking(k) && cd.margin[k] <= tol_f),
                         Cand::Slide { moving } => {
-                            f_n >= -tol_f && (moving || mu_of(&contacts[k]) == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -slip_tol(k, trial.slip[k]))
+                            f_n >= -tol_f && (moving || contacts[k].unilateral_friction() == 0.0 || accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] >= -slip_tol(k, trial.slip[k]))
                         }
                     };
                 }
@@ -354,7 +348,7 @@ pub fn choose_modes_within(
                     .enumerate()
                     .filter(|&(i, &k)| {
                         let accel = |axis: usize| cd.rows.dot(3 * k + axis, qdd) + cd.rows.bias[3 * k + axis];
-                        twins[i].is_none() && cands[i][idx[i]] == (Cand::Slide { moving: false }) && mu_of(&contacts[k]) > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k])
+                        twins[i].is_none() && cands[i][idx[i]] == (Cand::Slide { moving: false }) && contacts[k].unilateral_friction() > 0.0 && accel(1) * trial.slip[k][0] + accel(2) * trial.slip[k][1] <= slip_tol(k, trial.slip[k])
                     })
                     .map(|(i, _)| i)
                     .collect();
@@ -384,14 +378,14 @@ pub fn choose_modes_within(
             break;
         }
     }
-    let mus = closed.iter().map(|&k| format!("{} (mu = {})", contacts[k].name(), mu_of(&contacts[k]))).collect::<Vec<_>>().join(", ");
+    let mus = closed.iter().map(|&k| format!("{} (mu = {})", contacts[k].name(), contacts[k].unilateral_friction())).collect::<Vec<_>>().join(", ");
     let Some(best) = feasible.iter().enumerate().max_by_key(|(i, f)| (f.score, usize::MAX - i)).map(|(_, f)| f) else {
         // say why at each frictional contact (the rigid problem's terms at this state)
         // (a twin group once, as one contact carrying the group's force: [`as_one`])
         let whys: Vec<String> = closed
             .iter()
             .enumerate()
-            .filter(|&(i, &k)| mu_of(&contacts[k]) > 0.0 && twins[i].is_none())
+            .filter(|&(i, &k)| contacts[k].unilateral_friction() > 0.0 && twins[i].is_none())
             .filter_map(|(i, &k)| {
                 let v = cd.rows.slip(k);
                 let speed = v[0].hypot(v[1]);
@@ -505,7 +499,7 @@ pub fn one_contact(contacts: &[Contact], state: &ContactState, k: usize, stabili
         fd.b.copy_from(&b0);
         st.mode[k] = ContactMode::Sticking;
         if ok && solve_modes(contacts, &st, stabilization, fd, cd).is_ok() {
-            out = Some(OneContact { g, a0, f_n: cd.f_n[k], f_t: cd.f_t[k], mu: mu_of(&contacts[k]) });
+            out = Some(OneContact { g, a0, f_n: cd.f_n[k], f_t: cd.f_t[k], mu: contacts[k].unilateral_friction() });
         }
     }
     fd.b.copy_from(&b0);

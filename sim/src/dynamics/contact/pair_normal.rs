@@ -19,7 +19,7 @@
 //! equations are linear), as `modes::one_contact` does. Events and diagnostics only (allocates).
 
 use super::forward::{solve_modes, ContactData, ContactState};
-use super::{Contact, ContactMode, ContactModel};
+use super::{Contact, ContactMode};
 use crate::dynamics::forward::{ForwardData, Stabilization};
 
 /// The pair's normal problem at a state (m s⁻² N⁻¹ and m/s²).
@@ -78,12 +78,6 @@ impl PairNormal {
     }
 }
 
-fn mu_of(c: &Contact) -> f64 {
-    match c.model {
-        ContactModel::Unilateral { friction, .. } => friction,
-        _ => 0.0,
-    }
-}
 
 /// [`PairNormal`] of contacts `ks` sliding along `s` (unit, tangent basis), the other contacts
 /// in `state`'s modes, after [`super::forward::prepare`] at the state; None when a solve is
@@ -100,7 +94,7 @@ pub fn pair_normal(contacts: &[Contact], state: &ContactState, ks: [usize; 2], s
         let qdd = &fd.qdd.as_slice()[..nv];
         std::array::from_fn(|i| cd.rows.dot(3 * ks[i], qdd) + cd.rows.bias[3 * ks[i]])
     };
-    let mu = [mu_of(&contacts[ks[0]]), mu_of(&contacts[ks[1]])];
+    let mu = [contacts[ks[0]].unilateral_friction(), contacts[ks[1]].unilateral_friction()];
     let mut out = None;
     if solve_modes(contacts, &st, stabilization, fd, cd).is_ok() {
         let a0 = normal(fd, cd);
@@ -112,7 +106,7 @@ pub fn pair_normal(contacts: &[Contact], state: &ContactState, ks: [usize; 2], s
                 fd.b.copy_from(&b0);
                 let k = ks[j];
                 let f = if with_friction { mu[j] } else { 0.0 };
-                let (rn, r1, r2) = (cd.rows.row(3 * k).to_vec(), cd.rows.row(3 * k + 1).to_vec(), cd.rows.row(3 * k + 2).to_vec());
+                let (rn, r1, r2) = (cd.rows.row(3 * k), cd.rows.row(3 * k + 1), cd.rows.row(3 * k + 2));
                 for (v, bj) in fd.b.iter_mut().enumerate() {
                     *bj += rn[v] - f * (s[j][0] * r1[v] + s[j][1] * r2[v]);
                 }
@@ -138,7 +132,7 @@ pub fn pair_normal(contacts: &[Contact], state: &ContactState, ks: [usize; 2], s
 pub fn painleve_pairs(contacts: &[Contact], state: &ContactState, closed: &[usize], vel_tol: f64, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) -> Vec<String> {
     let sliding: Vec<(usize, [f64; 2])> = closed
         .iter()
-        .filter(|&&k| mu_of(&contacts[k]) > 0.0)
+        .filter(|&&k| contacts[k].unilateral_friction() > 0.0)
         .filter_map(|&k| {
             let v = cd.rows.slip(k);
             let m = v[0].hypot(v[1]);
