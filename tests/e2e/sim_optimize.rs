@@ -187,9 +187,17 @@ fn bad_study_files_exit_2_naming_the_file_the_field_and_the_value() {
         // the hand load: its validation names the field and the value
         (serde_json::json!([{"kind": "categorical", "field": "hand_load.mass", "values": [0.5, -1.0]}]), "hand_load.mass", "-1"),
     ];
-    for (k, (vars, field, value)) in cases.iter().enumerate() {
+    // the method: a start design names a dimension of the study and lies in its range
+    let kd = serde_json::json!([{"kind": "continuous", "field": "controller.kd", "min": 2, "max": 20}]);
+    let methods = [
+        (serde_json::json!({"start": {"controller.kp": 3}}), "method.start.controller.kp", "3"),
+        (serde_json::json!({"start": {"controller.kd": 25}}), "method.start.controller.kd", "25"),
+        (serde_json::json!({"sigma0": 0}), "method.sigma0", "0"),
+    ];
+    let cases: Vec<_> = cases.iter().map(|(v, f, x)| (v.clone(), serde_json::json!({}), *f, *x)).chain(methods.iter().map(|(m, f, x)| (kd.clone(), m.clone(), *f, *x))).collect();
+    for (k, (vars, method, field, value)) in cases.iter().enumerate() {
         let f = tmp.path().join(format!("bad{k}.json"));
-        let doc = serde_json::json!({"name": "bad", "scene": scene, "duration": 0.1, "variables": vars});
+        let doc = serde_json::json!({"name": "bad", "scene": scene, "duration": 0.1, "variables": vars, "method": method});
         std::fs::write(&f, doc.to_string()).unwrap();
         let out = run_sim(&["optimize", f.to_str().unwrap(), "-o", tmp.path().join("o").to_str().unwrap()]);
         let err = String::from_utf8_lossy(&out.stderr);

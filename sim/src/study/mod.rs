@@ -57,6 +57,8 @@ pub struct Study {
     /// Per variable: the geometry of an `on-link` variable, read from the base scene.
     pub placements: Vec<Option<Placement>>,
     pub settings: Settings,
+    /// The start design on [0, 1]^n (`method.start`; empty without one).
+    pub start: Vec<f64>,
 }
 
 /// One continuous dimension of the design space: `x = lo + u (hi − lo)` for `u ∈ [0, 1]`.
@@ -188,6 +190,27 @@ impl Study {
         if !(m.resolution > 0.0 && m.resolution < 0.5) {
             return Err(err("method.resolution", &m.resolution, "must be in (0, 0.5): a fraction of each variable's range".into()));
         }
+        if !(m.sigma0 > 0.0 && m.sigma0 <= 1.0) {
+            return Err(err("method.sigma0", &m.sigma0, "must be in (0, 1]: a fraction of each continuous range".into()));
+        }
+        let start = match &m.start {
+            None => Vec::new(),
+            Some(values) => {
+                if continuous.is_empty() {
+                    return Err(err("method.start", &"(set)", "the study has no continuous variable to start from: its discrete combinations are each evaluated once".into()));
+                }
+                for (name, &x) in values {
+                    let Some(d) = continuous.iter().find(|d| &d.name == name) else {
+                        let names: Vec<&str> = continuous.iter().map(|d| d.name.as_str()).collect();
+                        return Err(err(&format!("method.start.{name}"), &x, format!("names no continuous dimension of the study; its dimensions are {}", names.join(", "))));
+                    };
+                    if !(x.is_finite() && d.lo <= x && x <= d.hi) {
+                        return Err(err(&format!("method.start.{name}"), &x, format!("must be within the dimension's range [{}, {}]", d.lo, d.hi)));
+                    }
+                }
+                continuous.iter().map(|d| values.get(&d.name).map_or(0.5, |&x| (x - d.lo) / (d.hi - d.lo))).collect()
+            }
+        };
         if continuous.is_empty() && m.evaluations < combos {
             return Err(err("method.evaluations", &m.evaluations, format!("fewer than the {combos} discrete combinations, each evaluated once")));
         }
@@ -231,15 +254,17 @@ impl Study {
             evaluations: m.evaluations,
             population: m.population.unwrap_or_else(|| Settings::default_population(dims)),
             local_fraction: m.local_fraction,
-            sigma0: 0.3,
+            sigma0: m.sigma0,
             local_step: 0.1,
             min_step: m.resolution,
+            starts: if start.is_empty() { 0 } else { combos },
         };
         settings.check().map_err(|why| err("method.evaluations", &m.evaluations, why))?;
-        let study = Study { spec, file: file.clone(), base, discrete, continuous, placements, settings };
+        let study = Study { spec, file: file.clone(), base, discrete, continuous, placements, settings, start };
         // the corners of the design space validate as scenes (numbers too), before anything runs
         let corners = [0.0, 1.0].map(|u| Point { combo: 0, u: vec![u; dims] });
-        for p in corners.iter().chain([&Point { combo: combos - 1, u: vec![0.5; dims] }]) {
+        let centre = Point { combo: combos - 1, u: if study.start.is_empty() { vec![0.5; dims] } else { study.start.clone() } };
+        for p in corners.iter().chain([&centre]) {
             study.scene(&study.variant(0, p), None)?;
         }
         Ok(study)

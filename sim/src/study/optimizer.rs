@@ -1,6 +1,9 @@
 //! The study's optimiser as one ask/tell state ([`Optimizer`]): discrete choices (integer and
-//! categorical variables) enumerated, every combination searched by CMA-ES ([`super::cmaes`])
-//! over the continuous variables scaled to [0, 1]^n with an equal share of the global budget,
+//! categorical variables) enumerated; a start design, if the study gives one (CMA-ES's x₀,
+//! Hansen 2016 §2 / Fig. 7's inputs), evaluated first in every combination; every combination
+//! searched by CMA-ES ([`super::cmaes`]), its mean starting at the start design (else the
+//! box's centre), over the continuous variables scaled to [0, 1]^n with an equal share of the
+//! global budget,
 //! then a compass search ([`super::compass`]) from the best point of every combination in turn
 //! (each load of a study is resolved, not only the overall best), each with an equal share of
 //! what is left (what one leaves goes to the next).
@@ -31,6 +34,8 @@ pub struct Point {
 pub enum Phase {
     /// Every combination once (no continuous variables).
     Enumerate,
+    /// The start design, once in every combination.
+    Start,
     /// CMA-ES on combination `combo`, `used` evaluations of its share so far.
     Global { combo: usize, used: usize, cmaes: Cmaes },
     /// Compass search on combination `combo`, `used` evaluations so far of its `share`.
@@ -68,13 +73,17 @@ pub struct Settings {
     /// The compass search's first step and the step it stops below, on [0, 1]^n.
     pub local_step: f64,
     pub min_step: f64,
+    /// Evaluations of the start design before the global phase (one per combination; 0
+    /// without a start design).
+    #[serde(default)]
+    pub starts: usize,
 }
 
 impl Settings {
     /// Evaluations of the global phase per combination.
     pub fn global_share(&self) -> usize {
         let local = (self.evaluations as f64 * self.local_fraction).round() as usize;
-        (self.evaluations - local.min(self.evaluations)) / self.combos.max(1)
+        self.evaluations.saturating_sub(local).saturating_sub(self.starts) / self.combos.max(1)
     }
 
     /// Why these settings cannot run, if they cannot.
@@ -84,10 +93,11 @@ impl Settings {
         }
         if self.global_share() < self.population {
             return Err(format!(
-                "{} evaluation(s) leave {} per discrete combination ({} combination(s)) for the global search, fewer than one generation of {}: raise `method.evaluations` or lower `method.population`",
+                "{} evaluation(s) leave {} per discrete combination ({} combination(s){}) for the global search, fewer than one generation of {}: raise `method.evaluations` or lower `method.population`",
                 self.evaluations,
                 self.global_share(),
                 self.combos,
+                if self.starts > 0 { ", each with its start design" } else { "" },
                 self.population
             ));
         }
@@ -113,17 +123,37 @@ pub struct Optimizer {
     /// The best feasible candidate of every discrete combination (the first of equals).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub best_per_combo: Vec<Option<(Point, f64)>>,
+    /// The start design on [0, 1]^n (empty: the box's centre, not evaluated).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub start: Vec<f64>,
     pub phase: Phase,
 }
 
 impl Optimizer {
+    /// An optimiser from its settings, without a start design.
     pub fn new(settings: Settings) -> Optimizer {
-        let phase = if settings.dims == 0 { Phase::Enumerate } else { Self::global(&settings, 0) };
-        Optimizer { settings, rng: Rng(settings.seed), generation: 0, evaluations: 0, best: None, best_per_combo: vec![None; settings.combos], phase }
+        Self::with_start(settings, Vec::new())
     }
 
-    fn global(s: &Settings, combo: usize) -> Phase {
-        Phase::Global { combo, used: 0, cmaes: Cmaes::new(vec![0.5; s.dims], s.sigma0, s.population) }
+    /// An optimiser whose search starts at `start` (on [0, 1]^n; empty: the box's centre, not
+    /// evaluated); `settings.starts` must be the combinations' count with a start, 0 without.
+    pub fn with_start(settings: Settings, start: Vec<f64>) -> Optimizer {
+        assert!(start.is_empty() || (start.len() == settings.dims && settings.starts == settings.combos), "a start design has one coordinate per dimension and is evaluated once per combination");
+        let mut o = Optimizer { settings, rng: Rng(settings.seed), generation: 0, evaluations: 0, best: None, best_per_combo: vec![None; settings.combos], start, phase: Phase::Done };
+        o.phase = if settings.dims == 0 {
+            Phase::Enumerate
+        } else if o.start.is_empty() {
+            o.global(0)
+        } else {
+            Phase::Start
+        };
+        o
+    }
+
+    fn global(&self, combo: usize) -> Phase {
+        let s = &self.settings;
+        let mean = if self.start.is_empty() { vec![0.5; s.dims] } else { self.start.clone() };
+        Phase::Global { combo, used: 0, cmaes: Cmaes::new(mean, s.sigma0, s.population) }
     }
 
     pub fn done(&self) -> bool {
@@ -134,6 +164,7 @@ impl Optimizer {
     pub fn ask(&mut self) -> Vec<Point> {
         match &self.phase {
             Phase::Enumerate => (0..self.settings.combos).map(|combo| Point { combo, u: Vec::new() }).collect(),
+            Phase::Start => (0..self.settings.combos).map(|combo| Point { combo, u: self.start.clone() }).collect(),
             Phase::Global { combo, cmaes, .. } => cmaes.ask(&mut self.rng).into_iter().map(|u| Point { combo: *combo, u }).collect(),
             Phase::Local { combo, compass, .. } => compass.ask().into_iter().map(|u| Point { combo: *combo, u }).collect(),
             Phase::Done => Vec::new(),
@@ -163,13 +194,16 @@ impl Optimizer {
         let budget_left = s.evaluations.saturating_sub(self.evaluations);
         self.phase = match std::mem::replace(&mut self.phase, Phase::Done) {
             Phase::Enumerate | Phase::Done => Phase::Done,
+            // the start design's values are kept as the best so far, not told to CMA-ES (its
+            // update learns from its own samples around the mean)
+            Phase::Start => self.global(0),
             Phase::Global { combo, used, mut cmaes } => {
                 cmaes.tell(&us, f);
                 let used = used + points.len();
                 if used + s.population <= s.global_share() {
                     Phase::Global { combo, used, cmaes }
                 } else if combo + 1 < s.combos {
-                    Self::global(&s, combo + 1)
+                    self.global(combo + 1)
                 } else {
                     self.local_phase(0, budget_left)
                 }
@@ -218,6 +252,7 @@ mod tests {
             sigma0: 0.3,
             local_step: 0.05,
             min_step: 1e-4,
+            starts: 0,
         }
     }
 
@@ -318,10 +353,69 @@ mod tests {
         assert!((p.u[0] - 0.6).abs() < 2e-3, "{:?}", p.u);
     }
 
+    /// A broad bowl with its minimum 1 at (0.3, 0.3) and a narrow well (radius ≈ 0.03) going
+    /// down to 0 at (0.8, 0.75): the shape of the pair study's landscape, where the best design
+    /// sits in a valley a few hundredths of the box wide.
+    fn bowl_and_well(u: &[f64]) -> f64 {
+        let bowl = 1.0 + (u[0] - 0.3).powi(2) + (u[1] - 0.3).powi(2);
+        let well = 1000.0 * ((u[0] - 0.8).powi(2) + (u[1] - 0.75).powi(2));
+        bowl.min(well)
+    }
+
+    #[test]
+    fn a_start_design_is_evaluated_first_in_every_combination_and_the_search_starts_there() {
+        let mut s = settings(2, 2, 120);
+        s.starts = 2;
+        let start = vec![0.78, 0.76];
+        let mut o = Optimizer::with_start(s, start.clone());
+        let first = o.ask();
+        assert_eq!(first, vec![Point { combo: 0, u: start.clone() }, Point { combo: 1, u: start.clone() }]);
+        o.tell(&first, &[2.0, 1.0]);
+        // both start values are kept as each combination's best so far
+        assert_eq!(o.best, Some((first[1].clone(), 1.0)));
+        assert_eq!(o.best_per_combo[0], Some((first[0].clone(), 2.0)));
+        match &o.phase {
+            Phase::Global { combo: 0, used: 0, cmaes } => assert_eq!(cmaes.mean, start),
+            p => panic!("after the start design: {p:?}"),
+        }
+        // the start's evaluations come out of the global budget: 120 in all
+        let mut n = 2;
+        while !o.done() {
+            let pts = o.ask();
+            n += pts.len();
+            let v: Vec<f64> = pts.iter().map(|p| p.combo as f64 + bowl_and_well(&p.u)).collect();
+            o.tell(&pts, &v);
+        }
+        assert!(n <= 120 && o.evaluations == n, "{n} evaluations");
+    }
+
+    #[test]
+    fn a_narrow_well_the_centre_start_misses_is_resolved_from_a_start_design_in_it() {
+        let s = settings(2, 1, 120);
+        // from the centre (seed 3, 120 evaluations) the search settles in the broad bowl ...
+        let (p, v, _) = minimise(s, |_, u| bowl_and_well(u));
+        assert!(v > 0.99 && (p.u[0] - 0.3).abs() < 0.02, "from the centre: u = {:?}, f = {v}", p.u);
+        // ... and from a start design inside the well (f = 0.8 there) it reaches the well's
+        // bottom to 2e-3 (the compass search, 30 % of the 120 evaluations, ends on its budget)
+        let mut s = s;
+        s.starts = 1;
+        let mut o = Optimizer::with_start(s, vec![0.78, 0.77]);
+        while !o.done() {
+            let pts = o.ask();
+            let v: Vec<f64> = pts.iter().map(|p| bowl_and_well(&p.u)).collect();
+            o.tell(&pts, &v);
+        }
+        let (p, v) = o.best.clone().unwrap();
+        assert!(o.evaluations <= 120);
+        assert!((p.u[0] - 0.8).abs() < 2e-3 && (p.u[1] - 0.75).abs() < 2e-3, "from the start: u = {:?}, f = {v}", p.u);
+    }
+
     #[test]
     fn the_state_resumes_exactly_through_json() {
         let f = |_: usize, u: &[f64]| (u[0] - 0.3).powi(2) + 3.0 * (u[1] - 0.6).powi(2);
-        let mut a = Optimizer::new(settings(2, 1, 120));
+        let mut s = settings(2, 1, 120);
+        s.starts = 1;
+        let mut a = Optimizer::with_start(s, vec![0.2, 0.9]);
         let mut b = a.clone();
         let mut g = 0;
         while !a.done() {

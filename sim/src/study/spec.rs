@@ -2,6 +2,8 @@
 //! refused, every field with its description (the schema `sim schema study` prints and the
 //! book's "Study fields" page). [`super::Study`] is it checked.
 
+use std::collections::BTreeMap;
+
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -174,6 +176,18 @@ pub struct MethodSpec {
     /// (default 1e-3).
     #[serde(default = "a_thousandth")]
     pub resolution: f64,
+    /// A design to start from (CMA-ES's x₀): values of some or all continuous dimensions, by
+    /// their names in the tables (a continuous variable's dot path, `<contact>.along`,
+    /// `<contact>.around`); the others start at their range's centre. It is evaluated first, in
+    /// every discrete combination, and each combination's CMA-ES starts its mean there. E.g. a
+    /// pair study started from the best single brace (default: every range's centre, not
+    /// evaluated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<BTreeMap<String, f64>>,
+    /// CMA-ES's initial step size σ₀, a fraction of every continuous range, in (0, 1]
+    /// (default 0.3).
+    #[serde(default = "three_tenths", skip_serializing_if = "is_three_tenths")]
+    pub sigma0: f64,
 }
 
 fn one() -> u64 {
@@ -185,13 +199,26 @@ fn two_hundred() -> usize {
 fn three_tenths() -> f64 {
     0.3
 }
+// a default σ₀ is left out of the study as written into its state file, so that a state
+// written before the field existed still resumes
+fn is_three_tenths(x: &f64) -> bool {
+    *x == three_tenths()
+}
 fn a_thousandth() -> f64 {
     1e-3
 }
 
 impl Default for MethodSpec {
     fn default() -> Self {
-        MethodSpec { seed: one(), evaluations: two_hundred(), population: None, local_fraction: three_tenths(), resolution: a_thousandth() }
+        MethodSpec {
+            seed: one(),
+            evaluations: two_hundred(),
+            population: None,
+            local_fraction: three_tenths(),
+            resolution: a_thousandth(),
+            start: None,
+            sigma0: three_tenths(),
+        }
     }
 }
 

@@ -245,7 +245,7 @@ pub fn run(args: &OptimizeArgs, v: Verbosity) -> Result<u8> {
                 started.elapsed().as_secs_f64()
             );
         }
-        State { study: study.spec.name.clone(), spec: spec_value, calibration, optimizer: Optimizer::new(study.settings), evaluations: Vec::new() }
+        State { study: study.spec.name.clone(), spec: spec_value, calibration, optimizer: Optimizer::with_start(study.settings, study.start.clone()), evaluations: Vec::new() }
     };
     let rtol = state.calibration.as_ref().map(|c| c.loose);
     let bar = cli::progress::count(study.settings.evaluations, &study.spec.name, "evaluations", v.quiet);
