@@ -155,3 +155,35 @@ fn the_where_pair_design_whose_touch_down_refired_completes() {
         assert!(!(w[0].contact == w[1].contact && w[0].kind == w[1].kind && w[1].t - w[0].t < 1e-9), "repeated event {:?} {:?}", w[0], w[1]);
     }
 }
+
+/// The same design at the study's tight tolerance (`touchdown-refire-pair-tight.json`: rtol
+/// 1e-8, atol 1e-10, 0.1 s) stopped at 0.072268126 s with 33 touch-downs of elbow7 at one
+/// instant, by another path: elbow7 lands (plastic, −0.1065 m/s), throws elbow4 off, and the
+/// mode problem separates elbow7 (ġ = 0, g̈ = +0.43 m/s²); elbow7 rises ~1e-11 m and lands
+/// again inside the restart's first step (8.3e-5 s), which ends 3.5e-9 m below its start gap.
+/// Its touch-down, watched from that gap, fired at the step's start because the rise (1.4e-11
+/// m at a probe) was judged against the 1e-9 m dead band; the handler found elbow7 at ġ = 0
+/// leaving again, and the step was retaken. Now a gap's departure is judged against its
+/// rounding (`GAP_DEPARTURE`, 1e-12 m, `HybridSystem::event_departure`) and the second landing
+/// is located: 24.1 µs after the first at −5.2e-6 m/s (from ġ = 0 and g̈ = +0.43 m/s² a
+/// return needs g̈ to turn, so it comes after the step's start and before its end, at an
+/// approach speed above `vel_tol` and far below the first landing's). The run completes with
+/// the audit at every sample and the balance within 1e-8 of E (measured 1.6e-9), no contact
+/// logs the same event twice within 1e-9 s, and elbow4's flight is the ballistic 2 ġ⁺ / |g̈|
+/// as at rtol 1e-5 (2 %). Fails on the old driver (the 33 touch-downs).
+#[test]
+fn the_where_pair_design_whose_touch_down_refired_completes_at_the_tight_tolerance() {
+    let c = completes_with_the_audit_and_the_balance("elbow4 under the hand, elbow7 at joint 7, rtol 1e-8", &scene("touchdown-refire-pair-tight.json", None), "two-elbow-unilateral", 1e-8);
+    let landing = c.events.iter().find(|e| e.kind == ContactEventKind::Impact && e.contact == 1 && (e.t - 0.072268126).abs() < 1e-6).unwrap_or_else(|| panic!("elbow7's landing at 0.072268126 s: {:?}", c.events));
+    let again = c.events.iter().find(|e| e.contact == 1 && e.t > landing.t && matches!(e.kind, ContactEventKind::Impact | ContactEventKind::Rest)).unwrap_or_else(|| panic!("elbow7 lands again: {:?}", c.events));
+    assert!(again.t - landing.t > 1e-6 && again.t - landing.t < 8.3e-5, "elbow7 lands again {} s after its landing", again.t - landing.t);
+    assert!(again.gap_rate_before < -1e-9 && again.gap_rate_before > 1e-3 * landing.gap_rate_before, "elbow7's second approach {} m/s (first {} m/s)", again.gap_rate_before, landing.gap_rate_before);
+    let thrown = c.events.iter().find(|e| e.kind == ContactEventKind::LiftOff && e.contact == 0 && e.t == landing.t).unwrap_or_else(|| panic!("elbow4 thrown off at elbow7's landing: {:?}", c.events));
+    let back = c.events.iter().find(|e| e.contact == 0 && e.t > landing.t && matches!(e.kind, ContactEventKind::Impact | ContactEventKind::Rest)).unwrap_or_else(|| panic!("elbow4 lands again: {:?}", c.events));
+    let flight = 2.0 * thrown.gap_rate_after / 102.2;
+    assert!(((back.t - landing.t) - flight).abs() <= 0.02 * flight, "elbow4's flight {} s, ballistic {flight} s", back.t - landing.t);
+    for w in c.events.windows(2) {
+        assert!(!(w[0].contact == w[1].contact && w[0].kind == w[1].kind && w[1].t - w[0].t < 1e-9), "repeated event {:?} {:?}", w[0], w[1]);
+    }
+    assert!(c.events.len() <= 40, "{} events in 0.1 s: {:?}", c.events.len(), c.events);
+}

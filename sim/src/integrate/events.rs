@@ -133,6 +133,19 @@ pub trait HybridSystem: OdeSystem {
         let _ = i;
         None
     }
+
+    /// How far off its firing side a watched function that fired at a step's start must be
+    /// found at a probe inside the step for the driver to take it as having left and come back
+    /// (`locate::departed_inside`), in the function's units. The default: its
+    /// [`HybridSystem::event_tolerance`] (a force of `−c t³` computed as `+1e-20` at a tiny
+    /// probe is no departure). A system whose function is computed to far better than its dead
+    /// band (a contact's gap: rounding ~1e-15 m against a dead band of 1e-9 m) gives that
+    /// smaller bound, so an excursion above the rounding but inside the dead band (a contact
+    /// that lifts off by 1e-11 m and lands again within the step) is located, not fired at the
+    /// step's start, where the handler finds it leaving again and the same step is retaken.
+    fn event_departure(&self, i: usize) -> Option<f64> {
+        self.event_tolerance(i)
+    }
 }
 
 /// Settings of the event driver.

@@ -43,6 +43,20 @@ fn stops_here(v_t: [f64; 2], vel_tol: f64) -> bool {
     v_t[0].hypot(v_t[1]) <= vel_tol.max(SLIP_DIRECTION_SPEED)
 }
 
+/// How far above its start gap, m, a separated contact watched from its start value (at or
+/// below it after a lift-off, or after a landing the mode problem separated again) must be
+/// found inside a step to count as having left the table and come back (`integrate::events`,
+/// `departed_inside`), instead of its touch-down firing at the step's start. The gap is
+/// `n · p − d` with `|p|` a few metres, computed to a few ulp of that (~1e-15 m); this bound
+/// is 1000 times that and 1/1000 of the closed-contact tolerance `gap_tol` (1e-9 m), which
+/// stays the dead band for *firing*. Traced (issue 23 item 6 A,
+/// `touchdown-refire-pair-tight.json`, rtol 1e-8, atol 1e-10): elbow7, landed at 0.0722681 s
+/// and separated by the mode problem (ġ = 0, g̈ = +0.43 m/s²), rises ~1e-11 m and lands again
+/// inside the restart's 8.3e-5-s step, which ends 3.5e-9 m below its start gap; with the dead
+/// band as the departure bound its touch-down fired at the step's start, the handler found
+/// elbow7 at ġ = 0 leaving again, and the same step was retaken 33 times.
+pub const GAP_DEPARTURE: f64 = 1e-12;
+
 /// The contacts' part of the [`HybridSystem`] (`drive_modes.rs` has the drives' part; the
 /// trait's implementation there joins them: the contacts' functions come first).
 impl ArmSystem<'_> {
@@ -72,6 +86,18 @@ impl ArmSystem<'_> {
             (ContactModel::Unilateral { .. }, ContactMode::Sliding, 1) if h.state.onset[k].is_none() => Some(cs.vel_tol),
             (ContactModel::Unilateral { .. }, ContactMode::Sticking | ContactMode::Sliding, _) => Some(1e-8),
             _ => None,
+        }
+    }
+
+    /// How far above its start gap a separated unilateral contact's touch-down function must
+    /// be found inside a step to have left the table (`HybridSystem::event_departure`):
+    /// [`GAP_DEPARTURE`]; the other functions' bound is their dead band.
+    pub(super) fn contact_event_departure(&self, i: usize) -> Option<f64> {
+        let h = self.hybrid.as_ref()?;
+        let k = i / 2;
+        match (h.contacts[k].model, h.state.mode[k], i % 2) {
+            (ContactModel::Unilateral { .. }, ContactMode::Separated, 0) => Some(GAP_DEPARTURE),
+            _ => self.contact_event_tolerance(i),
         }
     }
 

@@ -445,6 +445,15 @@ impl HybridSystem for ArmSystem<'_> {
         }
     }
 
+    fn event_departure(&self, i: usize) -> Option<f64> {
+        let nc = self.contact_n_events();
+        if i < nc {
+            self.contact_event_departure(i)
+        } else {
+            self.drive_event_tolerance(i - nc)
+        }
+    }
+
     fn events(&mut self, t: f64, y: &[f64], out: &mut [f64]) -> Result<(), RunError> {
         let nc = self.contact_n_events();
         self.contact_events(t, y, &mut out[..nc])?;

@@ -24,6 +24,9 @@ pub(super) struct Bracket {
     watched: Vec<bool>,
     /// `event_tolerance(i)` of the watched functions, read with the bases.
     tolerance: Vec<f64>,
+    /// `event_departure(i)` of the watched functions (at most their tolerance), read with the
+    /// bases: how far off its firing side a probe of [`departed_inside`] must find it.
+    departure: Vec<f64>,
     /// The functions [`Bracket::left_at_start`] fired, kept while another function's root in
     /// the same step is located ([`Bracket::hold_start_firing`]).
     start_fired: Vec<bool>,
@@ -46,6 +49,7 @@ impl Bracket {
             base: vec![0.0; n],
             watched: vec![false; n],
             tolerance: vec![0.0; n],
+            departure: vec![0.0; n],
             start_fired: vec![false; n],
         }
     }
@@ -64,6 +68,7 @@ impl Bracket {
             self.watched[i] = on_firing_side && g.is_finite() && tolerance.is_some();
             self.base[i] = if self.watched[i] { g } else { 0.0 };
             self.tolerance[i] = tolerance.unwrap_or(0.0);
+            self.departure[i] = sys.event_departure(i).map_or(self.tolerance[i], |d| d.min(self.tolerance[i]));
             if self.watched[i] {
                 self.g_lo[i] = 0.0;
             }
@@ -294,8 +299,9 @@ pub(super) fn locate_root<S: HybridSystem, St: Stepper<S> + ?Sized>(
 /// first probe `t_p` where every fired function is off its firing side, `fired` is cleared and
 /// the bracket to locate returned: `[t_p, t_hi]` with the probe's values as `g_lo`, or
 /// `[t_lo, t_p]` with them as `g_hi` when some function changes sign before `t_p` (the earlier
-/// root). Off the firing side means by more than the function's tolerance
-/// ([`HybridSystem::event_tolerance`]), as past it towards the firing side does for firing.
+/// root). Off the firing side means by more than the function's departure bound
+/// ([`HybridSystem::event_departure`], by default its [`HybridSystem::event_tolerance`], as
+/// past it towards the firing side does for firing).
 /// `None`: they moved straight to their firing side; they fire at the step's start.
 /// `y` is scratch (length dim).
 #[allow(clippy::too_many_arguments)]
@@ -323,11 +329,12 @@ pub(super) fn departed_inside<S: HybridSystem, St: Stepper<S> + ?Sized>(
         stepper.interpolate(t_p, y);
         sys.events(t_p, y, &mut br.g_mid).map_err(IntegrateError::Rhs)?;
         shift(&mut br.g_mid, &br.base, &br.watched);
-        // off the firing side by more than the function's tolerance, as firing needs past it
-        // (a force of −c t³ computed as +1e-20 at a tiny probe is no departure)
+        // off the firing side by more than the function's departure bound (its tolerance, as
+        // firing needs past it, unless the system resolves it finer: a force of −c t³ computed
+        // as +1e-20 at a tiny probe is no departure; a gap 1e-11 m up is)
         let departed = (0..n).filter(|&i| br.fired[i]).all(|i| match br.dir[i] {
-            d if d < 0 => br.g_mid[i] > br.tolerance[i],
-            d if d > 0 => br.g_mid[i] < -br.tolerance[i],
+            d if d < 0 => br.g_mid[i] > br.departure[i],
+            d if d > 0 => br.g_mid[i] < -br.departure[i],
             _ => false,
         });
         if departed {

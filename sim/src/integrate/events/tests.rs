@@ -519,3 +519,68 @@ fn a_function_within_its_dead_band_does_not_pre_empt_another_root_in_the_step() 
         assert!((t - t_r).abs() <= 1e-12, "{name}: first event at {t}, closed form {t_r}");
     }
 }
+
+/// A gap that starts at 0 (watched from there, dead band `tol`) and rises less than the dead
+/// band before it comes back through: `x'' = a − b t` from rest, `x = a t²/2 − b t³/6`, its
+/// top `a³/(3 b²)` at `a/b` and its return to 0 at `t* = 3 a/b`; one step of 0.01 s (rk4's;
+/// the adaptive methods' first step, exact for this cubic) ends at `x = −1.2e-7` < `−tol`.
+/// With a departure bound below the top (`event_departure`, 1e-12 against the top 3.3e-10 and
+/// `tol` 1e-9) the probe at h/4 (`x` = 5.2e-10) is a departure and the return is located at
+/// `t*` (to 1e-12 s); with the bound at the dead band (the default) the function fires at the
+/// step's start, t = 0, where a contact's handler finds it leaving again and the same step is
+/// retaken (issue 23 item 6 A, `touchdown-refire-pair-tight.json`).
+struct RiseBelowTheDeadBand {
+    a: f64,
+    b: f64,
+    tol: f64,
+    departure: Option<f64>,
+    reached: bool,
+}
+
+impl Law for RiseBelowTheDeadBand {
+    fn n(&self) -> usize {
+        1
+    }
+    fn dir(&self, _i: usize) -> i8 {
+        -1
+    }
+    fn acc(&self, t: f64, _y: &[f64]) -> f64 {
+        self.a - self.b * t
+    }
+    fn events(&self, _t: f64, y: &[f64], out: &mut [f64]) {
+        out[0] = if self.reached { 1.0 } else { y[0] };
+    }
+    fn handle(&mut self, _t: f64, _y: &mut [f64], fired: &[bool]) -> bool {
+        self.reached |= fired[0];
+        false
+    }
+    fn watch(&self) -> Option<f64> {
+        Some(self.tol)
+    }
+    fn departure(&self) -> Option<f64> {
+        self.departure.or(Some(self.tol))
+    }
+}
+
+#[test]
+fn a_rise_below_the_dead_band_and_back_is_located_with_a_finer_departure_bound() {
+    let (a, b, tol, h): (f64, f64, f64, f64) = (1e-3, 1.0, 1e-9, 0.01);
+    let t_star = 3.0 * a / b;
+    let top = a.powi(3) / (3.0 * b * b);
+    assert!(top > 1e-12 && top < tol && a * h * h / 2.0 - b * h.powi(3) / 6.0 < -tol);
+    let ctl = StepControl { h_max: h, h_init: Some(h), ..StepControl::new(1e-8, 1e-10) };
+    for (departure, want) in [(Some(1e-12), t_star), (None, 0.0)] {
+        let steppers: Vec<Named<RiseBelowTheDeadBand>> = vec![
+            ("rk4", Box::new(Rk4::new(2, h))),
+            ("dopri45", Box::new(DormandPrince45::new(2, ctl))),
+            ("rodas5p", Box::new(Rodas::new(2, ctl))),
+        ];
+        for (name, mut st) in steppers {
+            let mut toy = Toy::new(RiseBelowTheDeadBand { a, b, tol, departure, reached: false });
+            run(st.as_mut(), &mut toy, [0.0, 0.0], 2.0 * h, h, EventSettings::default()).expect(name);
+            let (t, fired, _) = &toy.log[0];
+            assert_eq!(fired, &vec![true], "{name}: {:?}", toy.log);
+            assert!((t - want).abs() <= 1e-12, "{name}, departure {departure:?}: the event at {t} s, want {want} s");
+        }
+    }
+}

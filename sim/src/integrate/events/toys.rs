@@ -22,6 +22,10 @@ pub(super) trait Law {
     fn watch(&self) -> Option<f64> {
         None
     }
+    /// [`HybridSystem::event_departure`] of every function. Default: its tolerance.
+    fn departure(&self) -> Option<f64> {
+        self.watch()
+    }
     /// The modes at the start; may move `y` (returns whether it did). Default: nothing.
     fn init(&mut self, _y: &mut [f64]) -> bool {
         false
@@ -104,6 +108,9 @@ impl<L: Law> HybridSystem for Toy<L> {
     }
     fn event_tolerance(&self, _i: usize) -> Option<f64> {
         self.law.watch()
+    }
+    fn event_departure(&self, _i: usize) -> Option<f64> {
+        self.law.departure()
     }
     // the toys exercise the restarts that keep the step (`Stepper::first_step_after_restart`):
     // the bouncing ball's first step after a bounce must stay Hairer's (a disarmed function)
