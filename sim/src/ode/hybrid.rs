@@ -26,7 +26,9 @@
 //! adds its kinetic-energy loss to the contacts' impact-loss quadratures and the rotors'
 //! impulsive torque work `−J_m (q̇⁺² − q̇⁻²)/2` to the link works W_j. Allocation happens at
 //! events only (the mode enumeration, the impact), not in the step loop. The event functions
-//! and the event handler are in `contact_events.rs` (file size).
+//! and the event handler are in `contact_events.rs` (file size); the end of an accumulation of
+//! impacts (a lift-off whose flight stays within `gap_tol` held closed, a landed contact's
+//! departure at ġ = 0) in `zeno.rs`.
 
 use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState, SLIP_DIRECTION_SPEED};
 use crate::dynamics::contact::impact::solve_impact;
@@ -38,6 +40,7 @@ use crate::integrate::Watch;
 use crate::scene::{Run, Scene};
 
 use super::arm::{currents_in, plant, ArmSystem};
+use super::zeno::{flight_within_gap_tol, DEPARTURE_DEPTH};
 
 /// The hybrid part of an [`ArmSystem`].
 pub(crate) struct Hybrid {
@@ -71,6 +74,9 @@ pub(crate) struct Hybrid {
     /// Whether `gap_ref` is to be taken at the next evaluation of the event functions (the
     /// restart after the event that made the contact leave).
     pub(crate) rebound: Vec<bool>,
+    /// The contacts an impact at the current event landed and closed (ġ⁺ ≤ `vel_tol`), read
+    /// (and cleared) by the mode problem's call after it (`resolve_modes`).
+    pub(crate) landed: Vec<bool>,
 }
 
 impl Hybrid {
@@ -95,6 +101,7 @@ impl Hybrid {
             gap_ref: vec![0.0; nc],
             rebound_t: vec![f64::NAN; nc],
             rebound: vec![false; nc],
+            landed: vec![false; nc],
             contacts,
         }
     }
@@ -275,6 +282,7 @@ impl ArmSystem<'_> {
         self.prepare_at(t, y)?;
         let h = self.hybrid.as_ref().expect("hybrid");
         let st = h.settings;
+        let nc = h.contacts.len();
         let mut uni = Vec::new();
         let mut bil = Vec::new();
         for (k, c) in h.contacts.iter().enumerate() {
@@ -292,19 +300,24 @@ impl ArmSystem<'_> {
         }
         let fd = &self.ws.fd;
         let mut imp = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &uni, &bil, t)?;
-        // the end of an accumulation of impacts ([`gap_resolution`]): a plastic contact the
-        // impulse leaves separating slower than the step control resolves stays closed, its
-        // ġ⁺ held at 0 as a bilateral row's in the impact (its impulse and the energy it takes
-        // are the impact's, booked below); repeated while the held set grows (≤ m solves)
+        // the end of an accumulation of impacts ([`gap_resolution`], `zeno::flight_within_gap_tol`):
+        // a plastic contact the impulse leaves separating slower than the step control resolves,
+        // or whose flight would not rise above the closed band `gap_tol`, stays closed, its ġ⁺
+        // held at 0 as a bilateral row's in the impact (its impulse and the energy it takes are
+        // the impact's, booked below); repeated while the held set grows (≤ m solves)
         let tolerances = self.scene.integrator().tolerances();
-        let qd0 = &y[l.qd()];
+        let qd0 = y[l.qd()].to_vec();
         let mut held: Vec<usize> = Vec::new();
         loop {
-            let more: Vec<usize> = uni
-                .iter()
-                .filter(|&&(k, e)| e == 0.0 && !held.contains(&k) && imp.gap_rate_after[k] > st.vel_tol && imp.gap_rate_after[k] <= gap_resolution(tolerances, &h.cd.rows, k, qd0, y.len()))
-                .map(|&(k, _)| k)
-                .collect();
+            let h = self.hybrid.as_ref().expect("hybrid");
+            let (vel_tol, gap_tol) = (h.settings.vel_tol, h.settings.gap_tol);
+            let lifted: Vec<usize> = uni.iter().filter(|&&(k, e)| e == 0.0 && !held.contains(&k) && imp.gap_rate_after[k] > vel_tol).map(|&(k, _)| k).collect();
+            if lifted.is_empty() {
+                break;
+            }
+            let noise: Vec<bool> = lifted.iter().map(|&k| imp.gap_rate_after[k] <= gap_resolution(tolerances, &h.cd.rows, k, &qd0, y.len())).collect();
+            let w = if noise.iter().all(|&n| n) { vec![f64::NAN; nc] } else { self.flight_accelerations(t, y, &imp, &uni)? };
+            let more: Vec<usize> = lifted.iter().zip(&noise).filter(|&(&k, &n)| n || flight_within_gap_tol(imp.gap_rate_after[k], w[k], gap_tol)).map(|(&k, _)| k).collect();
             if more.is_empty() {
                 break;
             }
@@ -312,12 +325,16 @@ impl ArmSystem<'_> {
             trial.extend(more);
             let free: Vec<(usize, f64)> = uni.iter().copied().filter(|(k, _)| !trial.contains(k)).collect();
             let fixed: Vec<usize> = bil.iter().chain(&trial).copied().collect();
+            let h = self.hybrid.as_ref().expect("hybrid");
+            let fd = &self.ws.fd;
             // no solution with them held (every active set singular or infeasible): the impact
             // as solved, they leave as before
             let Ok(i) = solve_impact(&h.contacts, &h.cd.rows, fd.m_j.as_slice(), &fd.l_inv_diag, &free, &fixed, t) else { break };
             imp = i;
             held = trial;
         }
+        let h = self.hybrid.as_ref().expect("hybrid");
+        let st = h.settings;
         let d = &self.scene.drives;
         for j in 0..nv {
             let before = y[l.qd().start + j];
@@ -327,6 +344,7 @@ impl ArmSystem<'_> {
         }
         let mut closed = Vec::new();
         let mut opened = Vec::new();
+        let mut landed = Vec::new();
         let vel_tol = st.vel_tol;
         let rest_velocity = st.rest_velocity;
         for &k in uni.iter().map(|(k, _)| k).chain(bil.iter()) {
@@ -336,6 +354,9 @@ impl ArmSystem<'_> {
             let (before, after) = (imp.gap_rate_before[k], imp.gap_rate_after[k]);
             if after <= vel_tol {
                 closed.push(k);
+                if approaching.contains(&k) {
+                    landed.push(k);
+                }
             } else {
                 opened.push(k);
             }
@@ -343,6 +364,10 @@ impl ArmSystem<'_> {
                 let kind = if -before < rest_velocity { ContactEventKind::Rest } else { ContactEventKind::Impact };
                 self.log(ContactEvent { t, contact: k, kind, impulse: imp.impulse[k], energy_lost: imp.energy_lost[k], gap_rate_before: before, gap_rate_after: after })?;
             }
+        }
+        let h = self.hybrid.as_mut().expect("hybrid");
+        for k in landed {
+            h.landed[k] = true;
         }
         Ok((closed, opened))
     }
@@ -360,6 +385,16 @@ impl ArmSystem<'_> {
             }
         }
         choose_modes_within(&h.contacts, &mut h.state, closed, preferred, h.settings.vel_tol, stab, &mut self.ws.fd, &mut h.cd, t, h.watch)?;
+        for k in 0..h.contacts.len() {
+            // a contact an impact closed and the mode problem separates at ġ ≈ 0 (g̈ > 0):
+            // its departure is located from g₀ − `zeno::DEPARTURE_DEPTH`
+            let st = h.settings;
+            if std::mem::take(&mut h.landed[k]) && h.state.mode[k] == ContactMode::Separated && h.cd.rows.gap[k].abs() <= st.gap_tol && h.cd.rows.vel[3 * k].abs() <= st.vel_tol {
+                h.gap_ref[k] = h.cd.rows.gap[k].min(0.0) - DEPARTURE_DEPTH;
+                h.rebound_t[k] = t;
+                h.rebound[k] = false;
+            }
+        }
         let mut events = Vec::new();
         for k in 0..h.contacts.len() {
             let (a, b) = (before[k], h.state.mode[k]);

@@ -53,6 +53,7 @@ mod outputs;
 mod projection;
 mod stop_slip;
 mod workspace;
+mod zeno;
 
 pub use arm::ArmSystem;
 pub use drive_modes::GearEvent;
