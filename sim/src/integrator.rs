@@ -9,9 +9,9 @@ use schemas::IntegratorInfo;
 use crate::error::{short, SceneError};
 use crate::integrate::{
     integrate_hybrid, integrate_sampled_within, ArkImex, EventSettings, HybridSystem, DormandPrince45, IntegrateError, OdeJacobian, Rk4, Rodas, RodasMethod, Rosenbrock, SplitSystem, Stats,
-    StepControl, Stepper,
+    StepControl, StepSizeControl, Stepper,
 };
-use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, RosenbrockSpec};
+use crate::scene::spec::{AdaptiveSpec, IntegratorSpec, RosenbrockSpec, StepSizeControlSpec};
 
 /// Most step attempts of a run when a scene does not say (`max_steps`).
 pub const DEFAULT_MAX_STEPS: u64 = 100_000_000;
@@ -24,18 +24,19 @@ pub enum Integrator {
     /// Dormand–Prince 5(4).
     Dopri45(StepControl),
     /// ROS34PW2 with the arm's structured Jacobian, refreshed every `jacobian_reuse` steps.
-    Rosenbrock { control: StepControl, jacobian_reuse: usize },
+    Rosenbrock { control: StepControl, jacobian_reuse: usize, step_size_control: StepSizeControl },
     /// ARK4(3)6L[2]SA, the armature circuits implicit.
     Imex(StepControl),
     /// RODAS5P or RODAS4 with the exact Jacobian (finite differences over the q, q̇, i block),
     /// refreshed every `jacobian_reuse` steps.
-    Rodas { method: RodasMethod, control: StepControl, jacobian_reuse: usize },
+    Rodas { method: RodasMethod, control: StepControl, jacobian_reuse: usize, step_size_control: StepSizeControl },
 }
 
 impl Integrator {
     /// Validates `spec` of a scene read from `file` whose runs last `duration` s and are
     /// recorded every `output_interval` s. Defaults: `h_max` = the output interval (no step
-    /// skips over a sample), `max_steps` = [`DEFAULT_MAX_STEPS`], `jacobian_reuse` = 1.
+    /// skips over a sample), `max_steps` = [`DEFAULT_MAX_STEPS`], `jacobian_reuse` = 1,
+    /// `step_size_control` = elementary.
     pub fn from_spec(spec: &IntegratorSpec, file: &str, duration: f64, output_interval: f64) -> Result<Self, SceneError> {
         let err = |field: &str, value: &dyn std::fmt::Display, why: &str| SceneError::new(file, format!("integrator.{field}"), value, why);
         let control = |rtol: f64, atol: f64, h_max: Option<f64>, max_steps: Option<u64>| -> Result<StepControl, SceneError> {
@@ -86,7 +87,11 @@ impl Integrator {
                 Integrator::Imex(control(*rtol, *atol, *h_max, *max_steps)?)
             }
             IntegratorSpec::Rosenbrock(s) | IntegratorSpec::Rodas5p(s) | IntegratorSpec::Rodas4(s) => {
-                let RosenbrockSpec { rtol, atol, h_max, max_steps, jacobian_reuse } = s;
+                let RosenbrockSpec { rtol, atol, h_max, max_steps, jacobian_reuse, step_size_control } = s;
+                let step_size_control = match step_size_control {
+                    None | Some(StepSizeControlSpec::Elementary) => StepSizeControl::Elementary,
+                    Some(StepSizeControlSpec::Predictive) => StepSizeControl::Predictive,
+                };
                 let reuse = jacobian_reuse.unwrap_or(1);
                 if reuse == 0 {
                     return Err(err("jacobian_reuse", &reuse, "must be >= 1"));
@@ -94,9 +99,9 @@ impl Integrator {
                 let jacobian_reuse = usize::try_from(reuse).unwrap_or(usize::MAX);
                 let control = control(*rtol, *atol, *h_max, *max_steps)?;
                 match spec {
-                    IntegratorSpec::Rodas5p(_) => Integrator::Rodas { method: RodasMethod::Rodas5P, control, jacobian_reuse },
-                    IntegratorSpec::Rodas4(_) => Integrator::Rodas { method: RodasMethod::Rodas4, control, jacobian_reuse },
-                    _ => Integrator::Rosenbrock { control, jacobian_reuse },
+                    IntegratorSpec::Rodas5p(_) => Integrator::Rodas { method: RodasMethod::Rodas5P, control, jacobian_reuse, step_size_control },
+                    IntegratorSpec::Rodas4(_) => Integrator::Rodas { method: RodasMethod::Rodas4, control, jacobian_reuse, step_size_control },
+                    _ => Integrator::Rosenbrock { control, jacobian_reuse, step_size_control },
                 }
             }
         })
@@ -147,17 +152,25 @@ impl Integrator {
         match self {
             Integrator::Rk4 { step } => IntegratorInfo { step: Some(*step), ..info("rk4", None) },
             Integrator::Dopri45(c) => info("dopri45", Some(c)),
-            Integrator::Rosenbrock { control, jacobian_reuse } => IntegratorInfo {
-                jacobian_reuse: Some(*jacobian_reuse as u64),
-                ..info("rosenbrock (ROS34PW2, structured Jacobian)", Some(control))
-            },
-            Integrator::Imex(c) => info("imex (ARK4(3)6L[2]SA, armature circuits implicit)", Some(c)),
-            Integrator::Rodas { method, control, jacobian_reuse } => IntegratorInfo {
+            Integrator::Rosenbrock { control, jacobian_reuse, step_size_control } => IntegratorInfo {
                 jacobian_reuse: Some(*jacobian_reuse as u64),
                 ..info(
-                    match method {
-                        RodasMethod::Rodas5P => "rodas5p (RODAS5P, exact Jacobian by differences)",
-                        RodasMethod::Rodas4 => "rodas4 (RODAS4, exact Jacobian by differences)",
+                    match step_size_control {
+                        StepSizeControl::Elementary => "rosenbrock (ROS34PW2, structured Jacobian)",
+                        StepSizeControl::Predictive => "rosenbrock (ROS34PW2, structured Jacobian, predictive step-size control)",
+                    },
+                    Some(control),
+                )
+            },
+            Integrator::Imex(c) => info("imex (ARK4(3)6L[2]SA, armature circuits implicit)", Some(c)),
+            Integrator::Rodas { method, control, jacobian_reuse, step_size_control } => IntegratorInfo {
+                jacobian_reuse: Some(*jacobian_reuse as u64),
+                ..info(
+                    match (method, step_size_control) {
+                        (RodasMethod::Rodas5P, StepSizeControl::Elementary) => "rodas5p (RODAS5P, exact Jacobian by differences)",
+                        (RodasMethod::Rodas4, StepSizeControl::Elementary) => "rodas4 (RODAS4, exact Jacobian by differences)",
+                        (RodasMethod::Rodas5P, StepSizeControl::Predictive) => "rodas5p (RODAS5P, exact Jacobian by differences, predictive step-size control)",
+                        (RodasMethod::Rodas4, StepSizeControl::Predictive) => "rodas4 (RODAS4, exact Jacobian by differences, predictive step-size control)",
                     },
                     Some(control),
                 )
@@ -197,9 +210,13 @@ impl Integrator {
         match *self {
             Integrator::Rk4 { step } => Box::new(Rk4::new(dim, step)),
             Integrator::Dopri45(c) => Box::new(DormandPrince45::new(dim, c)),
-            Integrator::Rosenbrock { control, jacobian_reuse } => Box::new(Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse)),
+            Integrator::Rosenbrock { control, jacobian_reuse, step_size_control } => {
+                Box::new(Rosenbrock::new(dim, control).with_jacobian_reuse(jacobian_reuse).with_step_size_control(step_size_control))
+            }
             Integrator::Imex(c) => Box::new(ArkImex::new(dim, c)),
-            Integrator::Rodas { method, control, jacobian_reuse } => Box::new(Rodas::new(dim, control).with_method(method).with_jacobian_reuse(jacobian_reuse)),
+            Integrator::Rodas { method, control, jacobian_reuse, step_size_control } => {
+                Box::new(Rodas::new(dim, control).with_method(method).with_jacobian_reuse(jacobian_reuse).with_step_size_control(step_size_control))
+            }
         }
     }
 
@@ -239,14 +256,18 @@ mod tests {
         assert_eq!(i, Integrator::Dopri45(StepControl { rtol: 1e-10, atol: 1e-12, h_init: None, h_max: 1e-3, h_min: 0.0, max_steps: DEFAULT_MAX_STEPS }));
         assert_eq!(DEFAULT_MAX_STEPS, 100_000_000, "the README states 10^8");
         let i = Integrator::from_spec(&spec(r#"{"method":"rosenbrock","rtol":1e-5,"atol":1e-7,"h_max":0.5}"#), "s.json", 5.0, 1e-3).unwrap();
-        assert!(matches!(i, Integrator::Rosenbrock { jacobian_reuse: 1, control } if control.h_max == 0.5));
+        assert!(matches!(i, Integrator::Rosenbrock { jacobian_reuse: 1, control, step_size_control: StepSizeControl::Elementary } if control.h_max == 0.5));
         assert_eq!(i.describe().phrase(), "rosenbrock (ROS34PW2, structured Jacobian) rtol 1e-5 atol 1e-7 h_max 5e-1 jacobian_reuse 1");
         let i = Integrator::from_spec(&spec(r#"{"method":"rodas5p","rtol":1e-6,"atol":1e-8}"#), "s.json", 5.0, 1e-3).unwrap();
-        assert!(matches!(i, Integrator::Rodas { method: RodasMethod::Rodas5P, jacobian_reuse: 1, control } if control.h_max == 1e-3));
+        assert!(matches!(i, Integrator::Rodas { method: RodasMethod::Rodas5P, jacobian_reuse: 1, control, step_size_control: StepSizeControl::Elementary } if control.h_max == 1e-3));
         assert_eq!(i.method(), "rodas5p");
         assert_eq!(i.describe().phrase(), "rodas5p (RODAS5P, exact Jacobian by differences) rtol 1e-6 atol 1e-8 h_max 1e-3 jacobian_reuse 1");
         let i = Integrator::from_spec(&spec(r#"{"method":"rodas4","rtol":1e-6,"atol":1e-8,"jacobian_reuse":3}"#), "s.json", 5.0, 1e-3).unwrap();
         assert!(matches!(i, Integrator::Rodas { method: RodasMethod::Rodas4, jacobian_reuse: 3, .. }));
+        let i = Integrator::from_spec(&spec(r#"{"method":"rodas5p","rtol":1e-8,"atol":1e-10,"step_size_control":"predictive"}"#), "s.json", 5.0, 1e-3).unwrap();
+        assert!(matches!(i, Integrator::Rodas { step_size_control: StepSizeControl::Predictive, .. }));
+        assert!(i.describe().phrase().contains("predictive step-size control"));
+        assert!(serde_json::from_str::<IntegratorSpec>(r#"{"method":"rodas5p","rtol":1e-8,"atol":1e-10,"step_size_control":"pi"}"#).unwrap_err().to_string().contains("unknown variant `pi`"));
     }
 
     #[test]

@@ -160,7 +160,7 @@ pub fn reference(scene: &Scene, run: &Run) -> Result<Reference, ReferenceError> 
     let adaptive = AdaptiveSpec { rtol: 1e-12, atol: 1e-14, h_max: Some(1.0 / scene.output_rate), max_steps: None };
     let method = reference_method(scene, run);
     let spec = if method.starts_with("rodas5p") {
-        let r = crate::scene::spec::RosenbrockSpec { rtol: adaptive.rtol, atol: adaptive.atol, h_max: adaptive.h_max, max_steps: None, jacobian_reuse: None };
+        let r = crate::scene::spec::RosenbrockSpec { rtol: adaptive.rtol, atol: adaptive.atol, h_max: adaptive.h_max, max_steps: None, jacobian_reuse: None, step_size_control: None };
         IntegratorSpec::Rodas5p(r)
     } else {
         IntegratorSpec::Dopri45(adaptive)

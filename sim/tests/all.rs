@@ -45,6 +45,8 @@ mod contacts_seesaw;
 mod contacts_scene;
 #[path = "contacts_start.rs"]
 mod contacts_start;
+#[path = "contacts_steps.rs"]
+mod contacts_steps;
 #[path = "convergence.rs"]
 mod convergence;
 #[path = "drive_features.rs"]

@@ -4,12 +4,24 @@
 //!
 //! References (HNW I = Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*,
 //! 2nd ed., 1993): error norm and controller HNW I §II.4 (4.11)–(4.13); starting step HNW I
-//! §II.4 "Starting Step Size" (a)–(f). [`super::DormandPrince45`], [`super::Rosenbrock`] and
-//! [`super::ArkImex`] share these, the state they carry between attempts ([`Core`]) and the
-//! step loop ([`step`]); [`super::DormandPrince45`] keeps its own (PI) controller.
+//! §II.4 "Starting Step Size" (a)–(f); Gustafsson's predictive controller HNW II §IV.8 (8.21)
+//! ([`Core::accepted_factor`], `control.rs`). [`super::DormandPrince45`], [`super::Rosenbrock`],
+//! [`super::Rodas`] and [`super::ArkImex`] share these, the state they carry between attempts
+//! ([`Core`]), the step loop ([`step`]) and the first step after an event's restart
+//! ([`first_step_after_restart`]); [`super::DormandPrince45`] keeps its own (PI) controller.
+//!
+//! The first step after an event ([`super::Stepper::restart`], then
+//! [`super::Stepper::first_step_after_restart`]): the state and statistics restart as in
+//! `init`, but the first step is the last accepted step's size (at most `h_max`) when every
+//! event function is armed at the restart ([`RestartStart::Armed`]), and the smaller of that
+//! and Hairer's starting step (or `h_init`) when one is disarmed ([`RestartStart::Disarmed`]: a
+//! function not tested in the first step, `events.rs`, so that step must be short enough not to
+//! jump over its next root). Hairer's step alone ignores what the steps before the event learned
+//! about the solution's scale (on the elbow runs often far too large, then rejected down by
+//! factors of 5). Only for systems that allow it ([`super::HybridSystem::restart_keeps_step_size`]).
 
-use super::control::{Controller, StepControl};
-use super::{IntegrateError, OdeSystem, Stats};
+use super::control::{Controller, StepControl, StepSizeControl};
+use super::{IntegrateError, OdeSystem, RestartStart, Stats};
 
 /// `sqrt(1/m sum (e_i / sc_i)^2)` over the `m` components `i` with `measured[i]`,
 /// `sc_i = atol + rtol max(|y_i|, |y_new_i|)` (HNW I (4.11)); 0 for `m = 0`. NaN/inf
@@ -88,6 +100,15 @@ pub(super) struct Core {
     /// The components the error norm measures (`dim` long), read from the system in every
     /// [`Core::init`] ([`OdeSystem::error_measured`]); allocated by the first.
     pub measured: Vec<bool>,
+    /// The rule for the step after an accepted one ([`Core::accepted_factor`]).
+    pub step_size_control: StepSizeControl,
+    /// Size and scaled error (at least 1e-2, as `radau5.f`) of the last accepted step, for the
+    /// predictive controller (`h_acc = 0` before the first since `init`).
+    pub h_acc: f64,
+    pub err_acc: f64,
+    /// The last accepted step's size before a [`super::Stepper::restart`], until the first step
+    /// after it is chosen ([`first_step_after_restart`]; 0: none).
+    pub h_carry: f64,
 }
 
 impl Core {
@@ -106,6 +127,10 @@ impl Core {
             t_stop: 0.0,
             singular_run: 0,
             measured: Vec::new(),
+            step_size_control: StepSizeControl::Elementary,
+            h_acc: 0.0,
+            err_acc: 1.0,
+            h_carry: 0.0,
         }
     }
 
@@ -143,7 +168,35 @@ impl Core {
         self.rejected_last = false;
         self.failure = Failure::None;
         self.singular_run = 0;
+        self.h_acc = 0.0;
+        self.err_acc = 1.0;
+        self.h_carry = 0.0;
         Ok(())
+    }
+
+    /// The last accepted step's size, to carry over a restart (0 before `init` or any step).
+    pub fn h_to_carry(&self) -> f64 {
+        if self.initialized {
+            self.h_last
+        } else {
+            0.0
+        }
+    }
+
+    /// The step-size factor `h_new / h` after the attempt of size `h` with scaled error `err`
+    /// passed the error test (method of error order `1/expo - 1`): the elementary
+    /// [`Controller::factor`]; with [`StepSizeControl::Predictive`] and an accepted step
+    /// before it since the last `init` (a restart starts the history afresh), the smaller of
+    /// that and [`Controller::predictive_factor`] (`radau5.f`). Records `h` and `err` as the
+    /// last accepted step's: call it once per accepted step, before [`Core::accept`].
+    pub fn accepted_factor(&mut self, err: f64, expo: f64, h: f64) -> f64 {
+        let mut fac = self.controller.factor(err, expo);
+        if self.step_size_control == StepSizeControl::Predictive && self.stats.steps > 0 && self.h_acc > 0.0 {
+            fac = fac.min(self.controller.predictive_factor(err, expo, h, self.h_acc, self.err_acc));
+        }
+        self.h_acc = h;
+        self.err_acc = err.max(1e-2);
+        fac
     }
 
     /// Records a rejected attempt; the next one uses `h_next`.
@@ -266,6 +319,35 @@ pub(super) fn step<S: OdeSystem, A: Adaptive<S>>(
             return Ok(st.core().t);
         }
     }
+}
+
+/// [`super::Stepper::first_step_after_restart`] of an adaptive stepper whose `restart` kept
+/// [`Core::h_carry`] (module docs): the last accepted step where every event function is
+/// armed, the smaller of it and the fresh starting step (or `h_init`) where one is disarmed;
+/// at most `h_max`. Nothing (`init`'s choice) before any accepted step or once stepped.
+pub(super) fn first_step_after_restart<S: OdeSystem, A: Adaptive<S>>(
+    st: &mut A,
+    sys: &mut S,
+    start: RestartStart,
+) -> Result<(), IntegrateError<S::Error>> {
+    let core = st.core();
+    let h_last = std::mem::take(&mut core.h_carry);
+    if h_last <= 0.0 || core.stats.steps > 0 {
+        return Ok(());
+    }
+    let h = match start {
+        RestartStart::Armed => h_last,
+        RestartStart::Disarmed => {
+            let fresh = match core.control.h_init {
+                Some(h) => h,
+                None => st.starting_step(sys)?,
+            };
+            h_last.min(fresh)
+        }
+    };
+    let core = st.core();
+    core.h_next = Some(h.min(core.control.h_max));
+    Ok(())
 }
 
 /// `h` is too small: below `h_min`, or `0.1 h <= |t| eps` (`dopri5.f`), or not positive.

@@ -6,7 +6,10 @@
 //! `h_new / h` (`SAFE`, `FAC1`, `FAC2`) are properties of each method, fixed to the values of
 //! its reference code. References: HNW I = Hairer, Nørsett & Wanner, *Solving Ordinary
 //! Differential Equations I*, 2nd ed., Springer 1993, §II.4 (error norm, controller (4.13),
-//! starting step).
+//! starting step); HNW II = Hairer & Wanner, *Solving Ordinary Differential Equations II*, 2nd
+//! ed., Springer 1996, §IV.8 (8.21): Gustafsson's predictive controller ([`StepSizeControl`],
+//! K. Gustafsson, "Control-theoretic techniques for stepsize selection in implicit Runge–Kutta
+//! methods", ACM TOMS 20 (1994) 496–517; coded as in Hairer's `radau5.f`, `IWORK(8) = 1`).
 //!
 //! [`StepControl`] has no `Default`: the library imposes no limit unless asked
 //! ([`StepControl::new`]); user-facing defaults (a step budget, `h_max` = the output interval)
@@ -130,7 +133,40 @@ pub(super) struct Controller {
     pub fac_max: f64,
 }
 
+/// How an adaptive stepper chooses the step after an accepted one (the rejected ones always
+/// use the elementary rule). A user setting, as `radau5.f`'s `IWORK(8)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StepSizeControl {
+    /// The elementary controller of HNW I (4.13) ([`Controller::factor`]): the step the last
+    /// error predicts, as Hairer's `rodas.f`.
+    #[default]
+    Elementary,
+    /// Gustafsson's predictive controller (HNW II §IV.8 (8.21), `radau5.f`): after the second
+    /// accepted step since a (re)start, the smaller of the elementary step and the one
+    /// extrapolated from the last two accepted steps' sizes and errors
+    /// ([`Controller::predictive_factor`]). It damps the elementary rule's growth where the
+    /// error grows faster than `h^(q+1)` (the pattern "grow, reject, shrink").
+    Predictive,
+}
+
 impl Controller {
+    /// Gustafsson's predictive factor `h_new / h` after an accepted step `h` with scaled error
+    /// `err`, the accepted step before it having had size `h_acc` and error `err_acc`
+    /// (HNW II §IV.8 (8.21); `radau5.f` keeps `err_acc >= 1e-2`, which the caller does):
+    /// `safety (h / h_acc) (err_acc / err^2)^expo`, `expo = 1/(q+1)` for an error estimate of
+    /// order `q`, bounded to `[fac_min, fac_max]`; a NaN or infinite `err` gives `fac_min`,
+    /// `err = 0` gives `fac_max`.
+    pub fn predictive_factor(&self, err: f64, expo: f64, h: f64, h_acc: f64, err_acc: f64) -> f64 {
+        let finite = err < f64::INFINITY; // false for inf and NaN
+        if !finite {
+            return self.fac_min;
+        }
+        if err == 0.0 {
+            return self.fac_max;
+        }
+        (self.safety * (h / h_acc) * (err_acc / (err * err)).powf(expo)).clamp(self.fac_min, self.fac_max)
+    }
+
     /// Step-size factor `h_new / h` for the scaled error `err` of a method whose error
     /// estimate is `O(h^(1/expo))` (HNW I (4.13)): `safety err^(-expo)` bounded to
     /// `[fac_min, fac_max]`; a NaN or infinite `err` gives `fac_min`.
@@ -162,6 +198,35 @@ mod tests {
         assert_eq!(c.factor(f64::INFINITY, 1.0 / 3.0), 0.2);
         assert!((c.factor(1.0, 1.0 / 3.0) - 0.9).abs() < 1e-15);
         assert!((c.factor(8.0, 1.0 / 3.0) - 0.45).abs() < 1e-15);
+    }
+
+    /// HNW II (8.21) on a known sequence of accepted steps: `h_{n+1} = safety h_n
+    /// (1/err_{n+1})^(1/k) (h_n/h_{n-1}) (err_n/err_{n+1})^(1/k)` with `k = q + 1 = 5`
+    /// (RODAS5P's embedded order 4). Steps 1e-3, 2e-3 with errors 0.3, 0.6: the elementary
+    /// rule would grow by 0.9 0.6^(-1/5) = 0.9968 (`radau5.f`'s `quot`), the predictive one by
+    /// 0.9 2 (0.3 / 0.36)^(1/5) = 1.7355 — here the larger, so `radau5.f` keeps the
+    /// elementary 0.9968 (the smaller step); with the errors the other way round (0.6, 0.3:
+    /// an error falling as h grew) 0.9 (2) (0.6/0.09)^(1/5) = 2.6306, against the elementary
+    /// 1.1450. The old code had no such factor: this test does not compile on it.
+    #[test]
+    fn predictive_factor_is_gustafssons_formula() {
+        let c = Controller { safety: 0.9, fac_min: 0.2, fac_max: 6.0 };
+        let k = 5.0;
+        let hnw = |h_n: f64, h_prev: f64, err_n: f64, err_new: f64| 0.9 * (1.0 / err_new).powf(1.0 / k) * (h_n / h_prev) * (err_n / err_new).powf(1.0 / k);
+        for (h_prev, h_n, err_n, err_new) in [(1e-3, 2e-3, 0.3, 0.6), (1e-3, 2e-3, 0.6, 0.3), (1.5e-3, 1e-3, 0.05, 0.8), (2e-3, 2e-3, 0.5, 0.5)] {
+            let want = hnw(h_n, h_prev, err_n, err_new);
+            let got = c.predictive_factor(err_new, 1.0 / k, h_n, h_prev, err_n);
+            assert!((got - want).abs() <= 1e-14 * want, "{got} vs {want}");
+        }
+        assert!((c.predictive_factor(0.6, 0.2, 2e-3, 1e-3, 0.3) - 1.735_5).abs() < 1e-4);
+        assert!((c.factor(0.6, 0.2) - 0.996_8).abs() < 1e-4);
+        // equal steps and errors: (8.21) reduces to the elementary rule
+        assert!((c.predictive_factor(0.5, 0.2, 2e-3, 2e-3, 0.5) - c.factor(0.5, 0.2)).abs() < 1e-15);
+        // bounds and non-finite errors as the elementary rule
+        assert_eq!(c.predictive_factor(1e-12, 0.2, 1.0, 1e-3, 1.0), 6.0);
+        assert_eq!(c.predictive_factor(0.99, 0.2, 1e-3, 1.0, 1e-2), 0.2);
+        assert_eq!(c.predictive_factor(f64::NAN, 0.2, 1.0, 1.0, 1.0), 0.2);
+        assert_eq!(c.predictive_factor(0.0, 0.2, 1.0, 1.0, 1.0), 6.0);
     }
 
     #[test]

@@ -12,7 +12,8 @@
 //!   safety 0.9, plus the PI ("Lund") stabilisation of `dopri5.f` (Gustafsson, ACM TOMS 17
 //!   (1991); HNW II §IV.2): `h_new = h safety err^-(1/5 - 0.75 beta) err_old^beta`,
 //!   `beta = 0.04`. After a rejection the next accepted step may not grow.
-//! - starting step: HNW I §II.4, "Starting Step Size" (a–f), with the RMS norm above.
+//! - starting step: HNW I §II.4, "Starting Step Size" (a–f), with the RMS norm above; after an
+//!   event's restart, the last accepted step (`adaptive.rs`, as RODAS).
 //! - dense output: the continuous extension of HNW I §II.6 as coded in `dopri5.f`'s `contd5`:
 //!   `y(t_prev + s h) = r0 + s (r1 + (1-s) (r2 + s (r3 + (1-s) r4)))`, of order 4.
 //!
@@ -41,8 +42,8 @@
 use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::Controller;
 use super::{
-    dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeSystem, SettingsError,
-    Stats, StepControl, Stepper,
+    dense_output, eval, eval_finite, first_non_finite, IntegrateError, OdeSystem, RestartStart,
+    SettingsError, Stats, StepControl, Stepper,
 };
 
 // Dormand & Prince (1980) tableau, HNW I §II.5 (c6 = c7 = 1).
@@ -428,6 +429,21 @@ impl<S: OdeSystem> Stepper<S> for DormandPrince45 {
         eval_finite(&mut self.core.stats, sys, t0, y0, &mut self.k1)?;
         self.core.initialized = true;
         Ok(())
+    }
+
+    /// `init`, keeping the last accepted step's size for [`Stepper::first_step_after_restart`]
+    /// (`adaptive.rs`).
+    fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        let h_last = self.core.h_to_carry();
+        Stepper::init(self, sys, t0, y0)?;
+        self.core.h_carry = h_last;
+        Ok(())
+    }
+
+    /// The first step after an event: the last accepted step where every event function is
+    /// armed, else the smaller of it and Hairer's starting step (`adaptive.rs`).
+    fn first_step_after_restart(&mut self, sys: &mut S, start: RestartStart) -> Result<(), IntegrateError<S::Error>> {
+        adaptive::first_step_after_restart(self, sys, start)
     }
 
     fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {

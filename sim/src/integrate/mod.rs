@@ -120,7 +120,7 @@ pub mod test_problems;
 #[cfg(test)]
 mod testutil;
 
-pub use self::control::{SettingsError, StepControl};
+pub use self::control::{SettingsError, StepControl, StepSizeControl};
 pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
 pub use self::events::{integrate_hybrid, EventSettings, HybridSystem};
 pub use self::imex::ArkImex;

@@ -23,16 +23,20 @@
 //! - error norm and step-size control: the RMS norm of HNW I §II.4 with `atol + rtol max(|y|,
 //!   |y_new|)` over the components the system measures ([`super::OdeSystem::error_measured`]); `h_new = h min(6, max(0.2, 0.9 err^(-1/(q+1))))` with `q` the embedded order
 //!   (Hairer's `rodas.f`: SAFE = 0.9, FAC1 = 5, FAC2 = 1/6); after a rejection the next
-//!   accepted step may not grow. (Gustafsson's predictive controller, HNW II §IV.8 (8.21),
-//!   was measured here, issue 24: with `h_max` 1 s it cut the paper-unilateral runs' right-hand
-//!   sides, but it broke RODAS5P's tolerance proportionality with gear friction (error ∝
-//!   rtol^0.85, `convergence.rs`) and the restitution run's balance bound (1e-9 E); not kept.
+//!   accepted step may not grow. Optionally ([`Rodas::with_step_size_control`], a scene's
+//!   `step_size_control: "predictive"`), Gustafsson's predictive controller after accepted
+//!   steps (HNW II §IV.8 (8.21), as `radau5.f`'s `IWORK(8) = 1`; [`super::adaptive::Core::accepted_factor`]).
+//!   It is not the default: as the default it broke RODAS5P's tolerance proportionality with
+//!   gear friction (error ∝ rtol^0.85, `convergence.rs`) and the restitution run's balance
+//!   bound (1e-9 E) when measured in issue 24's first pass; the paper-unilateral scene opts in
+//!   (BENCHMARKS.md, "Issue 24, sixth pass").
 //!   Gustafsson's PI controller, HNW II §IV.2, β = 0.04 as `dopri5.f`, brought the
 //!   paper-unilateral runs' rejected steps from 6–7 % to 4.1–4.5 % for 6–9 % more steps, but
 //!   put RODAS5P's dense output on Prothero–Robinson at 114 tol (tol 1e-6; bound 100,
 //!   `contract.rs`); not kept either, BENCHMARKS.md.)
 //! - restart after an event ([`Stepper::restart`], then
-//!   [`Stepper::first_step_after_restart`]): the state, Jacobian and statistics
+//!   [`Stepper::first_step_after_restart`], shared with dopri45 and rosenbrock in
+//!   `adaptive.rs`): the state, Jacobian and statistics
 //!   restart as in `init`, but the first step is the last accepted step's size (at most
 //!   `h_max`) when every event function is armed at the restart ([`RestartStart::Armed`]: a
 //!   stick ↔ slip change, a lift-off, a touch-down whose functions the driver watches from
@@ -63,7 +67,7 @@
 
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
 use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
-use super::control::Controller;
+use super::control::{Controller, StepSizeControl};
 use super::jacobian::{fd_jacobian_columns_within, DifferenceIncrement};
 use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::rosenbrock::{stage_argument, stage_rhs, time_derivative};
@@ -145,9 +149,6 @@ pub struct Rodas {
     f_new: Vec<f64>,
     /// The deadline the difference Jacobian and the factorisation look at.
     watch: Watch,
-    /// The last accepted step's size before a [`Stepper::restart`], until the first step after
-    /// it is chosen (0: none).
-    h_carry: f64,
 }
 
 impl Rodas {
@@ -196,13 +197,19 @@ impl Rodas {
             y_new: z(),
             f_new: z(),
             watch: Watch::default(),
-            h_carry: 0.0,
         })
     }
 
     /// The same stepper running `method`'s tableau.
     pub fn with_method(mut self, method: RodasMethod) -> Self {
         self.tab = method.tableau();
+        self
+    }
+
+    /// The same stepper choosing the step after an accepted one by `control` (module docs;
+    /// default [`StepSizeControl::Elementary`]).
+    pub fn with_step_size_control(mut self, control: StepSizeControl) -> Self {
+        self.core.step_size_control = control;
         self
     }
 
@@ -444,9 +451,9 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
             self.y_new[i] = yn;
         }
         let err = self.core.error_norm(&self.u[s_last], &self.y, &self.y_new);
-        let fac = CONTROLLER.factor(err, 1.0 / f64::from(tab.embedded_order + 1));
+        let expo = 1.0 / f64::from(tab.embedded_order + 1);
         if err > 1.0 {
-            return Ok(self.core.reject(h * fac.min(1.0), Failure::None));
+            return Ok(self.core.reject(h * CONTROLLER.factor(err, expo).min(1.0), Failure::None));
         }
         if let Some(i) = first_non_finite(&self.y_new) {
             return Ok(self.core.reject_non_finite(h, t_new, i));
@@ -467,6 +474,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rodas {
                 *wi = hk[..tab.stages].iter().zip(&self.u).map(|(c, u)| c * u[i]).sum();
             }
         }
+        let fac = self.core.accepted_factor(err, expo, h);
         let h_new = self.core.limit_growth(h * fac, h, h_proposed);
         std::mem::swap(&mut self.y_prev, &mut self.y);
         std::mem::swap(&mut self.y, &mut self.y_new);
@@ -500,16 +508,15 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
         }
         eval_finite(&mut self.core.stats, sys, t0, y0, &mut self.f0)?;
         self.core.initialized = true;
-        self.h_carry = 0.0;
         Ok(())
     }
 
     /// `init`, keeping the last accepted step's size for [`Stepper::first_step_after_restart`]
     /// (module docs).
     fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
-        let h_last = if self.core.initialized { self.core.h_last } else { 0.0 };
+        let h_last = self.core.h_to_carry();
         self.init(sys, t0, y0)?;
-        self.h_carry = h_last;
+        self.core.h_carry = h_last;
         Ok(())
     }
 
@@ -517,22 +524,7 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
     /// event function is armed, the smaller of it and the fresh starting step where one is
     /// disarmed; at most `h_max`. As `init` before any accepted step.
     fn first_step_after_restart(&mut self, sys: &mut S, start: RestartStart) -> Result<(), IntegrateError<S::Error>> {
-        let h_last = std::mem::take(&mut self.h_carry);
-        if h_last <= 0.0 || self.core.stats.steps > 0 {
-            return Ok(());
-        }
-        let h = match start {
-            RestartStart::Armed => h_last,
-            RestartStart::Disarmed => {
-                let fresh = match self.core.control.h_init {
-                    Some(h) => h,
-                    None => Adaptive::<S>::starting_step(self, sys)?,
-                };
-                h_last.min(fresh)
-            }
-        };
-        self.core.h_next = Some(h.min(self.core.control.h_max));
-        Ok(())
+        adaptive::first_step_after_restart(self, sys, start)
     }
 
     fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {

@@ -27,7 +27,10 @@
 //! - error estimate and step-size control: `err = ||y_new - y_hat||` in the RMS norm of
 //!   HNW I §II.4 with `atol + rtol max(|y|, |y_new|)`; `h_new = h min(fac_max, max(fac_min,
 //!   safety err^(-1/3)))` (the embedded solution has order 2), as in Hairer's `ros4.f`; after a
-//!   rejection the next accepted step may not grow.
+//!   rejection the next accepted step may not grow; optionally Gustafsson's predictive
+//!   controller after accepted steps ([`Rosenbrock::with_step_size_control`]; HNW II §IV.8
+//!   (8.21), `adaptive.rs`). After an event's restart the first step is the last accepted one
+//!   (`adaptive.rs`, as RODAS).
 //! - Jacobian reuse (the W property): `J` is evaluated at the start of a step and kept for
 //!   `jacobian_reuse` accepted steps; a rejection with a stale `J` triggers a refresh. `f_t`
 //!   (one column of the autonomised Jacobian, cheap) is evaluated at the start of every step:
@@ -54,11 +57,11 @@
 
 use self::tableau::{Tableau, GAMMA};
 use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
-use super::control::Controller;
+use super::control::{Controller, StepSizeControl};
 use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::{
     dense_output, eval, eval_finite, first_non_finite, hermite, IntegrateError, OdeJacobian,
-    Phase, SettingsError, Stats, StepControl, Stepper, Watch,
+    Phase, RestartStart, SettingsError, Stats, StepControl, Stepper, Watch,
 };
 
 mod tableau;
@@ -157,6 +160,13 @@ impl Rosenbrock {
             f_new: z(),
             watch: Watch::default(),
         })
+    }
+
+    /// The same stepper choosing the step after an accepted one by `control` (module docs;
+    /// default [`StepSizeControl::Elementary`]).
+    pub fn with_step_size_control(mut self, control: StepSizeControl) -> Self {
+        self.core.step_size_control = control;
+        self
     }
 
     /// Keeps each Jacobian for `k` accepted steps (`k >= 1`; the default, 1, evaluates a
@@ -362,10 +372,9 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
             self.y_stage[i] = e;
         }
         let err = self.core.error_norm(&self.y_stage, &self.y, &self.y_new);
-        let fac = CONTROLLER.factor(err, 1.0 / 3.0);
         let passed = err <= 1.0;
         if !passed {
-            return Ok(self.core.reject(h * fac.min(1.0), Failure::None));
+            return Ok(self.core.reject(h * CONTROLLER.factor(err, 1.0 / 3.0).min(1.0), Failure::None));
         }
         if let Some(i) = first_non_finite(&self.y_new) {
             return Ok(self.core.reject_non_finite(h, t_new, i));
@@ -380,6 +389,7 @@ impl<S: OdeJacobian> Adaptive<S> for Rosenbrock {
             return Ok(self.core.reject_non_finite(h, t_new, i));
         }
 
+        let fac = self.core.accepted_factor(err, 1.0 / 3.0, h);
         let h_new = self.core.limit_growth(h * fac, h, h_proposed);
         // commit: (y, f0) become the left Hermite data, the new point the current one
         std::mem::swap(&mut self.y_prev, &mut self.y);
@@ -408,6 +418,21 @@ impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
         self.f_prev.copy_from_slice(&self.f0);
         self.core.initialized = true;
         Ok(())
+    }
+
+    /// `init`, keeping the last accepted step's size for [`Stepper::first_step_after_restart`]
+    /// (`adaptive.rs`).
+    fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+        let h_last = self.core.h_to_carry();
+        Stepper::init(self, sys, t0, y0)?;
+        self.core.h_carry = h_last;
+        Ok(())
+    }
+
+    /// The first step after an event: the last accepted step where every event function is
+    /// armed, else the smaller of it and Hairer's starting step (`adaptive.rs`).
+    fn first_step_after_restart(&mut self, sys: &mut S, start: RestartStart) -> Result<(), IntegrateError<S::Error>> {
+        adaptive::first_step_after_restart(self, sys, start)
     }
 
     fn step(&mut self, sys: &mut S, t_stop: f64) -> Result<f64, IntegrateError<S::Error>> {

@@ -808,6 +808,23 @@ pub struct RosenbrockSpec {
     /// Accepted steps between Jacobian refreshes (default 1: every step).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub jacobian_reuse: Option<u64>,
+    /// How the step after an accepted one is chosen (default `elementary`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_size_control: Option<StepSizeControlSpec>,
+}
+
+/// The step-size controller after an accepted step (rejected steps always shrink by the
+/// elementary rule).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum StepSizeControlSpec {
+    /// The step the last error predicts, `h (0.9 / err)^(1/(q+1))` (Hairer & Wanner, HNW I
+    /// (4.13); Hairer's `rodas.f`).
+    Elementary,
+    /// Gustafsson's predictive controller (HNW II §IV.8 (8.21); `radau5.f`): the smaller of the
+    /// elementary step and one extrapolated from the last two accepted steps' sizes and errors;
+    /// fewer rejected steps where the error grows faster than the elementary rule assumes.
+    Predictive,
 }
 
 impl IntegratorSpec {
@@ -817,9 +834,9 @@ impl IntegratorSpec {
         Some(match method {
             "dopri45" => IntegratorSpec::Dopri45(a),
             "imex" => IntegratorSpec::Imex(a),
-            "rosenbrock" => IntegratorSpec::Rosenbrock(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None }),
-            "rodas5p" => IntegratorSpec::Rodas5p(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None }),
-            "rodas4" => IntegratorSpec::Rodas4(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None }),
+            "rosenbrock" => IntegratorSpec::Rosenbrock(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None, step_size_control: None }),
+            "rodas5p" => IntegratorSpec::Rodas5p(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None, step_size_control: None }),
+            "rodas4" => IntegratorSpec::Rodas4(RosenbrockSpec { rtol, atol: a.atol, h_max, max_steps: None, jacobian_reuse: None, step_size_control: None }),
             _ => return None,
         })
     }

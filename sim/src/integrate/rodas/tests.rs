@@ -393,3 +393,70 @@ fn restart_tries_the_last_accepted_step() {
     let (disarmed, hairer, h_last) = first(RestartStart::Disarmed);
     assert!(hairer < h_last && disarmed == hairer, "disarmed {disarmed:e}, Hairer {hairer:e}, last {h_last:e}");
 }
+
+// dopri45 and rosenbrock restart as RODAS (`adaptive::first_step_after_restart`, issue 24's
+// sixth pass): on y' = cos(1000 t) (rtol 1e-8, atol 1e-10), 40 steps, then a restart at the
+// same point. Armed: the first step is the last accepted one (to the rounding of t - t_prev)
+// and is accepted at once; disarmed: the smaller of it and Hairer's starting step, which here
+// is more than 2x longer (checked; 2.6x for dopri45). On the old code their `restart` was `init`: `h_next` was
+// `None` (Hairer's step, then rejections down by factors of 5), so this fails there.
+#[test]
+fn dopri45_and_rosenbrock_restart_from_the_last_accepted_step() {
+    use super::super::{DormandPrince45, Rosenbrock};
+    let mut p = FastCosine { omega: 1000.0 };
+    macro_rules! check {
+        ($new:expr) => {{
+            for start in [RestartStart::Armed, RestartStart::Disarmed] {
+                let mut st = $new;
+                st.init(&mut p, 0.0, &[0.0]).unwrap();
+                for _ in 0..40 {
+                    st.step(&mut p, 100.0).unwrap();
+                }
+                let (t, h_last) = (st.t(), st.t() - st.t_prev());
+                let y = st.y().to_vec();
+                let hairer = Adaptive::<FastCosine>::starting_step(&mut st, &mut p).unwrap();
+                assert!(hairer > 2.0 * h_last, "Hairer's step {hairer:e} vs the last {h_last:e}");
+                Stepper::restart(&mut st, &mut p, t, &y).unwrap();
+                Stepper::first_step_after_restart(&mut st, &mut p, start).unwrap();
+                assert_eq!(st.stats().steps, 0);
+                let h = st.h_next().expect("a carried step");
+                assert!((h - h_last).abs() <= 1e-9 * h_last, "{start:?}: {h:e} vs {h_last:e}");
+                st.step(&mut p, 100.0).unwrap();
+                assert_eq!(st.stats().rejected, 0, "{start:?}");
+                Stepper::init(&mut st, &mut p, t, &y).unwrap();
+                assert_eq!(st.h_next(), None);
+            }
+        }};
+    }
+    check!(DormandPrince45::new(1, StepControl::new(1e-8, 1e-10)));
+    check!(Rosenbrock::new(1, StepControl::new(1e-8, 1e-10)));
+}
+
+// The predictive controller (`Rodas::with_step_size_control`, HNW II §IV.8 (8.21)) on the
+// stiff Kepler problem at rtol 1e-7: the end error stays within 100 tol as the elementary
+// controller's, and it takes fewer rejected steps (the case it is for: the elementary rule's
+// growth rejected and shrunk again). Before any accepted step since `init` it is the
+// elementary rule (checked on the first step's proposal).
+#[test]
+fn predictive_control_keeps_the_error_and_rejects_less() {
+    use super::super::test_problems::ExactSolution;
+    let p = StiffKepler { e: 0.3, k: 1e3 };
+    let mut runs = Vec::new();
+    for control in [StepSizeControl::Elementary, StepSizeControl::Predictive] {
+        let mut st = Rodas::new(p.dim(), StepControl::new(1e-7, 1e-7)).with_step_size_control(control);
+        let r = run_exact(p, &mut st, std::f64::consts::TAU);
+        eprintln!("{control:?}: err {:.2e} {:?}", r.err_end, r.stats);
+        assert!(r.err_end < 100.0 * 1e-7, "{control:?}: {}", r.err_end);
+        runs.push(r.stats);
+    }
+    assert!(runs[1].rejected <= runs[0].rejected, "{runs:?}");
+    let first = |control| {
+        let mut st = Rodas::new(p.dim(), StepControl::new(1e-7, 1e-7)).with_step_size_control(control);
+        let mut q = p;
+        let y0 = q.y0();
+        st.init(&mut q, 0.0, &y0).unwrap();
+        st.step(&mut q, 1.0).unwrap();
+        st.h_next()
+    };
+    assert_eq!(first(StepSizeControl::Elementary), first(StepSizeControl::Predictive));
+}
