@@ -34,8 +34,10 @@ use super::hybrid::in_touch;
 /// evaluation 23 at 0.044062663 s: elbow7 lands at −0.106 m/s, the mode problem separates it at
 /// g̈ = +1.18 m/s², and its touch-down fired 33 times within 8e-12 s). `g − (g₀ − 1e-12 m)` is
 /// 1e4 times that rounding above zero at the restart and a thousandth of `gap_tol` below it at
-/// the return: the flight's return is located inside the closed band.
-pub const DEPARTURE_DEPTH: f64 = 1e-12;
+/// the return: the flight's return is located inside the closed band. The same scale as the
+/// departure bound of a separated contact inside a step ([`super::contact_events::GAP_DEPARTURE`],
+/// 1000 × the gap's rounding): one constant for both.
+pub const DEPARTURE_DEPTH: f64 = super::contact_events::GAP_DEPARTURE;
 
 /// Whether a contact leaving the table at `gap_rate` (m/s, > 0) with the normal acceleration
 /// `accel` (m/s², its g̈ in the flight) stays within the closed band: a ballistic flight
