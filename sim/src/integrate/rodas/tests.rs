@@ -434,11 +434,10 @@ fn dopri45_and_rosenbrock_restart_from_the_last_accepted_step() {
 
 // The predictive controller (`Rodas::with_step_size_control`, HNW II §IV.8 (8.21)) on the
 // stiff Kepler problem at rtol 1e-7: the end error stays within 100 tol as the elementary
-// controller's, and it takes fewer rejected steps (the case it is for: the elementary rule's
-// growth rejected and shrunk again). Before any accepted step since `init` it is the
-// elementary rule (checked on the first step's proposal).
+// controller's. Before any accepted step since `init` it is the elementary rule (checked on
+// the first step's proposal).
 #[test]
-fn predictive_control_keeps_the_error_and_rejects_less() {
+fn predictive_control_keeps_the_error_and_takes_the_elementary_first_step() {
     use super::super::test_problems::ExactSolution;
     let p = StiffKepler { e: 0.3, k: 1e3 };
     let mut runs = Vec::new();
@@ -449,6 +448,8 @@ fn predictive_control_keeps_the_error_and_rejects_less() {
         assert!(r.err_end < 100.0 * 1e-7, "{control:?}: {}", r.err_end);
         runs.push(r.stats);
     }
+    // no more rejections than the elementary controller (on this problem neither rejects: the
+    // claim that it rejects fewer is the scene's, `contacts_steps`)
     assert!(runs[1].rejected <= runs[0].rejected, "{runs:?}");
     let first = |control| {
         let mut st = Rodas::new(p.dim(), StepControl::new(1e-7, 1e-7)).with_step_size_control(control);
