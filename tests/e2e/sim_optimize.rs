@@ -1,7 +1,8 @@
 //! `sim optimize`: on the small arm's study (`sim/scenes/studies/small-kd.json`, 0.2-s runs),
 //! the optimum lies within one spacing of a dense grid's best (the grid run by `sim sweep`),
 //! within the study's budget of 40 evaluations; the same seed gives byte-identical outputs; three
-//! shards of a generation merge to the unsharded generation; a study stopped (by
+//! shards of a generation merge to the unsharded generation; `--seeds` runs one study per seed
+//! and states their optima's spread; a study stopped (by
 //! `--generations` and by a kill) and resumed gives the uninterrupted study's outputs.
 
 use crate::run_sim;
@@ -112,6 +113,39 @@ fn the_same_seed_gives_byte_identical_outputs_and_a_resumed_study_the_same() {
     assert_eq!(state(&c)["optimizer"]["generation"], 3);
     optimize(&c, &[]);
     assert_eq!(outputs(&a), outputs(&c), "stopped and resumed");
+}
+
+/// `--seeds 2`: `seed-1/` holds the study run alone (the same bytes), `seed-2/` the study with
+/// seed 2, and seeds.csv / seeds.md give each seed's best objective (the least feasible one of
+/// its evaluations.csv), the best over the two and their spread (max − min).
+#[test]
+fn seeds_run_one_study_per_seed_and_state_the_spread_of_their_optima() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (many, one) = (tmp.path().join("many"), tmp.path().join("one"));
+    let printed = optimize(&many, &["--seeds", "2"]);
+    optimize(&one, &[]);
+    assert_eq!(outputs(&one), outputs(&many.join("seed-1")), "seed 1 of two against the study alone");
+    let state2 = state(&many.join("seed-2"));
+    assert_eq!(state2["spec"]["method"]["seed"], 2);
+    assert_ne!(state(&one)["evaluations"], state2["evaluations"], "another seed, other candidates");
+    // each seed's best from its own table
+    let best_of = |dir: &Path| -> f64 {
+        let mut r = csv::Reader::from_path(dir.join("evaluations.csv")).unwrap();
+        let h = r.headers().unwrap().clone();
+        let col = h.iter().position(|c| c == "objective_j").unwrap();
+        r.records().filter_map(|x| x.unwrap()[col].parse::<f64>().ok()).fold(f64::INFINITY, f64::min)
+    };
+    let (b1, b2) = (best_of(&many.join("seed-1")), best_of(&many.join("seed-2")));
+    let mut r = csv::Reader::from_path(many.join("seeds.csv")).unwrap();
+    let rows: Vec<(String, f64)> = r.records().map(|x| x.unwrap()).map(|x| (x[1].to_string(), x[2].parse().unwrap())).collect();
+    assert_eq!(rows, vec![("1".to_string(), b1), ("2".to_string(), b2)]);
+    let md = std::fs::read_to_string(many.join("seeds.md")).unwrap();
+    let spread = format!("{:.2e}", (b1 - b2).abs());
+    assert!(md.contains(&format!("| {:.4} |", b1.min(b2))) && md.contains(&spread), "best {} and spread {spread} not in:\n{md}", b1.min(b2));
+    assert!(String::from_utf8_lossy(&printed.stdout).contains(&spread), "seeds.md is printed");
+    // --seeds with --shard or --generations is refused
+    let bad = run_sim(&["optimize", study_file().to_str().unwrap(), "--seeds", "2", "--generations", "1"]);
+    assert_eq!(bad.status.code(), Some(2));
 }
 
 #[test]

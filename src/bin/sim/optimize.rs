@@ -44,8 +44,15 @@ generation, written to DIR/gen-<g>.shard-<i>-of-<n>.json), then one `sim optimiz
 Exit status: 0 the study finished (or stopped at --generations), 1 no feasible design was
 found, 2 bad input.
 
+With --seeds N the study runs N times, with the study's seed, seed + 1, ..., each in
+DIR/seed-<s>/ (each a whole study: resumable, byte-identical for its seed), then DIR/seeds.md
+(also printed) and DIR/seeds.csv give every combination's best design per seed, the best over
+the seeds and their spread (max - min): how well the search pins the optimum down, beside the
+tolerance's error bar.
+
 Examples:
   sim optimize sim/scenes/studies/which-elbow.json -j 2
+  sim optimize sim/scenes/studies/small-kd.json --seeds 3   the optimum's spread over 3 seeds
   sim optimize my-study.json --generations 3       three generations, then stop (resume later)
   sim optimize my-study.json --shard 0/3 -o /scratch/s   one shard of the pending generation")]
 pub struct OptimizeArgs {
@@ -61,6 +68,10 @@ pub struct OptimizeArgs {
     /// Stop after this many generations (the state resumes the study).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub generations: Option<u32>,
+    /// Run the study with N seeds (its seed, seed + 1, ...), each in DIR/seed-<s>/, and write
+    /// the spread of their optima (DIR/seeds.md, seeds.csv).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=100), conflicts_with_all = ["shard", "generations"])]
+    pub seeds: Option<u64>,
     #[command(flatten)]
     pub jobs: Jobs,
     #[command(flatten)]
@@ -209,8 +220,79 @@ fn write_json<T: serde::Serialize>(p: &Path, x: &T) -> Result<()> {
 
 pub fn run(args: &OptimizeArgs, v: Verbosity) -> Result<u8> {
     let study = Study::load(&args.study)?;
-    let spec_value = serde_json::to_value(&study.spec)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("out/study-{}", study.spec.name)));
+    let Some(n) = args.seeds.filter(|&n| n > 1) else { return run_study(args, study, out, v) };
+    cli::create_dir(&out)?;
+    let mut runs = Vec::new();
+    for i in 0..n {
+        let seed = study.settings.seed.wrapping_add(i);
+        let mut s = study.clone();
+        s.spec.method.seed = seed;
+        s.settings.seed = seed;
+        let dir = out.join(format!("seed-{seed}"));
+        let code = run_study(args, s, dir.clone(), v)?;
+        if code != exit::SUCCESS {
+            return Ok(code);
+        }
+        let state: State = read_json(&dir.join(STATE_FILE))?;
+        runs.push((seed, state));
+    }
+    seeds_summary(&study, &runs, &out, v)
+}
+
+/// The spread over seeds: every combination's best design (at the evaluations' tolerance) per
+/// seed, the best over the seeds and their spread, against the tolerance's error bar.
+fn seeds_summary(study: &Study, runs: &[(u64, State)], out: &Path, v: Verbosity) -> Result<u8> {
+    let cols = study.columns();
+    let name = &study.spec.name;
+    let mut md = String::new();
+    let mut csv = csv::Writer::from_writer(Vec::new());
+    csv.write_record(["combination", "seed", "objective_j"].into_iter().map(String::from).chain(cols.iter().cloned()))?;
+    writeln!(md, "# Study `{name}` over {} seeds\n", runs.len())?;
+    writeln!(md, "Seeds {}: each a whole study in `seed-<s>/` (its report there). Objectives at the evaluations' tolerance.\n", runs.iter().map(|(s, _)| s.to_string()).collect::<Vec<_>>().join(", "))?;
+    writeln!(md, "| combination | best over the seeds [J] | seed | {} | spread (max − min) [J] | per seed [J] |", cols.join(" | "))?;
+    writeln!(md, "|---|---|---|{}---|---|", "---|".repeat(cols.len()))?;
+    let mut widest = 0.0f64;
+    for k in 0..study.settings.combos {
+        let mut per: Vec<(u64, &Evaluation)> = Vec::new();
+        for (seed, state) in runs {
+            let best = state.evaluations.iter().filter(|e| e.point.combo == k && e.objective.is_some()).min_by(|a, b| a.told().total_cmp(&b.told()).then(a.index.cmp(&b.index)));
+            if let Some(e) = best {
+                csv.write_record([k.to_string(), seed.to_string(), format!("{:e}", e.told())].into_iter().chain(study.cells(&e.point)))?;
+                per.push((*seed, e));
+            }
+        }
+        let label = format!("{k}: {}", study.combo_label(k));
+        let Some(&(seed, best)) = per.iter().min_by(|a, b| a.1.told().total_cmp(&b.1.told())) else {
+            writeln!(md, "| {label} | none feasible | - | {} | - | - |", vec!["-"; cols.len()].join(" | "))?;
+            continue;
+        };
+        let worst = per.iter().map(|(_, e)| e.told()).fold(f64::NEG_INFINITY, f64::max);
+        let spread = worst - best.told();
+        widest = widest.max(spread);
+        let each = per.iter().map(|(s, e)| format!("{s}: {:.4}", e.told())).collect::<Vec<_>>().join("; ");
+        writeln!(md, "| {label} | {:.4} | {seed} | {} | {spread:.2e} | {each} |", best.told(), study.cells(&best.point).join(" | "))?;
+    }
+    if let Some(c) = runs.first().and_then(|(_, s)| s.calibration.as_ref()) {
+        writeln!(
+            md,
+            "\nThe widest spread over the seeds, {widest:.2e} J, is {:.1} × the tolerance's error bar (±{:.2e} J): the optimum is known to {}.",
+            widest / c.error_j,
+            c.error_j,
+            if widest > c.error_j { "the spread over the seeds (the search's resolution), not to the error bar" } else { "within the error bar: every seed found the same optimum" }
+        )?;
+    }
+    cli::write_file(&out.join("seeds.csv"), String::from_utf8(csv.into_inner()?)?)?;
+    cli::write_file(&out.join("seeds.md"), &md)?;
+    if !v.quiet {
+        print_out(&md)?;
+    }
+    Ok(exit::SUCCESS)
+}
+
+/// One study, in `out`: calibrate (or resume), run the generations, finish.
+fn run_study(args: &OptimizeArgs, study: Study, out: PathBuf, v: Verbosity) -> Result<u8> {
+    let spec_value = serde_json::to_value(&study.spec)?;
     cli::create_dir(&out)?;
     let evals_dir = out.join("candidates");
     cli::create_dir(&evals_dir)?;
