@@ -13,7 +13,7 @@
 
 use std::path::Path;
 
-use sim::dynamics::contact::ContactEventKind;
+use sim::dynamics::contact::{ContactEvent, ContactEventKind};
 
 use crate::contacts_support::*;
 
@@ -143,17 +143,24 @@ fn the_where_elbow_candidate_whose_slip_reversed_inside_a_step_holds_the_audit()
 /// within rtol · E (measured 2.5e-7 E), and elbow4 lands again after the ballistic flight of a
 /// point leaving at ġ⁺ with the normal acceleration the trace measured there (g̈ = −102.2
 /// m/s²): t = 2 ġ⁺ / |g̈| = 88.9 µs (measured 88.6 µs; bound 2 %, g̈ changes along the flight).
+/// The touch-down re-fire designs' common checks: elbow4, thrown off at elbow7's landing at
+/// `t_landing`, lands again after the ballistic flight `2 ġ⁺ / |g̈|` (g̈ = −102.2 m/s², the
+/// trace's; bound 2 %), and no contact has the same event twice within 1e-9 s.
+fn elbow4_flies_ballistically_and_no_event_repeats(events: &[ContactEvent], t_landing: f64) {
+    let thrown = events.iter().find(|e| e.kind == ContactEventKind::LiftOff && e.contact == 0 && e.t == t_landing).unwrap_or_else(|| panic!("elbow4 thrown off at elbow7's landing: {events:?}"));
+    let back = events.iter().find(|e| e.contact == 0 && e.t > t_landing && matches!(e.kind, ContactEventKind::Impact | ContactEventKind::Rest)).unwrap_or_else(|| panic!("elbow4 lands again: {events:?}"));
+    let flight = 2.0 * thrown.gap_rate_after / 102.2;
+    assert!(((back.t - t_landing) - flight).abs() <= 0.02 * flight, "elbow4's flight {} s, ballistic {flight} s", back.t - t_landing);
+    for w in events.windows(2) {
+        assert!(!(w[0].contact == w[1].contact && w[0].kind == w[1].kind && w[1].t - w[0].t < 1e-9), "repeated event {:?} {:?}", w[0], w[1]);
+    }
+}
+
 #[test]
 fn the_where_pair_design_whose_touch_down_refired_completes() {
     let c = completes_with_the_audit_and_the_balance("elbow4 under the hand, elbow7 at joint 7, rtol 1e-5", &scene("touchdown-refire-pair.json", None), "two-elbow-unilateral", 1e-5);
     let landing = c.events.iter().find(|e| e.kind == ContactEventKind::Impact && e.contact == 1 && (e.t - 0.072268131).abs() < 1e-6).unwrap_or_else(|| panic!("elbow7's landing at 0.072268131 s: {:?}", c.events));
-    let thrown = c.events.iter().find(|e| e.kind == ContactEventKind::LiftOff && e.contact == 0 && e.t == landing.t).unwrap_or_else(|| panic!("elbow4 thrown off at elbow7's landing: {:?}", c.events));
-    let back = c.events.iter().find(|e| e.contact == 0 && e.t > landing.t && matches!(e.kind, ContactEventKind::Impact | ContactEventKind::Rest)).unwrap_or_else(|| panic!("elbow4 lands again: {:?}", c.events));
-    let flight = 2.0 * thrown.gap_rate_after / 102.2;
-    assert!(((back.t - landing.t) - flight).abs() <= 0.02 * flight, "elbow4's flight {} s, ballistic {flight} s", back.t - landing.t);
-    for w in c.events.windows(2) {
-        assert!(!(w[0].contact == w[1].contact && w[0].kind == w[1].kind && w[1].t - w[0].t < 1e-9), "repeated event {:?} {:?}", w[0], w[1]);
-    }
+    elbow4_flies_ballistically_and_no_event_repeats(&c.events, landing.t);
 }
 
 /// The same design at the study's tight tolerance (`touchdown-refire-pair-tight.json`: rtol
@@ -178,12 +185,6 @@ fn the_where_pair_design_whose_touch_down_refired_completes_at_the_tight_toleran
     let again = c.events.iter().find(|e| e.contact == 1 && e.t > landing.t && matches!(e.kind, ContactEventKind::Impact | ContactEventKind::Rest)).unwrap_or_else(|| panic!("elbow7 lands again: {:?}", c.events));
     assert!(again.t - landing.t > 1e-6 && again.t - landing.t < 8.3e-5, "elbow7 lands again {} s after its landing", again.t - landing.t);
     assert!(again.gap_rate_before < -1e-9 && again.gap_rate_before > 1e-3 * landing.gap_rate_before, "elbow7's second approach {} m/s (first {} m/s)", again.gap_rate_before, landing.gap_rate_before);
-    let thrown = c.events.iter().find(|e| e.kind == ContactEventKind::LiftOff && e.contact == 0 && e.t == landing.t).unwrap_or_else(|| panic!("elbow4 thrown off at elbow7's landing: {:?}", c.events));
-    let back = c.events.iter().find(|e| e.contact == 0 && e.t > landing.t && matches!(e.kind, ContactEventKind::Impact | ContactEventKind::Rest)).unwrap_or_else(|| panic!("elbow4 lands again: {:?}", c.events));
-    let flight = 2.0 * thrown.gap_rate_after / 102.2;
-    assert!(((back.t - landing.t) - flight).abs() <= 0.02 * flight, "elbow4's flight {} s, ballistic {flight} s", back.t - landing.t);
-    for w in c.events.windows(2) {
-        assert!(!(w[0].contact == w[1].contact && w[0].kind == w[1].kind && w[1].t - w[0].t < 1e-9), "repeated event {:?} {:?}", w[0], w[1]);
-    }
+    elbow4_flies_ballistically_and_no_event_repeats(&c.events, landing.t);
     assert!(c.events.len() <= 40, "{} events in 0.1 s: {:?}", c.events.len(), c.events);
 }

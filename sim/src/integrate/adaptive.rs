@@ -21,7 +21,7 @@
 //! factors of 5). Only for systems that allow it ([`super::HybridSystem::restart_keeps_step_size`]).
 
 use super::control::{Controller, StepControl, StepSizeControl};
-use super::{IntegrateError, OdeSystem, RestartStart, Stats};
+use super::{IntegrateError, OdeSystem, RestartStart, Stats, Stepper};
 
 /// `sqrt(1/m sum (e_i / sc_i)^2)` over the `m` components `i` with `measured[i]`,
 /// `sc_i = atol + rtol max(|y_i|, |y_new_i|)` (HNW I (4.11)); 0 for `m = 0`. NaN/inf
@@ -319,6 +319,15 @@ pub(super) fn step<S: OdeSystem, A: Adaptive<S>>(
             return Ok(st.core().t);
         }
     }
+}
+
+/// `init` at an event's restart, keeping the last accepted step's size in [`Core::h_carry`]
+/// for [`first_step_after_restart`] (every adaptive stepper's `Stepper::restart`).
+pub(super) fn restart<S: OdeSystem, A: Adaptive<S> + Stepper<S>>(st: &mut A, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
+    let h_last = st.core().h_to_carry();
+    Stepper::init(st, sys, t0, y0)?;
+    st.core().h_carry = h_last;
+    Ok(())
 }
 
 /// [`super::Stepper::first_step_after_restart`] of an adaptive stepper whose `restart` kept

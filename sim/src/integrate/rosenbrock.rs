@@ -423,10 +423,7 @@ impl<S: OdeJacobian> Stepper<S> for Rosenbrock {
     /// `init`, keeping the last accepted step's size for [`Stepper::first_step_after_restart`]
     /// (`adaptive.rs`).
     fn restart(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
-        let h_last = self.core.h_to_carry();
-        Stepper::init(self, sys, t0, y0)?;
-        self.core.h_carry = h_last;
-        Ok(())
+        adaptive::restart(self, sys, t0, y0)
     }
 
     /// The first step after an event: the last accepted step where every event function is
