@@ -149,28 +149,25 @@ impl Integrator {
             max_steps: c.map(|c| c.max_steps),
             jacobian_reuse: None,
         };
+        // "name (what)", the step-size control named when it is not the default
+        let named = |name: &str, what: &str, control: StepSizeControl| match control {
+            StepSizeControl::Elementary => format!("{name} ({what})"),
+            StepSizeControl::Predictive => format!("{name} ({what}, predictive step-size control)"),
+        };
         match self {
             Integrator::Rk4 { step } => IntegratorInfo { step: Some(*step), ..info("rk4", None) },
             Integrator::Dopri45(c) => info("dopri45", Some(c)),
             Integrator::Rosenbrock { control, jacobian_reuse, step_size_control } => IntegratorInfo {
                 jacobian_reuse: Some(*jacobian_reuse as u64),
-                ..info(
-                    match step_size_control {
-                        StepSizeControl::Elementary => "rosenbrock (ROS34PW2, structured Jacobian)",
-                        StepSizeControl::Predictive => "rosenbrock (ROS34PW2, structured Jacobian, predictive step-size control)",
-                    },
-                    Some(control),
-                )
+                ..info(&named("rosenbrock", "ROS34PW2, structured Jacobian", *step_size_control), Some(control))
             },
             Integrator::Imex(c) => info("imex (ARK4(3)6L[2]SA, armature circuits implicit)", Some(c)),
             Integrator::Rodas { method, control, jacobian_reuse, step_size_control } => IntegratorInfo {
                 jacobian_reuse: Some(*jacobian_reuse as u64),
                 ..info(
-                    match (method, step_size_control) {
-                        (RodasMethod::Rodas5P, StepSizeControl::Elementary) => "rodas5p (RODAS5P, exact Jacobian by differences)",
-                        (RodasMethod::Rodas4, StepSizeControl::Elementary) => "rodas4 (RODAS4, exact Jacobian by differences)",
-                        (RodasMethod::Rodas5P, StepSizeControl::Predictive) => "rodas5p (RODAS5P, exact Jacobian by differences, predictive step-size control)",
-                        (RodasMethod::Rodas4, StepSizeControl::Predictive) => "rodas4 (RODAS4, exact Jacobian by differences, predictive step-size control)",
+                    &match method {
+                        RodasMethod::Rodas5P => named("rodas5p", "RODAS5P, exact Jacobian by differences", *step_size_control),
+                        RodasMethod::Rodas4 => named("rodas4", "RODAS4, exact Jacobian by differences", *step_size_control),
                     },
                     Some(control),
                 )
