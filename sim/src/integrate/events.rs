@@ -293,19 +293,17 @@ pub fn integrate_hybrid<S: HybridSystem, St: Stepper<S> + ?Sized>(
         }
 
         // an event in [t_lo, t_hi]: its time, then the samples before it
-        let t_star = if at_start && br.hold_start_firing() {
-            // another function's root in the same step: the start firing only if it had moved
-            // past its dead band by that root
+        let t_star = if at_start && !br.hold_start_firing() {
+            t_before
+        } else {
+            // a root to locate; after a held start firing (another function's root in the same
+            // step), the start firing stands only if it had moved past its dead band by that root
             let t_root = locate_root(stepper, sys, &mut br, t_lo, t_hi, tol, watch, &mut buf)?;
-            if br.start_firing_before_root() {
+            if at_start && br.start_firing_before_root() {
                 t_before
             } else {
                 t_root
             }
-        } else if at_start {
-            t_before
-        } else {
-            locate_root(stepper, sys, &mut br, t_lo, t_hi, tol, watch, &mut buf)?
         };
         while k <= n_out && grid.time(k) < t_star {
             let t_k = grid.time(k);
