@@ -8,6 +8,7 @@ mod export_scene;
 mod list;
 mod live;
 mod optimize;
+mod optimize_seeds;
 mod precision;
 mod replay;
 mod run;
