@@ -80,6 +80,9 @@ pub struct DependentScratch {
     step: Vec<f64>,
     hess: Vec<f64>,
     inv: Vec<f64>,
+    /// Per contact: a member of a group of the last [`group_margins`] (its force is the
+    /// group's distribution, not unique where the program's maximiser is not).
+    grouped: Vec<bool>,
 }
 
 impl DependentScratch {
@@ -101,7 +104,19 @@ impl DependentScratch {
             step: vec![0.0; p + 1],
             hess: vec![0.0; (p + 1) * (p + 1)],
             inv: vec![0.0; p + 1],
+            grouped: vec![false; nc],
         }
+    }
+
+    /// Whether contact k was a member of a group (rows dependent across contacts) in the last
+    /// [`group_margins`] (false after [`DependentScratch::clear_groups`]).
+    pub fn in_group(&self, k: usize) -> bool {
+        self.grouped.get(k).copied().unwrap_or(false)
+    }
+
+    /// No contact in a group (a solve with fewer than two sticking contacts).
+    pub fn clear_groups(&mut self) {
+        self.grouped.fill(false);
     }
 }
 
@@ -144,6 +159,7 @@ pub struct GroupInput<'a> {
 /// groups are left as they are. No allocation (`s` sized for `f_n.len()` contacts).
 pub fn group_margins(input: &GroupInput, s: &mut DependentScratch, f_n: &mut [f64], f_t: &mut [[f64; 2]], margin: &mut [f64]) {
     let nc = f_n.len();
+    s.grouped.fill(false);
     s.idx.clear();
     s.pos.clear();
     s.local.clear();
@@ -221,6 +237,9 @@ pub fn group_margins(input: &GroupInput, s: &mut DependentScratch, f_n: &mut [f6
         let dg = orthonormalise(&mut s.basis, p, d);
         if dg == 0 {
             continue;
+        }
+        for i in (0..n).filter(|&i| s.comp[i] == label) {
+            s.grouped[s.idx[i]] = true;
         }
         solve_group(s, label, p, dg, f_n, f_t, margin);
     }
@@ -532,3 +551,7 @@ mod tests {
         assert_eq!((f_n, f_t, m), ([1.0, 2.0], [[2.0, 0.0], [0.0, 0.5]], vec![0.5 - 2.0, 1.0 - 0.5]));
     }
 }
+
+#[cfg(test)]
+#[path = "dependent_tests.rs"]
+mod onset_tests;

@@ -353,6 +353,20 @@ pub fn solve_modes(contacts: &[Contact], state: &ContactState, stabilization: St
 /// steps after an onset are the integrator's error (2e-5 … 8e-5 m/s, turning by up to 180°
 /// from step to step, whole-table at 0.2448 s) and a reference kept on the side of the
 /// previous step's slip turned round with them (a friction along the slip in the audit).
+///
+/// A member of a group of contacts with rows dependent across contacts ([`super::dependent`])
+/// that is inside its own cone (its margin above the group's) keeps the direction the mode
+/// problem chose at the event (`state.slip`: the slide from rest's consistent `a_t ∥ s`,
+/// `modes.rs`; Pfeiffer & Glocker 1996, §5.2; Glocker 2001, §7). The group program fixes only
+/// the value, the largest common margin (continuous: the onset's excess); its maximisers form a
+/// convex set (Boyd & Vandenberghe 2004, §4.2), along which a binding member's `f_t` can only
+/// move radially (its margin, concave, stays at the optimum, so `|f_t|` is affine there): its
+/// direction is unique and the rule above holds. A member inside its cone has no direction of
+/// leaving it, and its force was wherever the barrier's iterate fell (elbow4 at joint 3's
+/// origin, 0.66 N inside, elbow7 binding, `scenes/contacts/crawl-joint3-origin-pair-tight.json`:
+/// f_n 2.75–3.08 N between evaluations at one time, the anchor 1e-2 rad apart): the right-hand
+/// side was not smooth and rtol 1e-8 / atol 1e-10 crawled (1 089 steps, 703 rejected, in the
+/// first 2e-5 s).
 fn onset_anchors(contacts: &[Contact], state: &ContactState, stabilization: Stabilization, fd: &mut ForwardData, cd: &mut ContactData) {
     // every onset gets its stick's excess (its slip → stick function) and its anchor
     let in_onset = |k: usize| state.onset[k].is_some() && state.mode[k] == ContactMode::Sliding && matches!(contacts[k].model, ContactModel::Unilateral { friction, .. } if friction > 0.0);
@@ -375,7 +389,12 @@ fn onset_anchors(contacts: &[Contact], state: &ContactState, stabilization: Stab
                 cd.onset_excess[k] = if cd.margin[k].is_finite() { -cd.margin[k] } else { -1.0 };
                 let f = cd.f_t[k];
                 let m = f[0].hypot(f[1]);
-                if let (true, Some(r)) = (m > 1e-12 * (1.0 + cd.f_n[k].abs()), state.onset[k]) {
+                // a member of a dependent group inside its own cone keeps the event's direction
+                // (`state.slip`, set above): its share of the group's force is not a function
+                // of the state (doc); a binding one's direction is
+                let mu = contacts[k].unilateral_friction();
+                let free = cd.dependent.in_group(k) && mu * cd.f_n[k] - m - cd.margin[k] > 1e-8 * (1.0 + cd.f_n[k].abs() + m);
+                if let (true, Some(r), false) = (m > 1e-12 * (1.0 + cd.f_n[k].abs()), state.onset[k], free) {
                     let i = [-f[0] / m, -f[1] / m];
                     cd.anchor[k] = [r[0] * i[0] - r[1] * i[1], r[1] * i[0] + r[0] * i[1]];
                 }
@@ -439,6 +458,7 @@ fn stick_margins(contacts: &[Contact], mode: &[ContactMode], cd: &mut ContactDat
 fn group_margins(contacts: &[Contact], mode: &[ContactMode], cd: &mut ContactData) {
     let sticking_count = contacts.iter().zip(mode).filter(|(c, &m)| m == ContactMode::Sticking && matches!(c.model, ContactModel::Unilateral { friction, .. } if friction > 0.0)).count();
     if sticking_count < 2 {
+        cd.dependent.clear_groups();
         return;
     }
     let ContactData { rows, active, scratch, f_n, f_t, margin, dependent, .. } = cd;
