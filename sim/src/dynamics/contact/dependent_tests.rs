@@ -82,7 +82,9 @@ fn a_dependent_groups_onset_is_a_continuous_function_of_the_state() {
     let mut cur = cur0.clone();
     cur[9] *= 1.0 + 1e-12;
     states.push((q0.to_vec(), cur));
-    let mut first: Option<(Vec<[f64; 2]>, Vec<f64>, Vec<f64>, Vec<f64>)> = None;
+    // anchors, f_n, the onset's excess, q̈
+    type Outputs = (Vec<[f64; 2]>, Vec<f64>, Vec<f64>, Vec<f64>);
+    let mut first: Option<Outputs> = None;
     for (q, cur) in &states {
         solve(q, cur, &onset, &mut fd, &mut cd);
         let now = (cd.anchor.clone(), cd.f_n.clone(), cd.onset_excess.clone(), fd.qdd.as_slice()[..nv].to_vec());
