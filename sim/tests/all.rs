@@ -23,6 +23,8 @@ mod contacts_chatter;
 mod contacts_converge;
 #[path = "contacts_idle.rs"]
 mod contacts_idle;
+#[path = "contacts_ladder.rs"]
+mod contacts_ladder;
 #[path = "contacts_exact.rs"]
 mod contacts_exact;
 #[path = "contacts_pair.rs"]

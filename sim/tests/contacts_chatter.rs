@@ -114,18 +114,21 @@ fn the_where_elbow_candidate_that_crawled_after_its_onset_completes() {
 /// damping it, and recorded friction along a reversed slip of 1.36e-6 m/s; the stop came at
 /// 3.687096 s. With the friction opposing the slip past the zero (maximal dissipation;
 /// Glocker 2001, §7) the run holds the audit at every sample, and its events are those of
-/// rtol 1e-8, kind for kind, each within 1e-4 s (measured 5.2e-5 s, the stop at 3.683006 s
-/// against 3.683058 s; it was 4.0e-3 s late); the electric energy is within the study's error
-/// bar (2.43e-4 J) of rtol 1e-8's.
+/// rtol 1e-8, kind for kind, each within 2e-4 s (it was 4.0e-3 s late; measured 5.2e-5 s late
+/// with the stop at the slip's zero, 1.18e-4 s early — 3.682940 s against 3.683058 s — with
+/// the stop located where the slip falls to the integrator's resolution, `slip_stop_speed`:
+/// here ~0.7e-6 m/s above `v_s` on a slip decelerating at ~4e-3 m/s², which moves the stop by
+/// that speed over the deceleration, ~1.7e-4 s, and the contact point by ~6e-11 m); the
+/// electric energy is within the study's error bar (2.43e-4 J) of rtol 1e-8's.
 #[test]
 fn the_where_elbow_candidate_whose_slip_reversed_inside_a_step_holds_the_audit() {
     let loose = completes_with_the_audit_and_the_balance("link 8, s = 0.834, 0.5 kg, rtol 1e-5", &scene("audit-slip-reversal-05kg.json", None), "one-elbow-unilateral", 1e-5);
     let tight = completes_with_the_audit_and_the_balance("link 8, s = 0.834, 0.5 kg, rtol 1e-8", &scene("audit-slip-reversal-05kg.json", Some(1e-8)), "one-elbow-unilateral", 1e-8);
     assert_eq!(loose.events.len(), tight.events.len(), "link 8: the events at rtol 1e-5 {:?} and at 1e-8 {:?}", loose.events, tight.events);
     for (a, b) in loose.events.iter().zip(&tight.events) {
-        assert!(a.kind == b.kind && a.contact == b.contact && (a.t - b.t).abs() <= 1e-4, "link 8: event {a:?} at rtol 1e-5, {b:?} at rtol 1e-8");
+        assert!(a.kind == b.kind && a.contact == b.contact && (a.t - b.t).abs() <= 2e-4, "link 8: event {a:?} at rtol 1e-5, {b:?} at rtol 1e-8");
     }
-    assert!(loose.events.iter().any(|e| e.kind == ContactEventKind::SlipToStick && (e.t - 3.683).abs() < 1e-4), "the stop near 3.683 s: {:?}", loose.events);
+    assert!(loose.events.iter().any(|e| e.kind == ContactEventKind::SlipToStick && (e.t - 3.683).abs() < 2e-4), "the stop near 3.683 s: {:?}", loose.events);
     let e = |c: &Collected| c.samples.last().unwrap().electric_energy.iter().sum::<f64>();
     assert!((e(&loose) - e(&tight)).abs() <= 2.43e-4, "electric energy {} J at rtol 1e-5, {} J at 1e-8", e(&loose), e(&tight));
 }

@@ -128,7 +128,7 @@ pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, fd_jacobian_columns_w
 pub use self::rk4::Rk4;
 pub use self::rodas::{Rodas, RodasMethod};
 pub use self::rosenbrock::Rosenbrock;
-pub use self::sampled::{integrate_sampled, integrate_sampled_within, Deadline, Phase, Watch, PACE_AFTER};
+pub use self::sampled::{integrate_sampled, integrate_sampled_within, too_slow, Deadline, Phase, Watch, PACE_AFTER};
 
 /// What gets integrated: y' = f(t, y). Must be a pure function of (t, y) apart from scratch.
 ///

@@ -251,6 +251,22 @@ impl OutputGrid {
     }
 }
 
+/// The pace rule of [`Deadline`]: a run that has spent `spent` of wall time on the share `done`
+/// of its simulated span, with `limit` of wall time in all, is too slow when `spent` is at
+/// least `judge_after` and the linear projection `spent / done` exceeds twice `limit`:
+/// `Some(projection, s)`, else `None`. The projection is from the run's start, so a run whose
+/// start is far slower than the rest (the rodas5p rtol-1e-12 reference of `sim precision` on
+/// the unilateral scene spends ~11 % of its work on the first 0.03 % of its 0.3 s) is judged
+/// by its start: a caller that knows the run will finish (`precision::reference`) passes
+/// `judge_after = limit`, which leaves only the deadline.
+pub fn too_slow(spent: Duration, done: f64, judge_after: Duration, limit: Duration) -> Option<f64> {
+    if spent < judge_after || done <= 0.0 {
+        return None;
+    }
+    let projected_s = spent.as_secs_f64() / done;
+    (projected_s > 2.0 * limit.as_secs_f64()).then_some(projected_s)
+}
+
 /// The wall-clock watch of a run ([`Deadline`]): counts accepted steps and reads the clock
 /// every [`CLOCK_EVERY`] of them.
 pub(super) struct Pace {
@@ -278,11 +294,8 @@ impl Pace {
                 }
                 let spent = now.duration_since(self.started);
                 let done = (t_after - self.t0) / (self.t_end - self.t0);
-                if spent >= deadline.judge_pace_after && done > 0.0 {
-                    let projected_s = spent.as_secs_f64() / done;
-                    if projected_s > 2.0 * deadline.at.duration_since(self.started).as_secs_f64() {
-                        return Err(IntegrateError::TooSlow { t: t_after, projected_s });
-                    }
+                if let Some(projected_s) = too_slow(spent, done, deadline.judge_pace_after, deadline.at.duration_since(self.started)) {
+                    return Err(IntegrateError::TooSlow { t: t_after, projected_s });
                 }
             }
         }
@@ -301,6 +314,58 @@ impl Pace {
 
 #[cfg(test)]
 mod tests {
+    /// The pace rule's decisions on (simulated time, wall time) sequences, the run's span 0.3 s
+    /// and its limit 600 s: the rtol-1e-12 reference's profile (measured on the unilateral scene,
+    /// `sim run`, test profile, unloaded: 0.1 ms of 0.3 s after 0.9 s of wall time, 1 ms after
+    /// 1.3 s, 10 ms after 2.0 s, 0.3 s after 8.4 s) slowed 10× by load is stopped at its first
+    /// judgment with the default `PACE_AFTER` (what `sim precision` did on a loaded machine), and
+    /// never with `judge_after = limit` (`precision::reference`'s budget), where only the
+    /// deadline stops it; a run crawling at a constant pace that projects 3× its limit is stopped
+    /// at the first look past `judge_after` and not before; a run at a constant pace within the
+    /// limit never.
+    #[test]
+    fn pace_rule_decides_on_the_projection_from_the_start() {
+        let (span, limit) = (0.3, Duration::from_secs(600));
+        let profile = [(0.0001, 0.9), (0.001, 1.3), (0.01, 2.0), (0.3, 8.4)];
+        // wall time at simulated time t by linear interpolation of the profile, slowed `load`×
+        let wall = |t: f64, load: f64| {
+            let mut prev = (0.0, 0.0);
+            for &(ts, ws) in &profile {
+                if t <= ts {
+                    return load * (prev.1 + (ws - prev.1) * (t - prev.0) / (ts - prev.0));
+                }
+                prev = (ts, ws);
+            }
+            load * prev.1
+        };
+        let judge = |t: f64, w: f64, after: Duration| too_slow(Duration::from_secs_f64(w), t / span, after, limit);
+        let ts: Vec<f64> = (1..=3000).map(|i| span * f64::from(i) / 3000.0).chain([2e-5, 5e-5, 1e-4, 3e-4]).collect();
+        // loaded 10×: the default rule stops the reference (the first judgment at 5 s projects
+        // 10 × 0.9 s / (1e-4/0.3) ≈ 27 000 s > 1 200 s)
+        let stopped: Vec<f64> = ts.iter().filter(|&&t| judge(t, wall(t, 10.0), PACE_AFTER).is_some()).copied().collect();
+        assert!(!stopped.is_empty() && stopped.iter().all(|&t| t < 0.1), "{stopped:?}");
+        let first = stopped.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(wall(first, 10.0) >= 5.0, "judged before PACE_AFTER");
+        // the same loaded run with judge_after = limit: never stopped by the pace (84 s ≤ 600 s)
+        assert!(ts.iter().all(|&t| judge(t, wall(t, 10.0), limit).is_none()));
+        // unloaded, the default rule lets it run (8.4 s)
+        assert!(ts.iter().all(|&t| judge(t, wall(t, 1.0), PACE_AFTER).is_none()));
+        // a crawl at a constant pace projecting 1 800 s (3× the limit): stopped from 5 s on
+        let crawl = |t: f64| 1800.0 * t / span;
+        for &t in &ts {
+            let w = crawl(t);
+            let verdict = judge(t, w, PACE_AFTER);
+            assert_eq!(verdict.is_some(), w >= 5.0, "t {t}, wall {w}");
+            if let Some(p) = verdict {
+                assert!((p - 1800.0).abs() <= 1e-9 * 1800.0, "projection {p}");
+            }
+        }
+        // a constant pace within the limit (projecting 1 100 s < 2 × 600 s): never
+        assert!(ts.iter().all(|&t| judge(t, 1100.0 * t / span, PACE_AFTER).is_none()));
+        // nothing simulated yet: no projection
+        assert_eq!(too_slow(Duration::from_secs(100), 0.0, PACE_AFTER, limit), None);
+    }
+
     use super::super::test_problems::{
         ExactSolution, FailingRhs, HarmonicOscillator, Kepler, RhsFailure,
     };

@@ -3,6 +3,10 @@
 //! event functions is in its module doc): the functions' values, directions and dead bands, the
 //! modes at t0, and what an event does (impacts, stops, the modes chosen). Split from
 //! `hybrid.rs` (file size); Pfeiffer & Glocker 1996, ch. 5–6; Acary & Brogliato 2008, ch. 7.
+//! The slip's stop at the integrator's resolution of the slip ([`slip_stop_speed`]): Glocker,
+//! *Set-Valued Force Laws*, 2001, §7 (the friction at rest is set-valued: what a slip's zero is can
+//! only be told to the precision its velocity is known to); Acary & Brogliato 2008, §7.2 (an
+//! event-driven scheme's thresholds set by what the integrator resolves).
 
 use crate::dynamics::contact::forward::{has_rows, slip_direction, SLIP_DIRECTION_SPEED};
 use crate::dynamics::contact::rows::contact_gaps_where;
@@ -12,8 +16,29 @@ use crate::error::RunError;
 use super::arm::ArmSystem;
 use super::hybrid::{in_touch, slip_resolution, REBOUND_START};
 
+/// The speed (m/s) at which a plain slip's stop is located (its ev1 is `v_t · s_ref` minus this):
+/// the part of [`slip_resolution`] above [`SLIP_DIRECTION_SPEED`], 0 when the friction's blend
+/// towards `s_ref` (`forward::friction_direction`, below `v_s`) already covers what a step
+/// resolves. Above it the last `slip_resolution − v_s` of the slip is the integrator's error, whose
+/// direction the friction follows: a decelerating 2-D slip there did not reach the zero of `v_t ·
+/// s_ref` but crept at 1–2 `v_s` with the friction saturated (elbow7's stop at 0.1300525 s not
+/// reached within 0.3 s by dopri45 at rtol 1e-4 and rosenbrock at 1e-3, 6.1 ms late by rosenbrock
+/// at 1e-4; BENCHMARKS.md, "Issue 24 point 3" and "… point 3 again"). Located at the resolution,
+/// the stop is the velocity projection `stop_slip` of a slip the integrator cannot tell from rest
+/// (Pfeiffer & Glocker 1996, ch. 6; the gap's analogue is `hybrid::gap_resolution`'s accumulation
+/// rule, Acary & Brogliato 2008, §7.2): the stop's time moves by at most this speed / `|a_t|`, the
+/// kinetic energy it removes (≤ ½ m (this speed)²) is booked as friction work. Continuous in the
+/// state; 0 wherever the resolution is below `v_s`, as at the paper's rtol 1e-8 (~1e-8 m/s) and at
+/// every rung of `sim precision` on the unilateral scene from rtol 1e-5 on: those runs do not move
+/// at all (the rungs' right-hand sides and events to the digit, the printed paper energies).
+pub(super) fn slip_stop_speed(tolerances: Option<(f64, f64)>, rows: &crate::dynamics::contact::rows::ContactRows, k: usize, qd: &[f64], n: usize) -> f64 {
+    (slip_resolution(tolerances, rows, k, qd, n) - SLIP_DIRECTION_SPEED).max(0.0)
+}
+
 /// The slip→stick rule (issue 23, item 2). A sliding contact's ev1 is `v_t · s_ref` (m/s),
-/// `s_ref` the slip direction at the start of the step: no threshold, its zero is located like
+/// `s_ref` the slip direction at the start of the step, less [`slip_stop_speed`] (0 unless the
+/// integrator's resolution of the slip exceeds `SLIP_DIRECTION_SPEED`; the bound below is then
+/// at least twice it): its zero is located like
 /// a lift-off or a touch-down (the sliding right-hand side continues the friction's direction
 /// through the zero, `slip_direction`, so the integrator steps across it smoothly). In 1-D the
 /// zero of `v_t · s_ref` is the zero of the slip; in 2-D it is where the slip velocity turns
@@ -116,6 +141,7 @@ impl ArmSystem<'_> {
         }
         self.evaluate(t, y)?;
         self.separated_gaps();
+        let (tolerances, qd) = (self.scene.integrator().tolerances(), &y[self.layout.qd()]);
         let h = self.hybrid.as_mut().expect("hybrid");
         let r = &h.cd.rows;
         for (k, c) in h.contacts.iter().enumerate() {
@@ -139,7 +165,7 @@ impl ArmSystem<'_> {
                 (_, ContactMode::Sliding) if c.unilateral_friction() > 0.0 && h.state.onset[k].is_some() && h.cd.onset_excess[k].is_finite() => (f_n, h.cd.onset_excess[k]),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
-                    (f_n, if c.unilateral_friction() > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] } else { 1.0 })
+                    (f_n, if c.unilateral_friction() > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] - slip_stop_speed(tolerances, r, k, qd, y.len()) } else { 1.0 })
                 }
             };
             out[2 * k] = e0;
@@ -254,7 +280,7 @@ impl ArmSystem<'_> {
                         // rad, ~1e-6 N of 13 N) and the slide from rest reads a deceleration
                         // the stick's margin does not have (one-elbow at rtol 1e-5, 0.7161 s)
                         stopping.push(k);
-                    } else if f1 && stops_here(h.cd.rows.slip(k), if h.state.onset[k].is_some() { st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len())) } else { st.vel_tol }) {
+                    } else if f1 && stops_here(h.cd.rows.slip(k), if h.state.onset[k].is_some() { st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len())) } else { st.vel_tol.max(2.0 * slip_stop_speed(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len())) }) {
                         preferred[k] = ContactMode::Sticking;
                         stopping.push(k);
                         slip_stopped = true;

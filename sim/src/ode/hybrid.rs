@@ -8,7 +8,7 @@
 //! |---|---|---|
 //! | separated (unilateral) | g − g_ref (−1, touch-down) | 1 |
 //! | sticking | f_n (−1, lift-off) | μ f_n − \|f_t\| (−1, stick→slip; a statically indeterminate contact's largest, `contact/indeterminate.rs`) |
-//! | sliding | f_n (−1, lift-off) | v_t · s_ref (−1, slip→stick at its zero, `stops_here` in `contact_events.rs`; 1 when μ = 0) |
+//! | sliding | f_n (−1, lift-off) | v_t · s_ref − `slip_stop_speed` (−1, slip→stick at its zero, `stops_here` in `contact_events.rs`; 1 when μ = 0) |
 //! | compliant | g (0) | k δ + c δ̇ while δ > 0, else 1 (0) |
 //! | bilateral | 1 | 1 |
 //!
@@ -499,7 +499,10 @@ impl ArmSystem<'_> {
                 // the reference's side pushed it on (π rad at 0.245 s). Until then the
                 // reference keeps the anchor's side (the sticking force's impending direction)
                 let a = h.cd.anchor[k];
-                let resolved = SLIP_DIRECTION_SPEED.max(slip_resolution(tolerances, &h.cd.rows, k, &y[l.qd()], y.len()));
+                // (and past twice a plain slip's stop speed, so the slip it becomes is not
+                // stopped at once: `contact_events::slip_stop_speed`)
+                let res = slip_resolution(tolerances, &h.cd.rows, k, &y[l.qd()], y.len());
+                let resolved = SLIP_DIRECTION_SPEED.max(res).max(2.0 * (res - SLIP_DIRECTION_SPEED));
                 let ends = h.state.onset[k].is_some() && v_t[0].hypot(v_t[1]) > resolved && v_t[0] * a[0] + v_t[1] * a[1] > 0.0;
                 h.s_ref[k] = slip_direction(v_t, if ends { v_t } else { a });
                 h.state.slip[k] = h.s_ref[k];
