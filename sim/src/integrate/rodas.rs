@@ -53,8 +53,11 @@
 //!   (HNW II §IV.8, [`super::fd_jacobian_columns`], increment `sqrt(eps) max(|y_j|, floor)`
 //!   with `floor = atol / rtol` within `[1e-5, 1]`, the scale below which the error norm
 //!   treats a component as absolute, unless the system states its noise and scale,
-//!   [`OdeJacobian::difference_increment`]) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`. `f_t`:
-//!   [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
+//!   [`OdeJacobian::difference_increment`]) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`;
+//!   the trailing columns from [`OdeJacobian::exact_columns_start`] on exact where the system
+//!   writes them ([`OdeJacobian::exact_columns`], right after the difference sweep over the
+//!   leading ones; the arm's current columns, issue 24), else differenced too. `f_t`:
+//!   [`OdeJacobian::exact_time_derivative`], else [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
 //!   [`super::Rosenbrock`]. Both are evaluated at the start of every step by default;
 //!   `with_jacobian_reuse(k)` keeps `J` for `k` accepted steps (this loses the order, which
 //!   the error control then pays for in step size; `f_t` stays fresh).
@@ -68,7 +71,7 @@
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
 use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::{Controller, StepSizeControl};
-use super::jacobian::{fd_jacobian_columns_within, DifferenceIncrement};
+use super::jacobian::{fd_jacobian_column_range_within, DifferenceIncrement};
 use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::rosenbrock::{stage_argument, stage_rhs, time_derivative};
 use super::{
@@ -286,25 +289,12 @@ impl Rodas {
         if !exact {
             self.jac.fill(0.0);
             let inc = sys.difference_increment().unwrap_or(DifferenceIncrement { noise: f64::EPSILON, floor: fd_floor(&self.core.control) });
-            let stopped = fd_jacobian_columns_within(
-                sys,
-                t,
-                &self.y,
-                &self.f0,
-                &mut self.jac,
-                nc,
-                inc,
-                &mut self.y_stage,
-                &mut self.f_stage,
-                self.watch,
-            )
-            .map_err(IntegrateError::Rhs)?;
-            if let Some(j) = stopped {
-                self.core.stats.rhs_evals += j as u64;
-                self.jac_valid = false;
-                return Err(IntegrateError::OutOfTime { t, during: Phase::Jacobian { column: j + 1, columns: nc } });
+            // the leading columns by differences, the trailing ones exact where the system can
+            let k = sys.exact_columns_start().min(nc);
+            self.difference_columns(sys, 0..k, inc)?;
+            if k < nc && !sys.exact_columns(t, &self.y, &self.f0, &mut self.jac).map_err(IntegrateError::Rhs)? {
+                self.difference_columns(sys, k..nc, inc)?;
             }
-            self.core.stats.rhs_evals += nc as u64;
         }
         if let Some(k) = first_non_finite(&self.jac) {
             return Err(IntegrateError::NonFiniteState {
@@ -320,12 +310,50 @@ impl Rodas {
         Ok(())
     }
 
+    /// The difference columns `cols` of `J` at the current point, counted in
+    /// `Stats::rhs_evals`; [`IntegrateError::OutOfTime`] past the deadline.
+    fn difference_columns<S: OdeJacobian>(
+        &mut self,
+        sys: &mut S,
+        cols: std::ops::Range<usize>,
+        inc: DifferenceIncrement,
+    ) -> Result<(), IntegrateError<S::Error>> {
+        let (t, nc, start) = (self.core.t, self.nc, cols.start);
+        let stopped = fd_jacobian_column_range_within(
+            sys,
+            t,
+            &self.y,
+            &self.f0,
+            &mut self.jac,
+            cols.clone(),
+            inc,
+            &mut self.y_stage,
+            &mut self.f_stage,
+            self.watch,
+        )
+        .map_err(IntegrateError::Rhs)?;
+        if let Some(j) = stopped {
+            self.core.stats.rhs_evals += (j - start) as u64;
+            self.jac_valid = false;
+            return Err(IntegrateError::OutOfTime { t, during: Phase::Jacobian { column: j + 1, columns: nc } });
+        }
+        self.core.stats.rhs_evals += cols.len() as u64;
+        Ok(())
+    }
+
     /// `f_t` at the current point ([`super::rosenbrock::time_derivative`]).
     fn evaluate_dfdt<S: OdeJacobian>(
         &mut self,
         sys: &mut S,
     ) -> Result<(), IntegrateError<S::Error>> {
-        time_derivative(&mut self.core.stats, sys, self.core.t, &self.y, &self.f0, &mut self.dfdt, &mut self.f_stage)?;
+        let t = self.core.t;
+        if sys.exact_time_derivative(t, &self.y, &self.f0, &mut self.dfdt).map_err(IntegrateError::Rhs)? {
+            if let Some(i) = first_non_finite(&self.dfdt) {
+                return Err(IntegrateError::NonFiniteState { t, index: i });
+            }
+        } else {
+            time_derivative(&mut self.core.stats, sys, t, &self.y, &self.f0, &mut self.dfdt, &mut self.f_stage)?;
+        }
         self.dfdt_fresh = true;
         Ok(())
     }
