@@ -65,7 +65,10 @@
 //!   (quadratures) do not enter `f`, so `J = [[J_cc, 0], [J_qc, 0]]` and `I/(h gamma) - J` is
 //!   block lower triangular: only `I/(h gamma) - J_cc` (`nc x nc`) is factored (LU with
 //!   partial pivoting, `lu.rs`, once per step and reused by every stage), and the quadrature
-//!   part of each stage is the substitution `u_q = h gamma (r_q + J_qc u_c)`.
+//!   part of each stage is the substitution `u_q = h gamma (r_q + J_qc u_c)`, the product only
+//!   over the rows of `J_qc` that are not 0 (a separated candidate contact's losses are;
+//!   whole-table has 21 such rows of 50). The columns `nc..n` of `J` are zeroed once and not
+//!   scanned (the difference sweep writes the columns `0..nc` only).
 //! - singular matrix, non-finite stages, `t_stop`, `max_steps`: as in [`super::Rosenbrock`].
 
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
@@ -140,6 +143,12 @@ pub struct Rodas {
     dfdt_fresh: bool,
     steps_since_jac: usize,
     jac_max: f64,
+    /// Whether the columns `nc..dim` of `jac` are 0 (the difference path writes only the
+    /// columns `0..nc`, every row, so they stay 0 from one Jacobian to the next).
+    jac_tail_zero: bool,
+    /// The quadrature rows `nc..dim` of `jac` with a non-zero entry (the others, e.g. a
+    /// separated contact's losses, need no product in [`Rodas::solve`]), ascending.
+    quad_rows: Vec<usize>,
     /// LU of `I/(h gamma) - J_cc` (`nc x nc`, row-major) and the `h` it was formed for.
     lu: Vec<f64>,
     piv: Vec<usize>,
@@ -191,6 +200,8 @@ impl Rodas {
             dfdt_fresh: false,
             steps_since_jac: 0,
             jac_max: 0.0,
+            jac_tail_zero: false,
+            quad_rows: Vec::with_capacity(dim),
             lu: vec![0.0; dim * dim],
             piv: vec![0; dim],
             lu_h: f64::NAN,
@@ -286,8 +297,13 @@ impl Rodas {
         let exact = sys
             .exact_jacobian(t, &self.y, &self.f0, &mut self.jac)
             .map_err(IntegrateError::Rhs)?;
-        if !exact {
-            self.jac.fill(0.0);
+        if exact {
+            self.jac_tail_zero = false;
+        } else {
+            if !self.jac_tail_zero {
+                self.jac.fill(0.0);
+                self.jac_tail_zero = true;
+            }
             let inc = sys.difference_increment().unwrap_or(DifferenceIncrement { noise: f64::EPSILON, floor: fd_floor(&self.core.control) });
             // the leading columns by differences, the trailing ones exact where the system can
             let k = sys.exact_columns_start().min(nc);
@@ -296,13 +312,22 @@ impl Rodas {
                 self.difference_columns(sys, k..nc, inc)?;
             }
         }
-        if let Some(k) = first_non_finite(&self.jac) {
-            return Err(IntegrateError::NonFiniteState {
-                t,
-                index: k / n.max(1),
-            });
+        // the first non-finite entry's row and the largest |entry|, over the columns written
+        // (the others are 0)
+        let cols = if exact { n } else { nc };
+        let mut jac_max = 0.0f64;
+        self.quad_rows.clear();
+        for r in 0..n {
+            let row = &self.jac[r * n..r * n + cols];
+            if first_non_finite(row).is_some() {
+                return Err(IntegrateError::NonFiniteState { t, index: r });
+            }
+            jac_max = row.iter().fold(jac_max, |m, v| m.max(v.abs()));
+            if r >= nc && self.jac[r * n..r * n + nc].iter().any(|&v| v != 0.0) {
+                self.quad_rows.push(r);
+            }
         }
-        self.jac_max = self.jac.iter().fold(0.0, |m, v| m.max(v.abs()));
+        self.jac_max = jac_max;
         self.jac_valid = true;
         self.jac_fresh = true;
         self.steps_since_jac = 0;
@@ -389,10 +414,16 @@ impl Rodas {
         let (xc, xq) = x.split_at_mut(nc);
         lu_solve(&self.lu[..nc * nc], nc, &self.piv[..nc], xc);
         let hg = h * self.tab.gamma;
+        // a zero row of J_qc (not in quad_rows) contributes nothing
+        let mut rows = self.quad_rows.iter().copied().peekable();
         for (k, v) in xq.iter_mut().enumerate() {
-            let row = &self.jac[(nc + k) * n..(nc + k) * n + nc];
-            let s: f64 = row.iter().zip(xc.iter()).map(|(j, u)| j * u).sum();
-            *v = hg * (*v + s);
+            if rows.next_if_eq(&(nc + k)).is_some() {
+                let row = &self.jac[(nc + k) * n..(nc + k) * n + nc];
+                let s: f64 = row.iter().zip(xc.iter()).map(|(j, u)| j * u).sum();
+                *v = hg * (*v + s);
+            } else {
+                *v *= hg;
+            }
         }
     }
 
@@ -524,6 +555,7 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.core.init("Rodas", self.dim, &*sys, t0, y0)?;
         self.nc = sys.coupled_dim();
+        self.jac_tail_zero = false;
         assert!(self.nc <= self.dim, "Rodas::init: coupled_dim {} > dim {}", self.nc, self.dim);
         self.jac_valid = false;
         self.jac_fresh = false;

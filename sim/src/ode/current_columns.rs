@@ -55,6 +55,7 @@ impl ArmSystem<'_> {
     /// The current columns of `∂f/∂y (t, y)` (all rows) into `jac` (row-major `dim x dim`),
     /// `Ok(false)` without writing where they are not exact (module docs). Evaluates f at
     /// `(t, y)` (reusing the q-only part of a difference sweep at the same q).
+    #[allow(clippy::result_large_err)] // RunError, as every evaluation of the arm
     pub(super) fn exact_current_columns(&mut self, t: f64, y: &[f64], jac: &mut [f64]) -> Result<bool, RunError> {
         if !self.has_exact_current_columns() {
             return Ok(false);
@@ -138,8 +139,8 @@ impl ArmSystem<'_> {
             x.copy_from_slice(rows.row(ar.row));
             if let RowForce::Sliding { mu, s: dir } = ar.force {
                 let c = ar.row / 3;
-                for j in 0..nv {
-                    x[j] -= mu * (dir[0] * rows.row(3 * c + 1)[j] + dir[1] * rows.row(3 * c + 2)[j]);
+                for ((xj, t1), t2) in x.iter_mut().zip(rows.row(3 * c + 1)).zip(rows.row(3 * c + 2)) {
+                    *xj -= mu * (dir[0] * t1 + dir[1] * t2);
                 }
             }
             solve_mj(l_fac, inv, nv, x);
@@ -160,7 +161,7 @@ impl ArmSystem<'_> {
         for k in 0..m {
             let p = (k..m).max_by(|&i, &j| a[i * m + k].abs().total_cmp(&a[j * m + k].abs())).unwrap_or(k);
             let pivot = a[p * m + k];
-            if !(pivot.abs() > 0.0) || !pivot.is_finite() {
+            if pivot == 0.0 || !pivot.is_finite() {
                 return false;
             }
             if p != k {
@@ -183,7 +184,7 @@ impl ArmSystem<'_> {
                 }
             }
         }
-        if !(piv_min > PIVOT_RATIO * piv_max) {
+        if piv_min <= PIVOT_RATIO * piv_max {
             return false;
         }
         for k in (0..m).rev() {

@@ -26,6 +26,7 @@ use super::arm::ArmSystem;
 
 impl ArmSystem<'_> {
     /// `∂f/∂t (t, y)` into `dfdt` (module docs), or `Ok(false)` without writing.
+    #[allow(clippy::result_large_err)] // RunError, as every evaluation of the arm
     pub(super) fn exact_time_derivative_at(&mut self, t: f64, y: &[f64], dfdt: &mut [f64]) -> Result<bool, RunError> {
         let s = self.scene;
         let l = self.layout;
