@@ -51,6 +51,8 @@ mod contacts_start;
 mod contacts_steps;
 #[path = "convergence.rs"]
 mod convergence;
+#[path = "current_columns.rs"]
+mod current_columns;
 #[path = "drive_features.rs"]
 mod drive_features;
 #[path = "drives.rs"]

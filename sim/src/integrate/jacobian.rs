@@ -104,15 +104,41 @@ pub fn fd_jacobian_columns_within<S: OdeSystem>(
     scratch_f: &mut [f64],
     watch: Watch,
 ) -> Result<Option<usize>, S::Error> {
+    fd_jacobian_column_range_within(sys, t, y, fy, jac, 0..cols, inc, scratch_y, scratch_f, watch)
+}
+
+/// [`fd_jacobian_columns_within`] over the columns `cols` only (a sweep continued after
+/// columns the system wrote exactly, [`super::OdeJacobian::exact_columns`]); the deadline is
+/// read before every column after the first of the range.
+///
+/// # Errors
+/// The first error of `sys.rhs` (the remaining columns are not computed).
+///
+/// # Panics
+/// As [`fd_jacobian_columns`] (`cols.end > n`).
+#[allow(clippy::too_many_arguments)]
+pub fn fd_jacobian_column_range_within<S: OdeSystem>(
+    sys: &mut S,
+    t: f64,
+    y: &[f64],
+    fy: &[f64],
+    jac: &mut [f64],
+    cols: std::ops::Range<usize>,
+    inc: DifferenceIncrement,
+    scratch_y: &mut [f64],
+    scratch_f: &mut [f64],
+    watch: Watch,
+) -> Result<Option<usize>, S::Error> {
     let n = y.len();
     assert!(
-        fy.len() == n && scratch_y.len() == n && scratch_f.len() == n && jac.len() == n * n && cols <= n,
-        "fd_jacobian: slice lengths vs dim {n}, columns {cols}"
+        fy.len() == n && scratch_y.len() == n && scratch_f.len() == n && jac.len() == n * n && cols.end <= n,
+        "fd_jacobian: slice lengths vs dim {n}, columns {cols:?}"
     );
     let rel = inc.noise.max(f64::EPSILON).sqrt();
     scratch_y.copy_from_slice(y);
-    for j in 0..cols {
-        if j > 0 && watch.out_of_time() {
+    let first = cols.start;
+    for j in cols {
+        if j > first && watch.out_of_time() {
             return Ok(Some(j));
         }
         let yj = y[j];

@@ -124,7 +124,7 @@ pub use self::control::{SettingsError, StepControl, StepSizeControl};
 pub use self::dopri5::{DormandPrince45, STIFF_STEPS_LEFT};
 pub use self::events::{integrate_hybrid, EventSettings, HybridSystem};
 pub use self::imex::ArkImex;
-pub use self::jacobian::{fd_jacobian, fd_jacobian_columns, fd_jacobian_columns_within, DifferenceIncrement, FdJacobian};
+pub use self::jacobian::{fd_jacobian, fd_jacobian_column_range_within, fd_jacobian_columns, fd_jacobian_columns_within, DifferenceIncrement, FdJacobian};
 pub use self::rk4::Rk4;
 pub use self::rodas::{Rodas, RodasMethod};
 pub use self::rosenbrock::Rosenbrock;
@@ -205,6 +205,21 @@ pub trait OdeJacobian: OdeSystem {
         Ok(false)
     }
 
+    /// For the classical Rosenbrock methods ([`Rodas`]), whose order needs the exact `∂f/∂t`:
+    /// writes it into `dfdt` and returns `Ok(true)`, or returns `Ok(false)` without writing,
+    /// and the stepper takes [`OdeJacobian::time_derivative`] (else a difference in `t`, one
+    /// evaluation of `rhs` per step). The default returns `Ok(false)`.
+    fn exact_time_derivative(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        fy: &[f64],
+        dfdt: &mut [f64],
+    ) -> Result<bool, Self::Error> {
+        let _ = (t, y, fy, dfdt);
+        Ok(false)
+    }
+
     /// For the classical Rosenbrock methods ([`Rodas`]), whose order needs the exact `∂f/∂y`:
     /// writes it like [`OdeJacobian::jacobian`] and returns `Ok(true)`, or returns `Ok(false)`
     /// without writing, and the stepper differences `f` over the coupled columns
@@ -228,6 +243,31 @@ pub trait OdeJacobian: OdeSystem {
     /// assumes nothing.
     fn coupled_dim(&self) -> usize {
         self.dim()
+    }
+
+    /// For [`Rodas`] when [`OdeJacobian::exact_jacobian`] gives no Jacobian: the first column
+    /// `k ≤ coupled_dim()` of the trailing columns `k..coupled_dim()` that
+    /// [`OdeJacobian::exact_columns`] may write exactly; the stepper differences `f` over
+    /// `0..k` first. The default, `coupled_dim()`: no such column.
+    fn exact_columns_start(&self) -> usize {
+        self.coupled_dim()
+    }
+
+    /// Writes the columns `k..coupled_dim()` (`k = exact_columns_start()`, every row) of the
+    /// exact `∂f/∂y (t, y)` into `jac` and returns `Ok(true)`, or returns `Ok(false)` without
+    /// writing where it cannot at this state, and the stepper differences those columns too.
+    /// [`Rodas`] calls it right after its difference sweep over `0..k` at the same `(t, y)`
+    /// (so a system may reuse what the sweep left, as in [`OdeSystem::rhs_column`]), and a
+    /// sweep over `k..coupled_dim()` may follow it. The default returns `Ok(false)`.
+    fn exact_columns(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        fy: &[f64],
+        jac: &mut [f64],
+    ) -> Result<bool, Self::Error> {
+        let _ = (t, y, fy, jac);
+        Ok(false)
     }
 
     /// How [`Rodas`] differences `f` when [`OdeJacobian::exact_jacobian`] gives no Jacobian:

@@ -53,8 +53,11 @@
 //!   (HNW II §IV.8, [`super::fd_jacobian_columns`], increment `sqrt(eps) max(|y_j|, floor)`
 //!   with `floor = atol / rtol` within `[1e-5, 1]`, the scale below which the error norm
 //!   treats a component as absolute, unless the system states its noise and scale,
-//!   [`OdeJacobian::difference_increment`]) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`. `f_t`:
-//!   [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
+//!   [`OdeJacobian::difference_increment`]) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`;
+//!   the trailing columns from [`OdeJacobian::exact_columns_start`] on exact where the system
+//!   writes them ([`OdeJacobian::exact_columns`], right after the difference sweep over the
+//!   leading ones; the arm's current columns, issue 24), else differenced too. `f_t`:
+//!   [`OdeJacobian::exact_time_derivative`], else [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
 //!   [`super::Rosenbrock`]. Both are evaluated at the start of every step by default;
 //!   `with_jacobian_reuse(k)` keeps `J` for `k` accepted steps (this loses the order, which
 //!   the error control then pays for in step size; `f_t` stays fresh).
@@ -62,13 +65,16 @@
 //!   (quadratures) do not enter `f`, so `J = [[J_cc, 0], [J_qc, 0]]` and `I/(h gamma) - J` is
 //!   block lower triangular: only `I/(h gamma) - J_cc` (`nc x nc`) is factored (LU with
 //!   partial pivoting, `lu.rs`, once per step and reused by every stage), and the quadrature
-//!   part of each stage is the substitution `u_q = h gamma (r_q + J_qc u_c)`.
+//!   part of each stage is the substitution `u_q = h gamma (r_q + J_qc u_c)`, the product only
+//!   over the rows of `J_qc` that are not 0 (a separated candidate contact's losses are;
+//!   whole-table has 21 such rows of 50). The columns `nc..n` of `J` are zeroed once and not
+//!   scanned (the difference sweep writes the columns `0..nc` only).
 //! - singular matrix, non-finite stages, `t_stop`, `max_steps`: as in [`super::Rosenbrock`].
 
 use self::tableau::{Tableau, MAX_STAGES, RODAS4, RODAS5P};
 use super::adaptive::{self, initial_step, Adaptive, Attempt, Core, Failure};
 use super::control::{Controller, StepSizeControl};
-use super::jacobian::{fd_jacobian_columns_within, DifferenceIncrement};
+use super::jacobian::{fd_jacobian_column_range_within, DifferenceIncrement};
 use super::lu::{lu_factor_within, lu_solve, LuStop};
 use super::rosenbrock::{stage_argument, stage_rhs, time_derivative};
 use super::{
@@ -137,6 +143,12 @@ pub struct Rodas {
     dfdt_fresh: bool,
     steps_since_jac: usize,
     jac_max: f64,
+    /// Whether the columns `nc..dim` of `jac` are 0 (the difference path writes only the
+    /// columns `0..nc`, every row, so they stay 0 from one Jacobian to the next).
+    jac_tail_zero: bool,
+    /// The quadrature rows `nc..dim` of `jac` with a non-zero entry (the others, e.g. a
+    /// separated contact's losses, need no product in [`Rodas::solve`]), ascending.
+    quad_rows: Vec<usize>,
     /// LU of `I/(h gamma) - J_cc` (`nc x nc`, row-major) and the `h` it was formed for.
     lu: Vec<f64>,
     piv: Vec<usize>,
@@ -188,6 +200,8 @@ impl Rodas {
             dfdt_fresh: false,
             steps_since_jac: 0,
             jac_max: 0.0,
+            jac_tail_zero: false,
+            quad_rows: Vec::with_capacity(dim),
             lu: vec![0.0; dim * dim],
             piv: vec![0; dim],
             lu_h: f64::NAN,
@@ -283,40 +297,72 @@ impl Rodas {
         let exact = sys
             .exact_jacobian(t, &self.y, &self.f0, &mut self.jac)
             .map_err(IntegrateError::Rhs)?;
-        if !exact {
-            self.jac.fill(0.0);
-            let inc = sys.difference_increment().unwrap_or(DifferenceIncrement { noise: f64::EPSILON, floor: fd_floor(&self.core.control) });
-            let stopped = fd_jacobian_columns_within(
-                sys,
-                t,
-                &self.y,
-                &self.f0,
-                &mut self.jac,
-                nc,
-                inc,
-                &mut self.y_stage,
-                &mut self.f_stage,
-                self.watch,
-            )
-            .map_err(IntegrateError::Rhs)?;
-            if let Some(j) = stopped {
-                self.core.stats.rhs_evals += j as u64;
-                self.jac_valid = false;
-                return Err(IntegrateError::OutOfTime { t, during: Phase::Jacobian { column: j + 1, columns: nc } });
+        if exact {
+            self.jac_tail_zero = false;
+        } else {
+            if !self.jac_tail_zero {
+                self.jac.fill(0.0);
+                self.jac_tail_zero = true;
             }
-            self.core.stats.rhs_evals += nc as u64;
+            let inc = sys.difference_increment().unwrap_or(DifferenceIncrement { noise: f64::EPSILON, floor: fd_floor(&self.core.control) });
+            // the leading columns by differences, the trailing ones exact where the system can
+            let k = sys.exact_columns_start().min(nc);
+            self.difference_columns(sys, 0..k, inc)?;
+            if k < nc && !sys.exact_columns(t, &self.y, &self.f0, &mut self.jac).map_err(IntegrateError::Rhs)? {
+                self.difference_columns(sys, k..nc, inc)?;
+            }
         }
-        if let Some(k) = first_non_finite(&self.jac) {
-            return Err(IntegrateError::NonFiniteState {
-                t,
-                index: k / n.max(1),
-            });
+        // the first non-finite entry's row and the largest |entry|, over the columns written
+        // (the others are 0)
+        let cols = if exact { n } else { nc };
+        let mut jac_max = 0.0f64;
+        self.quad_rows.clear();
+        for r in 0..n {
+            let row = &self.jac[r * n..r * n + cols];
+            if first_non_finite(row).is_some() {
+                return Err(IntegrateError::NonFiniteState { t, index: r });
+            }
+            jac_max = row.iter().fold(jac_max, |m, v| m.max(v.abs()));
+            if r >= nc && self.jac[r * n..r * n + nc].iter().any(|&v| v != 0.0) {
+                self.quad_rows.push(r);
+            }
         }
-        self.jac_max = self.jac.iter().fold(0.0, |m, v| m.max(v.abs()));
+        self.jac_max = jac_max;
         self.jac_valid = true;
         self.jac_fresh = true;
         self.steps_since_jac = 0;
         self.lu_h = f64::NAN;
+        Ok(())
+    }
+
+    /// The difference columns `cols` of `J` at the current point, counted in
+    /// `Stats::rhs_evals`; [`IntegrateError::OutOfTime`] past the deadline.
+    fn difference_columns<S: OdeJacobian>(
+        &mut self,
+        sys: &mut S,
+        cols: std::ops::Range<usize>,
+        inc: DifferenceIncrement,
+    ) -> Result<(), IntegrateError<S::Error>> {
+        let (t, nc, start) = (self.core.t, self.nc, cols.start);
+        let stopped = fd_jacobian_column_range_within(
+            sys,
+            t,
+            &self.y,
+            &self.f0,
+            &mut self.jac,
+            cols.clone(),
+            inc,
+            &mut self.y_stage,
+            &mut self.f_stage,
+            self.watch,
+        )
+        .map_err(IntegrateError::Rhs)?;
+        if let Some(j) = stopped {
+            self.core.stats.rhs_evals += (j - start) as u64;
+            self.jac_valid = false;
+            return Err(IntegrateError::OutOfTime { t, during: Phase::Jacobian { column: j + 1, columns: nc } });
+        }
+        self.core.stats.rhs_evals += cols.len() as u64;
         Ok(())
     }
 
@@ -325,7 +371,14 @@ impl Rodas {
         &mut self,
         sys: &mut S,
     ) -> Result<(), IntegrateError<S::Error>> {
-        time_derivative(&mut self.core.stats, sys, self.core.t, &self.y, &self.f0, &mut self.dfdt, &mut self.f_stage)?;
+        let t = self.core.t;
+        if sys.exact_time_derivative(t, &self.y, &self.f0, &mut self.dfdt).map_err(IntegrateError::Rhs)? {
+            if let Some(i) = first_non_finite(&self.dfdt) {
+                return Err(IntegrateError::NonFiniteState { t, index: i });
+            }
+        } else {
+            time_derivative(&mut self.core.stats, sys, t, &self.y, &self.f0, &mut self.dfdt, &mut self.f_stage)?;
+        }
         self.dfdt_fresh = true;
         Ok(())
     }
@@ -361,10 +414,16 @@ impl Rodas {
         let (xc, xq) = x.split_at_mut(nc);
         lu_solve(&self.lu[..nc * nc], nc, &self.piv[..nc], xc);
         let hg = h * self.tab.gamma;
+        // a zero row of J_qc (not in quad_rows) contributes nothing
+        let mut rows = self.quad_rows.iter().copied().peekable();
         for (k, v) in xq.iter_mut().enumerate() {
-            let row = &self.jac[(nc + k) * n..(nc + k) * n + nc];
-            let s: f64 = row.iter().zip(xc.iter()).map(|(j, u)| j * u).sum();
-            *v = hg * (*v + s);
+            if rows.next_if_eq(&(nc + k)).is_some() {
+                let row = &self.jac[(nc + k) * n..(nc + k) * n + nc];
+                let s: f64 = row.iter().zip(xc.iter()).map(|(j, u)| j * u).sum();
+                *v = hg * (*v + s);
+            } else {
+                *v *= hg;
+            }
         }
     }
 
@@ -496,6 +555,7 @@ impl<S: OdeJacobian> Stepper<S> for Rodas {
     fn init(&mut self, sys: &mut S, t0: f64, y0: &[f64]) -> Result<(), IntegrateError<S::Error>> {
         self.core.init("Rodas", self.dim, &*sys, t0, y0)?;
         self.nc = sys.coupled_dim();
+        self.jac_tail_zero = false;
         assert!(self.nc <= self.dim, "Rodas::init: coupled_dim {} > dim {}", self.nc, self.dim);
         self.jac_valid = false;
         self.jac_fresh = false;

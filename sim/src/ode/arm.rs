@@ -119,9 +119,15 @@ impl<'a> ArmSystem<'a> {
     pub(super) fn voltage_at(&mut self, t: f64, q: &[f64], qd: &[f64], current: Option<&[f64]>) -> Result<(), DynamicsError> {
         let s = self.scene;
         let ws = &mut self.ws;
-        let qdd_des = if ws.want_qdd { Some(&mut ws.qdd_des[..]) } else { None };
-        s.target.eval(t, &s.model, &s.hand, &mut ws.target, &mut ws.q_des, &mut ws.qd_des, qdd_des)
-            .map_err(|why| DynamicsError::Unreachable { t, why })?;
+        // the targets depend on t alone: a difference Jacobian's columns and the stage at
+        // c = 0 share theirs (the paper's IK: atan2, acos, sin, cos per evaluation)
+        if ws.target_t.to_bits() != t.to_bits() {
+            let qdd_des = if ws.want_qdd { Some(&mut ws.qdd_des[..]) } else { None };
+            ws.target_t = f64::NAN;
+            s.target.eval(t, &s.model, &s.hand, &mut ws.target, &mut ws.q_des, &mut ws.qd_des, qdd_des)
+                .map_err(|why| DynamicsError::Unreachable { t, why })?;
+            ws.target_t = t;
+        }
         let input = crate::control::ControlInput { q, qd, current, q_des: &ws.q_des, qd_des: &ws.qd_des, qdd_des: &ws.qdd_des };
         s.controller.voltage(&s.model, &s.drives, &mut ws.data, &mut ws.ctrl, &input, &mut ws.voltage);
         // the drive's current window at the winding's resistance now (R(T_w) with the thermal
@@ -186,7 +192,7 @@ impl<'a> ArmSystem<'a> {
     /// [`ArmSystem::evaluate`] of a hybrid run at a state whose q is the one of the q-only
     /// part in the workspace (`sweep_q`, checked by the caller): the inputs in full, eq 21 with
     /// that part reused (`forward_dynamics_contacts_same_q`), bit for bit a full evaluation.
-    fn evaluate_same_q(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
+    pub(super) fn evaluate_same_q(&mut self, t: f64, y: &[f64]) -> Result<(), DynamicsError> {
         self.inputs(t, y)?;
         let l = self.layout;
         let s = self.scene;

@@ -27,9 +27,11 @@
 //!   `∂i̇/∂T_w = −R' i / L` (inductive) or through `i = (v − K_e k q̇)/R(T_w)` (L = 0).
 //! - For the classical Rosenbrock methods (`Rodas`), which need the exact Jacobian:
 //!   [`OdeJacobian::coupled_dim`] = the q, q̇, i block (the quadratures never feed back, so
-//!   their columns are zero), and no analytic exact Jacobian, so the stepper differences the
-//!   right-hand side over those columns, with the increment the arm's units and rounding noise
-//!   call for ([`OdeJacobian::difference_increment`]).
+//!   their columns are zero); the current columns exact (`current_columns.rs`,
+//!   [`OdeJacobian::exact_columns`]) where the scene and the state allow, and the stepper
+//!   differences the right-hand side over the q and q̇ columns (and the current ones where
+//!   they are not exact), with the increment the arm's units and rounding noise call for
+//!   ([`OdeJacobian::difference_increment`]).
 //! - [`SplitSystem`]: the armature circuit `L di/dt = v − R i − K_e k q̇` (K_e k = K_m unless
 //!   the scene gives `back_emf_constant`) is linear in i with a diagonal matrix, so its implicit
 //!   stage equation `z − γ f_I(z) = r` has the closed form
@@ -49,7 +51,7 @@ use super::arm::ArmSystem;
 impl ArmSystem<'_> {
     /// `M_c⁻¹` at the state of the last evaluation (M in `data.m`, J_c in `fd.jac`), into the
     /// Jacobian scratch.
-    fn constrained_inverse_inertia(&mut self, t: f64) -> Result<(), RunError> {
+    pub(super) fn constrained_inverse_inertia(&mut self, t: f64) -> Result<(), RunError> {
         let nv = self.layout.nv;
         // a hybrid run's rows depend on its modes and are not in fd.jac: the unconstrained
         // M_J⁻¹ there (a bounded approximation, which the W-methods allow; the classical
@@ -112,6 +114,25 @@ impl OdeJacobian for ArmSystem<'_> {
     /// increment of 3.2e-7 rad/s would straddle.
     fn difference_increment(&self) -> Option<crate::integrate::DifferenceIncrement> {
         self.hybrid.is_none().then_some(crate::integrate::DifferenceIncrement { noise: 1e-13, floor: 1.0 })
+    }
+
+    /// The current columns, exact where `current_columns.rs` says; the q and q̇ columns by
+    /// differences.
+    fn exact_columns_start(&self) -> usize {
+        if self.has_exact_current_columns() {
+            self.layout.current().start
+        } else {
+            self.coupled_dim()
+        }
+    }
+
+    fn exact_columns(&mut self, t: f64, y: &[f64], _fy: &[f64], jac: &mut [f64]) -> Result<bool, RunError> {
+        self.exact_current_columns(t, y, jac)
+    }
+
+    /// `time_derivative.rs`.
+    fn exact_time_derivative(&mut self, t: f64, y: &[f64], _fy: &[f64], dfdt: &mut [f64]) -> Result<bool, RunError> {
+        self.exact_time_derivative_at(t, y, dfdt)
     }
 
     fn jacobian(&mut self, t: f64, y: &[f64], _fy: &[f64], jac: &mut [f64]) -> Result<(), RunError> {

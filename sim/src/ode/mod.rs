@@ -36,7 +36,8 @@
 //! (`dynamics/supply.rs`), reported as `SupplyOutput::residual`.
 //!
 //! Files: `layout.rs` (state indices), `workspace.rs` (the scratch), `arm.rs` (the system and
-//! its right-hand side), `outputs.rs`, `jacobian.rs` (Rosenbrock's Jacobian, IMEX's split),
+//! its right-hand side), `outputs.rs`, `jacobian.rs` (Rosenbrock's Jacobian, IMEX's split), `current_columns.rs` and `time_derivative.rs`
+//! (RODAS's exact current columns and `∂f/∂t`),
 //! `projection.rs`.
 
 mod arm;
@@ -44,6 +45,7 @@ mod describe;
 mod drive_forces;
 mod drive_modes;
 mod contact_events;
+mod current_columns;
 mod gear_decide;
 mod gear_hold;
 mod hybrid;
@@ -52,6 +54,7 @@ mod layout;
 mod outputs;
 mod projection;
 mod stop_slip;
+mod time_derivative;
 mod workspace;
 mod zeno;
 

@@ -21,6 +21,9 @@ pub(super) struct Workspace {
     /// Target q̈_d (nv), rad/s^2, for the controllers that feed it forward; written by
     /// `ArmSystem::voltage_at` when `want_qdd`.
     pub(super) qdd_des: Vec<f64>,
+    /// The time of the targets in `q_des`, `qd_des` (and `qdd_des`), NaN when none: they
+    /// depend on t alone, so `ArmSystem::voltage_at` computes them once per t.
+    pub(super) target_t: f64,
     /// Whether the controller reads q̈_d (computed torque; the paper's PD does not, and the
     /// paper target then skips computing it). Set once in `ArmSystem::new`.
     pub(super) want_qdd: bool,
@@ -65,6 +68,7 @@ impl Workspace {
             q_des: vec![0.0; nv],
             qd_des: vec![0.0; nv],
             qdd_des: vec![0.0; nv],
+            target_t: f64::NAN,
             want_qdd: false,
             target: TargetScratch::new(model),
             voltage: vec![0.0; nv],
@@ -98,6 +102,12 @@ pub(super) struct JacobianScratch {
     pub(super) f: Vec<f64>,
     /// The controller's diagonal linearisation per joint (k_p', k_d', k_i').
     pub(super) lin: Vec<(f64, f64, f64)>,
+    /// The exact current columns' matrices (`current_columns.rs`).
+    pub(super) cur: super::current_columns::CurrentColumnsScratch,
+    /// The target's q_d, q̇_d, q̈_d for the exact `∂f/∂t` (`time_derivative.rs`), nv each.
+    pub(super) q_d: Vec<f64>,
+    pub(super) qd_d: Vec<f64>,
+    pub(super) qdd_d: Vec<f64>,
 }
 
 impl JacobianScratch {
@@ -111,6 +121,10 @@ impl JacobianScratch {
             ayt: DMatrix::zeros(nc, nv),
             f: vec![0.0; dim],
             lin: vec![(0.0, 0.0, 0.0); nv],
+            cur: super::current_columns::CurrentColumnsScratch::new(nv, nc),
+            q_d: vec![0.0; nv],
+            qd_d: vec![0.0; nv],
+            qdd_d: vec![0.0; nv],
         }
     }
 }

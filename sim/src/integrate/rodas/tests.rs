@@ -215,6 +215,10 @@ fn dense_output_local_order() {
 struct WithQuadratures {
     coupled: bool,
     exact: bool,
+    /// Without `exact`: `Some(true)` writes the velocity columns 2, 3 exactly
+    /// ([`OdeJacobian::exact_columns`]) and f_t = 0 ([`OdeJacobian::exact_time_derivative`]),
+    /// `Some(false)` offers those columns and then declines; `None` offers nothing.
+    tail: Option<bool>,
 }
 
 impl OdeSystem for WithQuadratures {
@@ -253,6 +257,30 @@ impl OdeJacobian for WithQuadratures {
             6
         }
     }
+    fn exact_columns_start(&self) -> usize {
+        if self.tail.is_some() {
+            2
+        } else {
+            self.coupled_dim()
+        }
+    }
+    fn exact_columns(&mut self, t: f64, y: &[f64], fy: &[f64], jac: &mut [f64]) -> Result<bool, Self::Error> {
+        if self.tail != Some(true) {
+            return Ok(false);
+        }
+        let mut full = [0.0; 36];
+        self.jacobian(t, y, fy, &mut full)?;
+        for r in 0..6 {
+            for c in 2..4 {
+                jac[r * 6 + c] = full[r * 6 + c];
+            }
+        }
+        Ok(true)
+    }
+    fn exact_time_derivative(&mut self, _t: f64, _y: &[f64], _fy: &[f64], dfdt: &mut [f64]) -> Result<bool, Self::Error> {
+        dfdt.fill(0.0);
+        Ok(self.tail == Some(true))
+    }
 }
 
 fn run_to(sys: &mut WithQuadratures, t_end: f64) -> (Vec<f64>, Stats) {
@@ -272,13 +300,13 @@ fn run_to(sys: &mut WithQuadratures, t_end: f64) -> (Vec<f64>, Stats) {
 #[test]
 fn block_solve_and_fd_jacobian_match_the_full_exact_solve() {
     let t_end = 3.0;
-    let (full, s_full) = run_to(&mut WithQuadratures { coupled: false, exact: true }, t_end);
-    let (block, s_block) = run_to(&mut WithQuadratures { coupled: true, exact: true }, t_end);
+    let (full, s_full) = run_to(&mut WithQuadratures { coupled: false, exact: true, tail: None }, t_end);
+    let (block, s_block) = run_to(&mut WithQuadratures { coupled: true, exact: true, tail: None }, t_end);
     assert_eq!(s_full.steps, s_block.steps);
     for (a, b) in full.iter().zip(&block) {
         assert!((a - b).abs() < 1e-12, "{full:?} vs {block:?}");
     }
-    let (fd, s_fd) = run_to(&mut WithQuadratures { coupled: true, exact: false }, t_end);
+    let (fd, s_fd) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: None }, t_end);
     for (a, b) in full.iter().zip(&fd) {
         assert!((a - b).abs() < 1e-7, "{full:?} vs {fd:?}");
     }
@@ -288,6 +316,27 @@ fn block_solve_and_fd_jacobian_match_the_full_exact_solve() {
     assert_eq!(s_fd.jacobian_evals, s_fd.steps);
     assert_eq!(s_fd.rhs_evals, 2 + 4 * s_fd.jacobian_evals + s_fd.steps + 7 * attempts + s_fd.steps, "{s_fd:?}");
     eprintln!("full {s_full:?}\nblock {s_block:?}\nfd {s_fd:?}");
+}
+
+// Exact trailing columns (`OdeJacobian::exact_columns`, the arm's current columns): the
+// columns 2, 3 written by the system after the difference sweep over 0, 1 and an exact f_t
+// follow the analytic run to 1e-7 with 2 right-hand sides per Jacobian and none for f_t; a
+// system that offers the columns and declines gets them differenced, the same Jacobian bit for
+// bit as the plain difference run (same steps, same states, same count).
+#[test]
+fn exact_trailing_columns_replace_their_differences() {
+    let t_end = 3.0;
+    let (full, _) = run_to(&mut WithQuadratures { coupled: true, exact: true, tail: None }, t_end);
+    let (mixed, s_mixed) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(true) }, t_end);
+    for (a, b) in full.iter().zip(&mixed) {
+        assert!((a - b).abs() < 1e-7, "{full:?} vs {mixed:?}");
+    }
+    let attempts = s_mixed.steps + s_mixed.rejected;
+    assert_eq!(s_mixed.rhs_evals, 2 + 2 * s_mixed.jacobian_evals + 7 * attempts + s_mixed.steps, "{s_mixed:?}");
+    let (fd, s_fd) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: None }, t_end);
+    let (declined, s_declined) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(false) }, t_end);
+    assert_eq!(s_declined, s_fd);
+    assert_eq!(declined.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), fd.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
 }
 
 // Reusing J over k steps keeps the error controlled (the estimate sees the order loss): on
