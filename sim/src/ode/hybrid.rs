@@ -15,10 +15,10 @@
 //! `s_ref` is the slip direction at the start of the step (refreshed in `after_step`).
 //! `g_ref` is 0, except after a contact left the table with a separating speed (a rebound):
 //! then it is the restart's gap (less `zeno::DEPARTURE_DEPTH`, 1e-12 m, when the step control
-//! does not resolve the rebound's ġ⁺: a return on the gap's rounding is none), and the function is positive at the restart itself ([`REBOUND_START`]), so the
-//! return is located as a root however short the flight. A fired
-//! touch-down with ġ > `vel_tol` (separating) closes nothing: a contact is closed only with
-//! |g| ≤ `gap_tol` and |ġ| ≤ `vel_tol`.
+//! does not resolve the rebound's ġ⁺: a return on the gap's rounding is none), and the
+//! function is positive at the restart itself ([`REBOUND_START`]), so the return is located as
+//! a root however short the flight. A fired touch-down with ġ > `vel_tol` (separating) closes
+//! nothing: a contact is closed only with |g| ≤ `gap_tol` and |ġ| ≤ `vel_tol`.
 //! The force-type functions need a full evaluation of eq 21 at the interpolated state.
 //! At an event ([`HybridSystem::handle_events`]): touch-downs with approach speed above
 //! `vel_tol` are impacts (`dynamics/contact/impact.rs`; below `rest_velocity` plastic: the Zeno
@@ -118,8 +118,8 @@ impl Hybrid {
 /// event's bracket (≤ |ġ| · 1e-12 s inside); its touch-down function is `g − min(g₀, 0)` after
 /// the restart (less `zeno::DEPARTURE_DEPTH` for a rebound the step control does not resolve:
 /// a return on the gap's rounding is none) and this positive value at it, so the driver sees it
-/// on the open side, watches nothing, and locates its return to g₀ like any root — even when the whole flight is
-/// shorter than one step (the end of a bounce sequence). Without it the function started at
+/// on the open side, watches nothing, and locates its return to g₀ like any root — even when
+/// the whole flight is shorter than one step (the end of a bounce sequence). Without it the function started at
 /// g₀ ≤ 0, was watched from there, and a flight inside the first step fired the touch-down at
 /// the restart itself, closing a contact that separates. Once a step ends with the contact
 /// above the table (g > 0) the function is `g` again (`release_rebounds`).
@@ -444,7 +444,8 @@ impl ArmSystem<'_> {
                 let gd = h.cd.rows.vel[3 * k];
                 if h.cd.rows.gap[k].abs() <= st.gap_tol && gd > st.vel_tol {
                     h.rebound[k] = true;
-                    h.rebound_depth[k] = if gd <= gap_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len()) { DEPARTURE_DEPTH } else { 0.0 };
+                    let resolved = gap_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len());
+                    h.rebound_depth[k] = if gd <= resolved { DEPARTURE_DEPTH } else { 0.0 };
                 }
             } else {
                 h.gap_ref[k] = 0.0;
