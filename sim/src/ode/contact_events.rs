@@ -146,8 +146,11 @@ impl ArmSystem<'_> {
         let r = &h.cd.rows;
         for (k, c) in h.contacts.iter().enumerate() {
             if h.rebound[k] {
-                // the restart after the contact left with a separating speed
-                h.gap_ref[k] = r.gap[k].min(0.0);
+                // the restart after the contact left with a separating speed; one the step
+                // control does not resolve has its return located `zeno::DEPARTURE_DEPTH` below
+                // its restart gap (`mark_rebounds`): it rises above the gap's rounding too
+                // slowly for a return on g₀ itself to be one
+                h.gap_ref[k] = r.gap[k].min(0.0) - h.rebound_depth[k];
                 h.rebound_t[k] = t;
                 h.rebound[k] = false;
             }
@@ -208,7 +211,7 @@ impl ArmSystem<'_> {
             .collect();
         let before_log = self.hybrid.as_ref().map_or(0, |h| h.log.len());
         self.resolve_modes(t, y, &closed, &preferred, &[])?;
-        self.mark_rebounds();
+        self.mark_rebounds(y);
         // the initial choice is not an event
         let h = self.hybrid.as_mut().expect("hybrid");
         let n = h.log.len();
@@ -259,6 +262,7 @@ impl ArmSystem<'_> {
                             // separating: the gap is not closing (a contact is closed only with
                             // its gap rate at zero); its return is located from the restart
                             h.rebound[k] = true;
+                            h.rebound_depth[k] = 0.0;
                         } else {
                             touched.push(k);
                             preferred[k] = if c.unilateral_friction() > 0.0 { ContactMode::Sticking } else { ContactMode::Sliding };
@@ -354,7 +358,7 @@ impl ArmSystem<'_> {
             moved = true;
         }
         self.resolve_modes(t, y, &closed, &preferred, &logged)?;
-        self.mark_rebounds();
+        self.mark_rebounds(y);
         Ok(moved)
     }
 

@@ -14,10 +14,11 @@
 //!
 //! `s_ref` is the slip direction at the start of the step (refreshed in `after_step`).
 //! `g_ref` is 0, except after a contact left the table with a separating speed (a rebound):
-//! then it is the restart's gap, and the function is positive at the restart itself
-//! ([`REBOUND_START`]), so the return is located as a root however short the flight. A fired
-//! touch-down with ġ > `vel_tol` (separating) closes nothing: a contact is closed only with
-//! |g| ≤ `gap_tol` and |ġ| ≤ `vel_tol`.
+//! then it is the restart's gap (less `zeno::DEPARTURE_DEPTH`, 1e-12 m, when the step control
+//! does not resolve the rebound's ġ⁺: a return on the gap's rounding is none), and the
+//! function is positive at the restart itself ([`REBOUND_START`]), so the return is located as
+//! a root however short the flight. A fired touch-down with ġ > `vel_tol` (separating) closes
+//! nothing: a contact is closed only with |g| ≤ `gap_tol` and |ġ| ≤ `vel_tol`.
 //! The force-type functions need a full evaluation of eq 21 at the interpolated state.
 //! At an event ([`HybridSystem::handle_events`]): touch-downs with approach speed above
 //! `vel_tol` are impacts (`dynamics/contact/impact.rs`; below `rest_velocity` plastic: the Zeno
@@ -65,15 +66,19 @@ pub(crate) struct Hybrid {
     pub(crate) watch: Watch,
     /// A separated contact's touch-down function is `g − gap_ref` (m): `gap_ref` is 0 except
     /// after the contact left the table with a separating speed (a rebound, or thrown off by
-    /// another contact's impulse), where it is the restart's gap `min(g₀, 0)`, and the
-    /// function's value AT the restart time `rebound_t` is [`REBOUND_START`] (the contact is
-    /// leaving: on the open side), so its return to g₀ is located as a root.
+    /// another contact's impulse), where it is the restart's gap `min(g₀, 0)` (less
+    /// `rebound_depth`), and the function's value AT the restart time `rebound_t` is
+    /// [`REBOUND_START`] (the contact is leaving: on the open side), so its return to g₀ is
+    /// located as a root.
     pub(crate) gap_ref: Vec<f64>,
     /// The restart time of that rebound, s (NaN: none).
     pub(crate) rebound_t: Vec<f64>,
     /// Whether `gap_ref` is to be taken at the next evaluation of the event functions (the
     /// restart after the event that made the contact leave).
     pub(crate) rebound: Vec<bool>,
+    /// How far below the restart gap that rebound's return is located, m: `zeno::DEPARTURE_DEPTH`
+    /// when the step control does not resolve its ġ⁺ (`gap_resolution`), else 0.
+    pub(crate) rebound_depth: Vec<f64>,
     /// The contacts an impact at the current event landed and closed (ġ⁺ ≤ `vel_tol`), read
     /// (and cleared) by the mode problem's call after it (`resolve_modes`).
     pub(crate) landed: Vec<bool>,
@@ -101,6 +106,7 @@ impl Hybrid {
             gap_ref: vec![0.0; nc],
             rebound_t: vec![f64::NAN; nc],
             rebound: vec![false; nc],
+            rebound_depth: vec![0.0; nc],
             landed: vec![false; nc],
             contacts,
         }
@@ -110,9 +116,10 @@ impl Hybrid {
 /// The value of a rebounding contact's touch-down function at its restart, m (issue 23). A
 /// contact that leaves the table with ġ > `vel_tol` restarts at a gap g₀ that is 0 up to the
 /// event's bracket (≤ |ġ| · 1e-12 s inside); its touch-down function is `g − min(g₀, 0)` after
-/// the restart and this positive value at it, so the driver sees it on the open side, watches
-/// nothing, and locates its return to g₀ like any root — even when the whole flight is
-/// shorter than one step (the end of a bounce sequence). Without it the function started at
+/// the restart (less `zeno::DEPARTURE_DEPTH` for a rebound the step control does not resolve:
+/// a return on the gap's rounding is none) and this positive value at it, so the driver sees it
+/// on the open side, watches nothing, and locates its return to g₀ like any root — even when
+/// the whole flight is shorter than one step (the end of a bounce sequence). Without it the function started at
 /// g₀ ≤ 0, was watched from there, and a flight inside the first step fired the touch-down at
 /// the restart itself, closing a contact that separates. Once a step ends with the contact
 /// above the table (g > 0) the function is `g` again (`release_rebounds`).
@@ -423,7 +430,10 @@ impl ArmSystem<'_> {
     /// `resolve_modes`): every separated unilateral contact at the table (|g| ≤ gap_tol) that
     /// leaves it with ġ > vel_tol has its touch-down function re-based at the restart
     /// ([`REBOUND_START`]); a contact that closes has it at `g` again.
-    pub(super) fn mark_rebounds(&mut self) {
+    /// A rebound the step control does not resolve (ġ⁺ ≤ [`gap_resolution`] at `y`) has its
+    /// return located `zeno::DEPARTURE_DEPTH` below its restart gap (`rebound_depth`).
+    pub(super) fn mark_rebounds(&mut self, y: &[f64]) {
+        let (tolerances, qd) = (self.scene.integrator().tolerances(), self.layout.qd());
         let Some(h) = &mut self.hybrid else { return };
         let st = h.settings;
         for (k, c) in h.contacts.iter().enumerate() {
@@ -431,8 +441,11 @@ impl ArmSystem<'_> {
                 continue;
             }
             if h.state.mode[k] == ContactMode::Separated {
-                if h.cd.rows.gap[k].abs() <= st.gap_tol && h.cd.rows.vel[3 * k] > st.vel_tol {
+                let gd = h.cd.rows.vel[3 * k];
+                if h.cd.rows.gap[k].abs() <= st.gap_tol && gd > st.vel_tol {
                     h.rebound[k] = true;
+                    let resolved = gap_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len());
+                    h.rebound_depth[k] = if gd <= resolved { DEPARTURE_DEPTH } else { 0.0 };
                 }
             } else {
                 h.gap_ref[k] = 0.0;

@@ -15,8 +15,8 @@
 //! free accelerations and the held impact plus the closed contact's force both bring ġ of the
 //! pair to 0 through impulses along `M⁻¹Jᵀ`, so the states after differ by O(the tail's
 //! duration) in velocity and by at most the tail's flight height in position. Also here: the
-//! return of a contact an impact closed and the mode problem separates at ġ = 0
-//! ([`DEPARTURE_DEPTH`]).
+//! return of a contact an impact closed and the mode problem separates at ġ = 0, and of a
+//! rebound, located below the gap's rounding ([`DEPARTURE_DEPTH`]).
 
 use crate::dynamics::contact::forward::{slip_direction, solve_modes};
 use crate::dynamics::contact::impact::Impact;
@@ -37,6 +37,22 @@ use super::hybrid::in_touch;
 /// the return: the flight's return is located inside the closed band. The same scale as the
 /// departure bound of a separated contact inside a step ([`super::contact_events::GAP_DEPARTURE`],
 /// 1000 × the gap's rounding): one constant for both.
+///
+/// The same depth is under the return of a *rebound* (a contact that leaves the table at
+/// ġ⁺ > `vel_tol`) that the step control does not resolve, ġ⁺ ≤ `hybrid::gap_resolution` (its
+/// touch-down function `g − (min(g₀, 0) − DEPARTURE_DEPTH)`, `hybrid.rs::mark_rebounds`): such a
+/// rebound rises above the gap's rounding only after `~1e-16 m / ġ⁺` (2e-9 s at 4.6e-8 m/s),
+/// and with the return located from g₀ itself each rounding dip below g₀ inside that time was a
+/// root. A resolved rebound returns to g₀ itself: the depth would move its return by
+/// `DEPARTURE_DEPTH / |ġ|` in time and `g · DEPARTURE_DEPTH / |ġ|` in speed (3.6e-9 m/s at the
+/// bouncing ball's 2.7e-3 m/s, above its closed form's 1.5e-9 m/s bound, `contacts_exact`). Traced (where-pair-frictionless's evaluation 93, `departure-pair.json`, rtol 1e-5): elbow4
+/// lands at 0.0627154 s and is separated at ġ = 0; 3e-7 s later its gap, integrated to ~1e-12 m
+/// at this tolerance, is 1e-12 m below g₀ while ġ reads +4.6e-8 m/s, the touch-down fires with the
+/// contact separating (a rebound), and from there each dip of the gap's rounding below the new g₀
+/// fired again ~3e-11 s after the restart: 9 550 restarts (none logged: the mode stays separated)
+/// in 6.4e-7 s, 9 670 steps for the 0.07-s run (7 790 at atol 1e-10). With the depth: 128 and
+/// 150 steps, the same events. A return whose flight is longer than a step is unchanged: once a
+/// step ends with the contact above the table its function is `g` again (`release_rebounds`).
 pub const DEPARTURE_DEPTH: f64 = super::contact_events::GAP_DEPARTURE;
 
 /// Whether a contact leaving the table at `gap_rate` (m/s, > 0) with the normal acceleration
