@@ -73,7 +73,9 @@ impl ArmSystem<'_> {
                 return Ok(false);
             }
         } else {
-            self.constrained_inverse_inertia(t)?;
+            if !self.constrained_inverse_inertia(t)? {
+                return Ok(false);
+            }
             let js = &mut self.ws.jac;
             for c in 0..nv {
                 for r in 0..nv {

@@ -50,8 +50,9 @@ use super::arm::ArmSystem;
 
 impl ArmSystem<'_> {
     /// `M_c⁻¹` at the state of the last evaluation (M in `data.m`, J_c in `fd.jac`), into the
-    /// Jacobian scratch.
-    pub(super) fn constrained_inverse_inertia(&mut self, t: f64) -> Result<(), RunError> {
+    /// Jacobian scratch. False when the constraints' A could not be solved and the unconstrained
+    /// `M_J⁻¹` was left there: an approximation the W-methods allow, not an exact column.
+    pub(super) fn constrained_inverse_inertia(&mut self, t: f64) -> Result<bool, RunError> {
         let nv = self.layout.nv;
         // a hybrid run's rows depend on its modes and are not in fd.jac: the unconstrained
         // M_J⁻¹ there (a bounded approximation, which the W-methods allow; the classical
@@ -71,17 +72,19 @@ impl ArmSystem<'_> {
         };
         js.minv.fill_with_identity();
         chol.solve_mut(&mut js.minv);
+        let mut constrained = true;
         if nc > 0 {
             // Y = M_J⁻¹ J_cᵀ, A = J_c Y, then M_c⁻¹ = M_J⁻¹ − Y A⁻¹ Yᵀ (A regularised like the
             // force solve, dynamics/spd.rs)
             schur_complement(&chol, &fd.jac, &mut js.y, &mut js.a);
             js.ayt.tr_copy_from(&js.y);
-            if solve_regularized(&js.a, &mut js.a_factor, &mut js.ayt).is_some() {
+            constrained = solve_regularized(&js.a, &mut js.a_factor, &mut js.ayt).is_some();
+            if constrained {
                 js.minv.gemm(-1.0, &js.y, &js.ayt, 1.0);
             }
         }
         js.m_j = chol.unpack_dirty();
-        Ok(())
+        Ok(constrained)
     }
 }
 
@@ -141,6 +144,7 @@ impl OdeJacobian for ArmSystem<'_> {
         let r = self.rhs(t, y, &mut f);
         self.ws.jac.f = f;
         r?;
+        // M_J⁻¹ where A is not solved: the approximation the W-methods allow (module docs)
         self.constrained_inverse_inertia(t)?;
         let l = self.layout;
         let (nv, dim) = (l.nv, l.dim());
