@@ -202,7 +202,7 @@ fn the_where_pair_design_whose_touch_down_refired_completes_at_the_tight_toleran
 /// With that member's anchor held at the event's direction (`forward::onset_anchors`) the
 /// run completes with the audit at every sample and the balance within 1e-8 of E, both
 /// contacts' stick → slip at the common onset (within 1e-9 s of each other and 1e-8 s of
-/// 1.1965e-5 s), in at most 1 000 steps with at most 15 % rejected (measured 485 and 23:
+/// 1.1965e-5 s), in at most 1 000 steps with at most 15 % rejected (measured 495 and 31 on main after the merge, 484 and 24 on i-crawl alone:
 /// the bound is twice the steps and the rejection bound of the other reproducers).
 #[test]
 fn the_where_pair_design_with_a_point_at_joint_3s_origin_completes_at_the_tight_tolerance() {
