@@ -35,7 +35,7 @@
 //! central differences at random states of the paper arm in every contact mode and without
 //! contacts (`sim/tests/current_columns.rs`).
 
-use crate::dynamics::contact::solve::{solve_mj, RowForce};
+use crate::dynamics::contact::solve::{lu_resolve, lu_solve_in_place, solve_mj, RowForce};
 use crate::dynamics::contact::{ContactMode, ContactModel};
 use crate::dynamics::motor::Electrical;
 use crate::error::RunError;
@@ -152,56 +152,26 @@ impl ArmSystem<'_> {
                 s.a[i * m + k] = rows.dot(ai.row, &s.x[k * nv..(k + 1) * nv]);
             }
             for c in 0..nv {
-                s.lam[i * nv + c] = -rows.dot(ai.row, &s.q[c * nv..(c + 1) * nv]);
+                s.lam[c * m + i] = -rows.dot(ai.row, &s.q[c * nv..(c + 1) * nv]);
             }
         }
-        // Λ = A⁻¹ (−W U): Gaussian elimination with partial pivoting on all nv right-hand
-        // sides at once (Golub & Van Loan, Matrix Computations, 4th ed., Alg. 3.4.1)
-        let (a, lam) = (&mut s.a[..m * m], &mut s.lam[..m * nv]);
-        let mut piv_max = 0.0f64;
-        let mut piv_min = f64::INFINITY;
-        for k in 0..m {
-            let p = (k..m).max_by(|&i, &j| a[i * m + k].abs().total_cmp(&a[j * m + k].abs())).unwrap_or(k);
-            let pivot = a[p * m + k];
-            if pivot == 0.0 || !pivot.is_finite() {
-                return false;
-            }
-            if p != k {
-                for j in 0..m {
-                    a.swap(k * m + j, p * m + j);
-                }
-                for c in 0..nv {
-                    lam.swap(k * nv + c, p * nv + c);
-                }
-            }
-            piv_max = piv_max.max(pivot.abs());
-            piv_min = piv_min.min(pivot.abs());
-            for i in k + 1..m {
-                let f = a[i * m + k] / pivot;
-                for j in k + 1..m {
-                    a[i * m + j] -= f * a[k * m + j];
-                }
-                for c in 0..nv {
-                    lam[i * nv + c] -= f * lam[k * nv + c];
-                }
-            }
+        // Λ = A⁻¹ (−W U): the force solve's LU with partial pivoting (`contact/solve.rs`),
+        // factored with the first right-hand side and reused for the other nv − 1
+        let (a, lam, piv) = (&mut s.a[..m * m], &mut s.lam[..m * nv], &mut s.piv[..m]);
+        if lu_solve_in_place(a, m, piv, &mut lam[..m], 0.0).is_err() {
+            return false;
         }
+        let (piv_min, piv_max) = (0..m).map(|k| a[k * m + k].abs()).fold((f64::INFINITY, 0.0f64), |(lo, hi), p| (lo.min(p), hi.max(p)));
         if piv_min <= PIVOT_RATIO * piv_max {
             return false;
         }
-        for k in (0..m).rev() {
-            for c in 0..nv {
-                let mut x = lam[k * nv + c];
-                for j in k + 1..m {
-                    x -= a[k * m + j] * lam[j * nv + c];
-                }
-                lam[k * nv + c] = x / a[k * m + k];
-            }
+        for c in 1..nv {
+            lu_resolve(a, m, piv, &mut lam[c * m..(c + 1) * m]);
         }
         // Q = U + X Λ
         for c in 0..nv {
             for k in 0..m {
-                let f = lam[k * nv + c];
+                let f = lam[c * m + k];
                 let (q, x) = (&mut s.q[c * nv..(c + 1) * nv], &s.x[k * nv..(k + 1) * nv]);
                 for (qr, xr) in q.iter_mut().zip(x) {
                     *qr += xr * f;
@@ -239,6 +209,7 @@ impl ArmSystem<'_> {
         }
         let Some(h) = &self.hybrid else { return };
         let (rows, active) = (&h.cd.rows, &h.cd.active);
+        let m = active.len();
         for (i, ar) in active.iter().enumerate() {
             let k = ar.row / 3;
             if matches!(h.contacts[k].model, ContactModel::Compliant { .. }) {
@@ -256,7 +227,7 @@ impl ArmSystem<'_> {
             }
             let row = l.friction_work(k);
             for c in 0..nv {
-                jac[row * n + l.current().start + c] -= per_lambda * s.lam[i * nv + c];
+                jac[row * n + l.current().start + c] -= per_lambda * s.lam[c * m + i];
             }
         }
     }
@@ -270,13 +241,15 @@ pub(super) struct CurrentColumnsScratch {
     pub(super) x: Vec<f64>,
     /// A and its LU (row-major, up to 3 nc x 3 nc).
     pub(super) a: Vec<f64>,
-    /// `−W U`, then `Λ = ∂λ/∂i` (row-major 3 nc x nv).
+    /// `−W U`, then `Λ = ∂λ/∂i` (column-major m x nv, m the active rows).
     pub(super) lam: Vec<f64>,
+    /// A's row interchanges.
+    pub(super) piv: Vec<usize>,
 }
 
 impl CurrentColumnsScratch {
     pub(super) fn new(nv: usize, nc: usize) -> Self {
         let m = 3 * nc;
-        Self { q: vec![0.0; nv * nv], x: vec![0.0; nv * m], a: vec![0.0; m * m], lam: vec![0.0; m * nv] }
+        Self { q: vec![0.0; nv * nv], x: vec![0.0; nv * m], a: vec![0.0; m * m], lam: vec![0.0; m * nv], piv: vec![0; m] }
     }
 }

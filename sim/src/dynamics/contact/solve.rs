@@ -221,7 +221,7 @@ fn residual(a: &[f64], rhs: &[f64], x: &[f64], res: &mut [f64]) {
 /// Solve with the factors [`lu_solve_in_place`] left in `a` and `piv` (the multipliers below the
 /// diagonal, permuted with the rows as LAPACK's getrf keeps them): the row swaps in order,
 /// then L's and U's substitutions (Golub & Van Loan §3.4.4).
-fn lu_resolve(a: &[f64], m: usize, piv: &[usize], rhs: &mut [f64]) {
+pub fn lu_resolve(a: &[f64], m: usize, piv: &[usize], rhs: &mut [f64]) {
     for (k, &p) in piv.iter().enumerate().take(m) {
         rhs.swap(k, p);
     }
