@@ -81,6 +81,8 @@ mod properties;
 mod recording;
 #[path = "reductions.rs"]
 mod reductions;
+#[path = "rng_support.rs"]
+mod rng_support;
 #[path = "robot_spec.rs"]
 mod robot_spec;
 #[path = "runaway.rs"]

@@ -15,15 +15,7 @@ use sim::integrate::{fd_jacobian_columns, HybridSystem as _, OdeJacobian as _, O
 use sim::ode::ArmSystem;
 use sim::scene::Scene;
 
-/// A reproducible uniform draw in [−1, 1) (a 64-bit LCG, Knuth's MMIX constants).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-}
+use crate::rng_support::Lcg;
 
 /// The columns of the currents by central differences of `rhs`, δ = 1e-3 A.
 fn central_current_columns(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {

@@ -14,15 +14,7 @@ use sim::scene::Scene;
 
 use sim::dynamics::contact::ContactMode;
 
-/// A reproducible uniform draw in [−1, 1) (a 64-bit LCG, Knuth's MMIX constants).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-}
+use crate::rng_support::Lcg;
 
 /// The same forward differences as `fd_jacobian_columns` (increment `sqrt(eps) max(|y_j|,
 /// floor)`, signed like `y_j`, divided by the increment represented), each column a full

@@ -12,6 +12,8 @@ use sim::dynamics::kinematics::{body_point, forward_kinematics};
 use sim::dynamics::{Data, Model};
 use sim::scene::{Scene, PAPER_SCENE_JSON, PAPER_URDF};
 
+use crate::rng_support::Lcg;
+
 /// A serial arm from (axis, origin xyz) pairs: unit boxes of 1 kg, links named l0..ln, the
 /// hand link `hand` 0.1 m beyond the last joint.
 fn arm_urdf(joints: &[([f64; 3], [f64; 3])], limits: Option<(f64, f64)>) -> String {
@@ -62,15 +64,6 @@ fn seven_dof() -> Model {
     Model::from_urdf(&arm_urdf(&j, Some((-2.8, 2.8))), "seven.urdf", Vector3::new(0.0, 0.0, -9.81)).unwrap()
 }
 
-/// A deterministic generator in [0, 1) (64-bit LCG, Knuth's MMIX constants).
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 fn hand_at(model: &Model, q: &[f64]) -> Vector3<f64> {
     let hand = body_point(model, "hand", Vector3::zeros()).unwrap();
     let mut data = Data::new(model);
@@ -89,7 +82,7 @@ fn general_ik_reaches_random_reachable_targets() {
         let nv = model.nv;
         let hand = body_point(&model, "hand", Vector3::zeros()).unwrap();
         for case in 0..20 {
-            let q_goal: Vec<f64> = (0..nv).map(|_| 4.0 * rng.next() - 2.0).collect();
+            let q_goal: Vec<f64> = (0..nv).map(|_| 4.0 * rng.unit() - 2.0).collect();
             let r = hand_at(&model, &q_goal);
             let orient = nv == 7 && case % 2 == 0;
             let mut data = Data::new(&model);
@@ -514,7 +507,7 @@ fn general_ik_reaches_targets_through_prismatic_joints() {
     let hand = body_point(&model, "hand", Vector3::zeros()).unwrap();
     let mut rng = Lcg(11);
     for case in 0..20 {
-        let q_goal = [4.0 * rng.next() - 2.0, 0.1 + 0.3 * rng.next(), 1.6 * rng.next() - 0.8, 0.05 + 0.3 * rng.next()];
+        let q_goal = [4.0 * rng.unit() - 2.0, 0.1 + 0.3 * rng.unit(), 1.6 * rng.unit() - 0.8, 0.05 + 0.3 * rng.unit()];
         let r = hand_at(&model, &q_goal);
         let ik = GeneralIk { hand, orientation: None, contacts: vec![], active: vec![true; 4], posture: vec![0.0, 0.25, 0.0, 0.2] };
         let mut q = vec![q_goal[0] + 0.3, q_goal[1] - 0.05, q_goal[2] + 0.3, q_goal[3] - 0.04];
