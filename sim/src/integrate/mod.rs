@@ -272,6 +272,14 @@ pub trait OdeJacobian: OdeSystem {
         Ok(false)
     }
 
+    /// How many right-hand sides one call of [`OdeJacobian::exact_columns`] counts as in
+    /// [`Stats::rhs_evals`], whether it writes the columns or declines: the evaluations of `f`
+    /// it makes itself (the arm's one same-q re-solve of its mode problem). The default, 0:
+    /// columns from a closed form that evaluates no `f`.
+    fn exact_columns_rhs_evals(&self) -> u64 {
+        0
+    }
+
     /// How [`Rodas`] differences `f` when [`OdeJacobian::exact_jacobian`] gives no Jacobian:
     /// the relative noise of `f` and the components' natural size ([`DifferenceIncrement`]).
     /// The default, `None`: `f` rounded to eps, and the stepper's own floor (`atol / rtol`
@@ -311,7 +319,10 @@ pub trait SplitSystem: OdeSystem {
 /// Work counters since the last [`Stepper::init`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Stats {
-    /// Calls to [`OdeSystem::rhs`], including failed ones and those of rejected steps.
+    /// Calls to [`OdeSystem::rhs`] (and [`OdeSystem::rhs_column`]), including failed ones and
+    /// those of rejected steps, plus [`OdeJacobian::exact_columns_rhs_evals`] per call of
+    /// [`OdeJacobian::exact_columns`] ([`Rodas`]: the system's own evaluations for its exact
+    /// columns).
     pub rhs_evals: u64,
     /// Accepted steps.
     pub steps: u64,

@@ -56,7 +56,9 @@
 //!   [`OdeJacobian::difference_increment`]) over the *coupled* columns only (`j < coupled_dim`), counted in `Stats::rhs_evals`;
 //!   the trailing columns from [`OdeJacobian::exact_columns_start`] on exact where the system
 //!   writes them ([`OdeJacobian::exact_columns`], right after the difference sweep over the
-//!   leading ones; the arm's current columns, issue 24), else differenced too. `f_t`:
+//!   leading ones; the arm's current columns, issue 24; the system's own evaluations for them,
+//!   [`OdeJacobian::exact_columns_rhs_evals`], counted in `Stats::rhs_evals` too), else
+//!   differenced too. `f_t`:
 //!   [`OdeJacobian::exact_time_derivative`], else [`OdeJacobian::time_derivative`], else a forward difference in `t` as in
 //!   [`super::Rosenbrock`]. Both are evaluated at the start of every step by default;
 //!   `with_jacobian_reuse(k)` keeps `J` for `k` accepted steps (this loses the order, which

@@ -133,6 +133,13 @@ impl OdeJacobian for ArmSystem<'_> {
         self.exact_current_columns(t, y, jac)
     }
 
+    /// One: the evaluation of f at `(t, y)` that `current_columns.rs` makes (a hybrid run's
+    /// same-q re-solve, as a difference column after the sweep's first q̇ one, which counts
+    /// one too), made whether the columns are written or declined.
+    fn exact_columns_rhs_evals(&self) -> u64 {
+        1
+    }
+
     /// `time_derivative.rs`.
     fn exact_time_derivative(&mut self, t: f64, y: &[f64], _fy: &[f64], dfdt: &mut [f64]) -> Result<bool, RunError> {
         self.exact_time_derivative_at(t, y, dfdt)

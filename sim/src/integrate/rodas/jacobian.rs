@@ -31,8 +31,13 @@ impl Rodas {
             // the leading columns by differences, the trailing ones exact where the system can
             let k = sys.exact_columns_start().min(nc);
             self.difference_columns(sys, 0..k, inc)?;
-            if k < nc && !sys.exact_columns(t, &self.y, &self.f0, &mut self.jac).map_err(IntegrateError::Rhs)? {
-                self.difference_columns(sys, k..nc, inc)?;
+            if k < nc {
+                // the system's own evaluations for the columns count whether it writes them or
+                // declines (`Stats::rhs_evals`)
+                self.core.stats.rhs_evals += sys.exact_columns_rhs_evals();
+                if !sys.exact_columns(t, &self.y, &self.f0, &mut self.jac).map_err(IntegrateError::Rhs)? {
+                    self.difference_columns(sys, k..nc, inc)?;
+                }
             }
         }
         // the first non-finite entry's row and the largest |entry|, over the columns written

@@ -219,6 +219,8 @@ struct WithQuadratures {
     /// ([`OdeJacobian::exact_columns`]) and f_t = 0 ([`OdeJacobian::exact_time_derivative`]),
     /// `Some(false)` offers those columns and then declines; `None` offers nothing.
     tail: Option<bool>,
+    /// [`OdeJacobian::exact_columns_rhs_evals`]: what a call of the exact columns counts as.
+    tail_evals: u64,
 }
 
 impl OdeSystem for WithQuadratures {
@@ -281,6 +283,9 @@ impl OdeJacobian for WithQuadratures {
         dfdt.fill(0.0);
         Ok(self.tail == Some(true))
     }
+    fn exact_columns_rhs_evals(&self) -> u64 {
+        self.tail_evals
+    }
 }
 
 fn run_to(sys: &mut WithQuadratures, t_end: f64) -> (Vec<f64>, Stats) {
@@ -300,13 +305,13 @@ fn run_to(sys: &mut WithQuadratures, t_end: f64) -> (Vec<f64>, Stats) {
 #[test]
 fn block_solve_and_fd_jacobian_match_the_full_exact_solve() {
     let t_end = 3.0;
-    let (full, s_full) = run_to(&mut WithQuadratures { coupled: false, exact: true, tail: None }, t_end);
-    let (block, s_block) = run_to(&mut WithQuadratures { coupled: true, exact: true, tail: None }, t_end);
+    let (full, s_full) = run_to(&mut WithQuadratures { coupled: false, exact: true, tail: None, tail_evals: 0 }, t_end);
+    let (block, s_block) = run_to(&mut WithQuadratures { coupled: true, exact: true, tail: None, tail_evals: 0 }, t_end);
     assert_eq!(s_full.steps, s_block.steps);
     for (a, b) in full.iter().zip(&block) {
         assert!((a - b).abs() < 1e-12, "{full:?} vs {block:?}");
     }
-    let (fd, s_fd) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: None }, t_end);
+    let (fd, s_fd) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: None, tail_evals: 0 }, t_end);
     for (a, b) in full.iter().zip(&fd) {
         assert!((a - b).abs() < 1e-7, "{full:?} vs {fd:?}");
     }
@@ -326,17 +331,23 @@ fn block_solve_and_fd_jacobian_match_the_full_exact_solve() {
 #[test]
 fn exact_trailing_columns_replace_their_differences() {
     let t_end = 3.0;
-    let (full, _) = run_to(&mut WithQuadratures { coupled: true, exact: true, tail: None }, t_end);
-    let (mixed, s_mixed) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(true) }, t_end);
+    let (full, _) = run_to(&mut WithQuadratures { coupled: true, exact: true, tail: None, tail_evals: 0 }, t_end);
+    let (mixed, s_mixed) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(true), tail_evals: 0 }, t_end);
     for (a, b) in full.iter().zip(&mixed) {
         assert!((a - b).abs() < 1e-7, "{full:?} vs {mixed:?}");
     }
     let attempts = s_mixed.steps + s_mixed.rejected;
     assert_eq!(s_mixed.rhs_evals, 2 + 2 * s_mixed.jacobian_evals + 7 * attempts + s_mixed.steps, "{s_mixed:?}");
-    let (fd, s_fd) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: None }, t_end);
-    let (declined, s_declined) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(false) }, t_end);
+    let (fd, s_fd) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: None, tail_evals: 0 }, t_end);
+    let (declined, s_declined) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(false), tail_evals: 0 }, t_end);
     assert_eq!(s_declined, s_fd);
     assert_eq!(declined.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), fd.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    // a system whose columns cost one evaluation of its own (the arm's same-q re-solve) has
+    // it counted per Jacobian, written or declined, and nothing else moves
+    let (_, s_mixed1) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(true), tail_evals: 1 }, t_end);
+    assert_eq!(s_mixed1, Stats { rhs_evals: s_mixed.rhs_evals + s_mixed.jacobian_evals, ..s_mixed });
+    let (_, s_declined1) = run_to(&mut WithQuadratures { coupled: true, exact: false, tail: Some(false), tail_evals: 1 }, t_end);
+    assert_eq!(s_declined1, Stats { rhs_evals: s_fd.rhs_evals + s_fd.jacobian_evals, ..s_fd });
 }
 
 // Reusing J over k steps keeps the error controlled (the estimate sees the order loss): on
