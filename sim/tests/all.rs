@@ -53,6 +53,8 @@ mod contacts_steps;
 mod convergence;
 #[path = "current_columns.rs"]
 mod current_columns;
+#[path = "current_columns_cases.rs"]
+mod current_columns_cases;
 #[path = "drive_features.rs"]
 mod drive_features;
 #[path = "drives.rs"]

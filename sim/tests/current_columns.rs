@@ -18,7 +18,7 @@ use sim::scene::Scene;
 use crate::rng_support::Lcg;
 
 /// The columns of the currents by central differences of `rhs`, δ = 1e-3 A.
-fn central_current_columns(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {
+pub(crate) fn central_current_columns(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {
     let n = y.len();
     let l = sys.layout();
     let mut jac = vec![0.0; n * n];
@@ -40,7 +40,7 @@ fn central_current_columns(sys: &mut ArmSystem, t: f64, y: &[f64]) -> Vec<f64> {
 }
 
 /// The blocks of rows whose entries share a scale: q̇, q̈, di/dt, then each quadrature alone.
-fn row_block(sys: &ArmSystem, r: usize) -> std::ops::Range<usize> {
+pub(crate) fn row_block(sys: &ArmSystem, r: usize) -> std::ops::Range<usize> {
     let l = sys.layout();
     for b in [l.q(), l.qd(), l.current()] {
         if b.contains(&r) {
@@ -53,7 +53,7 @@ fn row_block(sys: &ArmSystem, r: usize) -> std::ops::Range<usize> {
 /// Checks the exact columns against the central ones at `(t, y)`; returns the largest error
 /// relative to the row block's largest entry, or `None` where the system gave no exact
 /// columns.
-fn check(sys: &mut ArmSystem, t: f64, y: &[f64], what: &str) -> Option<f64> {
+pub(crate) fn check(sys: &mut ArmSystem, t: f64, y: &[f64], what: &str) -> Option<f64> {
     let n = y.len();
     let l = sys.layout();
     let mut f = vec![0.0; n];
@@ -90,7 +90,7 @@ fn check(sys: &mut ArmSystem, t: f64, y: &[f64], what: &str) -> Option<f64> {
 /// Checks the exact `∂f/∂t` against central differences in t (δ = 1e-5 s: truncation
 /// `δ² |f'''| / 6` and rounding `eps |f| / δ` both below 1e-10 of the block's largest entry
 /// here); returns the largest error relative to the row block's largest entry.
-fn check_time_derivative(sys: &mut ArmSystem, t: f64, y: &[f64], what: &str) -> f64 {
+pub(crate) fn check_time_derivative(sys: &mut ArmSystem, t: f64, y: &[f64], what: &str) -> f64 {
     let n = y.len();
     let mut f = vec![0.0; n];
     sys.rhs(t, y, &mut f).unwrap();

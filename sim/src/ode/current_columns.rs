@@ -33,7 +33,11 @@
 //! contact's force chosen by the largest margin (`indeterminate.rs`, `dependent.rs`), and an A
 //! whose LU pivots span more than 1e10 (`solve.rs` regularises from 1e12 on). Checked against
 //! central differences at random states of the paper arm in every contact mode and without
-//! contacts (`sim/tests/current_columns.rs`).
+//! contacts (`sim/tests/current_columns.rs`), and with pd-gravity, K_e ≠ K_m, Baumgarte
+//! stabilisation and a compliant contact (written), in an onset, at an indeterminate contact,
+//! with gears, a supply, the thermal model and a current loop (declined, the differenced
+//! columns checked; `sim/tests/current_columns_cases.rs`). RODAS counts the evaluation made
+//! here as one right-hand side (`OdeJacobian::exact_columns_rhs_evals`).
 
 use crate::dynamics::contact::solve::{lu_resolve, lu_solve_in_place, solve_mj, RowForce};
 use crate::dynamics::contact::{ContactMode, ContactModel};

@@ -17,7 +17,9 @@
 //! `i = (v − K_e k q̇)/R`), computed torque (v reads `q̈_d`, whose derivative the targets do not
 //! give), drive limits (the window clips v), gear friction and a supply (`drive_modes.rs`), or a
 //! target whose `q̈_d` fails at t (the paper's at a singular J₃: the difference never asks for it).
-//! Checked against central differences in t at random states (`sim/tests/current_columns.rs`).
+//! Checked against central differences in t at random states (`sim/tests/current_columns.rs`;
+//! with pd-gravity's feed-forward, with and without friction, and K_e ≠ K_m:
+//! `sim/tests/current_columns_cases.rs`).
 
 use crate::control::Law;
 use crate::dynamics::motor::Electrical;
