@@ -28,6 +28,7 @@
 pub mod atomic;
 pub mod cdr;
 pub mod error;
+mod flat;
 pub mod messages;
 pub mod layout;
 pub mod markers;

@@ -232,8 +232,12 @@ impl ContactFriction {
         self.friction_use.clear();
         for k in 0..s.normal_force.len() {
             let cone = mu.get(k).copied().unwrap_or(0.0) * s.normal_force[k];
-            let f_t = s.friction_force_t1.get(k).copied().unwrap_or(0.0).hypot(s.friction_force_t2.get(k).copied().unwrap_or(0.0));
-            self.friction_use.push(if cone > 0.0 { f_t / cone } else { 0.0 });
+            // |f_t| only where it is used: not for a separated candidate (issue 24 item 2)
+            self.friction_use.push(if cone > 0.0 {
+                s.friction_force_t1.get(k).copied().unwrap_or(0.0).hypot(s.friction_force_t2.get(k).copied().unwrap_or(0.0)) / cone
+            } else {
+                0.0
+            });
         }
     }
 }
@@ -476,7 +480,37 @@ macro_rules! protobuf_message {
     )*};
 }
 
-protobuf_message!(MotorState, ConstraintState, Vec3, HandState, EnergyState, ContactState, ContactEventMsg, MotorThermalState, SupplyState, ContactFriction);
+protobuf_message!(MotorState, Vec3, HandState, EnergyState, ContactEventMsg, MotorThermalState, SupplyState);
+
+/// Implements [`Message`] for the protobuf types whose encoding is hand-written in
+/// `flat.rs` (the derive's bytes, in one pass: their size grows with a run's contacts).
+macro_rules! flat_message {
+    ($($t:ty => $encode:path),* $(,)?) => {$(
+        impl Message for $t {
+            fn schema_name() -> String {
+                protobuf_schema::<$t>().map(|s| s.name).unwrap_or_default()
+            }
+            fn schema_encoding() -> &'static str {
+                "protobuf"
+            }
+            fn schema_data() -> Vec<u8> {
+                protobuf_schema::<$t>().map(|s| s.data.into_owned()).unwrap_or_default()
+            }
+            fn message_encoding() -> &'static str {
+                "protobuf"
+            }
+            fn encode_into(&self, buf: &mut Vec<u8>) {
+                $encode(self, buf);
+            }
+        }
+    )*};
+}
+
+flat_message!(
+    ContactState => crate::flat::contact_state,
+    ContactFriction => crate::flat::contact_friction,
+    ConstraintState => crate::flat::constraint_state,
+);
 
 // every Foxglove well-known schema, so `sim` can record any of them without touching this crate
 use foxglove::messages as fm;

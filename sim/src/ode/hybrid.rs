@@ -199,12 +199,16 @@ impl ArmSystem<'_> {
         let l = self.layout;
         let Some(h) = &self.hybrid else { return };
         let r = &h.cd.rows;
-        for (k, c) in h.contacts.iter().enumerate() {
+        // contact k's three quadratures are `impact_loss(0) + 3k + (0, 1, 2)` (`Layout`): the
+        // offset once, not three layout sums per contact and evaluation (issue 24 item 2)
+        let base = l.impact_loss(0);
+        let rates = &mut dydt[base..base + 3 * h.contacts.len()];
+        for ((k, c), out) in h.contacts.iter().enumerate().zip(rates.chunks_exact_mut(3)) {
             let v = r.slip(k);
             let f_t = h.cd.f_t[k];
-            dydt[l.impact_loss(k)] = 0.0;
-            dydt[l.friction_work(k)] = -(f_t[0] * v[0] + f_t[1] * v[1]);
-            dydt[l.damping_loss(k)] = match c.model {
+            out[0] = 0.0;
+            out[1] = -(f_t[0] * v[0] + f_t[1] * v[1]);
+            out[2] = match c.model {
                 ContactModel::Compliant { stiffness, .. } => {
                     let (delta, delta_d) = (-r.gap[k], -r.vel[3 * k]);
                     if delta > 0.0 {

@@ -288,6 +288,10 @@ fn active_rows_of(contacts: &[Contact], mode: &[ContactMode], stabilization: Sta
     let r = &cd.rows;
     cd.active.clear();
     for (k, c) in contacts.iter().enumerate() {
+        if mode[k] == ContactMode::Separated {
+            // no row: nothing of a separated candidate is read (issue 24 item 2)
+            continue;
+        }
         let normal_extra = 2.0 * alpha * r.vel[3 * k] + beta * beta * r.gap[k];
         let normal = |force| ActiveRow { row: 3 * k, force, extra: normal_extra };
         let mu = c.unilateral_friction();

@@ -21,11 +21,15 @@ pub struct ContactRows {
     pub gap: Vec<f64>,
     /// `ġ, v_t1, v_t2` (3 nc), m/s.
     pub vel: Vec<f64>,
+    /// Whether contact k's three rows of `jac` are all zero (as `new` makes them, and as a
+    /// fill without its rows leaves them): such rows are not zeroed again, so a separated
+    /// candidate costs no write per evaluation (issue 24 item 2). Only this module writes `jac`.
+    zero: Vec<bool>,
 }
 
 impl ContactRows {
     pub fn new(nv: usize, nc: usize) -> Self {
-        ContactRows { nv, jac: vec![0.0; 3 * nc * nv], bias: vec![0.0; 3 * nc], gap: vec![0.0; nc], vel: vec![0.0; 3 * nc] }
+        ContactRows { nv, jac: vec![0.0; 3 * nc * nv], bias: vec![0.0; 3 * nc], gap: vec![0.0; nc], vel: vec![0.0; 3 * nc], zero: vec![true; nc] }
     }
 
     /// Row `r` (`3k + axis`).
@@ -77,7 +81,7 @@ pub fn contact_gaps_where(data: &Data, contacts: &[Contact], rows: &mut ContactR
             continue;
         }
         let n = c.plane.normal_world.into_inner();
-        let touch = c.touch(data);
+        let touch = c.touch_moving(data);
         rows.gap[k] = touch.gap;
         for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
             rows.vel[3 * k + axis] = dir.dot(&touch.velocity);
@@ -87,15 +91,22 @@ pub fn contact_gaps_where(data: &Data, contacts: &[Contact], rows: &mut ContactR
 
 fn fill_rows(model: &Model, data: &Data, contacts: &[Contact], rows: &mut ContactRows, rows_of: impl Fn(usize) -> bool, others: bool) {
     let nv = model.nv;
-    rows.jac.fill(0.0);
     for (k, c) in contacts.iter().enumerate() {
         let full = rows_of(k);
+        // the contact's three rows zero before they are filled (the Jacobian writes its
+        // chain's columns only) or left empty: what a fill of the whole `jac` with zeros gave,
+        // without writing the rows that are zero already
+        if full || !rows.zero[k] {
+            rows.jac[3 * k * nv..(3 * k + 3) * nv].fill(0.0);
+        }
+        rows.zero[k] = !full;
         if !full && !others {
             rows.bias[3 * k..3 * k + 3].fill(0.0);
             continue;
         }
         let n = c.plane.normal_world.into_inner();
-        let touch = c.touch(data);
+        // J̇ q̇ only for the contacts with rows (the others' biases are 0)
+        let touch = if full { c.touch(data) } else { c.touch_moving(data) };
         rows.gap[k] = touch.gap;
         for (axis, dir) in [n, c.t1, c.t2].iter().enumerate() {
             let r = 3 * k + axis;
@@ -129,3 +140,7 @@ pub fn contact_velocities_only(data: &Data, contacts: &[Contact], rows: &mut Con
         }
     }
 }
+
+#[cfg(test)]
+#[path = "rows_tests.rs"]
+mod tests;

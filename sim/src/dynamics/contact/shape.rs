@@ -137,6 +137,18 @@ impl Contact {
     /// The touching point, gap, velocity and `J̇ q̇` at once. Needs `forward_kinematics` and
     /// `forward_velocities`.
     pub fn touch(&self, data: &Data) -> Touch {
+        self.touch_with::<true>(data)
+    }
+
+    /// [`Contact::touch`] without `J̇ q̇` (`bias` zero): the point, gap and velocity by the
+    /// same operations, so the same values bit for bit. For what reads only the gap and the
+    /// velocities (a separated candidate's event function, `rows::contact_gaps_where`; issue 24
+    /// item 2). Needs `forward_kinematics` and `forward_velocities`.
+    pub fn touch_moving(&self, data: &Data) -> Touch {
+        self.touch_with::<false>(data)
+    }
+
+    fn touch_with<const BIAS: bool>(&self, data: &Data) -> Touch {
         let point = &self.plane.point;
         match (self.shape, point.body) {
             (ContactShape::Sphere { radius }, Some(b)) => {
@@ -148,7 +160,7 @@ impl Contact {
                     point: p,
                     gap: self.plane.normal_world.dot(&c) - self.plane.offset - radius,
                     velocity: data.v_world[b] + w.cross(&(p - o)),
-                    bias: data.a_bias_world[b] + data.alpha_bias_world[b].cross(&(p - o)) + w.cross(&w.cross(&(c - o))),
+                    bias: if BIAS { data.a_bias_world[b] + data.alpha_bias_world[b].cross(&(p - o)) + w.cross(&w.cross(&(c - o))) } else { Vector3::zeros() },
                 }
             }
             (ContactShape::Rim { radius, .. }, Some(b)) => {
@@ -159,18 +171,23 @@ impl Contact {
                 let (a, m, u) = self.rim(data);
                 let s = m.norm();
                 let p = c + radius * u;
-                // u̇ = −(I − û ûᵀ) ṁ / |m| = −(ṁ − u (u·ṁ)) / |m|, û = −u (zero when degenerate: refused by check_rims)
-                let ad = w.cross(&a);
-                let md = -n.dot(&ad) * a - n.dot(&a) * ad;
-                let ud = if s > 0.0 { -(md - u * u.dot(&md)) / s } else { Vector3::zeros() };
-                Touch {
-                    point: p,
-                    gap: n.dot(&c) - self.plane.offset - radius * s,
-                    velocity: data.v_world[b] + w.cross(&(p - o)),
-                    bias: data.a_bias_world[b] + data.alpha_bias_world[b].cross(&(p - o)) + w.cross(&w.cross(&(c - o))) + radius * w.cross(&ud),
-                }
+                let bias = if BIAS {
+                    // u̇ = −(I − û ûᵀ) ṁ / |m| = −(ṁ − u (u·ṁ)) / |m|, û = −u (zero when degenerate: refused by check_rims)
+                    let ad = w.cross(&a);
+                    let md = -n.dot(&ad) * a - n.dot(&a) * ad;
+                    let ud = if s > 0.0 { -(md - u * u.dot(&md)) / s } else { Vector3::zeros() };
+                    data.a_bias_world[b] + data.alpha_bias_world[b].cross(&(p - o)) + w.cross(&w.cross(&(c - o))) + radius * w.cross(&ud)
+                } else {
+                    Vector3::zeros()
+                };
+                Touch { point: p, gap: n.dot(&c) - self.plane.offset - radius * s, velocity: data.v_world[b] + w.cross(&(p - o)), bias }
             }
-            _ => Touch { point: point.position(data), gap: self.plane.position(data), velocity: point.velocity(data), bias: point.bias_acceleration(data) },
+            _ => Touch {
+                point: point.position(data),
+                gap: self.plane.position(data),
+                velocity: point.velocity(data),
+                bias: if BIAS { point.bias_acceleration(data) } else { Vector3::zeros() },
+            },
         }
     }
 
