@@ -522,7 +522,8 @@ impl ArmSystem<'_> {
                 // reference keeps the anchor's side (the sticking force's impending direction)
                 let a = h.cd.anchor[k];
                 // (and past twice a plain slip's stop speed, so the slip it becomes is not
-                // stopped at once: `contact_events::slip_stop_speed`)
+                // stopped at once: `contact_events::slip_stop_speed`; and past the onset's own
+                // blend speed, `onset_speed`, so its friction is Coulomb's when it ends)
                 let res = slip_resolution(tolerances, &h.cd.rows, k, &y[l.qd()], y.len());
                 let resolved = SLIP_DIRECTION_SPEED.max(res).max(2.0 * (res - SLIP_DIRECTION_SPEED)).max(h.cd.onset_speed[k]);
                 let ends = h.state.onset[k].is_some() && v_t[0].hypot(v_t[1]) > resolved && v_t[0] * a[0] + v_t[1] * a[1] > 0.0;
