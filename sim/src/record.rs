@@ -202,6 +202,8 @@ pub fn contacts_record(contacts: &[Contact], settings: &ContactSettings) -> Cont
         velocity_tolerance: settings.vel_tol,
         rest_velocity: settings.rest_velocity,
         max_events: settings.max_events,
+        // stated only where it exceeds v_s (loose tolerances): every other record as before
+        onset_slip_speed: (settings.onset_slip_speed > crate::dynamics::contact::forward::SLIP_DIRECTION_SPEED).then_some(settings.onset_slip_speed),
     }
 }
 

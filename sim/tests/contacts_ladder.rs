@@ -7,8 +7,13 @@
 //! decelerating slip crept at the integrator's resolution instead of stopping at 0.1300525 s
 //! (no stop at all within 0.3 s at dopri45 1e-4 and rosenbrock 1e-3, 6.1 ms late at
 //! rosenbrock 1e-4). The stop is now located where the slip falls to that resolution
-//! (`ode/contact_events.rs::slip_stop_speed`). dopri45 at rtol 1e-5 and 1e-6 is not monotone
-//! yet (the onset at 0.2446 s, BENCHMARKS.md) and is not asserted here.
+//! (`ode/contact_events.rs::slip_stop_speed`). dopri45 took 36 375 / 330 635 / 188 585 right-hand
+//! sides at rtol 1e-4 / 1e-5 / 1e-6 against 21 683 at 1e-7 (and 37 911 / 202 055 / 24 533 at
+//! 1e-4 / 1e-6 / 1e-8 with `h_max` free): elbow7's stick → slip onset at 0.2446 s held its slip
+//! at the integrator's resolution for up to 17 ms, DP45 at its stability limit on the friction's
+//! direction. An onset's friction now blends towards its anchor up to K = 30 times that
+//! resolution (`forward::onset_direction`, `ode/hybrid.rs::onset_speed`; BENCHMARKS.md, "Issue
+//! 24, eighth pass"), and both dopri45 series are asserted monotone here (they fail on `1958b6a`).
 //!
 //! The physics checked beside the counts: elbow7's slip → stick (the only one before 0.2 s)
 //! is located within `4 s × rtol` of the converged time (the dopri45 rtol-1e-8 rung's,
@@ -18,9 +23,11 @@
 //! 8× that (measured: dopri45 48 µs at 1e-4; rosenbrock 67 µs at 1e-3, 9 µs at
 //! 1e-4, 22 µs at 1e-5, the last unchanged by the fix). Every rung also has the converged
 //! run's contact events (contacts and kinds, in order): the stop and the onset at 0.2446 s
-//! happen, and no extra stop → onset cycles.
+//! happen, and no extra stop → onset cycles. And every rung's friction laws hold (the audit
+//! `sim` and `analyze` run, with the bounds of the run's record `contacts`, whose declared
+//! regularisation speed `onset_slip_speed` is 30 × rtol × 1 m/s at rtol ≥ 3.3e-8).
 //!
-//! Cost: 9 runs of 0.3 s, ~145 000 right-hand sides in all, ~1.5 s of CPU (test profile).
+//! Cost: 16 runs of 0.3 s, ~260 000 right-hand sides in all, ~3 s of CPU (test profile).
 
 use std::path::Path;
 
@@ -53,10 +60,11 @@ fn the_unilateral_ladder_stops_the_slip_in_time_and_costs_less_at_looser_toleran
     let converged = rung(&scene, "dopri45", "rtol 1e-8");
     let (t_stop, events) = stop_and_events(&collect(&converged, RUN), &converged);
     // (series, rungs, whether work is asserted monotone over them)
-    let series: [(&str, &[f64], bool); 3] = [
+    let series: [(&str, &[f64], bool); 4] = [
         ("rosenbrock (structured J)", &[1e-3, 1e-4, 1e-5, 1e-6], true),
         ("imex (circuits implicit)", &[1e-4, 1e-6, 1e-8], true),
-        ("dopri45", &[1e-4], false),
+        ("dopri45", &[1e-4, 1e-5, 1e-6, 1e-7], true),
+        ("dopri45 (h_max free)", &[1e-4, 1e-6, 1e-8], true),
     ];
     for (name, tols, monotone) in series {
         let mut previous: Option<(f64, u64)> = None;
@@ -70,10 +78,17 @@ fn the_unilateral_ladder_stops_the_slip_in_time_and_costs_less_at_looser_toleran
                 assert!(loose_rhs <= rhs, "{name}: rtol {loose:.0e} costs {loose_rhs} right-hand sides, more than rtol {tol:.0e} ({rhs})");
             }
             previous = Some((tol, rhs));
+            // the friction laws of the audit (the closed gap's drift at rtol 1e-3 is the
+            // integrator's, 2.6e-5 m against the 1e-6 m bound: not this test's)
+            let a = audit(&s, RUN, &c);
+            let friction: u64 = a.contacts.iter().map(|l| l.slip_angle_rad.breaches + l.cone_excess_n.breaches).sum();
+            assert_eq!(friction, 0, "{name} rtol {tol:.0e}: {:?}", a.verdict());
             assert_eq!(ev, events, "{name} rtol {tol:.0e}: the converged run's contact events");
-            // imex at rtol 1e-4 stops 6.8 ms late (16.7 ms before the fix; BENCHMARKS.md): its
-            // stop time is not checked
-            if !(name.starts_with("imex") && tol > 1e-5) {
+            // imex at rtol 1e-4 stops 5.8 ms late (16.7 ms before the stop's fix, 6.8 ms before
+            // the onset's; BENCHMARKS.md), and dopri45 with h_max free 1.0 ms late at 1e-4
+            // (1.05 ms before the onset's fix;
+            // its steps are not held to the output interval): their stop times are not checked
+            if !((name.starts_with("imex") || name.ends_with("(h_max free)")) && tol > 1e-5) {
                 assert!((t - t_stop).abs() <= 4.0 * tol, "{name} rtol {tol:.0e}: elbow7 stops at {t} s, converged {t_stop} s");
             }
         }

@@ -18,6 +18,15 @@
 //! | a separated contact carries no force | `max |f|` while separated | ≤ [`AuditBounds::force_n`] | ≤ [`AuditBounds::force_n`] |
 //! | friction stays in its cone | `max (|f_t| − μ max(f_n, 0))` | ≤ [`AuditBounds::force_n`] + [`AuditBounds::cone_rel`] μ f_n | same |
 //! | sliding friction opposes the slip | `max ∠(−f_t, v_t)` while sliding with `|v_t| > slip_m_s`, `|f_t| > force_n` | ≤ [`AuditBounds::angle_rad`] | same (in touch) |
+//!
+//! `slip_m_s` is the larger of the gap-rate bound and the speed the run declares its friction
+//! direction regularised below (`ContactsRecord::onset_slip_speed`, absent: `v_s` = 1e-6 m/s,
+//! which the gap-rate bound's floor covers): below it Coulomb's direction `−v_t/|v_t|` is not
+//! the model's. At tight tolerances (the integrator's resolution of a slip below `v_s`, as at
+//! the paper's rtol 1e-8) nothing changes; at loose ones a stick → slip onset's friction
+//! direction is resolved only to the integrator's slip resolution (`sim`'s
+//! `ode/hybrid.rs::onset_speed`, K = 30 times it: 2.9e-3 m/s at rtol 1e-4 on the paper's
+//! unilateral scene), so slips slower than that are not judged there.
 //! | complementarity | `max |f_n g|` | reported (≤ `max |f_n|` · `gap_m` when the rows above hold) | — |
 //!
 //! Bilateral contacts (the paper's) have no law to break here: the table may pull, and their
@@ -57,7 +66,8 @@ pub struct AuditBounds {
     pub force_n: f64,
     /// The cone's relative slack (of μ f_n).
     pub cone_rel: f64,
-    /// Slip speeds at or below this have no direction to oppose, m/s.
+    /// Slip speeds at or below this have no direction to oppose, m/s: the gap-rate bound, or
+    /// the run's declared regularisation speed (`ContactsRecord::onset_slip_speed`) if larger.
     pub slip_m_s: f64,
     /// The angle between −f_t and v_t while sliding, rad.
     pub angle_rad: f64,
@@ -74,7 +84,7 @@ impl AuditBounds {
             penetration_m: gap_m,
             force_n: 1e-6,
             cone_rel: 1e-9,
-            slip_m_s: gap_rate_m_s,
+            slip_m_s: gap_rate_m_s.max(record.onset_slip_speed.unwrap_or(0.0)),
             angle_rad: 1e-3,
         }
     }
@@ -354,6 +364,7 @@ mod tests {
             velocity_tolerance: 1e-9,
             rest_velocity: 1e-4,
             max_events: 1000,
+            onset_slip_speed: None,
         }
     }
 
@@ -527,5 +538,48 @@ mod tests {
         let tight = ContactsRecord { gap_tolerance: 1e-15, velocity_tolerance: 1e-15, ..record() };
         let b = AuditBounds::of(&tight);
         assert_eq!((b.gap_m, b.gap_rate_m_s), (1e-9, 1e-6));
+    }
+
+    /// A run that declares its friction direction regularised below 3e-3 m/s
+    /// (`onset_slip_speed`): a slip of 2e-3 m/s with the friction at 0.5 rad off is not
+    /// judged, one of 4e-3 m/s is; the bound is the declared speed. A record without the field
+    /// (every recording before it) audits as before: both slips judged, `slip_m_s` the
+    /// gap-rate bound.
+    #[test]
+    fn a_declared_regularisation_speed_is_not_judged_below_and_judged_above() {
+        let off = |speed: f64| {
+            let mut s = lawful();
+            // v_t along (0.6, 0.8) at `speed`, −f_t rotated from it by 0.5 rad, |f_t| = μ f_n
+            let (c, sn) = (f64::cos(0.5), f64::sin(0.5));
+            s[1].slip_velocity_t1[0] = 0.6 * speed;
+            s[1].slip_velocity_t2[0] = 0.8 * speed;
+            s[1].friction_force_t1[0] = -5.0 * (c * 0.6 - sn * 0.8);
+            s[1].friction_force_t2[0] = -5.0 * (sn * 0.6 + c * 0.8);
+            s
+        };
+        let run = |record: &ContactsRecord, samples: &[ContactState]| {
+            let mut a = ContactAuditor::new(record);
+            for (k, s) in samples.iter().enumerate() {
+                a.sample(k as f64 * 0.01, s);
+            }
+            a.finish()
+        };
+        let declared = ContactsRecord { onset_slip_speed: Some(3e-3), ..record() };
+        assert_eq!(AuditBounds::of(&declared).slip_m_s, 3e-3);
+        let below = run(&declared, &off(2e-3));
+        assert_eq!((below.breaches, below.contacts[0].slip_angle_rad.value), (0, 0.0), "{:?}", below.verdict());
+        let above = run(&declared, &off(4e-3));
+        let w = above.contacts[0].slip_angle_rad;
+        assert_eq!((above.breaches, w.breaches, w.first_breach_t), (1, 1, Some(0.01)));
+        assert!((w.value - 0.5).abs() < 1e-12, "{}", w.value);
+        // the old record: the bounds of before (slip_m_s = the gap-rate bound, SLACK × 1e-9
+        // m/s), the slip below the declared speed judged
+        let b = AuditBounds::of(&record());
+        assert_eq!(b, AuditBounds { slip_m_s: b.gap_rate_m_s, ..AuditBounds::of(&declared) });
+        assert_eq!(b.slip_m_s, SLACK * 1e-9);
+        let old = run(&record(), &off(2e-3));
+        assert_eq!((old.breaches, old.contacts[0].slip_angle_rad.breaches), (1, 1));
+        // a declared speed below the gap-rate bound changes nothing
+        assert_eq!(AuditBounds::of(&ContactsRecord { onset_slip_speed: Some(1e-7), ..record() }), AuditBounds::of(&record()));
     }
 }

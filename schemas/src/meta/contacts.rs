@@ -139,6 +139,16 @@ pub struct ContactsRecord {
     /// Most events in a run.
     #[serde(with = "super::text")]
     pub max_events: u64,
+    /// The largest slip speed below which the run regularised a sliding contact's friction
+    /// direction, m/s: a stick → slip onset's friction blends towards the direction the sticking
+    /// force leaves its cone below `max(v_s, min(K · slip resolution, this))` (`sim`'s
+    /// `ode/hybrid.rs`, `onset_speed`), so below this speed the friction's direction is
+    /// resolved only to the integrator's resolution of the slip. Absent: `v_s` = 1e-6 m/s
+    /// (every recording made before it, and every run whose tolerances resolve the slip
+    /// below `v_s`, as the paper's rtol 1e-8). The contact audit does not judge the direction
+    /// of slips at or below it ([`super::AuditBounds::of`]).
+    #[serde(default, skip_serializing_if = "Option::is_none", with = "super::sci_opt")]
+    pub onset_slip_speed: Option<f64>,
 }
 
 impl MetadataRecord for ContactsRecord {
@@ -184,6 +194,7 @@ mod tests {
             velocity_tolerance: 1e-9,
             rest_velocity: 1e-4,
             max_events: 100_000,
+            onset_slip_speed: None,
         }
     }
 
@@ -201,6 +212,11 @@ mod tests {
         assert!(e["contacts"].contains(r#"{"name":"elbow7","model":"bilateral","normal""#), "{}", e["contacts"]);
         assert_eq!(from_entries::<ContactsRecord>(&e).unwrap(), r);
         assert_eq!(r.contact("pad").and_then(|c| c.stiffness), Some(1e5));
+        // the onset's declared speed: a key only when set, read back equal
+        let loose = ContactsRecord { onset_slip_speed: Some(3e-3), ..sample() };
+        let el = to_entries(&loose).unwrap();
+        assert_eq!(el["onset_slip_speed"], "3e-3");
+        assert_eq!(from_entries::<ContactsRecord>(&el).unwrap(), loose);
         let mut bad = e.clone();
         bad.insert("contacts".into(), "[1]".into());
         assert!(from_entries::<ContactsRecord>(&bad).unwrap_err().contains("not a JSON array of contacts"));

@@ -102,6 +102,7 @@ pub fn unilateral() -> (Synth, UnilateralTruth) {
         velocity_tolerance: 1e-9,
         rest_velocity: 1e-4,
         max_events: 100_000,
+        onset_slip_speed: None,
     });
     s.energy_terms = Some(EnergyTermsRecord { impact_loss: Some(0.06), friction_work: Some(0.006), damping_loss: Some(0.0), ..Default::default() });
     let truth = UnilateralTruth {

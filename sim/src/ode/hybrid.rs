@@ -31,7 +31,7 @@
 //! impacts (a lift-off whose flight stays within `gap_tol` held closed, a landed contact's
 //! departure at ġ = 0) in `zeno.rs`.
 
-use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState, SLIP_DIRECTION_SPEED};
+use crate::dynamics::contact::forward::{prepare, slip_direction, ContactData, ContactState, ONSET_RESOLUTION_FACTOR, SLIP_DIRECTION_SPEED};
 use crate::dynamics::contact::impact::solve_impact;
 use crate::dynamics::contact::modes::choose_modes_within;
 use crate::dynamics::contact::{Contact, ContactEvent, ContactEventKind, ContactMode, ContactModel, ContactOutput, ContactSettings};
@@ -153,6 +153,7 @@ impl ArmSystem<'_> {
             h.state.mode.copy_from_slice(&o.state.mode);
             h.state.slip.copy_from_slice(&o.state.slip);
             h.state.onset.copy_from_slice(&o.state.onset);
+            h.cd.onset_speed.copy_from_slice(&o.cd.onset_speed);
             h.s_ref.copy_from_slice(&o.s_ref);
         }
         if let (Some(m), Some(o)) = (&mut self.drive_modes, &other.drive_modes) {
@@ -390,12 +391,20 @@ impl ArmSystem<'_> {
         let stab = self.scene.stabilization;
         let h = self.hybrid.as_mut().expect("hybrid");
         let before = h.state.mode.clone();
+        let onset_before = h.state.onset.clone();
         for (k, c) in h.contacts.iter().enumerate() {
             if matches!(c.model, ContactModel::Unilateral { .. }) && !closed.contains(&k) {
                 h.state.mode[k] = ContactMode::Separated;
             }
         }
         choose_modes_within(&h.contacts, &mut h.state, closed, preferred, h.settings.vel_tol, stab, &mut self.ws.fd, &mut h.cd, t, h.watch)?;
+        let tolerances = self.scene.integrator().tolerances();
+        for (k, was) in onset_before.iter().enumerate() {
+            // a new onset's blend speed, fixed for the onset (`onset_speed`)
+            if h.state.onset[k].is_some() && was.is_none() {
+                h.cd.onset_speed[k] = onset_speed(tolerances, &h.cd.rows, k, &y[self.layout.qd()], y.len(), h.settings.onset_slip_speed);
+            }
+        }
         for k in 0..h.contacts.len() {
             // a contact an impact closed and the mode problem separates at ġ ≈ 0 (g̈ > 0):
             // its departure is located from g₀ − `zeno::DEPARTURE_DEPTH`
@@ -517,9 +526,10 @@ impl ArmSystem<'_> {
                 // reference keeps the anchor's side (the sticking force's impending direction)
                 let a = h.cd.anchor[k];
                 // (and past twice a plain slip's stop speed, so the slip it becomes is not
-                // stopped at once: `contact_events::slip_stop_speed`)
+                // stopped at once: `contact_events::slip_stop_speed`; and past the onset's own
+                // blend speed, `onset_speed`, so its friction is Coulomb's when it ends)
                 let res = slip_resolution(tolerances, &h.cd.rows, k, &y[l.qd()], y.len());
-                let resolved = SLIP_DIRECTION_SPEED.max(res).max(2.0 * (res - SLIP_DIRECTION_SPEED));
+                let resolved = SLIP_DIRECTION_SPEED.max(res).max(2.0 * (res - SLIP_DIRECTION_SPEED)).max(h.cd.onset_speed[k]);
                 let ends = h.state.onset[k].is_some() && v_t[0].hypot(v_t[1]) > resolved && v_t[0] * a[0] + v_t[1] * a[1] > 0.0;
                 h.s_ref[k] = slip_direction(v_t, if ends { v_t } else { a });
                 h.state.slip[k] = h.s_ref[k];
@@ -563,6 +573,14 @@ pub(super) fn gap_resolution(tolerances: Option<(f64, f64)>, rows: &crate::dynam
 pub(super) fn slip_resolution(tolerances: Option<(f64, f64)>, rows: &crate::dynamics::contact::rows::ContactRows, k: usize, qd: &[f64], n: usize) -> f64 {
     let Some((rtol, atol)) = tolerances else { return 0.0 };
     (n as f64 * (weighted_row_sq(rows, 3 * k + 1, qd, rtol, atol) + weighted_row_sq(rows, 3 * k + 2, qd, rtol, atol))).sqrt()
+}
+
+/// The speed below which a stick → slip onset's friction blends towards its anchor
+/// (`forward::onset_direction`'s `v_on`), m/s, fixed at the onset's start:
+/// `max(v_s, min(K · slip_resolution, bound))`, K = [`ONSET_RESOLUTION_FACTOR`], `bound` the
+/// run's declared largest (`ContactSettings::onset_slip_speed`, `forward::onset_speed_bound`).
+pub(super) fn onset_speed(tolerances: Option<(f64, f64)>, rows: &crate::dynamics::contact::rows::ContactRows, k: usize, qd: &[f64], n: usize, bound: f64) -> f64 {
+    SLIP_DIRECTION_SPEED.max((ONSET_RESOLUTION_FACTOR * slip_resolution(tolerances, rows, k, qd, n)).min(bound))
 }
 
 /// `Σ_i (J_r,i w_i)²` of contact row `r` over the joint speeds, `w_i = atol + rtol |q̇_i|` (the

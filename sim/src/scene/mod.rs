@@ -191,9 +191,12 @@ impl Scene {
     pub fn contact_models(&self) -> &[Contact] {
         &self.contact_models
     }
-    /// The event-driven contact handling's tolerances and limits (`events`).
+    /// The event-driven contact handling's tolerances and limits (`events`), with the onset's
+    /// regularisation bound of the scene's integrator
+    /// (`contact::forward::onset_speed_bound`).
     pub fn contact_settings(&self) -> ContactSettings {
-        self.contact_settings
+        let onset_slip_speed = crate::dynamics::contact::forward::onset_speed_bound(&self.integrator);
+        ContactSettings { onset_slip_speed, ..self.contact_settings }
     }
     /// The runs, in the scene's order.
     pub fn runs(&self) -> &[Run] {

@@ -69,6 +69,11 @@ pub struct ContactData {
     /// Per contact: in an onset in the last solve (`ContactState::onset`): its friction opposes
     /// a slip that runs back across the anchor ([`active_rows_of`]).
     onset_now: Vec<bool>,
+    /// Per contact in an onset: the slip speed below which its friction's direction blends
+    /// towards the anchor ([`onset_direction`]'s `v_on`), m/s, fixed at the onset's start
+    /// (`ode/hybrid.rs`, `onset_speed`): [`SLIP_DIRECTION_SPEED`] unless the integrator's
+    /// resolution of the slip is coarser. [`SLIP_DIRECTION_SPEED`] outside onsets.
+    pub onset_speed: Vec<f64>,
     /// Scratch of [`onset_anchors`]: the modes with the onset contacts sticking.
     stick_mode: Vec<ContactMode>,
     /// Scratch of the groups of sticking contacts dependent across contacts
@@ -88,6 +93,7 @@ impl ContactData {
             anchor: vec![[1.0, 0.0]; nc],
             onset_excess: vec![f64::NAN; nc],
             onset_now: vec![false; nc],
+            onset_speed: vec![SLIP_DIRECTION_SPEED; nc],
             stick_mode: vec![ContactMode::Separated; nc],
             dependent: super::dependent::DependentScratch::new(nc),
         }
@@ -107,9 +113,43 @@ impl ContactData {
 /// 2e-13 m; in 1-D (a slip along a fixed line) the direction is exact.
 pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 
+/// The factor K between a stick → slip onset's blend speed and the integrator's resolution of
+/// its slip (`ode/hybrid.rs::onset_speed`): the slip's direction resolved to 1/K rad. In the
+/// prototype K = 20 and 50 gave the same ladder as 30, K = 10 left dopri45 at rtol 1e-6 at
+/// 188 585 right-hand sides (BENCHMARKS.md, issue 24 "point 3 again" and "eighth pass").
+pub const ONSET_RESOLUTION_FACTOR: f64 = 30.0;
+
+/// The largest blend speed of an onset in a run integrated by `integrator`, m/s, fixed at the
+/// start (the record `contacts` states it for the audit): `max(v_s, K · rtol · 1 m/s)`, K =
+/// [`ONSET_RESOLUTION_FACTOR`], for the methods that take the friction's direction explicitly
+/// (dopri45; imex, whose implicit part is the armature circuits; rosenbrock, whose structured
+/// Jacobian, `ode/jacobian.rs`, linearises the drives and the controller, not the friction),
+/// where an onset's slip held at the integrator's resolution sits at the stability limit of
+/// the direction's stiffness `μ f_n / (m |v_t|)` (≈ 2e6 /s at 2e-6 m/s on elbow7 at 0.2446 s;
+/// Hairer & Wanner, *Solving ODEs II*, §IV.2: an explicit method's step is bounded by its
+/// stability region, whatever its accuracy). The slip
+/// resolution `sqrt(n) |J_t (atol + rtol |q̇|)|` is dominated by its `rtol |q̇|` part at the
+/// study's `atol = rtol/100`; on the paper's unilateral scene it is 0.08 … 0.97 × rtol × 1 m/s
+/// at its onsets, so this bound caps nothing there. [`SLIP_DIRECTION_SPEED`] for rodas5p and
+/// rodas4 (their Jacobian, differenced over q̇, has the direction's stiffness: no stability
+/// limit, nothing to regularise), for rk4 (no tolerances) and at rtol ≤ 3.3e-8.
+pub fn onset_speed_bound(integrator: &crate::integrator::Integrator) -> f64 {
+    use crate::integrator::Integrator;
+    const SPEED_SCALE: f64 = 1.0;
+    match *integrator {
+        Integrator::Dopri45(c) | Integrator::Imex(c) | Integrator::Rosenbrock { control: c, .. } => SLIP_DIRECTION_SPEED.max(ONSET_RESOLUTION_FACTOR * c.rtol * SPEED_SCALE),
+        Integrator::Rodas { .. } | Integrator::Rk4 { .. } => SLIP_DIRECTION_SPEED,
+    }
+}
+
 /// The direction an onset's friction opposes (unit, tangent basis; `ContactState::onset`):
-/// `w/|w|` with `w = v_t + v_s ψ(|v_t|/v_s) anchor`, [`friction_direction`]'s blend (the same
-/// since that lost its side-keeping sign) towards the anchor. Coulomb's law (Glocker, *Set-Valued Force Laws*, 2001, §7; Pfeiffer &
+/// `w/|w|` with `w = v_t + v_on ψ(|v_t|/v_on) anchor`, [`friction_direction`]'s blend (the same
+/// since that lost its side-keeping sign) towards the anchor, at the onset's own speed `v_on`
+/// (`ContactData::onset_speed`: `v_s`, or at loose tolerances of an explicit method up to
+/// [`ONSET_RESOLUTION_FACTOR`] times the integrator's resolution of the slip, so the slip's
+/// direction is resolved to 1/K rad; below v_on the friction's direction is the model's
+/// regularisation, declared in the record `contacts` for the audit, [`onset_speed_bound`]). Read
+/// `v_s` for `v_on` below wherever the tolerances resolve the slip below `v_s`. Coulomb's law (Glocker, *Set-Valued Force Laws*, 2001, §7; Pfeiffer &
 /// Glocker 1996, §5.2): the friction opposes the slip, `−μ f_n v_t/|v_t|`, from `v_s` on in
 /// every direction, a slip run back across the anchor included (it returns); below `v_s` the
 /// direction is regularised towards the anchor, the direction the sticking force leaves the
@@ -122,16 +162,15 @@ pub const SLIP_DIRECTION_SPEED: f64 = 1e-6;
 /// (|v_t| ≈ 4e-9 m/s, mostly across the anchor) sat on, which RODAS5P's stages straddled in
 /// each of the 440 steps it rejected in that onset (two-elbow-unilateral, rtol 1e-8, with the
 /// event-aware restart; BENCHMARKS.md, issue 24 item 1, fourth attempt).
-pub fn onset_direction(v_t: [f64; 2], anchor: [f64; 2]) -> [f64; 2] {
-    let vs = SLIP_DIRECTION_SPEED;
-    blended(v_t, (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (vs * vs), anchor)
+pub fn onset_direction(v_t: [f64; 2], anchor: [f64; 2], v_on: f64) -> [f64; 2] {
+    blended(v_t, (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (v_on * v_on), anchor, v_on)
 }
 
 /// `w/|w|`, `w = v + v_s (1 − r²)² toward` for `r² = |v_t|²/v_s² < 1` (else `w = v`): the
 /// blend of [`friction_direction`] and [`onset_direction`], `v` the slip (signed by the
-/// caller) and `r2` as the caller computed it; `toward` itself when `w = 0`.
-fn blended(v: [f64; 2], r2: f64, toward: [f64; 2]) -> [f64; 2] {
-    let vs = SLIP_DIRECTION_SPEED;
+/// caller), `vs` the blend's speed and `r2` as the caller computed it; `toward` itself when
+/// `w = 0`.
+fn blended(v: [f64; 2], r2: f64, toward: [f64; 2], vs: f64) -> [f64; 2] {
     let blend = if r2 < 1.0 { vs * (1.0 - r2) * (1.0 - r2) } else { 0.0 };
     let w = [v[0] + blend * toward[0], v[1] + blend * toward[1]];
     let n = w[0].hypot(w[1]);
@@ -184,7 +223,7 @@ pub fn slip_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
 /// the friction along it: the audit's π rad; `scenes/contacts/audit-slip-reversal-05kg.json`).
 pub fn friction_direction(v_t: [f64; 2], stored: [f64; 2]) -> [f64; 2] {
     let vs = SLIP_DIRECTION_SPEED;
-    blended(v_t, (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (vs * vs), stored)
+    blended(v_t, (v_t[0] * v_t[0] + v_t[1] * v_t[1]) / (vs * vs), stored, vs)
 }
 
 /// Kinematics, b (with compliant forces), `M_J` and its Cholesky factor (in `fd.m_j`,
@@ -306,7 +345,7 @@ fn active_rows_of(contacts: &[Contact], mode: &[ContactMode], stabilization: Sta
             }
             ContactMode::Sticking | ContactMode::Sliding => {
                 let (v, anchor) = (r.slip(k), cd.anchor[k]);
-                let s = if cd.onset_now[k] { onset_direction(v, anchor) } else { friction_direction(v, anchor) };
+                let s = if cd.onset_now[k] { onset_direction(v, anchor, cd.onset_speed[k]) } else { friction_direction(v, anchor) };
                 cd.active.push(normal(if mu > 0.0 { RowForce::Sliding { mu, s } } else { RowForce::Same }));
             }
         }

@@ -215,6 +215,11 @@ pub struct ContactSettings {
     /// Most events in a row at one instant (within `10 time_tol` of each other) before the
     /// run stops as chattering (default [`DEFAULT_MAX_EVENTS_AT_ONE_TIME`]).
     pub max_events_at_one_time: u32,
+    /// The largest speed below which a stick → slip onset's friction direction is regularised,
+    /// m/s ([`forward::onset_speed_bound`] of the run's tolerances; default
+    /// [`forward::SLIP_DIRECTION_SPEED`]): written in the record `contacts`, where the audit
+    /// reads it.
+    pub onset_slip_speed: f64,
 }
 
 /// The default of the scene's `events.max_events_at_one_time`.
@@ -233,6 +238,7 @@ impl Default for ContactSettings {
             rest_velocity: 1e-4,
             max_events: 100_000,
             max_events_at_one_time: DEFAULT_MAX_EVENTS_AT_ONE_TIME,
+            onset_slip_speed: forward::SLIP_DIRECTION_SPEED,
         }
     }
 }

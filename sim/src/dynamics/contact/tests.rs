@@ -487,11 +487,11 @@ fn an_onsets_friction_direction_is_coulombs_past_v_s_and_smooth_near_rest() {
     let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     for &anchor_angle in &[0.0f64, 0.7, -2.1, 2.8] {
         let anchor = [anchor_angle.cos(), anchor_angle.sin()];
-        assert!(dist(onset_direction([0.0, 0.0], anchor), anchor) <= 1e-15, "at rest");
+        assert!(dist(onset_direction([0.0, 0.0], anchor, VS), anchor) <= 1e-15, "at rest");
         for k in 0..36 {
             let ray = [(anchor_angle + 0.1745 * f64::from(k)).cos(), (anchor_angle + 0.1745 * f64::from(k)).sin()];
             for &speed in &[VS, 1.5 * VS, 1e-3, 2.0] {
-                let d = onset_direction([speed * ray[0], speed * ray[1]], anchor);
+                let d = onset_direction([speed * ray[0], speed * ray[1]], anchor, VS);
                 assert!(dist(d, ray) <= 1e-15, "Coulomb's direction at {speed:e} m/s, ray {k}: {d:?}");
             }
         }
@@ -500,7 +500,7 @@ fn an_onsets_friction_direction_is_coulombs_past_v_s_and_smooth_near_rest() {
         for i in -70..=70 {
             for j in -70..70 {
                 // (along, across) the anchor, and the next point across
-                let at = |a: f64, c: f64| onset_direction([a * anchor[0] - c * anchor[1], a * anchor[1] + c * anchor[0]], anchor);
+                let at = |a: f64, c: f64| onset_direction([a * anchor[0] - c * anchor[1], a * anchor[1] + c * anchor[0]], anchor, VS);
                 let (a, c) = (step * f64::from(i), step * f64::from(j));
                 let (d, next) = (at(a, c), at(a, c + step));
                 assert!(dist(d, next) <= bound, "a jump of {} at ({a:e}, {c:e}) m/s", dist(d, next));
@@ -511,7 +511,7 @@ fn an_onsets_friction_direction_is_coulombs_past_v_s_and_smooth_near_rest() {
         }
         // elbow7's onset: 4e-9 m/s, mostly across the anchor, on both sides of v_t · a = −1e-9
         let across = [-anchor[1], anchor[0]];
-        let side = |along: f64| onset_direction([along * anchor[0] + 3.7e-9 * across[0], along * anchor[1] + 3.7e-9 * across[1]], anchor);
+        let side = |along: f64| onset_direction([along * anchor[0] + 3.7e-9 * across[0], along * anchor[1] + 3.7e-9 * across[1]], anchor, VS);
         assert!(dist(side(-0.9e-9), side(-1.1e-9)) <= 1e-3, "{:?} vs {:?}", side(-0.9e-9), side(-1.1e-9));
     }
 }
