@@ -3,7 +3,6 @@
 
 use crate::dynamics::constraints::PointOnPlane;
 use crate::dynamics::contact::forward::{forward_dynamics_contacts, forward_dynamics_contacts_same_q};
-use crate::dynamics::contact::{ContactMode, ContactModel};
 use crate::dynamics::energy::{link_kinetic_energy, magnetic_energy, potential_energy, rotor_kinetic_energy};
 use crate::dynamics::forward::{forward_dynamics, Plant, Stabilization};
 use crate::dynamics::kinematics::forward_kinematics;
@@ -273,7 +272,7 @@ impl OdeSystem for ArmSystem<'_> {
     fn error_measured(&self, measured: &mut [bool]) {
         let Some(h) = &self.hybrid else { return };
         for (k, (c, mode)) in h.contacts.iter().zip(&h.state.mode).enumerate() {
-            if matches!(c.model, ContactModel::Unilateral { .. }) && *mode == ContactMode::Separated {
+            if super::hybrid::quadratures_idle(c, *mode) {
                 for i in self.layout.contact_quadratures(k) {
                     measured[i] = false;
                 }

@@ -14,7 +14,7 @@ use crate::dynamics::contact::{ContactEvent, ContactEventKind, ContactMode, Cont
 use crate::error::RunError;
 
 use super::arm::ArmSystem;
-use super::hybrid::{in_touch, slip_resolution, REBOUND_START};
+use super::hybrid::{in_touch, measured_len, slip_resolution, REBOUND_START};
 
 /// The speed (m/s) at which a plain slip's stop is located (its ev1 is `v_t · s_ref` minus this):
 /// the part of [`slip_resolution`] above [`SLIP_DIRECTION_SPEED`], 0 when the friction's blend
@@ -168,7 +168,7 @@ impl ArmSystem<'_> {
                 (_, ContactMode::Sliding) if c.unilateral_friction() > 0.0 && h.state.onset[k].is_some() && h.cd.onset_excess[k].is_finite() => (f_n, h.cd.onset_excess[k]),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
-                    (f_n, if c.unilateral_friction() > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] - slip_stop_speed(tolerances, r, k, qd, y.len()) } else { 1.0 })
+                    (f_n, if c.unilateral_friction() > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] - slip_stop_speed(tolerances, r, k, qd, measured_len(h, y.len())) } else { 1.0 })
                 }
             };
             out[2 * k] = e0;
@@ -284,7 +284,7 @@ impl ArmSystem<'_> {
                         // rad, ~1e-6 N of 13 N) and the slide from rest reads a deceleration
                         // the stick's margin does not have (one-elbow at rtol 1e-5, 0.7161 s)
                         stopping.push(k);
-                    } else if f1 && stops_here(h.cd.rows.slip(k), if h.state.onset[k].is_some() { st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len())) } else { st.vel_tol.max(2.0 * slip_stop_speed(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len())) }) {
+                    } else if f1 && stops_here(h.cd.rows.slip(k), if h.state.onset[k].is_some() { st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], measured_len(h, y.len()))) } else { st.vel_tol.max(2.0 * slip_stop_speed(tolerances, &h.cd.rows, k, &y[qd.clone()], measured_len(h, y.len()))) }) {
                         preferred[k] = ContactMode::Sticking;
                         stopping.push(k);
                         slip_stopped = true;
@@ -312,7 +312,7 @@ impl ArmSystem<'_> {
             // own zero (`contacts_start::two_slips_stopping_at_once_…`, 1e-12 s)
             for (k, pref) in preferred.iter_mut().enumerate() {
                 let v = h.cd.rows.slip(k);
-                let resolved = st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], y.len()));
+                let resolved = st.vel_tol.max(slip_resolution(tolerances, &h.cd.rows, k, &y[qd.clone()], measured_len(h, y.len())));
                 if !stopping.contains(&k) && h.state.mode[k] == ContactMode::Sliding && h.contacts[k].unilateral_friction() > 0.0 && v[0].hypot(v[1]) <= resolved {
                     *pref = ContactMode::Sticking;
                     stopping.push(k);

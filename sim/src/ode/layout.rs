@@ -2,6 +2,9 @@
 
 use crate::dynamics::motor::Electrical;
 
+/// The quadratures each contact adds to the state ([`Layout::contact_quadratures`]).
+pub const QUADRATURES_PER_CONTACT: usize = 3;
+
 /// Index ranges of the state vector.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Layout {
@@ -111,7 +114,7 @@ impl Layout {
         self.loss_r() + 3 + usize::from(self.conversion) + usize::from(self.stops) + 3 * k
     }
     /// Contact k's three quadratures: impact loss, friction work, damping loss.
-    pub fn contact_quadratures(&self, k: usize) -> [usize; 3] {
+    pub fn contact_quadratures(&self, k: usize) -> [usize; QUADRATURES_PER_CONTACT] {
         [self.impact_loss(k), self.friction_work(k), self.damping_loss(k)]
     }
     /// Contact k's friction work `∫ −f_t · v_t dt`, J.

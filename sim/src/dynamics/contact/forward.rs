@@ -72,7 +72,8 @@ pub struct ContactData {
     /// Per contact in an onset: the slip speed below which its friction's direction blends
     /// towards the anchor ([`onset_direction`]'s `v_on`), m/s, fixed at the onset's start
     /// (`ode/hybrid.rs`, `onset_speed`): [`SLIP_DIRECTION_SPEED`] unless the integrator's
-    /// resolution of the slip is coarser. [`SLIP_DIRECTION_SPEED`] outside onsets.
+    /// resolution of the slip is coarser. Read only while the contact is in an onset (set
+    /// at each onset's start; a value left from an ended onset is never read).
     pub onset_speed: Vec<f64>,
     /// Scratch of [`onset_anchors`]: the modes with the onset contacts sticking.
     stick_mode: Vec<ContactMode>,
