@@ -452,22 +452,30 @@ fn protobuf_schema<T: foxglove::Encode>() -> Option<foxglove::Schema> {
     T::get_schema()
 }
 
+/// The schema half of [`Message`] for a protobuf type (its schema from [`foxglove::Encode`]),
+/// shared by [`protobuf_message`] and [`flat_message`].
+macro_rules! protobuf_schema_methods {
+    ($t:ty) => {
+        fn schema_name() -> String {
+            protobuf_schema::<$t>().map(|s| s.name).unwrap_or_default()
+        }
+        fn schema_encoding() -> &'static str {
+            "protobuf"
+        }
+        fn schema_data() -> Vec<u8> {
+            protobuf_schema::<$t>().map(|s| s.data.into_owned()).unwrap_or_default()
+        }
+        fn message_encoding() -> &'static str {
+            "protobuf"
+        }
+    };
+}
+
 /// Implements [`Message`] for protobuf types that implement [`foxglove::Encode`].
 macro_rules! protobuf_message {
     ($($t:ty),* $(,)?) => {$(
         impl Message for $t {
-            fn schema_name() -> String {
-                protobuf_schema::<$t>().map(|s| s.name).unwrap_or_default()
-            }
-            fn schema_encoding() -> &'static str {
-                "protobuf"
-            }
-            fn schema_data() -> Vec<u8> {
-                protobuf_schema::<$t>().map(|s| s.data.into_owned()).unwrap_or_default()
-            }
-            fn message_encoding() -> &'static str {
-                "protobuf"
-            }
+            protobuf_schema_methods!($t);
             fn encode_into(&self, buf: &mut Vec<u8>) {
                 // a Vec grows on demand, so the encoder has no failure mode here;
                 // the writer uses try_encode_into, which does report one
@@ -487,18 +495,7 @@ protobuf_message!(MotorState, Vec3, HandState, EnergyState, ContactEventMsg, Mot
 macro_rules! flat_message {
     ($($t:ty => $encode:path),* $(,)?) => {$(
         impl Message for $t {
-            fn schema_name() -> String {
-                protobuf_schema::<$t>().map(|s| s.name).unwrap_or_default()
-            }
-            fn schema_encoding() -> &'static str {
-                "protobuf"
-            }
-            fn schema_data() -> Vec<u8> {
-                protobuf_schema::<$t>().map(|s| s.data.into_owned()).unwrap_or_default()
-            }
-            fn message_encoding() -> &'static str {
-                "protobuf"
-            }
+            protobuf_schema_methods!($t);
             fn encode_into(&self, buf: &mut Vec<u8>) {
                 $encode(self, buf);
             }
