@@ -524,8 +524,11 @@ fn findings(all: &[RunMetrics], base: usize, links: &[LinkComparison], why_not: 
             })
             .collect();
         gaps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        // a gap printed as ±0.000 J says nothing: only gaps that show at the 1 mJ printed
+        let shown = |d: f64| d.abs() >= 5e-4;
         let top: Vec<String> = gaps
             .iter()
+            .filter(|(_, d, _)| shown(*d))
             .take(3)
             .map(|(j, d, q)| {
                 format!(
@@ -543,6 +546,8 @@ fn findings(all: &[RunMetrics], base: usize, links: &[LinkComparison], why_not: 
                 b.run,
                 top.join(", ")
             ));
+        } else if !gaps.is_empty() {
+            out.push(format!("No joint's electric energy differs by 1 mJ or more between {} and {}.", r.run, b.run));
         }
     }
 
