@@ -104,7 +104,7 @@ fn the_unilateral_ladder_stops_the_slip_in_time_and_costs_less_at_looser_toleran
 /// of the converged time (as above) from rtol 1e-6 on, and within 0.5 ms at 1e-4 and 1e-5, where
 /// the stop is located at `0.5 rtol × 1 m/s` (the creep's speed ~0.25 rtol × 1 m/s over
 /// elbow7's deceleration ~0.2 m/s² gives ≤ 0.25 ms; measured +89 µs at 1e-4, +0.16 ms at 1e-5).
-/// Fails on `f1e9356` (46 646 > 13 864; the stop 5.5 ms late).
+/// Fails on `f1e9356`: imex rtol 1e-4 stops elbow7 7.0 ms late (0.137024 s; 7 949 right-hand sides).
 #[test]
 fn imex_between_its_rungs_costs_less_at_looser_tolerances_and_stops_the_slip() {
     use sim::scene::spec::IntegratorSpec;
