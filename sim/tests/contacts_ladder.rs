@@ -27,7 +27,8 @@
 //! `sim` and `analyze` run, with the bounds of the run's record `contacts`, whose declared
 //! regularisation speed `onset_slip_speed` is 30 × rtol × 1 m/s at rtol ≥ 3.3e-8).
 //!
-//! Cost: 16 runs of 0.3 s, ~260 000 right-hand sides in all, ~3 s of CPU (test profile).
+//! Cost: 16 runs of 0.3 s, ~260 000 right-hand sides in all, ~3 s of CPU (test profile); the
+//! imex test below 6 more runs, ~80 000.
 
 use std::path::Path;
 
@@ -92,5 +93,47 @@ fn the_unilateral_ladder_stops_the_slip_in_time_and_costs_less_at_looser_toleran
                 assert!((t - t_stop).abs() <= 4.0 * tol, "{name} rtol {tol:.0e}: elbow7 stops at {t} s, converged {t_stop} s");
             }
         }
+    }
+}
+
+/// Imex between the command's rungs (1e-4, 1e-6, 1e-8): at rtol 1e-5 elbow7's decelerating slip
+/// crept at 2–3 µm/s for 5.5 ms (46 646 right-hand sides against 7 838 at 1e-4 and 13 864 at
+/// 1e-6, stop 5.5 ms late; at 1e-4 at 20–30 µm/s, stop 6 ms late): the explicit friction
+/// direction's stability limit (`contact_events::slip_stop_speed`, BENCHMARKS.md "imex between
+/// its rungs"). Now work is monotone over rtol 1e-4 … 1e-8 and the stop lies within `4 s × rtol`
+/// of the converged time (as above) from rtol 1e-6 on, and within 0.5 ms at 1e-4 and 1e-5, where
+/// the stop is located at `0.5 rtol × 1 m/s` (the creep's speed ~0.25 rtol × 1 m/s over
+/// elbow7's deceleration ~0.2 m/s² gives ≤ 0.25 ms; measured +89 µs at 1e-4, +0.16 ms at 1e-5).
+/// Fails on `f1e9356`: imex rtol 1e-4 stops elbow7 7.0 ms late (0.137024 s; 7 949 right-hand sides).
+#[test]
+fn imex_between_its_rungs_costs_less_at_looser_tolerances_and_stops_the_slip() {
+    use sim::scene::spec::IntegratorSpec;
+    let shipped = Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper_unilateral.json")).expect("the paper scene loads");
+    let scene = shipped.vary(|s| s.duration = 0.3).expect("0.3 s is valid");
+    let converged = rung(&scene, "dopri45", "rtol 1e-8");
+    let (t_stop, events) = stop_and_events(&collect(&converged, RUN), &converged);
+    let base = rung(&scene, "imex (circuits implicit)", "rtol 1e-4");
+    let mut previous: Option<(f64, u64)> = None;
+    for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
+        let s = base
+            .vary(|spec| {
+                let IntegratorSpec::Imex(a) = &mut spec.integrator else { panic!("the imex rung is imex") };
+                (a.rtol, a.atol) = (tol, tol * 1e-2);
+            })
+            .expect("the tolerances are valid");
+        let c = collect(&s, RUN);
+        let rhs = c.report.stats.rhs_evals;
+        let (t, ev) = stop_and_events(&c, &s);
+        eprintln!("imex rtol {tol:.0e}: {rhs} right-hand sides, elbow7 stops at {t:.9} s ({:+.1e} s)", t - t_stop);
+        if let Some((loose, loose_rhs)) = previous {
+            assert!(loose_rhs <= rhs, "imex: rtol {loose:.0e} costs {loose_rhs} right-hand sides, more than rtol {tol:.0e} ({rhs})");
+        }
+        previous = Some((tol, rhs));
+        let a = audit(&s, RUN, &c);
+        let friction: u64 = a.contacts.iter().map(|l| l.slip_angle_rad.breaches + l.cone_excess_n.breaches).sum();
+        assert_eq!(friction, 0, "imex rtol {tol:.0e}: {:?}", a.verdict());
+        assert_eq!(ev, events, "imex rtol {tol:.0e}: the converged run's contact events");
+        let bound = if tol > 1e-6 { 5e-4 } else { 4.0 * tol };
+        assert!((t - t_stop).abs() <= bound, "imex rtol {tol:.0e}: elbow7 stops at {t} s, converged {t_stop} s (bound {bound} s)");
     }
 }

@@ -530,7 +530,7 @@ impl ArmSystem<'_> {
                 // stopped at once: `contact_events::slip_stop_speed`; and past the onset's own
                 // blend speed, `onset_speed`, so its friction is Coulomb's when it ends)
                 let res = slip_resolution(tolerances, &h.cd.rows, k, &y[l.qd()], measured_len(h, y.len()));
-                let resolved = SLIP_DIRECTION_SPEED.max(res).max(2.0 * (res - SLIP_DIRECTION_SPEED)).max(h.cd.onset_speed[k]);
+                let resolved = SLIP_DIRECTION_SPEED.max(res).max(2.0 * super::contact_events::slip_stop_speed(tolerances, &h.cd.rows, k, &y[l.qd()], measured_len(h, y.len()), h.settings.onset_slip_speed)).max(h.cd.onset_speed[k]);
                 let ends = h.state.onset[k].is_some() && v_t[0].hypot(v_t[1]) > resolved && v_t[0] * a[0] + v_t[1] * a[1] > 0.0;
                 h.s_ref[k] = slip_direction(v_t, if ends { v_t } else { a });
                 h.state.slip[k] = h.s_ref[k];
