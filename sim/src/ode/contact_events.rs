@@ -34,13 +34,15 @@ use super::hybrid::{in_touch, measured_len, slip_resolution, REBOUND_START};
 ///
 /// For a method that takes the friction explicitly (dopri45, imex, rosenbrock: `bound`, the run's
 /// declared `ContactSettings::onset_slip_speed` of `forward::onset_speed_bound`, above `v_s`) it
-/// is at least `min(bound, STABILITY_STOP_FACTOR v_s) − v_s`: the friction's direction
+/// is at least `c · rtol · 1 m/s − v_s`, `c` = [`STABILITY_STOP_FACTOR`] (so from rtol 2e-6 up;
+/// below the declared `bound` = 30 · rtol · 1 m/s): the friction's direction
 /// `v_t/|v_t|` has the stiffness `λ ≈ μ f_n / (m_eff |v_t|)` (~2e6 /s at `v_s` on elbow7), and an
 /// explicit step is stable only for `h λ` inside its stability region (Hairer & Wanner, *Solving
 /// ODEs II*, §IV.2): below `v_stab = μ f_n h / (m_eff c_stab)` the step control holds `h` at that
 /// limit and the slip cannot be followed to its zero. Imex at rtol 1e-5 crept there at 2–3 `v_s`
 /// for 5.5 ms (elbow7's stop at 0.1300525 s located at 0.1355 s; 46 646 right-hand sides over
-/// 0.3 s against 13 864 at 1e-6): the stop located at `STABILITY_STOP_FACTOR v_s` is the velocity
+/// 0.3 s against 13 864 at 1e-6; the creep's speed scales with the step, ~0.25 · rtol · 1 m/s at
+/// rtol 1e-4 and 1e-5, measured, not derived): the stop located above it is the velocity
 /// projection of a slip the method cannot resolve, as above, and within the speed the run
 /// declares to the audit as regularised (`AuditBounds::of`). 0 for rodas and rk4 and at rtol ≤
 /// 3.3e-8 (`bound` = `v_s`): those runs do not move.
@@ -52,10 +54,12 @@ pub(super) fn slip_stop_speed(tolerances: Option<(f64, f64)>, rows: &crate::dyna
     (slip_resolution(tolerances, rows, k, qd, n) - SLIP_DIRECTION_SPEED).max(stability).max(0.0)
 }
 
-/// The multiple of [`SLIP_DIRECTION_SPEED`] below which an explicit method's decelerating slip
-/// is stopped ([`slip_stop_speed`]): above imex's creep at rtol 1e-5 (2–3 `v_s`, the stability
-/// limit `v_stab` of its steps there).
+/// `c` of the speed `c · rtol · 1 m/s` below which an explicit method's decelerating slip is
+/// stopped ([`slip_stop_speed`]): twice imex's measured creep (~0.25 · rtol · 1 m/s at rtol 1e-4
+/// and 1e-5, the stability limit `v_stab` of its steps there; tuned on the paper's unilateral
+/// scene, not computed from `h`, `μ f_n` and `m_eff`).
 const STABILITY_STOP_FACTOR: f64 = 0.5;
+/// The speed scale of [`STABILITY_STOP_FACTOR`], m/s (as `forward::onset_speed_bound`'s).
 const STABILITY_SPEED_SCALE: f64 = 1.0;
 
 /// The slip→stick rule (issue 23, item 2). A sliding contact's ev1 is `v_t · s_ref` (m/s),
