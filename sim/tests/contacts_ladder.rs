@@ -54,12 +54,19 @@ fn stop_and_events(c: &Collected, scene: &Scene) -> (f64, Vec<(usize, ContactEve
     (stops[0], c.events.iter().map(|e| (e.contact, e.kind)).collect())
 }
 
-#[test]
-fn the_unilateral_ladder_stops_the_slip_in_time_and_costs_less_at_looser_tolerances() {
+/// The shipped scene over its first 0.3 s, with elbow7's slip → stick time and the event
+/// sequence of its converged run (dopri45 at rtol 1e-8), the reference of both tests.
+fn converged_stop() -> (Scene, f64, Vec<(usize, ContactEventKind)>) {
     let shipped = Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper_unilateral.json")).expect("the paper scene loads");
     let scene = shipped.vary(|s| s.duration = 0.3).expect("0.3 s is valid");
     let converged = rung(&scene, "dopri45", "rtol 1e-8");
     let (t_stop, events) = stop_and_events(&collect(&converged, RUN), &converged);
+    (scene, t_stop, events)
+}
+
+#[test]
+fn the_unilateral_ladder_stops_the_slip_in_time_and_costs_less_at_looser_tolerances() {
+    let (scene, t_stop, events) = converged_stop();
     // (series, rungs, whether work is asserted monotone over them)
     let series: [(&str, &[f64], bool); 4] = [
         ("rosenbrock (structured J)", &[1e-3, 1e-4, 1e-5, 1e-6], true),
@@ -108,10 +115,7 @@ fn the_unilateral_ladder_stops_the_slip_in_time_and_costs_less_at_looser_toleran
 #[test]
 fn imex_between_its_rungs_costs_less_at_looser_tolerances_and_stops_the_slip() {
     use sim::scene::spec::IntegratorSpec;
-    let shipped = Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/paper_unilateral.json")).expect("the paper scene loads");
-    let scene = shipped.vary(|s| s.duration = 0.3).expect("0.3 s is valid");
-    let converged = rung(&scene, "dopri45", "rtol 1e-8");
-    let (t_stop, events) = stop_and_events(&collect(&converged, RUN), &converged);
+    let (scene, t_stop, events) = converged_stop();
     let base = rung(&scene, "imex (circuits implicit)", "rtol 1e-4");
     let mut previous: Option<(f64, u64)> = None;
     for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {

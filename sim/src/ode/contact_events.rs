@@ -171,6 +171,9 @@ impl ArmSystem<'_> {
         let (tolerances, qd) = (self.scene.integrator().tolerances(), &y[self.layout.qd()]);
         let h = self.hybrid.as_mut().expect("hybrid");
         let r = &h.cd.rows;
+        // the components the step control measures, for the slip stops below (the modes do not
+        // change within this evaluation)
+        let measured = measured_len(h, y.len());
         for (k, c) in h.contacts.iter().enumerate() {
             if h.rebound[k] {
                 // the restart after the contact left with a separating speed; one the step
@@ -195,7 +198,7 @@ impl ArmSystem<'_> {
                 (_, ContactMode::Sliding) if c.unilateral_friction() > 0.0 && h.state.onset[k].is_some() && h.cd.onset_excess[k].is_finite() => (f_n, h.cd.onset_excess[k]),
                 (_, ContactMode::Sliding) => {
                     let v = r.slip(k);
-                    (f_n, if c.unilateral_friction() > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] - slip_stop_speed(tolerances, r, k, qd, measured_len(h, y.len()), h.settings.onset_slip_speed) } else { 1.0 })
+                    (f_n, if c.unilateral_friction() > 0.0 { v[0] * h.s_ref[k][0] + v[1] * h.s_ref[k][1] - slip_stop_speed(tolerances, r, k, qd, measured, h.settings.onset_slip_speed) } else { 1.0 })
                 }
             };
             out[2 * k] = e0;
