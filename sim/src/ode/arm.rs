@@ -272,7 +272,7 @@ impl OdeSystem for ArmSystem<'_> {
     fn error_measured(&self, measured: &mut [bool]) {
         let Some(h) = &self.hybrid else { return };
         for (k, (c, mode)) in h.contacts.iter().zip(&h.state.mode).enumerate() {
-            if super::hybrid::quadratures_idle(c, *mode) {
+            if super::resolution::quadratures_idle(c, *mode) {
                 for i in self.layout.contact_quadratures(k) {
                     measured[i] = false;
                 }

@@ -14,7 +14,8 @@ use crate::dynamics::contact::{ContactEvent, ContactEventKind, ContactMode, Cont
 use crate::error::RunError;
 
 use super::arm::ArmSystem;
-use super::hybrid::{in_touch, measured_len, slip_resolution, REBOUND_START};
+use super::hybrid::{in_touch, REBOUND_START};
+use super::resolution::{measured_len, slip_resolution};
 
 /// The speed (m/s) at which a plain slip's stop is located (its ev1 is `v_t · s_ref` minus this):
 /// the part of [`slip_resolution`] above [`SLIP_DIRECTION_SPEED`], 0 when the friction's blend
@@ -25,7 +26,7 @@ use super::hybrid::{in_touch, measured_len, slip_resolution, REBOUND_START};
 /// reached within 0.3 s by dopri45 at rtol 1e-4 and rosenbrock at 1e-3, 6.1 ms late by rosenbrock
 /// at 1e-4; BENCHMARKS.md, "Issue 24 point 3" and "… point 3 again"). Located at the resolution,
 /// the stop is the velocity projection `stop_slip` of a slip the integrator cannot tell from rest
-/// (Pfeiffer & Glocker 1996, ch. 6; the gap's analogue is `hybrid::gap_resolution`'s accumulation
+/// (Pfeiffer & Glocker 1996, ch. 6; the gap's analogue is `resolution::gap_resolution`'s accumulation
 /// rule, Acary & Brogliato 2008, §7.2): the stop's time moves by at most this speed / `|a_t|`, the
 /// kinetic energy it removes (≤ ½ m (this speed)²) is booked as friction work. Continuous in the
 /// state; 0 wherever the resolution is below `v_s`, as at the paper's rtol 1e-8 (~1e-8 m/s) and at

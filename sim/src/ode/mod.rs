@@ -49,6 +49,7 @@ mod current_columns;
 mod gear_decide;
 mod gear_hold;
 mod hybrid;
+mod resolution;
 mod jacobian;
 mod layout;
 mod outputs;

@@ -39,7 +39,7 @@ use super::hybrid::in_touch;
 /// 1000 × the gap's rounding): one constant for both.
 ///
 /// The same depth is under the return of a *rebound* (a contact that leaves the table at
-/// ġ⁺ > `vel_tol`) that the step control does not resolve, ġ⁺ ≤ `hybrid::gap_resolution` (its
+/// ġ⁺ > `vel_tol`) that the step control does not resolve, ġ⁺ ≤ `resolution::gap_resolution` (its
 /// touch-down function `g − (min(g₀, 0) − DEPARTURE_DEPTH)`, `hybrid.rs::mark_rebounds`): such a
 /// rebound rises above the gap's rounding only after `~1e-16 m / ġ⁺` (2e-9 s at 4.6e-8 m/s),
 /// and with the return located from g₀ itself each rounding dip below g₀ inside that time was a
